@@ -1,0 +1,2 @@
+//! `drive-sim`: run, predict and sweep scenes.
+fn main() {}

@@ -1,0 +1,3 @@
+//! Host-side simulator for `drive-monitor`: scene files, dynamics assembled from the effects a
+//! scene calls for, synthetic encoder edges, and reports computed by the same core code that
+//! runs on the target.
