@@ -40,8 +40,8 @@ impl Math for Libm {
     }
 }
 
-/// Fast backend: the `micromath` crate's approximations (sqrt within about 1e-3 relative,
-/// sin/cos within about 1e-3 absolute; see the accuracy tables in the README).
+/// Fast backend: the `micromath` crate's approximations. Measured worst errors on (0, 10]
+/// (see the unit test): sqrt 6.1 % relative, sin/cos 1.1e-3 absolute, atan2 2.9e-3 rad.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Micromath;
 
@@ -68,24 +68,30 @@ impl Math for Micromath {
 mod tests {
     use super::*;
 
-    fn check<M: Math>(tol: f32) {
-        for i in 1..200 {
-            let x = i as f32 * 0.05;
-            assert!((M::sqrt(x) - (x as f64).sqrt() as f32).abs() <= tol * M::sqrt(x));
-            assert!((M::sin(x) - (x as f64).sin() as f32).abs() <= tol);
-            assert!((M::cos(x) - (x as f64).cos() as f32).abs() <= tol);
-            let (y, xx) = ((x as f64).sin(), -(x as f64).cos());
-            assert!((M::atan2(y as f32, xx as f32) - y.atan2(xx) as f32).abs() <= tol * 4.0);
+    /// Worst errors against f64 over (0, 10]: sqrt relative, sin, cos, atan2 absolute.
+    fn worst<M: Math>() -> [f64; 4] {
+        let mut e = [0f64; 4];
+        for i in 1..20_000 {
+            let x = i as f32 * 0.0005;
+            let xd = x as f64;
+            e[0] = e[0].max((M::sqrt(x) as f64 / xd.sqrt() - 1.0).abs());
+            e[1] = e[1].max((M::sin(x) as f64 - xd.sin()).abs());
+            e[2] = e[2].max((M::cos(x) as f64 - xd.cos()).abs());
+            let (y, xx) = ((xd.sin() as f32) as f64, (-xd.cos() as f32) as f64);
+            e[3] = e[3].max((M::atan2(y as f32, xx as f32) as f64 - y.atan2(xx)).abs());
         }
+        e
     }
 
     #[test]
     fn libm_is_accurate() {
-        check::<Libm>(2e-7);
+        let e = worst::<Libm>();
+        assert!(e[0] < 1.2e-7 && e[1] < 1e-6 && e[2] < 1e-6 && e[3] < 1e-6, "{e:?}");
     }
 
     #[test]
     fn micromath_is_within_its_stated_error() {
-        check::<Micromath>(2e-3);
+        let e = worst::<Micromath>();
+        assert!(e[0] < 0.062 && e[1] < 1.1e-3 && e[2] < 1.1e-3 && e[3] < 2.9e-3, "{e:?}");
     }
 }
