@@ -7,8 +7,14 @@
     warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+pub mod alarm;
+pub mod encoder;
 pub mod error;
+pub mod irregularity;
+pub mod learn;
 pub mod math;
+pub mod monitor;
+pub mod speed;
 
 pub use error::ConfigError;
 pub use math::{Libm, Math, Micromath};
