@@ -14,6 +14,7 @@
 mod bench;
 mod icount;
 mod math_bench;
+mod monitor_bench;
 mod stack;
 
 use cortex_m_rt::entry;
@@ -30,6 +31,7 @@ fn main() -> ! {
 
     bench::calibrate();
     math_bench::run();
+    monitor_bench::run();
 
     let (used, available) = stack::peak();
     hprintln!("stack: peak {} bytes (of {} available)", used, available);
