@@ -470,7 +470,10 @@ impl Scene {
             ));
         }
         if self.autobalancer.is_some() && self.platform.is_empty() {
-            return Err(bad("platform", "missing: the auto-balancer needs a platform"));
+            return Err(bad(
+                "platform",
+                "missing: the auto-balancer needs a platform",
+            ));
         }
         if (!self.unbalance.is_empty() || self.process_load.is_some()) && self.rotor.is_none() {
             return Err(bad("rotor", "missing: unbalances need a [rotor]"));
