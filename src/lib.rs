@@ -7,9 +7,15 @@
     warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+pub mod alarm;
 pub mod drive;
+pub mod encoder;
 pub mod error;
+pub mod irregularity;
+pub mod learn;
 pub mod math;
+pub mod monitor;
+pub mod speed;
 
 pub use error::ConfigError;
 pub use math::{Libm, Math, Micromath};

@@ -1,0 +1,179 @@
+//! The irregularity monitor on the target: a pulse sequence of known δ through the public API,
+//! what the core reports, checks on it, and instructions per encoder edge.
+//!
+//! The sequence is the capture timestamps of a 1024-line disc (index framing, 84 MHz 32-bit
+//! timer) on a shaft running ω(φ) = ω̄·(1 + ε·sin(φ/8)) with ω̄ = 134 rad/s: a load cycle of
+//! 8 revolutions like the seed's kneader, and δ = 2ε exactly. Timestamps are generated in f64
+//! (midpoint rule per pitch, error far below one tick) before anything is measured.
+
+use core::hint::black_box;
+
+use cortex_m_semihosting::hprintln;
+use drive_monitor::alarm::AlarmConfig;
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
+use drive_monitor::irregularity::{WindowConfig, WindowLength};
+use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::speed::Direction;
+
+use crate::bench::ensure;
+use crate::icount;
+
+const LINES: u16 = 1024;
+const TIMER_HZ: f64 = 84e6;
+const REVS: usize = 8 * 5 + 2;
+const EDGES: usize = LINES as usize * REVS;
+const EPS: f64 = 0.015;
+const OMEGA: f64 = 134.0;
+
+fn generate(ticks: &mut [u32; EDGES]) {
+    let pitch = core::f64::consts::TAU / f64::from(LINES);
+    let mut t = 0.0f64;
+    for (i, slot) in ticks.iter_mut().enumerate() {
+        let mid = (i as f64 + 0.5) * pitch;
+        t += pitch / (OMEGA * (1.0 + EPS * libm::sin(mid / 8.0)));
+        *slot = (t * TIMER_HZ) as u64 as u32;
+    }
+}
+
+fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
+    let mut c = EncoderConfig::new(LINES, TIMER_HZ);
+    c.estimator = Estimator::Edges(k);
+    c.min_speed = 10.0;
+    let Ok(enc) = Encoder::new(c) else {
+        crate::bench::fail(format_args!("encoder config rejected"));
+    };
+    let w = WindowConfig {
+        length: WindowLength::Revolutions(revs),
+        steady_tolerance: 0.02,
+    };
+    match DeltaMonitor::new(enc, w, Some(AlarmConfig::new(0.06))) {
+        Ok(m) => m,
+        Err(e) => crate::bench::fail(format_args!("monitor config rejected: {}", e)),
+    }
+}
+
+/// Feeds the stream (index pulse before every tooth 0); returns (instructions, windows).
+#[inline(never)]
+fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32; EDGES], print: bool) -> (u64, u32) {
+    let mut windows = 0;
+    let start = icount::instructions();
+    for (i, &t) in ticks.iter().enumerate() {
+        if i % LINES as usize == 0 {
+            m.on_index();
+        }
+        if let Some(o) = black_box(m.on_edge(black_box(t), Some(Direction::Forward))) {
+            windows += 1;
+            if print {
+                let r = o.report;
+                hprintln!(
+                    "window: delta {:.6} omega max {:.3} min {:.3} mean {:.3} floor {:.1e} valid {} steady {}",
+                    r.delta, r.omega_max, r.omega_min, r.omega_mean, r.noise_floor, r.valid(), r.steady
+                );
+            }
+        }
+    }
+    (icount::instructions() - start, windows)
+}
+
+/// The same loop without the monitor: what the loop itself costs.
+#[inline(never)]
+fn feed_empty(ticks: &[u32; EDGES]) -> u64 {
+    let start = icount::instructions();
+    for (i, &t) in ticks.iter().enumerate() {
+        if i % LINES as usize == 0 {
+            black_box(());
+        }
+        black_box(black_box(t));
+    }
+    icount::instructions() - start
+}
+
+pub fn run() {
+    let Some(ticks) = cortex_m::singleton!(: [u32; EDGES] = [0; EDGES]) else {
+        crate::bench::fail(format_args!("edge buffer taken twice"));
+    };
+    generate(ticks);
+    hprintln!(
+        "pulses: {} lines, {} revolutions, 84 MHz timer, expected delta {:.6}",
+        LINES,
+        REVS,
+        2.0 * EPS
+    );
+    let empty = feed_empty(ticks);
+
+    // The report, with 16-edge speed samples and 8-revolution windows.
+    let mut m = monitor(16, 8);
+    let (total16, windows) = feed(&mut m, ticks, true);
+    let d = m.diagnostics();
+    hprintln!(
+        "diagnostics: accepted {} glitches {} missing {} revolutions {} valid windows {} invalid {}",
+        d.edges.accepted, d.edges.glitches, d.edges.missing, d.edges.revolutions,
+        d.valid_windows, d.invalid_windows
+    );
+    ensure!(
+        windows == 5 && d.valid_windows == 5,
+        "expected 5 valid windows, got {:?}",
+        d
+    );
+    ensure!(
+        d.edges.glitches == 0 && d.edges.missing == 0,
+        "unexpected faults {:?}",
+        d
+    );
+
+    // Instructions per edge, amortised over the stream (windows included).
+    let per_edge = |total: u64| (total.saturating_sub(empty) + EDGES as u64 / 2) / EDGES as u64;
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "monitor::on_edge k=16",
+        per_edge(total16)
+    );
+    let mut m1 = monitor(1, 8);
+    let (total1, _) = feed(&mut m1, ticks, false);
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "monitor::on_edge k=1",
+        per_edge(total1)
+    );
+
+    // Window finalisation: one-revolution windows finish 8× as many windows on the same edges.
+    let mut mw = monitor(16, 1);
+    let (total_w, windows_w) = feed(&mut mw, ticks, false);
+    let extra = windows_w.saturating_sub(windows).max(1);
+    let per_window = total_w.saturating_sub(total16) / u64::from(extra);
+    hprintln!("bench {:<28} {:>7}", "monitor::window_finish", per_window);
+
+    // Check the δ the target computed against the known ripple (quantization floor ≈ 3e-5).
+    let mut check = monitor(16, 8);
+    let mut last = None;
+    for (i, &t) in ticks.iter().enumerate() {
+        if i % LINES as usize == 0 {
+            check.on_index();
+        }
+        if let Some(o) = check.on_edge(t, Some(Direction::Forward)) {
+            last = Some(o.report);
+        }
+    }
+    let Some(r) = last else {
+        crate::bench::fail(format_args!("no window reported"));
+    };
+    let err = libm::fabs(f64::from(r.delta) / (2.0 * EPS) - 1.0);
+    hprintln!(
+        "delta: measured {:.6}, exact {:.6}, relative error {:.1e}",
+        r.delta,
+        2.0 * EPS,
+        err
+    );
+    ensure!(
+        err < 3e-3,
+        "delta {} off the exact {} by {}",
+        r.delta,
+        2.0 * EPS,
+        err
+    );
+    ensure!(
+        r.steady && !check.alarm_active(),
+        "window not steady or alarm raised: {:?}",
+        r
+    );
+}

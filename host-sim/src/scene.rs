@@ -1,0 +1,557 @@
+//! Scene files: a machine described in TOML, SI units throughout.
+//!
+//! Every table is optional except what the effects present need; an effect is simulated only
+//! when its table is present. Unknown keys are errors (a misspelt key must not be silently
+//! ignored), and so are missing required keys and impossible values; every error names the
+//! file and the key.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// An error in a scene file, naming the file and the key.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        /// The scene file.
+        file: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown or missing key, or a value of the wrong type.
+    #[error("{file}: {message}")]
+    Parse {
+        /// The scene file.
+        file: PathBuf,
+        /// The parser's message (names the key and the line).
+        message: String,
+    },
+    /// A value that parses but is impossible.
+    #[error("{file}: `{key}`: {message}")]
+    Value {
+        /// The scene file.
+        file: PathBuf,
+        /// The offending key, e.g. `encoder.timer_hz`.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
+/// A whole scene.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// One-line description.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// Simulation settings.
+    #[serde(default)]
+    pub simulation: SimulationSpec,
+    /// The drive shaft's inertia.
+    pub shaft: Option<ShaftSpec>,
+    /// The motor (or a prescribed speed).
+    pub motor: Option<MotorSpec>,
+    /// The load torque.
+    pub load: Option<LoadSpec>,
+    /// The encoder and capture timer.
+    pub encoder: Option<EncoderSpec>,
+    /// Monitor settings.
+    pub monitor: Option<MonitorSpec>,
+    /// Vibration-machine platforms (1 to 3).
+    #[serde(default)]
+    pub platform: Vec<PlatformSpec>,
+    /// Couplings between platforms.
+    #[serde(default)]
+    pub coupling: Vec<CouplingSpec>,
+    /// The auto-balancer.
+    pub autobalancer: Option<AutobalancerSpec>,
+    /// A rotor on two supports (seed 002).
+    pub rotor: Option<RotorSpec>,
+    /// Unbalances of that rotor.
+    #[serde(default)]
+    pub unbalance: Vec<UnbalanceSpec>,
+    /// A distributed process load on that rotor.
+    pub process_load: Option<ProcessLoadSpec>,
+}
+
+/// How to integrate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    /// Fixed-step classical Runge–Kutta 4.
+    Rk4,
+    /// Adaptive Dormand–Prince 5(4) with dense output.
+    #[default]
+    Dp5,
+    /// Adaptive Dormand–Prince 8(5,3) with dense output.
+    Dop853,
+}
+
+/// `[simulation]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Simulated time, s.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    /// Integrator.
+    #[serde(default)]
+    pub integrator: IntegratorKind,
+    /// Relative tolerance (adaptive integrators).
+    #[serde(default = "default_rtol")]
+    pub rtol: f64,
+    /// Absolute tolerance (adaptive integrators).
+    #[serde(default = "default_atol")]
+    pub atol: f64,
+    /// Step, s (RK4), or the largest step (adaptive).
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Seed of every random effect (jitter, faults, perturbations).
+    #[serde(default)]
+    pub seed: u64,
+    /// Time to let transients settle before δ windows are counted as steady state, s.
+    #[serde(default)]
+    pub settle: Option<f64>,
+}
+
+fn default_duration() -> f64 {
+    30.0
+}
+fn default_rtol() -> f64 {
+    1e-9
+}
+fn default_atol() -> f64 {
+    1e-9
+}
+fn default_step() -> f64 {
+    1e-3
+}
+
+impl Default for SimulationSpec {
+    fn default() -> Self {
+        SimulationSpec {
+            duration: default_duration(),
+            integrator: IntegratorKind::default(),
+            rtol: default_rtol(),
+            atol: default_atol(),
+            step: default_step(),
+            seed: 0,
+            settle: None,
+        }
+    }
+}
+
+/// `[shaft]`: inertia reduced to the shaft.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShaftSpec {
+    /// Reduced inertia J, kg·m².
+    pub inertia: f64,
+    /// Added flywheel, kg·m².
+    #[serde(default)]
+    pub flywheel: f64,
+    /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase).
+    #[serde(default)]
+    pub inertia_harmonics: Vec<Harmonic>,
+    /// Initial speed, rad/s (default: the motor's no-load or prescribed speed).
+    #[serde(default)]
+    pub initial_speed: Option<f64>,
+}
+
+/// A harmonic term `amplitude·sin(order·φ + phase)` (cos for inertia).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Harmonic {
+    /// Cycles per revolution.
+    pub order: f64,
+    /// Amplitude (N·m for torque, kg·m² for inertia).
+    pub amplitude: f64,
+    /// Phase, rad.
+    #[serde(default)]
+    pub phase: f64,
+}
+
+/// `[motor]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "model", rename_all = "lowercase")]
+pub enum MotorSpec {
+    /// Parabolic characteristic through (ω0, 0) and (ω_m, M_m) (seed 000, eq. 3–4).
+    Parabola {
+        /// ω0, rad/s.
+        no_load_speed: f64,
+        /// ω_m, rad/s.
+        breakdown_speed: f64,
+        /// M_m, N·m.
+        breakdown_torque: f64,
+    },
+    /// Kloss characteristic (seed 000, eq. 2).
+    Kloss {
+        /// Synchronous speed ω_s, rad/s.
+        synchronous_speed: f64,
+        /// Breakdown slip σ_m.
+        breakdown_slip: f64,
+        /// Breakdown torque M_m, N·m.
+        breakdown_torque: f64,
+    },
+    /// A prescribed constant speed (no torque balance).
+    Speed {
+        /// ω, rad/s.
+        speed: f64,
+    },
+    /// A prescribed linear speed ramp.
+    Ramp {
+        /// Speed at t = 0, rad/s.
+        from: f64,
+        /// Speed at `duration`, rad/s (held after).
+        to: f64,
+        /// Ramp time, s.
+        duration: f64,
+    },
+}
+
+/// `[load]`: M_c(φ) = mean + Σ amplitude·sin(order·φ + phase).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Mean load torque M1, N·m.
+    pub mean: f64,
+    /// Harmonics.
+    #[serde(default)]
+    pub harmonics: Vec<Harmonic>,
+}
+
+/// Revolution framing of the encoder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum FramingSpec {
+    /// Index pulse once per revolution.
+    #[default]
+    Index,
+    /// Missing-tooth gap.
+    MissingTooth,
+    /// No marker.
+    None,
+}
+
+/// `[encoder]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderSpec {
+    /// Tooth positions per revolution (lines).
+    pub lines: u16,
+    /// Capture timer clock, Hz.
+    pub timer_hz: f64,
+    /// Counter width, bits.
+    #[serde(default = "default_bits")]
+    pub counter_bits: u8,
+    /// Framing.
+    #[serde(default)]
+    pub framing: FramingSpec,
+    /// Missing positions (missing-tooth framing).
+    #[serde(default)]
+    pub missing: u8,
+    /// Edges averaged per speed sample.
+    #[serde(default = "default_estimator_edges")]
+    pub estimator_edges: u16,
+    /// Edge jitter, standard deviation, s.
+    #[serde(default)]
+    pub jitter: f64,
+    /// Disc run-out over radius, e/r (angle error amplitude, rad).
+    #[serde(default)]
+    pub runout: f64,
+    /// Run-out phase, rad.
+    #[serde(default)]
+    pub runout_phase: f64,
+    /// Random pitch error per line, standard deviation, rad.
+    #[serde(default)]
+    pub pitch_error: f64,
+    /// Probability that an edge is lost.
+    #[serde(default)]
+    pub drop_probability: f64,
+    /// Probability per edge of a spurious extra edge.
+    #[serde(default)]
+    pub glitch_probability: f64,
+}
+
+fn default_bits() -> u8 {
+    32
+}
+fn default_estimator_edges() -> u16 {
+    16
+}
+
+/// `[monitor]`.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSpec {
+    /// Permissible δ.
+    pub delta_limit: Option<f64>,
+    /// δ window in revolutions (default: from the load's lowest order).
+    pub window_revolutions: Option<u16>,
+    /// Slowest running speed, rad/s (standstill below).
+    pub min_speed: Option<f64>,
+    /// Steady-speed tolerance between windows (fraction).
+    pub steady_tolerance: Option<f64>,
+    /// Relative margin band around each characteristic speed of the auto-balancer.
+    pub regime_margin: Option<f64>,
+    /// Warning band of the support limits, as a fraction of each limit.
+    pub warning_fraction: Option<f64>,
+}
+
+/// `[[platform]]`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlatformSpec {
+    /// Mass, kg (without the auto-balancer).
+    pub mass: f64,
+    /// Support stiffness to ground, N/m.
+    pub stiffness: f64,
+    /// Support damping, N·s/m.
+    #[serde(default)]
+    pub damping: f64,
+}
+
+/// `[[coupling]]`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSpec {
+    /// The two platforms (1-based).
+    pub between: [u8; 2],
+    /// Stiffness, N/m.
+    pub stiffness: f64,
+    /// Damping, N·s/m.
+    #[serde(default)]
+    pub damping: f64,
+}
+
+/// Auto-balancer kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BalancerKindSpec {
+    /// Balls, κ = 7/5.
+    Ball,
+    /// Rollers, κ = 3/2.
+    Roller,
+    /// Pendulums, κ = 1 + J_c/(m R²).
+    Pendulum,
+}
+
+/// `[autobalancer]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AutobalancerSpec {
+    /// Kind.
+    pub kind: BalancerKindSpec,
+    /// Pendulum inertia about its own centre, kg·m² (pendulum only).
+    #[serde(default)]
+    pub pendulum_inertia: Option<f64>,
+    /// Platform carrying it (1-based).
+    pub platform: u8,
+    /// Number of loads.
+    pub loads: u8,
+    /// Mass of each load, kg.
+    pub load_mass: f64,
+    /// Radius of the loads' track, m.
+    pub radius: f64,
+    /// Housing mass, kg.
+    #[serde(default)]
+    pub housing_mass: f64,
+    /// Viscosity of load motion relative to the housing, N·s/m.
+    pub viscosity: f64,
+    /// Rotor static unbalance the loads are to balance, kg·m.
+    #[serde(default)]
+    pub rotor_unbalance: Option<f64>,
+}
+
+/// `[rotor]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotorSpec {
+    /// Mass, kg.
+    pub mass: f64,
+    /// Axial position of the centre of mass, m.
+    pub centre_of_mass: f64,
+    /// Axial position of support A, m.
+    pub support_a: f64,
+    /// Axial position of support B, m.
+    pub support_b: f64,
+    /// ISO 21940-11 balance quality grade G, mm/s.
+    pub grade: f64,
+    /// Service speed, rad/s.
+    pub service_speed: f64,
+    /// Allowed dynamic load at A and B, N.
+    #[serde(default)]
+    pub support_load_limit: Option<[f64; 2]>,
+}
+
+/// `[[unbalance]]`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnbalanceSpec {
+    /// Axial position, m.
+    pub z: f64,
+    /// Amount, kg·m.
+    pub amount: f64,
+    /// Angle, degrees.
+    pub angle: f64,
+}
+
+/// `[process_load]`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProcessLoadSpec {
+    /// Load per length, N/m.
+    pub per_length: f64,
+    /// Start of the loaded interval, m.
+    pub from: f64,
+    /// End of the loaded interval, m.
+    pub to: f64,
+    /// Direction of the load, degrees.
+    pub angle: f64,
+}
+
+impl Scene {
+    /// Reads and parses a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Parses scene text; `path` names the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: path.to_path_buf(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        })?;
+        scene.check(path)?;
+        Ok(scene)
+    }
+
+    fn check(&self, path: &Path) -> Result<(), SceneError> {
+        let bad = |key: &str, message: &str| SceneError::Value {
+            file: path.to_path_buf(),
+            key: key.to_string(),
+            message: message.to_string(),
+        };
+        let s = &self.simulation;
+        let positive = |key: &str, x: f64| {
+            if !x.is_finite() {
+                Err(bad(key, &format!("must be finite, got {x}")))
+            } else if x <= 0.0 {
+                Err(bad(key, &format!("must be positive, got {x}")))
+            } else {
+                Ok(())
+            }
+        };
+        positive("simulation.duration", s.duration)?;
+        positive("simulation.rtol", s.rtol)?;
+        positive("simulation.atol", s.atol)?;
+        positive("simulation.step", s.step)?;
+        if let Some(t) = s.settle {
+            if !(t.is_finite() && t >= 0.0 && t < s.duration) {
+                return Err(bad(
+                    "simulation.settle",
+                    &format!("must be in [0, duration), got {t}"),
+                ));
+            }
+        }
+        if self.platform.len() > 3 {
+            return Err(bad("platform", "at most 3 platforms"));
+        }
+        if !self.platform.is_empty() && self.autobalancer.is_none() {
+            return Err(bad(
+                "autobalancer",
+                "missing: a vibration machine needs its auto-balancer",
+            ));
+        }
+        if self.autobalancer.is_some() && self.platform.is_empty() {
+            return Err(bad(
+                "platform",
+                "missing: the auto-balancer needs a platform",
+            ));
+        }
+        if (!self.unbalance.is_empty() || self.process_load.is_some()) && self.rotor.is_none() {
+            return Err(bad("rotor", "missing: unbalances need a [rotor]"));
+        }
+        if let Some(e) = &self.encoder {
+            if e.framing == FramingSpec::MissingTooth && e.missing == 0 {
+                return Err(bad(
+                    "encoder.missing",
+                    "missing-tooth framing needs missing = 1..3",
+                ));
+            }
+            for (key, x) in [
+                ("encoder.drop_probability", e.drop_probability),
+                ("encoder.glitch_probability", e.glitch_probability),
+            ] {
+                if !(0.0..=0.5).contains(&x) {
+                    return Err(bad(key, &format!("must be in [0, 0.5], got {x}")));
+                }
+            }
+            for (key, x) in [
+                ("encoder.jitter", e.jitter),
+                ("encoder.runout", e.runout),
+                ("encoder.pitch_error", e.pitch_error),
+            ] {
+                if !(x.is_finite() && x >= 0.0) {
+                    return Err(bad(key, &format!("must be finite and ≥ 0, got {x}")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Names of the effects this scene calls for, in assembly order.
+    pub fn effects(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        if self.motor.is_some() {
+            v.push("motor");
+        }
+        if self.load.is_some() {
+            v.push("load");
+        }
+        if !self.platform.is_empty() {
+            v.push("vibration");
+        }
+        if self.rotor.is_some() {
+            v.push("rotor-loads");
+        }
+        if self.encoder.is_some() {
+            v.push("encoder");
+        }
+        v
+    }
+}
+
+/// The scenes bundled with the simulator, by file name.
+pub const BUNDLED: &[(&str, &str)] = &[];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        Scene::parse(text, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn errors_name_the_file_and_key() {
+        let e = err("[shaft]\ninertia = 0.3\nflywhel = 1.0\n");
+        assert!(e.contains("bad.toml") && e.contains("flywhel"), "{e}");
+        let e = err("[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\n");
+        assert!(e.contains("breakdown_speed"), "{e}");
+        let e = err("[simulation]\nduration = -1.0\n");
+        assert!(e.contains("simulation.duration") && e.contains("-1"), "{e}");
+        let e = err("[encoder]\nlines = 100\ntimer_hz = 1e6\ndrop_probability = 2.0\n");
+        assert!(e.contains("encoder.drop_probability"), "{e}");
+        let e = err("[shaft]\ninertia = \"heavy\"\n");
+        assert!(e.contains("inertia"), "{e}");
+    }
+}

@@ -1,0 +1,293 @@
+//! δ limit alarm: N-of-M windows with hysteresis, only on steady, trustworthy windows, driving
+//! an `embedded-hal` output pin.
+//!
+//! A window counts only when it is valid, steady, and its noise floor is small against the
+//! limit (floor ≤ `floor_fraction`·limit); a window whose floor is near the limit is flagged
+//! ([`Verdict::FloorNearLimit`]) rather than trusted. The alarm raises when at least `n` of the
+//! last `m` counted windows exceed the limit, and clears when at least `n` of the last `m` are
+//! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter.
+
+use crate::error::{positive, ConfigError};
+use crate::irregularity::WindowReport;
+use embedded_hal::digital::OutputPin;
+
+/// Alarm settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AlarmConfig {
+    /// Permissible δ (e.g. 0.06 for the seed's kneader).
+    pub limit: f32,
+    /// Windows over the limit needed to raise (N).
+    pub raise_after: u8,
+    /// Of the last M counted windows (N ≤ M ≤ 32).
+    pub of_last: u8,
+    /// Relative hysteresis: clear below `limit·(1 − hysteresis)` (0 to 0.9).
+    pub hysteresis: f32,
+    /// Largest noise floor, as a fraction of the limit, for a window to be trusted (0 to 1).
+    pub floor_fraction: f32,
+}
+
+impl AlarmConfig {
+    /// Limit `limit`, 3 of 5 windows, 10 % hysteresis, floor at most 20 % of the limit.
+    pub fn new(limit: f32) -> Self {
+        AlarmConfig {
+            limit,
+            raise_after: 3,
+            of_last: 5,
+            hysteresis: 0.1,
+            floor_fraction: 0.2,
+        }
+    }
+
+    /// Checks the settings.
+    pub fn validate(self) -> Result<DeltaAlarm, ConfigError> {
+        positive("delta_limit", self.limit as f64)?;
+        if self.of_last == 0 || self.of_last > 32 {
+            return Err(ConfigError::OutOfRange("of_last"));
+        }
+        if self.raise_after == 0 || self.raise_after > self.of_last {
+            return Err(ConfigError::OutOfRange("raise_after"));
+        }
+        let h = self.hysteresis;
+        if !h.is_finite() {
+            return Err(ConfigError::NonFinite("hysteresis"));
+        }
+        if !(0.0..=0.9).contains(&h) {
+            return Err(ConfigError::OutOfRange("hysteresis"));
+        }
+        let f = positive("floor_fraction", self.floor_fraction as f64)?;
+        if f > 1.0 {
+            return Err(ConfigError::OutOfRange("floor_fraction"));
+        }
+        Ok(DeltaAlarm {
+            config: self,
+            over: 0,
+            under: 0,
+            seen: 0,
+            active: false,
+        })
+    }
+}
+
+/// How a window was judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Verdict {
+    /// Counted: δ within the limit.
+    Within,
+    /// Counted: δ over the limit.
+    Over,
+    /// Not counted: the window was invalid.
+    Invalid,
+    /// Not counted: the speed was not steady.
+    Unsteady,
+    /// Not counted: the quantization floor is too close to the limit to trust δ.
+    FloorNearLimit,
+}
+
+/// An alarm transition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AlarmEvent {
+    /// The alarm went on.
+    Raised,
+    /// The alarm went off.
+    Cleared,
+}
+
+/// Alarm state: the last M counted windows as bit histories.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DeltaAlarm {
+    config: AlarmConfig,
+    over: u32,
+    under: u32,
+    seen: u8,
+    active: bool,
+}
+
+impl DeltaAlarm {
+    /// The settings.
+    pub fn config(&self) -> &AlarmConfig {
+        &self.config
+    }
+
+    /// Whether the alarm is on.
+    pub fn active(&self) -> bool {
+        self.active
+    }
+
+    /// Judges a window without changing state.
+    pub fn judge(&self, r: &WindowReport) -> Verdict {
+        let c = &self.config;
+        if !r.valid() {
+            Verdict::Invalid
+        } else if !r.steady {
+            Verdict::Unsteady
+        } else if r.noise_floor.is_nan() || r.noise_floor > c.floor_fraction * c.limit {
+            Verdict::FloorNearLimit
+        } else if r.delta > c.limit {
+            Verdict::Over
+        } else {
+            Verdict::Within
+        }
+    }
+
+    /// Takes a window; returns its verdict and the transition it caused, if any.
+    pub fn update(&mut self, r: &WindowReport) -> (Verdict, Option<AlarmEvent>) {
+        let v = self.judge(r);
+        if !matches!(v, Verdict::Over | Verdict::Within) {
+            return (v, None);
+        }
+        let m = self.config.of_last as u32;
+        let mask = if m >= 32 { u32::MAX } else { (1u32 << m) - 1 };
+        let below = r.delta < self.config.limit * (1.0 - self.config.hysteresis);
+        self.over = ((self.over << 1) | (v == Verdict::Over) as u32) & mask;
+        self.under = ((self.under << 1) | below as u32) & mask;
+        self.seen = self.seen.saturating_add(1);
+        let n = self.config.raise_after as u32;
+        let event = if !self.active && self.over.count_ones() >= n {
+            self.active = true;
+            Some(AlarmEvent::Raised)
+        } else if self.active && self.under.count_ones() >= n {
+            self.active = false;
+            Some(AlarmEvent::Cleared)
+        } else {
+            None
+        };
+        (v, event)
+    }
+}
+
+/// Drives an output pin from the alarm state (high = alarm, or inverted).
+#[derive(Debug)]
+pub struct AlarmOutput<P: OutputPin> {
+    pin: P,
+    active_high: bool,
+}
+
+impl<P: OutputPin> AlarmOutput<P> {
+    /// Wraps `pin`; `active_high` selects the level that means "alarm".
+    pub fn new(pin: P, active_high: bool) -> Self {
+        AlarmOutput { pin, active_high }
+    }
+
+    /// Sets the pin to show `active`.
+    pub fn show(&mut self, active: bool) -> Result<(), P::Error> {
+        if active == self.active_high {
+            self.pin.set_high()
+        } else {
+            self.pin.set_low()
+        }
+    }
+
+    /// Returns the pin.
+    pub fn release(self) -> P {
+        self.pin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::convert::Infallible;
+
+    fn window(delta: f32, steady: bool, floor: f32) -> WindowReport {
+        WindowReport {
+            omega_max: 0.0,
+            omega_min: 0.0,
+            omega_mean: 100.0,
+            delta,
+            spread: delta,
+            noise_floor: floor,
+            revolutions: 8,
+            samples: 8192,
+            fault: None,
+            steady,
+        }
+    }
+
+    #[test]
+    fn raises_after_n_of_m_and_clears_with_hysteresis() {
+        let mut a = AlarmConfig::new(0.06).validate().unwrap();
+        let over = window(0.07, true, 1e-4);
+        let near = window(0.058, true, 1e-4); // within, but not below 0.054
+        let low = window(0.05, true, 1e-4);
+        assert_eq!(a.update(&over), (Verdict::Over, None));
+        assert_eq!(a.update(&low), (Verdict::Within, None));
+        assert_eq!(a.update(&over), (Verdict::Over, None));
+        assert_eq!(a.update(&over), (Verdict::Over, Some(AlarmEvent::Raised)));
+        assert!(a.active());
+        // Sitting just under the limit does not clear it.
+        for _ in 0..10 {
+            assert_eq!(a.update(&near), (Verdict::Within, None));
+        }
+        assert!(a.active());
+        assert_eq!(a.update(&low), (Verdict::Within, None));
+        assert_eq!(a.update(&low), (Verdict::Within, None));
+        assert_eq!(a.update(&low), (Verdict::Within, Some(AlarmEvent::Cleared)));
+    }
+
+    #[test]
+    fn untrusted_windows_do_not_count() {
+        let mut a = AlarmConfig::new(0.06).validate().unwrap();
+        for _ in 0..10 {
+            assert_eq!(a.update(&window(0.1, false, 1e-4)).0, Verdict::Unsteady);
+            assert_eq!(
+                a.update(&window(0.1, true, 0.02)).0,
+                Verdict::FloorNearLimit
+            );
+            assert_eq!(
+                a.update(&window(0.1, true, f32::NAN)).0,
+                Verdict::FloorNearLimit
+            );
+            let mut bad = window(0.1, true, 1e-4);
+            bad.fault = Some(crate::speed::Fault::Glitch);
+            assert_eq!(a.update(&bad).0, Verdict::Invalid);
+        }
+        assert!(!a.active());
+    }
+
+    #[test]
+    fn bad_settings_are_rejected() {
+        let mut c = AlarmConfig::new(0.06);
+        c.raise_after = 6;
+        assert_eq!(
+            c.validate().err(),
+            Some(ConfigError::OutOfRange("raise_after"))
+        );
+        assert_eq!(
+            AlarmConfig::new(f32::NAN).validate().err(),
+            Some(ConfigError::NonFinite("delta_limit"))
+        );
+        assert_eq!(
+            AlarmConfig::new(-0.1).validate().err(),
+            Some(ConfigError::NotPositive("delta_limit"))
+        );
+    }
+
+    struct Pin(bool);
+    impl embedded_hal::digital::ErrorType for Pin {
+        type Error = Infallible;
+    }
+    impl OutputPin for Pin {
+        fn set_low(&mut self) -> Result<(), Infallible> {
+            self.0 = false;
+            Ok(())
+        }
+        fn set_high(&mut self) -> Result<(), Infallible> {
+            self.0 = true;
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn output_follows_polarity() {
+        let mut o = AlarmOutput::new(Pin(false), true);
+        o.show(true).unwrap();
+        assert!(o.release().0);
+        let mut o = AlarmOutput::new(Pin(true), false);
+        o.show(true).unwrap();
+        assert!(!o.release().0);
+    }
+}

@@ -1,0 +1,354 @@
+//! Running irregularity δ over one load cycle, from framed speed samples.
+//!
+//! δ must be taken over a window that is one period of the load cycle: the seed's kneader load
+//! has order 1/8, so its cycle is 8 revolutions and a per-revolution δ would see only part of
+//! the swing. A window starts at a frame (tooth 0) and ends after `W` whole revolutions, so the
+//! mean speed is exact: ω_mean = W·2π / (sum of the window's intervals), the intervals summed
+//! as integers (no drift over any run length).
+//!
+//! Reported per window: ωmax, ωmin, ω_mean, δ = 2(ωmax − ωmin)/(ωmax + ωmin) (seed 000,
+//! eq. 13), the spread (ωmax − ωmin)/ω_mean, the quantization noise floor, validity with its
+//! reason, and whether the speed was steady. No filtering happens before δ: a low-pass would
+//! remove exactly the ripple δ measures.
+
+use crate::error::{positive, ConfigError};
+use crate::speed::{EdgeEvent, Fault, SpeedSample};
+
+/// Largest window, in revolutions.
+pub const MAX_WINDOW_REVS: u16 = 1024;
+
+/// How long a δ window is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum WindowLength {
+    /// A fixed number of revolutions.
+    Revolutions(u16),
+    /// The load's lowest order (cycles per revolution, e.g. 0.125 for one load cycle per 8
+    /// revolutions). The window is the smallest whole number of revolutions holding a whole
+    /// number of load cycles (order within 1e-4 relative of a fraction with denominator ≤ 1024).
+    LoadOrder(f64),
+}
+
+impl WindowLength {
+    /// The window in revolutions.
+    pub fn revolutions(self) -> Result<u16, ConfigError> {
+        match self {
+            WindowLength::Revolutions(n) => {
+                if n == 0 || n > MAX_WINDOW_REVS {
+                    Err(ConfigError::OutOfRange("window.revolutions"))
+                } else {
+                    Ok(n)
+                }
+            }
+            WindowLength::LoadOrder(order) => {
+                let order = positive("window.load_order", order)?;
+                for w in 1..=MAX_WINDOW_REVS {
+                    let cycles = order * w as f64;
+                    let whole = libm::round(cycles);
+                    if whole >= 1.0 && (cycles - whole).abs() <= 1e-4 * cycles {
+                        return Ok(w);
+                    }
+                }
+                Err(ConfigError::OutOfRange("window.load_order"))
+            }
+        }
+    }
+}
+
+/// Window settings, validated by [`WindowConfig::validate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindowConfig {
+    /// Window length.
+    pub length: WindowLength,
+    /// A window is steady when its mean speed differs from the previous window's by less than
+    /// this fraction (e.g. 0.02).
+    pub steady_tolerance: f32,
+}
+
+/// Validated window settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Window {
+    revolutions: u16,
+    steady_tolerance: f32,
+}
+
+impl WindowConfig {
+    /// Checks the settings.
+    pub fn validate(self) -> Result<Window, ConfigError> {
+        let revolutions = self.length.revolutions()?;
+        let t = positive("steady_tolerance", self.steady_tolerance as f64)?;
+        if t >= 1.0 {
+            return Err(ConfigError::OutOfRange("steady_tolerance"));
+        }
+        Ok(Window {
+            revolutions,
+            steady_tolerance: self.steady_tolerance,
+        })
+    }
+}
+
+impl Window {
+    /// Revolutions per window.
+    pub fn revolutions(&self) -> u16 {
+        self.revolutions
+    }
+}
+
+/// The result of one window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindowReport {
+    /// Largest speed sample, rad/s.
+    pub omega_max: f32,
+    /// Smallest speed sample, rad/s.
+    pub omega_min: f32,
+    /// Mean speed, angle over time, rad/s.
+    pub omega_mean: f32,
+    /// δ = 2(ωmax − ωmin)/(ωmax + ωmin).
+    pub delta: f32,
+    /// (ωmax − ωmin)/ω_mean.
+    pub spread: f32,
+    /// Bound on the error of δ from timer quantization: 2 / (mean ticks per speed sample).
+    pub noise_floor: f32,
+    /// Revolutions covered (the configured count for a valid window).
+    pub revolutions: u16,
+    /// Speed samples taken.
+    pub samples: u32,
+    /// `None` for a valid window, else the first fault seen in it.
+    pub fault: Option<Fault>,
+    /// The mean speed was within the steady tolerance of the previous valid window's.
+    pub steady: bool,
+}
+
+impl WindowReport {
+    /// A complete window with no fault.
+    pub fn valid(&self) -> bool {
+        self.fault.is_none()
+    }
+}
+
+/// An extreme sample kept exactly: angle and integer interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Extreme {
+    angle: f32,
+    ticks: u32,
+}
+
+/// Per-window accumulation state.
+#[derive(Debug, Clone)]
+pub struct WindowState {
+    started: bool,
+    revs: u16,
+    ticks: u64,
+    samples: u32,
+    sample_ticks: u64,
+    max: Extreme,
+    min: Extreme,
+    /// Mean speed of the previous valid window (0 when none).
+    prev_mean: f32,
+}
+
+impl Default for WindowState {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// a1·t2 − a2·t1 to within about one rounding of the result (Kahan's difference of products:
+/// the product a2·t1 is split exactly with a fused multiply-add, so equal speeds cancel to 0).
+fn cross(a1: f32, t2: f32, a2: f32, t1: f32) -> f32 {
+    let w = a2 * t1;
+    let e = libm::fmaf(-a2, t1, w);
+    let f = libm::fmaf(a1, t2, -w);
+    f + e
+}
+
+impl WindowState {
+    /// No window in progress.
+    pub const fn new() -> Self {
+        WindowState {
+            started: false,
+            revs: 0,
+            ticks: 0,
+            samples: 0,
+            sample_ticks: 0,
+            max: Extreme {
+                angle: 0.0,
+                ticks: 0,
+            },
+            min: Extreme {
+                angle: 0.0,
+                ticks: 0,
+            },
+            prev_mean: 0.0,
+        }
+    }
+
+    fn restart(&mut self) {
+        self.started = true;
+        self.revs = 0;
+        self.ticks = 0;
+        self.samples = 0;
+        self.sample_ticks = 0;
+    }
+
+    fn take(&mut self, s: &SpeedSample) {
+        if s.ticks == 0 {
+            return;
+        }
+        self.samples = self.samples.saturating_add(1);
+        self.sample_ticks = self.sample_ticks.saturating_add(s.ticks as u64);
+        if self.samples == 1 {
+            self.max = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
+            self.min = self.max;
+            return;
+        }
+        // Compare angle/ticks by cross-multiplying: no division per edge.
+        let t = s.ticks as f32;
+        if s.angle * self.max.ticks as f32 > self.max.angle * t {
+            self.max = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
+        }
+        if s.angle * (self.min.ticks as f32) < self.min.angle * t {
+            self.min = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
+        }
+    }
+
+    fn report(&self, window: &Window, timer_hz: f32, fault: Option<Fault>) -> WindowReport {
+        let (a1, t1) = (self.max.angle, self.max.ticks as f32);
+        let (a2, t2) = (self.min.angle, self.min.ticks as f32);
+        let omega_max = if t1 > 0.0 { a1 * timer_hz / t1 } else { 0.0 };
+        let omega_min = if t2 > 0.0 { a2 * timer_hz / t2 } else { 0.0 };
+        // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1): the numerator
+        // from exact integer ticks and an FMA difference, never by subtracting two speeds.
+        let num = cross(a1, t2, a2, t1);
+        let den = a1 * t2 + a2 * t1;
+        let delta = if den > 0.0 { 2.0 * num / den } else { 0.0 };
+        let omega_mean = if self.ticks > 0 {
+            self.revs as f32 * core::f32::consts::TAU * timer_hz / self.ticks as f32
+        } else {
+            0.0
+        };
+        let spread = if omega_mean > 0.0 {
+            (omega_max - omega_min) / omega_mean
+        } else {
+            0.0
+        };
+        let noise_floor = if self.sample_ticks > 0 {
+            2.0 * self.samples as f32 / self.sample_ticks as f32
+        } else {
+            1.0
+        };
+        let steady = fault.is_none()
+            && self.prev_mean > 0.0
+            && (omega_mean - self.prev_mean).abs() < window.steady_tolerance * omega_mean;
+        WindowReport {
+            omega_max,
+            omega_min,
+            omega_mean,
+            delta,
+            spread,
+            noise_floor,
+            revolutions: self.revs,
+            samples: self.samples,
+            fault,
+            steady,
+        }
+    }
+
+    /// Feeds one edge's event; returns a report when a window ends (complete, or cut short by
+    /// a fault: then invalid with that fault as its reason).
+    pub fn on_event(
+        &mut self,
+        window: &Window,
+        timer_hz: f32,
+        ev: &EdgeEvent,
+    ) -> Option<WindowReport> {
+        if let Some(fault) = ev.fault {
+            return self.abort(window, timer_hz, fault);
+        }
+        if !self.started {
+            if ev.frame {
+                self.restart();
+            }
+            return None;
+        }
+        if let Some((dt, _)) = ev.interval {
+            self.ticks = self.ticks.saturating_add(dt as u64);
+        }
+        if let Some(s) = &ev.sample {
+            self.take(s);
+        }
+        if ev.frame {
+            self.revs = self.revs.saturating_add(1);
+            if self.revs >= window.revolutions {
+                let r = self.report(window, timer_hz, None);
+                self.prev_mean = r.omega_mean;
+                self.restart();
+                return Some(r);
+            }
+        }
+        None
+    }
+
+    /// Ends the window in progress as invalid with `fault` (e.g. a timeout found by polling).
+    pub fn abort(&mut self, window: &Window, timer_hz: f32, fault: Fault) -> Option<WindowReport> {
+        let was = self.started;
+        self.started = false;
+        self.prev_mean = 0.0;
+        if was {
+            Some(self.report(window, timer_hz, Some(fault)))
+        } else {
+            None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn load_order_gives_whole_cycles() {
+        assert_eq!(WindowLength::LoadOrder(0.125).revolutions(), Ok(8));
+        assert_eq!(WindowLength::LoadOrder(1.0).revolutions(), Ok(1));
+        assert_eq!(WindowLength::LoadOrder(2.0).revolutions(), Ok(1));
+        assert_eq!(WindowLength::LoadOrder(1.5).revolutions(), Ok(2));
+        assert_eq!(WindowLength::LoadOrder(2.0 / 3.0).revolutions(), Ok(3));
+        assert_eq!(
+            WindowLength::LoadOrder(f64::NAN).revolutions(),
+            Err(ConfigError::NonFinite("window.load_order"))
+        );
+        assert_eq!(
+            WindowLength::LoadOrder(1e-6).revolutions(),
+            Err(ConfigError::OutOfRange("window.load_order"))
+        );
+        assert_eq!(
+            WindowLength::Revolutions(0).revolutions(),
+            Err(ConfigError::OutOfRange("window.revolutions"))
+        );
+    }
+
+    #[test]
+    fn cross_product_difference_is_exact_for_close_speeds() {
+        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding.
+        let a = 0.006_135_923_f32;
+        let (t1, t2) = (10_000_000f32, 10_000_001f32);
+        let num = cross(a, t2, a, t1);
+        let exact = a as f64 * 1.0;
+        assert!(
+            (num as f64 - exact).abs() <= 1e-7 * exact,
+            "{num} vs {exact}"
+        );
+    }
+}
