@@ -70,8 +70,8 @@ impl Load {
     /// A load with mean `mean` (N·m, finite, any sign) and the given harmonics.
     pub fn new(mean: f64, harmonics: &[Harmonic]) -> Result<Self, ConfigError> {
         let mean = finite("load.mean", mean)?;
-        let harmonics = heapless::Vec::from_slice(harmonics)
-            .map_err(|_| ConfigError::Capacity("harmonics"))?;
+        let harmonics =
+            heapless::Vec::from_slice(harmonics).map_err(|_| ConfigError::Capacity("harmonics"))?;
         Ok(Self { mean, harmonics })
     }
 

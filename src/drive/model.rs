@@ -328,7 +328,7 @@ impl DriveModel {
     pub fn predict(&self) -> Prediction {
         let ex = self.extremes();
         let u_min = self.u_mean + ex.s_min;
-        if !(u_min > 0.0) {
+        if !exceeds(u_min, 0.0) {
             return Prediction::Stalls(Stall {
                 u_mean: self.u_mean,
                 u_min,
@@ -357,7 +357,7 @@ impl DriveModel {
     pub fn sensitivity(&self) -> Option<Sensitivity> {
         let ex = self.extremes();
         let (x2, y2) = (self.u_mean + ex.s_max, self.u_mean + ex.s_min);
-        if !(y2 > 0.0) {
+        if !exceeds(y2, 0.0) {
             return None;
         }
         let (x, y) = (libm::sqrt(x2), libm::sqrt(y2));
@@ -403,8 +403,7 @@ impl DriveModel {
         let d_inertia = d_smax * smax_j + d_smin * smin_j;
         // Scaling the motor by λ multiplies a and B by λ: ∂ū/∂λ = M1/a, ∂s/∂λ = a·∂s/∂a.
         let a = -self.motor.model().a();
-        let d_lambda =
-            a * (d_smax * smax_a + d_smin * smin_a) + d_umean * (self.mean_load / a);
+        let d_lambda = a * (d_smax * smax_a + d_smin * smin_a) + d_umean * (self.mean_load / a);
         Some(Sensitivity {
             d_delta_d_inertia: d_inertia,
             d_delta_d_breakdown_torque: d_lambda / self.motor.model().breakdown_torque(),
@@ -427,7 +426,7 @@ impl DriveModel {
         if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
             return Err(DesignError::InvalidTarget);
         }
-        if !(self.u_mean > 0.0) {
+        if !exceeds(self.u_mean, 0.0) {
             return Err(DesignError::MeanLoadExceedsMotor);
         }
         let meets = |m: &DriveModel| match m.predict() {
@@ -446,7 +445,7 @@ impl DriveModel {
             let m2 = c.amplitude() * h / 2.0;
             let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
             let h_needed = 2.0 * m2 / (r * self.u_mean);
-            if !(h_needed > 2.0 * a) {
+            if !exceeds(h_needed, 2.0 * a) {
                 return Ok(0.0);
             }
             let j_needed = libm::sqrt((h_needed - 2.0 * a) * (h_needed + 2.0 * a)) / n;
@@ -632,6 +631,11 @@ struct Extremes {
     s_min: f64,
     phi_max: Option<f64>,
     phi_min: Option<f64>,
+}
+
+/// `x > y`, false when either is NaN.
+fn exceeds(x: f64, y: f64) -> bool {
+    x > y
 }
 
 fn wrap(phi: f64, period: f64) -> f64 {

@@ -20,7 +20,13 @@ fn h(order: f64, amplitude: f64, phase: f64) -> Harmonic {
 }
 
 fn drive(harmonics: &[Harmonic], inertia: f64) -> DriveModel {
-    DriveModel::new(seed_motor(), Load::new(24.0, harmonics).unwrap(), inertia, 0.0).unwrap()
+    DriveModel::new(
+        seed_motor(),
+        Load::new(24.0, harmonics).unwrap(),
+        inertia,
+        0.0,
+    )
+    .unwrap()
 }
 
 fn seed() -> DriveModel {
@@ -83,8 +89,14 @@ fn integrate(m: &DriveModel, settle: f64, period: f64, dt: f64) -> (f64, f64) {
     let acc = |phi: f64, w: f64| (motor.torque(w) - load.torque(phi)) / j;
     let step = |phi: f64, w: f64| {
         let (k1p, k1w) = (w, acc(phi, w));
-        let (k2p, k2w) = (w + 0.5 * dt * k1w, acc(phi + 0.5 * dt * k1p, w + 0.5 * dt * k1w));
-        let (k3p, k3w) = (w + 0.5 * dt * k2w, acc(phi + 0.5 * dt * k2p, w + 0.5 * dt * k2w));
+        let (k2p, k2w) = (
+            w + 0.5 * dt * k1w,
+            acc(phi + 0.5 * dt * k1p, w + 0.5 * dt * k1w),
+        );
+        let (k3p, k3w) = (
+            w + 0.5 * dt * k2w,
+            acc(phi + 0.5 * dt * k2p, w + 0.5 * dt * k2w),
+        );
         let (k4p, k4w) = (w + dt * k3w, acc(phi + dt * k3p, w + dt * k3w));
         (
             phi + dt / 6.0 * (k1p + 2.0 * k2p + 2.0 * k3p + k4p),
@@ -129,7 +141,7 @@ fn matches_direct_integration_one_harmonic() {
     let s = steady(&m);
     let (wmax, wmin) = integrate(&m, 1500.0, 16.0 * PI, 1e-4);
     let d = delta_of(wmax, wmin);
-    assert!(rel(d, s.delta) < 1e-6, "rk4 {d} model {}", s.delta);
+    assert!(rel(d, s.delta) < 1e-8, "rk4 {d} model {}", s.delta);
     assert!(rel(wmax, s.omega_max) < 1e-8 && rel(wmin, s.omega_min) < 1e-8);
 }
 
@@ -148,14 +160,21 @@ fn matches_direct_integration_two_and_three_harmonics() {
         assert!((radians - 16.0 * PI).abs() < 1e-12);
         let (wmax, wmin) = integrate(&m, 1500.0, radians, 1e-4);
         let d = delta_of(wmax, wmin);
-        assert!(rel(d, s.delta) < 1e-6, "rk4 {d} model {} ({samples})", s.delta);
+        assert!(
+            rel(d, s.delta) < 1e-8,
+            "rk4 {d} model {} ({samples})",
+            s.delta
+        );
     }
 }
 
 #[test]
 fn several_harmonics_match_brute_force_search() {
     // Orders 1, 2, 3 with nearly equal competing peaks.
-    let m = drive(&[h(1.0, 10.0, 0.0), h(2.0, 9.0, 0.3), h(3.0, 8.0, 2.0)], 0.05);
+    let m = drive(
+        &[h(1.0, 10.0, 0.0), h(2.0, 9.0, 0.3), h(3.0, 8.0, 2.0)],
+        0.05,
+    );
     let s = steady(&m);
     let n = 2_000_000;
     let (mut umax, mut umin) = (f64::MIN, f64::MAX);
@@ -187,7 +206,11 @@ fn tiny_delta_keeps_full_precision() {
         let r = r_amp / ubar;
         let reference = 2.0 * r / (1.0 + (1.0 - r * r).sqrt());
         assert!(rel(s.delta, expect) < 0.01, "{}", s.delta);
-        assert!(rel(s.delta, reference) < 1e-12, "{} vs {reference}", s.delta);
+        assert!(
+            rel(s.delta, reference) < 1e-12,
+            "{} vs {reference}",
+            s.delta
+        );
         // δ ≈ r + r³/4 (series): the same to rounding.
         assert!(rel(s.delta, r + r * r * r / 4.0) < 1e-12);
         // The textbook form subtracts two square roots and loses digits at δ ≈ 1e-13.
@@ -274,9 +297,15 @@ fn stalled_drive_is_reported_not_nan() {
     // Mean load above the stall torque B: no steady state and no flywheel helps.
     let over = DriveModel::new(seed_motor(), Load::new(200.0, &[]).unwrap(), J, 0.0).unwrap();
     assert!(matches!(over.predict(), Prediction::Stalls(s) if s.u_mean <= 0.0));
-    assert_eq!(over.flywheel_for(0.06), Err(DesignError::MeanLoadExceedsMotor));
+    assert_eq!(
+        over.flywheel_for(0.06),
+        Err(DesignError::MeanLoadExceedsMotor)
+    );
     let irr = over.irregularity(Some(0.06)).unwrap();
-    assert_eq!((irr.omega_max, irr.delta, irr.flywheel_for_limit), (0.0, 2.0, None));
+    assert_eq!(
+        (irr.omega_max, irr.delta, irr.flywheel_for_limit),
+        (0.0, 2.0, None)
+    );
 }
 
 #[test]
@@ -310,9 +339,7 @@ fn check_sensitivity(m: &DriveModel) {
     let sens = m.sensitivity().unwrap();
     let dj = 1e-5 * m.total_inertia();
     let d = |x: &DriveModel| steady(x).delta;
-    let with_j = |j: f64| {
-        DriveModel::new(*m.motor(), m.load().clone(), j, m.flywheel()).unwrap()
-    };
+    let with_j = |j: f64| DriveModel::new(*m.motor(), m.load().clone(), j, m.flywheel()).unwrap();
     let fd_j = (d(&with_j(m.inertia() + dj)) - d(&with_j(m.inertia() - dj))) / (2.0 * dj);
     let e = 1e-5;
     let mm = m.motor().model().breakdown_torque();
@@ -339,7 +366,9 @@ fn sensitivities_match_central_differences() {
     // Scaling the motor via its breakdown torque is the same as scaling the characteristic.
     let stronger: Motor = Parabola::new(W0, WM, MM * 1.1).unwrap().into();
     let a = seed().with_motor(stronger).unwrap();
-    let b = seed().with_motor(seed_motor().scaled(1.1).unwrap()).unwrap();
+    let b = seed()
+        .with_motor(seed_motor().scaled(1.1).unwrap())
+        .unwrap();
     assert!(rel(steady(&a).delta, steady(&b).delta) < 1e-14);
 }
 
@@ -383,7 +412,14 @@ fn horizons() {
 #[test]
 fn invalid_inputs_are_typed_errors() {
     let load = || Load::new(24.0, &[h(0.125, 12.0, 0.0)]).unwrap();
-    for x in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 0.0, -1.0, 1e-310] {
+    for x in [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        0.0,
+        -1.0,
+        1e-310,
+    ] {
         let e = DriveModel::new(seed_motor(), load(), x, 0.0).unwrap_err();
         assert_eq!(e.parameter(), "inertia");
         if x != 0.0 {
@@ -415,8 +451,9 @@ fn invalid_inputs_are_typed_errors() {
 
 #[test]
 fn kloss_prediction_error_against_the_real_curve() {
-    // A 4-pole 50 Hz motor, σm = 0.2, at a light load: the tangent fit predicts δ of the
-    // integrated Kloss drive to a few per cent, the paper's breakdown fit is far off.
+    // A 4-pole 50 Hz motor, σm = 0.2, at a light load (M1 = 40 N·m ≈ 0.25·M_m): measured,
+    // δ of the integrated Kloss drive 0.013776; the tangent fit predicts 0.013535 (−1.7 %),
+    // the paper's breakdown fit 0.019890 (+44 %).
     let k = Kloss::new(157.08, 0.2, 158.0).unwrap();
     let load = Load::new(40.0, &[h(0.125, 12.0, 0.0)]).unwrap();
     let at = |fit| DriveModel::new(Motor::kloss(k, fit).unwrap(), load.clone(), J, 0.0).unwrap();
@@ -426,8 +463,8 @@ fn kloss_prediction_error_against_the_real_curve() {
     let truth = delta_of(wmax, wmin);
     let et = rel(steady(&tangent).delta, truth);
     let eb = rel(steady(&breakdown).delta, truth);
-    assert!(et < 0.05, "tangent fit error {et}");
-    assert!(eb > 0.3, "breakdown fit error {eb}");
+    assert!(et < 0.02, "tangent fit error {et}");
+    assert!(eb > 0.4, "breakdown fit error {eb}");
 }
 
 proptest! {
@@ -469,7 +506,7 @@ proptest! {
                     prop_assert!(!sens.d_delta_d_breakdown_torque.is_nan());
                 }
             }
-            Prediction::Stalls(st) => prop_assert!(!(st.u_min > 0.0) && !st.u_mean.is_nan()),
+            Prediction::Stalls(st) => prop_assert!(st.u_min <= 0.0 && !st.u_mean.is_nan()),
         }
         if let Ok(irr) = m.irregularity(Some(limit)) {
             prop_assert!(irr.delta.is_finite() && irr.omega_max.is_finite());
