@@ -8,6 +8,7 @@
 )]
 
 pub mod alarm;
+pub mod drive;
 pub mod encoder;
 pub mod error;
 pub mod irregularity;

@@ -1,0 +1,20 @@
+//! Predicted running irregularity δ of a drive (seed 000): motor characteristic, load torque,
+//! reduced inertia plus flywheel; the steady state in closed form, δ without cancellation,
+//! the stall case, flywheel sizing and sensitivities.
+//!
+//! Everything here runs at configuration time in f64, allocation-free. The motor and load
+//! types are the single definition of the model: the host simulator integrates the same
+//! [`Motor::torque`] and [`Load::torque`].
+
+mod load;
+mod model;
+mod motor;
+#[cfg(test)]
+mod tests;
+
+pub use load::{Harmonic, Load, MAX_HARMONICS, MAX_ORDER};
+pub use model::{
+    DesignError, DriveModel, Horizon, Irregularity, Prediction, Sensitivity, Stall, SteadyState,
+    MAX_DENOMINATOR, MAX_SAMPLES, SAMPLES_PER_CYCLE,
+};
+pub use motor::{Kloss, KlossFit, Motor, Parabola};

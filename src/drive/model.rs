@@ -1,0 +1,787 @@
+//! Steady state of the drive (seed 000, eq. 11–13), its irregularity δ, flywheel sizing and
+//! sensitivities.
+//!
+//! ## Derivation
+//! With constant reduced inertia `J` (machine plus flywheel), eq. 1 reads
+//! `J·ω·dω/dφ = A·ω² + B − M_c(φ)`. In `u = ω²` it is linear:
+//! `du/dφ + 2·D1·u = 2·D2 − 2·Σ D3k·sin(n_k·φ + ψ_k)` with `a = −A`, `K = ω0² − ω_m²`,
+//! `D1 = a/J = M_m/(J·K)`, `D2 = (B − M1)/J`, `D3k = M2k/J`. Its periodic solution, to which
+//! every solution converges like `exp(−2·D1·φ)`, superposes exactly:
+//!
+//! `u(φ) = D2/D1 + Σ_k 2·D3k·(n_k·cos θ_k − 2·D1·sin θ_k)/(4·D1² + n_k²)`, `θ_k = n_k·φ + ψ_k`
+//!
+//! (eq. 11 for one harmonic). In the form used here, `ū = D2/D1 = (B − M1)/a` and
+//! `s_k(φ) = (2·M2k/h_k)·((n_k·J/h_k)·cos θ_k − (2a/h_k)·sin θ_k)`, `h_k = hypot(2a, n_k·J)`,
+//! of amplitude `R_k = 2·|M2k|/h_k`. An order-0 harmonic is a constant and joins the mean.
+//!
+//! δ = 2(ωmax − ωmin)/(ωmax + ωmin) (eq. 13) is evaluated as
+//! `2·(smax − smin)/(ωmax + ωmin)²`: the difference of squares, with `smax − smin` taken from
+//! the oscillating part alone, so δ keeps full relative precision down to 1e-15 and below.
+//!
+//! ## The seed's case and its published numbers
+//! ω0 = 145 s⁻¹, ω_m = 36 s⁻¹, M_m = 158 N·m, J = 0.323 kg·m², M_c = 24 + 12·sin(φ/8) N·m
+//! gives ωmax = 136.311 s⁻¹, ωmin = 132.196 s⁻¹, δ = 0.030656 (unit test
+//! `seed_case_reproduced`, confirmed by direct integration of eq. 1). The paper prints
+//! δ = 0.085 / 0.101 with ωmax = 145 s⁻¹; those figures do not follow from its own parameters
+//! (145 s⁻¹ is the no-load speed, which a loaded drive cannot reach) and are not reproduced.
+//! Its claim that 0.177 kg·m² of extra flywheel brings δ to 0.06 is moot for the same reason:
+//! δ is already below 0.06 without a flywheel.
+
+use super::load::{Harmonic, Load, MAX_HARMONICS};
+use super::motor::Motor;
+use crate::error::{non_negative, positive, ConfigError};
+use core::f64::consts::PI;
+
+/// Samples per period of the fastest harmonic when the extrema are searched numerically.
+pub const SAMPLES_PER_CYCLE: u64 = 32;
+/// Largest number of samples over one common period; a longer common period is treated as
+/// unbounded ([`Horizon::Unbounded`]).
+pub const MAX_SAMPLES: u64 = 1 << 16;
+/// Largest denominator accepted when an order is recognised as a rational number.
+pub const MAX_DENOMINATOR: u64 = 1024;
+/// Golden-section iterations per refined extremum (bracket shrinks by 0.618⁶⁴ ≈ 4e-14).
+const GOLDEN_ITERATIONS: u32 = 64;
+
+/// Over which range of φ the extrema of ω were taken.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Horizon {
+    /// The load has no oscillating harmonic: ω is constant.
+    Constant,
+    /// One distinct order: extrema in closed form (eq. 12).
+    ClosedForm,
+    /// Several commensurate orders: extrema searched over one common period of this many
+    /// radians, sampled `samples` times (32 per cycle of the fastest order) and refined by
+    /// golden section to within about 1e-13 of the oscillation amplitude.
+    Period {
+        /// Common period of all harmonics, rad.
+        radians: f64,
+        /// Number of samples over that period.
+        samples: u32,
+    },
+    /// Orders with no common period (not rationals with denominators ≤ [`MAX_DENOMINATOR`]) or
+    /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k`. That is the exact
+    /// supremum over an unbounded horizon for rationally independent orders (Kronecker), and a
+    /// conservative bound (δ too large, flywheel too big) for commensurate ones.
+    Unbounded,
+}
+
+/// A periodic steady state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SteadyState {
+    /// Maximum shaft speed ωmax, rad/s.
+    pub omega_max: f64,
+    /// Minimum shaft speed ωmin, rad/s.
+    pub omega_min: f64,
+    /// Irregularity δ = 2(ωmax − ωmin)/(ωmax + ωmin).
+    pub delta: f64,
+    /// RMS speed `√ū` (ū is the mean of ω² over the period), rad/s.
+    pub omega_rms: f64,
+    /// Shaft angle of ωmax within the period, rad (`None` for [`Horizon::Unbounded`] and
+    /// [`Horizon::Constant`]).
+    pub phi_max: Option<f64>,
+    /// Shaft angle of ωmin, rad (as `phi_max`).
+    pub phi_min: Option<f64>,
+    /// How the extrema were found.
+    pub horizon: Horizon,
+    /// `ωmin ≥` the motor's breakdown speed: the speed stays on the motor's stable working
+    /// branch, where the parabola stands for the real characteristic (see the motor module).
+    pub within_working_branch: bool,
+}
+
+/// The periodic solution would need `ω² ≤ 0`: the motor stalls under the peak load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Stall {
+    /// Mean of ω² over the period, `ū = (B − M1)/a`, s⁻²; `≤ 0` means the mean load alone
+    /// exceeds the motor's stall torque `B` and no flywheel can help.
+    pub u_mean: f64,
+    /// The minimum of the periodic ω², s⁻² (`≤ 0`).
+    pub u_min: f64,
+}
+
+/// Outcome of the steady-state prediction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Prediction {
+    /// A periodic steady state exists.
+    Steady(SteadyState),
+    /// No steady state: the motor stalls under the peak load.
+    Stalls(Stall),
+}
+
+impl Prediction {
+    /// The steady state, if there is one.
+    pub fn steady(&self) -> Option<&SteadyState> {
+        match self {
+            Prediction::Steady(s) => Some(s),
+            Prediction::Stalls(_) => None,
+        }
+    }
+}
+
+/// Sensitivities of δ at the current design point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sensitivity {
+    /// ∂δ/∂J, per kg·m² (the same for machine inertia and flywheel).
+    pub d_delta_d_inertia: f64,
+    /// ∂δ/∂M_m, per N·m: the whole motor characteristic scaled with its breakdown torque at
+    /// fixed speeds (the "drive moment" of the seed).
+    pub d_delta_d_breakdown_torque: f64,
+}
+
+/// Why no flywheel could be sized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DesignError {
+    /// The target δ is not a finite number in (0, 2).
+    InvalidTarget,
+    /// The mean load exceeds the motor's stall torque: no inertia gives a steady state.
+    MeanLoadExceedsMotor,
+    /// No finite inertia reaches the target (an order-0-only load cannot oscillate, so this
+    /// means the numbers left the f64 range).
+    Unreachable,
+}
+
+/// What the host reports as the `irregularity` member of `predict --json`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Irregularity {
+    /// ωmax, rad/s; with no steady state, `√max(ū + smax, 0)`.
+    pub omega_max: f64,
+    /// ωmin, rad/s; 0 with no steady state.
+    pub omega_min: f64,
+    /// δ; 2 with no steady state (the value of the definition when the shaft stops).
+    pub delta: f64,
+    /// Whether a periodic steady state exists.
+    pub steady_state: bool,
+    /// Extra flywheel inertia, kg·m², that brings δ to the limit (0 if already within);
+    /// `None` without a limit or when no flywheel can help.
+    pub flywheel_for_limit: Option<f64>,
+}
+
+/// One oscillating order of `u(φ) − ū = Σ c·cos(nφ) + d·sin(nφ)`, with the derivatives of
+/// `(c, d)` with respect to the total inertia `J` and to `a = −A`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Component {
+    order: f64,
+    /// `(p, q)` with `order = p/q`, if the order is such a rational.
+    ratio: Option<(u64, u64)>,
+    c: f64,
+    d: f64,
+    dc_dj: f64,
+    dd_dj: f64,
+    dc_da: f64,
+    dd_da: f64,
+}
+
+impl Component {
+    fn amplitude(&self) -> f64 {
+        libm::hypot(self.c, self.d)
+    }
+    fn value(&self, phi: f64) -> f64 {
+        let x = self.order * phi;
+        self.c * libm::cos(x) + self.d * libm::sin(x)
+    }
+}
+
+/// The validated drive: motor, load, reduced inertia and flywheel, with the steady-state
+/// coefficients computed once.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveModel {
+    motor: Motor,
+    load: Load,
+    inertia: f64,
+    flywheel: f64,
+    /// `ū = (B − M1 − Σ order-0 terms)/a`, s⁻².
+    u_mean: f64,
+    /// The mean load including order-0 harmonics, N·m.
+    mean_load: f64,
+    components: heapless::Vec<Component, MAX_HARMONICS>,
+    horizon: Horizon,
+}
+
+impl DriveModel {
+    /// A drive with reduced machine `inertia` (kg·m², > 0) and an added `flywheel`
+    /// (kg·m², ≥ 0). Rejects parameter combinations whose steady-state coefficients
+    /// overflow f64.
+    pub fn new(motor: Motor, load: Load, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
+        let inertia = positive("inertia", inertia)?;
+        let flywheel = non_negative("flywheel", flywheel)?;
+        let j = inertia + flywheel;
+        if !j.is_finite() {
+            return Err(ConfigError::OutOfRange("flywheel"));
+        }
+        let a = -motor.model().a();
+        let mut mean_load = load.mean();
+        for h in load.harmonics().iter().filter(|h| h.order() == 0.0) {
+            mean_load += h.amplitude() * libm::sin(h.phase());
+        }
+        let u_mean = (motor.model().b() - mean_load) / a;
+        if !(mean_load.is_finite() && u_mean.is_finite()) {
+            return Err(ConfigError::OutOfRange("load.mean"));
+        }
+        let mut components: heapless::Vec<Component, MAX_HARMONICS> = heapless::Vec::new();
+        for h in load.harmonics().iter().filter(|h| h.order() > 0.0) {
+            let k = component(h, a, j).ok_or(ConfigError::OutOfRange("harmonic.amplitude"))?;
+            match components.iter_mut().find(|c| same_order(c, &k)) {
+                Some(c) => {
+                    c.c += k.c;
+                    c.d += k.d;
+                    c.dc_dj += k.dc_dj;
+                    c.dd_dj += k.dd_dj;
+                    c.dc_da += k.dc_da;
+                    c.dd_da += k.dd_da;
+                }
+                // Cannot fail: at most as many components as harmonics.
+                None => components
+                    .push(k)
+                    .map_err(|_| ConfigError::Capacity("harmonics"))?,
+            }
+        }
+        components.retain(|c| c.amplitude() > 0.0);
+        let total: f64 = components.iter().map(Component::amplitude).sum();
+        if !(total.is_finite() && (u_mean + total).is_finite()) {
+            return Err(ConfigError::OutOfRange("harmonic.amplitude"));
+        }
+        let horizon = horizon(&components);
+        Ok(Self {
+            motor,
+            load,
+            inertia,
+            flywheel,
+            u_mean,
+            mean_load,
+            components,
+            horizon,
+        })
+    }
+
+    /// The same drive with a different added flywheel inertia.
+    pub fn with_flywheel(&self, flywheel: f64) -> Result<Self, ConfigError> {
+        Self::new(self.motor, self.load.clone(), self.inertia, flywheel)
+    }
+
+    /// The same drive with a different motor.
+    pub fn with_motor(&self, motor: Motor) -> Result<Self, ConfigError> {
+        Self::new(motor, self.load.clone(), self.inertia, self.flywheel)
+    }
+
+    /// The motor.
+    pub fn motor(&self) -> &Motor {
+        &self.motor
+    }
+
+    /// The load.
+    pub fn load(&self) -> &Load {
+        &self.load
+    }
+
+    /// Reduced machine inertia, kg·m².
+    pub fn inertia(&self) -> f64 {
+        self.inertia
+    }
+
+    /// Added flywheel inertia, kg·m².
+    pub fn flywheel(&self) -> f64 {
+        self.flywheel
+    }
+
+    /// Total inertia `J` (machine plus flywheel), kg·m².
+    pub fn total_inertia(&self) -> f64 {
+        self.inertia + self.flywheel
+    }
+
+    /// How the extrema are found for this load.
+    pub fn horizon(&self) -> Horizon {
+        self.horizon
+    }
+
+    /// Mean of ω² over the steady period, `ū = (B − M1)/a`, s⁻².
+    pub fn u_mean(&self) -> f64 {
+        self.u_mean
+    }
+
+    /// ω² of the periodic solution at shaft angle `phi`, s⁻² (may be ≤ 0 where the drive
+    /// would stall). NaN in, NaN out.
+    pub fn omega_squared(&self, phi: f64) -> f64 {
+        self.u_mean + self.oscillation(phi)
+    }
+
+    /// Steady-state speed at shaft angle `phi`, rad/s, for plots and for comparison with a
+    /// simulation; `None` where the periodic solution has `ω² ≤ 0` (check [`Self::predict`]
+    /// for whether the steady state exists at all) or for non-finite `phi`.
+    pub fn steady_omega(&self, phi: f64) -> Option<f64> {
+        let u = self.omega_squared(phi);
+        if u > 0.0 && u.is_finite() {
+            Some(libm::sqrt(u))
+        } else {
+            None
+        }
+    }
+
+    /// The steady state and its δ, or the stall.
+    pub fn predict(&self) -> Prediction {
+        let ex = self.extremes();
+        let u_min = self.u_mean + ex.s_min;
+        if !exceeds(u_min, 0.0) {
+            return Prediction::Stalls(Stall {
+                u_mean: self.u_mean,
+                u_min,
+            });
+        }
+        let w_max = libm::sqrt(self.u_mean + ex.s_max);
+        let w_min = libm::sqrt(u_min);
+        let w = w_max + w_min;
+        // δ from the difference of squares: (ωmax − ωmin) = (smax − smin)/(ωmax + ωmin).
+        let delta = 2.0 * ((ex.s_max - ex.s_min) / w) / w;
+        Prediction::Steady(SteadyState {
+            omega_max: w_max,
+            omega_min: w_min,
+            delta,
+            omega_rms: libm::sqrt(self.u_mean),
+            phi_max: ex.phi_max,
+            phi_min: ex.phi_min,
+            horizon: self.horizon,
+            within_working_branch: w_min >= self.motor.model().working_min_speed(),
+        })
+    }
+
+    /// ∂δ/∂J and ∂δ/∂M_m at the current design, analytic (envelope theorem: the derivative of
+    /// an extremum is the partial derivative at the extremal angle). `None` without a steady
+    /// state.
+    pub fn sensitivity(&self) -> Option<Sensitivity> {
+        let ex = self.extremes();
+        let (x2, y2) = (self.u_mean + ex.s_max, self.u_mean + ex.s_min);
+        if !exceeds(y2, 0.0) {
+            return None;
+        }
+        let (x, y) = (libm::sqrt(x2), libm::sqrt(y2));
+        let w = x + y;
+        let dd = ex.s_max - ex.s_min;
+        let g = 2.0 / (w * w);
+        let d_smax = g * (1.0 - dd / (w * x));
+        let d_smin = -g * (1.0 + dd / (w * y));
+        let d_umean = -(2.0 * dd / (w * w * w)) * (1.0 / x + 1.0 / y);
+        let (smax_j, smax_a, smin_j, smin_a) = match (ex.phi_max, ex.phi_min) {
+            (Some(pmax), Some(pmin)) => {
+                let dj = |phi: f64| {
+                    self.components
+                        .iter()
+                        .map(|c| {
+                            let t = c.order * phi;
+                            c.dc_dj * libm::cos(t) + c.dd_dj * libm::sin(t)
+                        })
+                        .sum::<f64>()
+                };
+                let da = |phi: f64| {
+                    self.components
+                        .iter()
+                        .map(|c| {
+                            let t = c.order * phi;
+                            c.dc_da * libm::cos(t) + c.dd_da * libm::sin(t)
+                        })
+                        .sum::<f64>()
+                };
+                (dj(pmax), da(pmax), dj(pmin), da(pmin))
+            }
+            _ => {
+                // smax = Σ R_k, smin = −Σ R_k (or both 0): derivative of each |(c, d)|.
+                let (mut rj, mut ra) = (0.0, 0.0);
+                for c in &self.components {
+                    let r = c.amplitude();
+                    rj += (c.c * c.dc_dj + c.d * c.dd_dj) / r;
+                    ra += (c.c * c.dc_da + c.d * c.dd_da) / r;
+                }
+                (rj, ra, -rj, -ra)
+            }
+        };
+        let d_inertia = d_smax * smax_j + d_smin * smin_j;
+        // Scaling the motor by λ multiplies a and B by λ: ∂ū/∂λ = M1/a, ∂s/∂λ = a·∂s/∂a.
+        let a = -self.motor.model().a();
+        let d_lambda = a * (d_smax * smax_a + d_smin * smin_a) + d_umean * (self.mean_load / a);
+        Some(Sensitivity {
+            d_delta_d_inertia: d_inertia,
+            d_delta_d_breakdown_torque: d_lambda / self.motor.model().breakdown_torque(),
+        })
+    }
+
+    /// The extra flywheel inertia (kg·m², on top of the current flywheel) that brings δ down
+    /// to `delta_target`; 0 if δ is already within.
+    ///
+    /// One oscillating order: closed form. With `r = δ/(1 + δ²/4)` (the inverse of
+    /// `δ = 2r/(1 + √(1 − r²))`, `r = R/ū`) the needed amplitude is `R = r·ū`, and
+    /// `R = 2|M2|/√(4a² + n²J²)` gives `J = √((2|M2|/R − 2a)(2|M2|/R + 2a))/n`, since `ū`
+    /// does not depend on `J`. Several orders: bisection in J between an inertia where the
+    /// target is missed and one where it is met (found by doubling); it returns the upper end,
+    /// where δ ≤ target holds, once the bracket is within 1e-10 relative. δ(J) falls
+    /// monotonically for one order and for [`Horizon::Unbounded`]; with several commensurate
+    /// orders the phases also move with J, and the answer is the first crossing the bracket
+    /// finds.
+    pub fn flywheel_for(&self, delta_target: f64) -> Result<f64, DesignError> {
+        if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
+            return Err(DesignError::InvalidTarget);
+        }
+        if !exceeds(self.u_mean, 0.0) {
+            return Err(DesignError::MeanLoadExceedsMotor);
+        }
+        let meets = |m: &DriveModel| match m.predict() {
+            Prediction::Steady(s) => s.delta <= delta_target,
+            Prediction::Stalls(_) => false,
+        };
+        if meets(self) {
+            return Ok(0.0);
+        }
+        let j = self.total_inertia();
+        if let ([c], Horizon::ClosedForm) = (self.components.as_slice(), self.horizon) {
+            let a = -self.motor.model().a();
+            let n = c.order;
+            let h = libm::hypot(2.0 * a, n * j);
+            // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
+            let m2 = c.amplitude() * h / 2.0;
+            let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
+            let h_needed = 2.0 * m2 / (r * self.u_mean);
+            if !exceeds(h_needed, 2.0 * a) {
+                return Ok(0.0);
+            }
+            let j_needed = libm::sqrt((h_needed - 2.0 * a) * (h_needed + 2.0 * a)) / n;
+            let extra = j_needed - j;
+            return if extra.is_finite() {
+                Ok(if extra > 0.0 { extra } else { 0.0 })
+            } else {
+                Err(DesignError::Unreachable)
+            };
+        }
+        let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
+        let mut lo = 0.0;
+        let mut hi = j;
+        let mut found = false;
+        for _ in 0..2100 {
+            match at(hi) {
+                Some(m) if meets(&m) => {
+                    found = true;
+                    break;
+                }
+                Some(_) => {
+                    lo = hi;
+                    hi *= 2.0;
+                }
+                None => return Err(DesignError::Unreachable),
+            }
+        }
+        if !found {
+            return Err(DesignError::Unreachable);
+        }
+        for _ in 0..200 {
+            if hi - lo <= 1e-10 * hi {
+                break;
+            }
+            let mid = lo + (hi - lo) / 2.0;
+            match at(mid) {
+                Some(m) if meets(&m) => hi = mid,
+                Some(_) => lo = mid,
+                None => return Err(DesignError::Unreachable),
+            }
+        }
+        Ok(hi)
+    }
+
+    /// The `irregularity` summary the host prints, with the flywheel for `delta_limit` when
+    /// one is given (it must be finite and in (0, 2)).
+    pub fn irregularity(&self, delta_limit: Option<f64>) -> Result<Irregularity, ConfigError> {
+        if let Some(l) = delta_limit {
+            let l = positive("delta_limit", l)?;
+            if l >= 2.0 {
+                return Err(ConfigError::OutOfRange("delta_limit"));
+            }
+        }
+        let flywheel_for_limit = delta_limit.and_then(|l| self.flywheel_for(l).ok());
+        Ok(match self.predict() {
+            Prediction::Steady(s) => Irregularity {
+                omega_max: s.omega_max,
+                omega_min: s.omega_min,
+                delta: s.delta,
+                steady_state: true,
+                flywheel_for_limit,
+            },
+            Prediction::Stalls(_) => {
+                let u_max = self.u_mean + self.extremes().s_max;
+                Irregularity {
+                    omega_max: if u_max > 0.0 { libm::sqrt(u_max) } else { 0.0 },
+                    omega_min: 0.0,
+                    delta: 2.0,
+                    steady_state: false,
+                    flywheel_for_limit,
+                }
+            }
+        })
+    }
+
+    fn oscillation(&self, phi: f64) -> f64 {
+        self.components.iter().map(|c| c.value(phi)).sum()
+    }
+
+    fn extremes(&self) -> Extremes {
+        match (self.horizon, self.components.as_slice()) {
+            (Horizon::ClosedForm, [c]) => {
+                // c·cos(nφ) + d·sin(nφ) = R·cos(nφ − α).
+                let r = c.amplitude();
+                let period = 2.0 * PI / c.order;
+                let mut alpha = libm::atan2(c.d, c.c);
+                if alpha < 0.0 {
+                    alpha += 2.0 * PI;
+                }
+                let phi_max = alpha / c.order;
+                let mut phi_min = phi_max + period / 2.0;
+                if phi_min >= period {
+                    phi_min -= period;
+                }
+                Extremes {
+                    s_max: r,
+                    s_min: -r,
+                    phi_max: Some(phi_max),
+                    phi_min: Some(phi_min),
+                }
+            }
+            (Horizon::Period { radians, samples }, _) => self.search(radians, samples),
+            (Horizon::Unbounded, _) => {
+                let r: f64 = self.components.iter().map(Component::amplitude).sum();
+                Extremes {
+                    s_max: r,
+                    s_min: -r,
+                    phi_max: None,
+                    phi_min: None,
+                }
+            }
+            _ => Extremes {
+                s_max: 0.0,
+                s_min: 0.0,
+                phi_max: None,
+                phi_min: None,
+            },
+        }
+    }
+
+    /// Extrema of the oscillation over one common period: sample, then refine by golden
+    /// section every sample that could lie next to the global extremum. A sample within h/2
+    /// of the true maximum is below it by at most `½·C·(h/2)²`, `C = Σ R_k·n_k² ≥ |s''|`;
+    /// every sample within `½·C·h²` of the best one is refined on its two neighbouring
+    /// intervals.
+    fn search(&self, period: f64, samples: u32) -> Extremes {
+        let n = samples.max(3);
+        let h = period / n as f64;
+        let at = |i: i64| self.oscillation(h * i as f64);
+        let (mut best_max, mut best_min) = (f64::NEG_INFINITY, f64::INFINITY);
+        let (mut i_max, mut i_min) = (0i64, 0i64);
+        for i in 0..n as i64 {
+            let v = at(i);
+            if v > best_max {
+                best_max = v;
+                i_max = i;
+            }
+            if v < best_min {
+                best_min = v;
+                i_min = i;
+            }
+        }
+        let curvature: f64 = self
+            .components
+            .iter()
+            .map(|c| c.amplitude() * c.order * c.order)
+            .sum();
+        let amplitude: f64 = self.components.iter().map(Component::amplitude).sum();
+        let margin = 0.5 * curvature * h * h + 8.0 * f64::EPSILON * amplitude;
+        let mut out = Extremes {
+            s_max: best_max,
+            s_min: best_min,
+            phi_max: Some(h * i_max as f64),
+            phi_min: Some(h * i_min as f64),
+        };
+        let (mut prev, mut cur) = (at(-1), at(0));
+        for i in 0..n as i64 {
+            let next = at(i + 1);
+            let (lo, hi) = (h * (i - 1) as f64, h * (i + 1) as f64);
+            if cur >= best_max - margin && (cur >= prev || cur >= next) {
+                let (phi, v) = golden(|p| self.oscillation(p), lo, hi, 1.0);
+                if v > out.s_max {
+                    out.s_max = v;
+                    out.phi_max = Some(wrap(phi, period));
+                }
+            }
+            if cur <= best_min + margin && (cur <= prev || cur <= next) {
+                let (phi, v) = golden(|p| self.oscillation(p), lo, hi, -1.0);
+                if v < out.s_min {
+                    out.s_min = v;
+                    out.phi_min = Some(wrap(phi, period));
+                }
+            }
+            prev = cur;
+            cur = next;
+        }
+        out
+    }
+}
+
+struct Extremes {
+    s_max: f64,
+    s_min: f64,
+    phi_max: Option<f64>,
+    phi_min: Option<f64>,
+}
+
+/// `x > y`, false when either is NaN.
+fn exceeds(x: f64, y: f64) -> bool {
+    x > y
+}
+
+fn wrap(phi: f64, period: f64) -> f64 {
+    if phi < 0.0 {
+        phi + period
+    } else if phi >= period {
+        phi - period
+    } else {
+        phi
+    }
+}
+
+/// Golden-section search for the maximum of `sign·f` on `[lo, hi]`; returns the best point
+/// seen and `f` there.
+fn golden(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, sign: f64) -> (f64, f64) {
+    const R: f64 = 0.618_033_988_749_894_8;
+    let mut x1 = hi - R * (hi - lo);
+    let mut x2 = lo + R * (hi - lo);
+    let (mut f1, mut f2) = (sign * f(x1), sign * f(x2));
+    for _ in 0..GOLDEN_ITERATIONS {
+        if f1 >= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - R * (hi - lo);
+            f1 = sign * f(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + R * (hi - lo);
+            f2 = sign * f(x2);
+        }
+    }
+    if f1 >= f2 {
+        (x1, sign * f1)
+    } else {
+        (x2, sign * f2)
+    }
+}
+
+/// The oscillating term of one harmonic as `c·cos(nφ) + d·sin(nφ)`, with derivatives;
+/// `None` if it overflows.
+fn component(h: &Harmonic, a: f64, j: f64) -> Option<Component> {
+    let n = h.order();
+    let nj = n * j;
+    let hy = libm::hypot(2.0 * a, nj);
+    let (u1, u2) = (nj / hy, 2.0 * a / hy);
+    let g = 2.0 * (h.amplitude() / hy);
+    // s = P·cos θ + Q·sin θ, θ = nφ + ψ.
+    let (p, q) = (g * u1, -g * u2);
+    let dp_dj = (n / hy) * (g - 2.0 * p * u1);
+    let dq_dj = -q * 2.0 * n * u1 / hy;
+    let dp_da = -p * 4.0 * u2 / hy;
+    let dq_da = -2.0 * g / hy - q * 4.0 * u2 / hy;
+    let (sp, cp) = (libm::sin(h.phase()), libm::cos(h.phase()));
+    // P·cos(nφ + ψ) + Q·sin(nφ + ψ) = (P cos ψ + Q sin ψ)·cos nφ + (Q cos ψ − P sin ψ)·sin nφ.
+    let rot = |p: f64, q: f64| (p * cp + q * sp, q * cp - p * sp);
+    let (c, d) = rot(p, q);
+    let (dc_dj, dd_dj) = rot(dp_dj, dq_dj);
+    let (dc_da, dd_da) = rot(dp_da, dq_da);
+    let all = [c, d, dc_dj, dd_dj, dc_da, dd_da];
+    if all.iter().all(|x| x.is_finite()) {
+        Some(Component {
+            order: n,
+            ratio: rational(n),
+            c,
+            d,
+            dc_dj,
+            dd_dj,
+            dc_da,
+            dd_da,
+        })
+    } else {
+        None
+    }
+}
+
+fn same_order(a: &Component, b: &Component) -> bool {
+    match (a.ratio, b.ratio) {
+        (Some(x), Some(y)) => x == y,
+        _ => a.order == b.order,
+    }
+}
+
+/// `(p, q)` with the smallest `q ≤ MAX_DENOMINATOR` such that `p/q` rounds to `x` within
+/// 2 ulp; `None` if there is none.
+fn rational(x: f64) -> Option<(u64, u64)> {
+    for q in 1..=MAX_DENOMINATOR {
+        let pf = libm::round(x * q as f64);
+        if !(1.0..=9.0e15).contains(&pf) {
+            continue;
+        }
+        if libm::fabs(pf / q as f64 - x) <= 2.0 * f64::EPSILON * x {
+            return Some((pf as u64, q));
+        }
+    }
+    None
+}
+
+const fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        let t = a % b;
+        a = b;
+        b = t;
+    }
+    a
+}
+
+/// With orders `n_k = m_k/Q` (`Q` the lcm of the denominators), the common period is
+/// `2π·Q/G`, `G = gcd(m_k)`, and it holds `max(m_k)/G` cycles of the fastest order.
+fn horizon(components: &[Component]) -> Horizon {
+    match components.len() {
+        0 => return Horizon::Constant,
+        1 => return Horizon::ClosedForm,
+        _ => {}
+    }
+    let mut q_all: u64 = 1;
+    for c in components {
+        let Some((_, q)) = c.ratio else {
+            return Horizon::Unbounded;
+        };
+        match (q_all / gcd(q_all, q)).checked_mul(q) {
+            Some(l) => q_all = l,
+            None => return Horizon::Unbounded,
+        }
+    }
+    let (mut g, mut m_max) = (0u64, 0u64);
+    for c in components {
+        let Some((p, q)) = c.ratio else {
+            return Horizon::Unbounded;
+        };
+        let Some(m) = p.checked_mul(q_all / q) else {
+            return Horizon::Unbounded;
+        };
+        g = gcd(g, m);
+        m_max = m_max.max(m);
+    }
+    if g == 0 {
+        return Horizon::Unbounded;
+    }
+    match (m_max / g).checked_mul(SAMPLES_PER_CYCLE) {
+        Some(n) if n <= MAX_SAMPLES => Horizon::Period {
+            radians: 2.0 * PI * q_all as f64 / g as f64,
+            samples: n as u32,
+        },
+        _ => Horizon::Unbounded,
+    }
+}
