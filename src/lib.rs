@@ -9,6 +9,7 @@
 
 pub mod error;
 pub mod math;
+pub mod supports;
 
 pub use error::ConfigError;
 pub use math::{Libm, Math, Micromath};
