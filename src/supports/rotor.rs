@@ -174,7 +174,10 @@ impl<const N: usize> Rotor<N> {
         }
         let mut items = [Unbalance::default(); N];
         let mut vectors = [Vec2::ZERO; N];
-        let mut scale = support_a.abs().max(support_b.abs()).max(centre_of_mass.abs());
+        let mut scale = support_a
+            .abs()
+            .max(support_b.abs())
+            .max(centre_of_mass.abs());
         for ((slot, vslot), u) in items.iter_mut().zip(vectors.iter_mut()).zip(unbalances) {
             finite("unbalance.z", u.z)?;
             non_negative("unbalance.amount", u.amount)?;
@@ -304,7 +307,11 @@ impl<const N: usize> Rotor<N> {
     pub fn plane_split(&self) -> PlaneSplit {
         let l = self.span();
         let d_st = self.static_unbalance();
-        let [static_a, static_b] = split([(self.centre_of_mass, d_st)], self.support_a, self.support_b);
+        let [static_a, static_b] = split(
+            [(self.centre_of_mass, d_st)],
+            self.support_a,
+            self.support_b,
+        );
         let m = self.moment_unbalance();
         let moment_b = Vec2::new(m.x / l, m.y / l);
         PlaneSplit {

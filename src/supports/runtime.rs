@@ -153,7 +153,11 @@ impl SupportMonitor {
         self.unbalance = [a, b];
         if let Some(f) = self.load_limit {
             for i in 0..2 {
-                let (s, fi, d) = (pick(self.static_load, i), pick(f, i), pick(self.unbalance, i));
+                let (s, fi, d) = (
+                    pick(self.static_load, i),
+                    pick(f, i),
+                    pick(self.unbalance, i),
+                );
                 let w = if s > fi {
                     0.0
                 } else if d == 0.0 {
