@@ -981,7 +981,14 @@ fn constructors_reject_bad_numbers_with_typed_errors() {
             Err(ConfigError::Inconsistent("process_load.to"))
         };
         assert_eq!(ok(rotor_with(1.0, 2.0, 0.0, 4.0, u, Some(pt))), want_t);
-        // Gravity: non-negative.
+        let pa = ProcessLoad { angle: x, ..p };
+        assert_eq!(
+            ok(rotor_with(1.0, 2.0, 0.0, 4.0, u, Some(pa))),
+            coord("process_load.angle")
+        );
+        // Gravity: non-negative, any finite direction.
+        let r0 = rotor_with(1.0, 2.0, 0.0, 4.0, u, None).unwrap();
+        assert_eq!(r0.with_gravity(1.0, x).map(|_| ()), coord("gravity.angle"));
         let r = rotor_with(1.0, 2.0, 0.0, 4.0, u, None).unwrap();
         let want_g = if nonfinite {
             Err(ConfigError::NonFinite("gravity"))
