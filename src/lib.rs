@@ -16,6 +16,7 @@ pub mod learn;
 pub mod math;
 pub mod monitor;
 pub mod speed;
+pub mod supports;
 
 pub use error::ConfigError;
 pub use math::{Libm, Math, Micromath};

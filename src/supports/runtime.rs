@@ -1,0 +1,189 @@
+//! The per-speed-update path: f32, O(1), total.
+
+use super::limits::SupportAnalysis;
+use crate::math::Math;
+
+/// Where a value stands against its limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Level {
+    /// At or below the warning threshold (`fraction·limit`).
+    Normal,
+    /// Above the warning threshold, at or below the limit.
+    Warning,
+    /// Above the limit.
+    Over,
+    /// Not known: the speed was not a number, or there is no limit to judge against.
+    Unknown,
+}
+
+impl Level {
+    #[inline]
+    fn of(value: f32, warn: f32, limit: f32) -> Level {
+        if value > limit {
+            Level::Over
+        } else if value > warn {
+            Level::Warning
+        } else if value <= warn {
+            Level::Normal
+        } else {
+            Level::Unknown
+        }
+    }
+}
+
+/// The result of one speed update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SupportStatus {
+    /// False when the speed was NaN (loads are then NaN and their levels `Unknown`).
+    pub speed_valid: bool,
+    /// Largest load on supports A and B over one turn, `|S| + |D|·ω²`, N.
+    pub peak_load: [f32; 2],
+    /// Smallest load over one turn, `||S| − |D|·ω²|`, N.
+    pub min_load: [f32; 2],
+    /// Peak load against each support's allowed load (`Unknown` without load limits).
+    pub load: [Level; 2],
+    /// Equivalent unbalance in each support plane against its permissible share.
+    pub unbalance: [Level; 2],
+    /// Maximum safe speed over both supports, rad/s (`None` without load limits).
+    pub max_safe_speed: Option<f32>,
+}
+
+/// Precomputed f32 numbers for the speed updates: a few multiplies and compares per update.
+///
+/// Speed enters only as ω², so a negative speed (reverse rotation) loads the supports like the
+/// positive one; an infinite speed gives infinite rotating loads (flagged `Over`) unless the
+/// unbalance is zero; NaN gives `speed_valid = false`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SupportMonitor {
+    unbalance: [f32; 2],
+    permissible: [f32; 2],
+    permissible_warn: [f32; 2],
+    static_load: [f32; 2],
+    load_limit: Option<[f32; 2]>,
+    load_warn: [f32; 2],
+    max_speed: [f32; 2],
+}
+
+impl SupportMonitor {
+    /// Precompute from an analysis (configuration time).
+    pub fn new(analysis: &SupportAnalysis) -> Self {
+        let w = analysis.warning_fraction;
+        let [da, db] = analysis.unbalance;
+        let [sa, sb] = analysis.static_load;
+        let p = analysis.permissible;
+        let load_limit = analysis.load_limit;
+        let max_speed = analysis.max_speed.unwrap_or([f64::INFINITY; 2]);
+        SupportMonitor {
+            unbalance: [da.norm() as f32, db.norm() as f32],
+            permissible: [p.a as f32, p.b as f32],
+            permissible_warn: [(w * p.a) as f32, (w * p.b) as f32],
+            static_load: [sa.norm() as f32, sb.norm() as f32],
+            load_limit: load_limit.map(|[a, b]| [a as f32, b as f32]),
+            load_warn: load_limit.map_or([f32::INFINITY; 2], |[a, b]| {
+                [(w * a) as f32, (w * b) as f32]
+            }),
+            max_speed: [max_speed[0] as f32, max_speed[1] as f32],
+        }
+    }
+
+    /// Loads and flags at speed `omega` rad/s. Total: any f32 gives a defined status.
+    pub fn update(&self, omega: f32) -> SupportStatus {
+        let w2 = omega * omega;
+        let valid = !w2.is_nan();
+        let mut peak = [f32::NAN; 2];
+        let mut min = [f32::NAN; 2];
+        let mut load = [Level::Unknown; 2];
+        let limits = self.load_limit.unwrap_or([f32::INFINITY; 2]);
+        for i in 0..2 {
+            let (d, s) = (pick(self.unbalance, i), pick(self.static_load, i));
+            if valid {
+                // 0·∞ is taken as 0: no unbalance, no rotating load at any speed.
+                let rot = if d == 0.0 { 0.0 } else { d * w2 };
+                set(&mut peak, i, s + rot);
+                set(&mut min, i, (s - rot).abs());
+                if self.load_limit.is_some() {
+                    let l = Level::of(s + rot, pick(self.load_warn, i), pick(limits, i));
+                    set(&mut load, i, l);
+                }
+            }
+        }
+        SupportStatus {
+            speed_valid: valid,
+            peak_load: peak,
+            min_load: min,
+            load,
+            unbalance: self.unbalance_levels(),
+            max_safe_speed: self.max_safe_speed(),
+        }
+    }
+
+    fn unbalance_levels(&self) -> [Level; 2] {
+        let l = |i| {
+            Level::of(
+                pick(self.unbalance, i),
+                pick(self.permissible_warn, i),
+                pick(self.permissible, i),
+            )
+        };
+        [l(0), l(1)]
+    }
+
+    /// Maximum safe speed over both supports, rad/s; `None` without load limits.
+    pub fn max_safe_speed(&self) -> Option<f32> {
+        self.load_limit
+            .map(|_| self.max_speed[0].min(self.max_speed[1]))
+    }
+
+    /// Equivalent unbalance magnitudes `[|D_A|, |D_B|]` in use, kg·m.
+    pub fn unbalance(&self) -> [f32; 2] {
+        self.unbalance
+    }
+
+    /// Replace the equivalent unbalance magnitudes (e.g. from a measurement) and recompute
+    /// the maximum safe speed (one square root per support through `M`). Values that are
+    /// not finite or are negative are refused: the previous values stay and `false` is
+    /// returned.
+    pub fn set_unbalance<M: Math>(&mut self, a: f32, b: f32) -> bool {
+        if !(a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0) {
+            return false;
+        }
+        self.unbalance = [a, b];
+        if let Some(f) = self.load_limit {
+            for i in 0..2 {
+                let (s, fi, d) = (
+                    pick(self.static_load, i),
+                    pick(f, i),
+                    pick(self.unbalance, i),
+                );
+                let w = if s > fi {
+                    0.0
+                } else if d == 0.0 {
+                    f32::INFINITY
+                } else {
+                    M::sqrt((fi - s) / d)
+                };
+                set(&mut self.max_speed, i, w);
+            }
+        }
+        true
+    }
+}
+
+#[inline]
+fn pick(a: [f32; 2], i: usize) -> f32 {
+    if i == 0 {
+        a[0]
+    } else {
+        a[1]
+    }
+}
+
+#[inline]
+fn set<T: Copy>(a: &mut [T; 2], i: usize, v: T) {
+    if let Some(slot) = a.get_mut(i) {
+        *slot = v;
+    }
+}
