@@ -3,4 +3,6 @@
 //! runs on the target.
 pub mod model;
 pub mod plot;
+pub mod predict;
+pub mod report;
 pub mod scene;

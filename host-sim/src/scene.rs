@@ -528,8 +528,49 @@ impl Scene {
     }
 }
 
-/// The scenes bundled with the simulator, by file name.
-pub const BUNDLED: &[(&str, &str)] = &[];
+/// The scenes bundled with the simulator: (file name, text).
+pub const BUNDLED: &[(&str, &str)] = &[
+    ("kneader.toml", include_str!("../scenes/kneader.toml")),
+    ("auger.toml", include_str!("../scenes/auger.toml")),
+    (
+        "auger-overhung.toml",
+        include_str!("../scenes/auger-overhung.toml"),
+    ),
+];
+
+/// The default scene of `drive-sim` without arguments.
+pub const DEFAULT_SCENE: &str = "kneader.toml";
+
+/// Loads `name`: a file if one exists at that path, else a bundled scene by file name (with or
+/// without `.toml`). Returns the scene and the path errors should name.
+pub fn resolve(name: &str) -> Result<(Scene, PathBuf), SceneError> {
+    let path = Path::new(name);
+    if path.exists() {
+        return Ok((Scene::load(path)?, path.to_path_buf()));
+    }
+    let file = if name.ends_with(".toml") {
+        name.to_string()
+    } else {
+        format!("{name}.toml")
+    };
+    let base = Path::new(&file)
+        .file_name()
+        .and_then(|f| f.to_str())
+        .unwrap_or("");
+    match BUNDLED.iter().find(|(n, _)| *n == base) {
+        Some((n, text)) => {
+            let shown = PathBuf::from(format!("host-sim/scenes/{n}"));
+            Ok((Scene::parse(text, &shown)?, shown))
+        }
+        None => Err(SceneError::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "no such file, and no bundled scene of that name (see `drive-sim scenes`)",
+            ),
+        }),
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -539,6 +580,17 @@ mod tests {
         Scene::parse(text, Path::new("bad.toml"))
             .unwrap_err()
             .to_string()
+    }
+
+    #[test]
+    fn bundled_scenes_parse() {
+        for (name, _) in BUNDLED {
+            let (scene, path) = resolve(name).unwrap();
+            assert!(path.ends_with(name));
+            assert!(scene.description.is_some(), "{name}");
+        }
+        assert!(resolve("kneader").is_ok());
+        assert!(resolve("no-such-scene").is_err());
     }
 
     #[test]

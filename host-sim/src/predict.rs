@@ -1,0 +1,200 @@
+//! Design-time results of a scene, computed by the core (no simulation): predicted δ and the
+//! flywheel for the limit, the support unbalances and limits, the auto-balancer's zones.
+
+use crate::scene::{MotorSpec, Scene, SceneError};
+use drive_monitor::drive::{DriveModel, Harmonic, Kloss, KlossFit, Load, Motor, Parabola};
+use drive_monitor::supports::{Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance};
+use drive_monitor::ConfigError;
+use serde::Serialize;
+use std::path::Path;
+
+/// Largest number of unbalances a scene may give.
+pub const MAX_UNBALANCES: usize = 32;
+
+/// Turns a core configuration error into a scene error naming `section.parameter`.
+pub fn value_error(file: &Path, section: &str, e: ConfigError) -> SceneError {
+    SceneError::Value {
+        file: file.to_path_buf(),
+        key: format!("{section}.{}", e.parameter()),
+        message: e.to_string(),
+    }
+}
+
+/// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
+/// or without a `[load]`).
+pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
+    let (Some(motor), Some(load)) = (&scene.motor, &scene.load) else {
+        return Ok(None);
+    };
+    let motor = match motor {
+        MotorSpec::Parabola {
+            no_load_speed,
+            breakdown_speed,
+            breakdown_torque,
+        } => Motor::parabola(
+            Parabola::new(*no_load_speed, *breakdown_speed, *breakdown_torque)
+                .map_err(|e| value_error(file, "motor", e))?,
+        ),
+        MotorSpec::Kloss {
+            synchronous_speed,
+            breakdown_slip,
+            breakdown_torque,
+        } => {
+            let k = Kloss::new(*synchronous_speed, *breakdown_slip, *breakdown_torque)
+                .map_err(|e| value_error(file, "motor", e))?;
+            Motor::kloss(k, KlossFit::SynchronousTangent)
+                .map_err(|e| value_error(file, "motor", e))?
+        }
+        MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } => return Ok(None),
+    };
+    let mut harmonics = Vec::with_capacity(load.harmonics.len());
+    for h in &load.harmonics {
+        harmonics.push(
+            Harmonic::new(h.order, h.amplitude, h.phase)
+                .map_err(|e| value_error(file, "load.harmonics", e))?,
+        );
+    }
+    let load = Load::new(load.mean, &harmonics).map_err(|e| value_error(file, "load", e))?;
+    let Some(shaft) = &scene.shaft else {
+        return Err(SceneError::Value {
+            file: file.to_path_buf(),
+            key: "shaft".into(),
+            message: "missing: a motor-driven scene needs [shaft] inertia".into(),
+        });
+    };
+    DriveModel::new(motor, load, shaft.inertia, shaft.flywheel)
+        .map(Some)
+        .map_err(|e| value_error(file, "shaft", e))
+}
+
+/// The rotor on two supports and its limits (`None` without `[rotor]`).
+pub fn rotor(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<(Rotor<MAX_UNBALANCES>, Limits)>, SceneError> {
+    let Some(r) = &scene.rotor else {
+        return Ok(None);
+    };
+    let unbalances: Vec<Unbalance> = scene
+        .unbalance
+        .iter()
+        .map(|u| Unbalance::new(u.z, u.amount, u.angle.to_radians()))
+        .collect();
+    if unbalances.len() > MAX_UNBALANCES {
+        return Err(SceneError::Value {
+            file: file.to_path_buf(),
+            key: "unbalance".into(),
+            message: format!("at most {MAX_UNBALANCES} unbalances"),
+        });
+    }
+    let process = scene.process_load.map(|p| ProcessLoad {
+        per_length: p.per_length,
+        from: p.from,
+        to: p.to,
+        angle: p.angle.to_radians(),
+    });
+    let rotor = Rotor::new(
+        r.mass,
+        r.centre_of_mass,
+        r.support_a,
+        r.support_b,
+        &unbalances,
+        process,
+    )
+    .map_err(|e| value_error(file, "rotor", e))?;
+    let warning = scene
+        .monitor
+        .as_ref()
+        .and_then(|m| m.warning_fraction)
+        .unwrap_or(0.8);
+    let limits = Limits::new(r.grade, r.service_speed, r.support_load_limit, warning)
+        .map_err(|e| value_error(file, "rotor", e))?;
+    Ok(Some((rotor, limits)))
+}
+
+/// `irregularity` member of `predict --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct IrregularityOut {
+    /// Largest steady-state speed, rad/s.
+    pub omega_max: f64,
+    /// Smallest steady-state speed, rad/s (0 when the drive stalls).
+    pub omega_min: f64,
+    /// δ = 2(ωmax − ωmin)/(ωmax + ωmin).
+    pub delta: f64,
+    /// Whether a steady state exists (false: the motor stalls under the peak load).
+    pub steady_state: bool,
+    /// Extra flywheel for `[monitor] delta_limit`, kg·m² (0 if already within; absent
+    /// without a limit; null when no flywheel can reach it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flywheel_for_limit: Option<Option<f64>>,
+    /// ∂δ/∂J, per kg·m².
+    pub d_delta_d_inertia: Option<f64>,
+    /// ∂δ/∂M_m, per N·m.
+    pub d_delta_d_breakdown_torque: Option<f64>,
+}
+
+/// `supports` member of `predict --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SupportsOut {
+    /// |D_A|, kg·m.
+    pub unbalance_a: f64,
+    /// |D_B|, kg·m.
+    pub unbalance_b: f64,
+    /// Permissible residual unbalance allocated to A, kg·m.
+    pub permissible_a: f64,
+    /// Permissible residual unbalance allocated to B, kg·m.
+    pub permissible_b: f64,
+    /// Largest safe speed, rad/s (null without load limits, or when no unbalance limits it).
+    pub max_speed: Option<f64>,
+    /// Static support loads (weight and process load), N.
+    pub static_load: [f64; 2],
+    /// Peak support loads over one turn at the service speed, N.
+    pub peak_load_at_service_speed: [f64; 2],
+}
+
+/// All design-time results of a scene.
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct Prediction {
+    /// Predicted irregularity (scenes with a torque motor and a load).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub irregularity: Option<IrregularityOut>,
+    /// Support unbalances and limits (scenes with a rotor).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub supports: Option<SupportsOut>,
+}
+
+/// Computes the design-time results of `scene`.
+pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
+    let mut p = Prediction::default();
+    if let Some(model) = drive_model(scene, file)? {
+        let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
+        let irr = model
+            .irregularity(limit)
+            .map_err(|e| value_error(file, "monitor", e))?;
+        let sens = model.sensitivity();
+        p.irregularity = Some(IrregularityOut {
+            omega_max: irr.omega_max,
+            omega_min: irr.omega_min,
+            delta: irr.delta,
+            steady_state: irr.steady_state,
+            flywheel_for_limit: limit.map(|_| irr.flywheel_for_limit),
+            d_delta_d_inertia: sens.map(|s| s.d_delta_d_inertia),
+            d_delta_d_breakdown_torque: sens.map(|s| s.d_delta_d_breakdown_torque),
+        });
+    }
+    if let Some((rotor, limits)) = rotor(scene, file)? {
+        let a = SupportAnalysis::new(&rotor, &limits);
+        let r = a.report();
+        let loads = rotor.loads(limits.service_speed());
+        p.supports = Some(SupportsOut {
+            unbalance_a: r.unbalance_a,
+            unbalance_b: r.unbalance_b,
+            permissible_a: r.permissible_a,
+            permissible_b: r.permissible_b,
+            max_speed: r.max_speed.filter(|v| v.is_finite()),
+            static_load: [a.static_load[0].norm(), a.static_load[1].norm()],
+            peak_load_at_service_speed: [loads[0].peak, loads[1].peak],
+        });
+    }
+    Ok(p)
+}
