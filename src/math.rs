@@ -86,12 +86,18 @@ mod tests {
     #[test]
     fn libm_is_accurate() {
         let e = worst::<Libm>();
-        assert!(e[0] < 1.2e-7 && e[1] < 1e-6 && e[2] < 1e-6 && e[3] < 1e-6, "{e:?}");
+        assert!(
+            e[0] < 1.2e-7 && e[1] < 1e-6 && e[2] < 1e-6 && e[3] < 1e-6,
+            "{e:?}"
+        );
     }
 
     #[test]
     fn micromath_is_within_its_stated_error() {
         let e = worst::<Micromath>();
-        assert!(e[0] < 0.062 && e[1] < 1.1e-3 && e[2] < 1.1e-3 && e[3] < 2.9e-3, "{e:?}");
+        assert!(
+            e[0] < 0.062 && e[1] < 1.1e-3 && e[2] < 1.1e-3 && e[3] < 2.9e-3,
+            "{e:?}"
+        );
     }
 }

@@ -439,6 +439,16 @@ pub enum ZoneKind {
     Gathering,
 }
 
+impl ZoneKind {
+    /// Lower-case name as used in the host's JSON: `"balancing"` or `"gathering"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ZoneKind::Balancing => "balancing",
+            ZoneKind::Gathering => "gathering",
+        }
+    }
+}
+
 /// A speed zone `[from, to)` in rad/s; `to == None` for the last, open-ended zone.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

@@ -1280,4 +1280,6 @@ fn kappa_by_kind() {
     let z1 = analyse(MachineConfig::new(&p, &[], balancer(1)).unwrap()).zones()[1].from;
     let z2 = analyse(MachineConfig::new(&p, &[], b).unwrap()).zones()[1].from;
     assert_eq!(z1, z2);
+    assert_eq!(ZoneKind::Balancing.name(), "balancing");
+    assert_eq!(ZoneKind::Gathering.name(), "gathering");
 }
