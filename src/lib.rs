@@ -8,6 +8,7 @@
 )]
 
 pub mod alarm;
+pub mod balancer;
 pub mod drive;
 pub mod encoder;
 pub mod error;

@@ -1,0 +1,283 @@
+//! Mass, stiffness and damping matrices; undamped resonant and additional speeds.
+//!
+//! Resonant speeds are the eigenfrequencies of `(K, M)`; additional speeds are those of the
+//! system with the exciter platform held fixed (the zeros of its driving-point receptance).
+//!
+//! * One platform: `√(k/M_Σ)` (seed eq. 8, 12).
+//! * Two degrees of freedom (two-platform resonances, three-platform additional speeds):
+//!   the quadratic `λ² − b·λ + c` of seed eq. 34–36 / 56–59 with every coefficient written
+//!   as a sum of positive terms (`c` from the corrected eq. 57, `d = b² − 4c` from the
+//!   corrected eq. 59), the large root `(b + √d)/2` and the small root by Vieta.
+//! * Three platforms: the cubic in `q²` is not solved as a cubic. Its roots are the
+//!   eigenvalues of the symmetric `A = M^{-1/2}·K·M^{-1/2}`, found by cyclic Jacobi
+//!   rotations. A symmetric eigenproblem is perfectly conditioned for (nearly) equal roots,
+//!   where a cubic's roots lose half their digits, zero coupling is a diagonal matrix
+//!   (returned exactly), and with the stopping rule `|a_pq| ≤ ε·√(a_pp·a_qq)` Jacobi is
+//!   accurate relative to each eigenvalue for graded matrices (Demmel & Veselić 1992): the
+//!   relevant condition number is that of `diag(K)^{-1/2}·K·diag(K)^{-1/2}`, which does not
+//!   depend on the masses, so a 1e6 mass ratio costs nothing.
+
+use super::complex::C64;
+use super::{MachineConfig, MAX_PLATFORMS};
+
+/// The machine as matrices (SI units), plus the raw support and coupling values that the
+/// positive-sum closed forms use.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct System {
+    pub n: usize,
+    pub e: usize,
+    pub m: [f64; MAX_PLATFORMS],
+    /// Support stiffness and damping to the ground.
+    pub ks: [f64; MAX_PLATFORMS],
+    pub cs: [f64; MAX_PLATFORMS],
+    /// Coupling stiffness and damping (symmetric, zero diagonal).
+    pub kc: [[f64; MAX_PLATFORMS]; MAX_PLATFORMS],
+    pub cc: [[f64; MAX_PLATFORMS]; MAX_PLATFORMS],
+}
+
+impl System {
+    pub fn new(cfg: &MachineConfig) -> Self {
+        let mut s = System {
+            n: cfg.platforms().len().min(MAX_PLATFORMS),
+            e: cfg.exciter_index() % MAX_PLATFORMS,
+            m: [0.0; MAX_PLATFORMS],
+            ks: [0.0; MAX_PLATFORMS],
+            cs: [0.0; MAX_PLATFORMS],
+            kc: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+            cc: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+        };
+        for (i, p) in cfg.platforms().iter().enumerate().take(MAX_PLATFORMS) {
+            s.m[i] = cfg.moving_mass(i);
+            s.ks[i] = p.stiffness;
+            s.cs[i] = p.damping;
+        }
+        for c in cfg.couplings() {
+            let a = usize::from(c.between[0]).saturating_sub(1) % MAX_PLATFORMS;
+            let b = usize::from(c.between[1]).saturating_sub(1) % MAX_PLATFORMS;
+            s.kc[a][b] = c.stiffness;
+            s.kc[b][a] = c.stiffness;
+            s.cc[a][b] = c.damping;
+            s.cc[b][a] = c.damping;
+        }
+        s
+    }
+
+    /// Stiffness matrix entry `K_ij`.
+    pub fn k(&self, i: usize, j: usize) -> f64 {
+        if i == j {
+            self.ks[i] + self.kc[i].iter().sum::<f64>()
+        } else {
+            -self.kc[i][j]
+        }
+    }
+
+    /// Damping matrix entry `C_ij`.
+    pub fn c(&self, i: usize, j: usize) -> f64 {
+        if i == j {
+            self.cs[i] + self.cc[i].iter().sum::<f64>()
+        } else {
+            -self.cc[i][j]
+        }
+    }
+
+    /// The platforms other than the exciter, ascending.
+    pub fn others(&self) -> ([usize; 2], usize) {
+        let mut o = [0usize; 2];
+        let mut n = 0;
+        for i in 0..self.n {
+            if i != self.e && n < 2 {
+                o[n] = i;
+                n += 1;
+            }
+        }
+        (o, n)
+    }
+
+    /// Undamped resonant speeds, ascending, rad/s.
+    pub fn resonant_speeds(&self) -> ([f64; MAX_PLATFORMS], usize) {
+        let mut out = [0.0; MAX_PLATFORMS];
+        match self.n {
+            1 => out[0] = libm::sqrt(self.ks[0] / self.m[0]),
+            2 => {
+                let (lo, hi) = two_dof(self.ks[0], self.ks[1], self.kc[0][1], self.m[0], self.m[1]);
+                out[0] = libm::sqrt(lo);
+                out[1] = libm::sqrt(hi);
+            }
+            _ => {
+                let mut a = [[0.0; 3]; 3];
+                for (i, row) in a.iter_mut().enumerate() {
+                    for (j, x) in row.iter_mut().enumerate() {
+                        *x = self.k(i, j) / libm::sqrt(self.m[i] * self.m[j]);
+                    }
+                }
+                let l = jacobi3(a);
+                for (o, x) in out.iter_mut().zip(l) {
+                    *o = libm::sqrt(x);
+                }
+            }
+        }
+        (out, self.n)
+    }
+
+    /// Undamped additional speeds (antiresonances of the exciter platform), ascending, rad/s.
+    pub fn additional_speeds(&self) -> ([f64; MAX_PLATFORMS - 1], usize) {
+        let mut out = [0.0; MAX_PLATFORMS - 1];
+        let e = self.e;
+        let ([a, b], n) = self.others();
+        match n {
+            1 => out[0] = libm::sqrt((self.ks[a] + self.kc[a][e]) / self.m[a]),
+            2 => {
+                // With the exciter held fixed, its couplings act as supports of a and b.
+                let (lo, hi) = two_dof(
+                    self.ks[a] + self.kc[a][e],
+                    self.ks[b] + self.kc[b][e],
+                    self.kc[a][b],
+                    self.m[a],
+                    self.m[b],
+                );
+                out[0] = libm::sqrt(lo);
+                out[1] = libm::sqrt(hi);
+            }
+            _ => {}
+        }
+        (out, n)
+    }
+
+    /// Dynamic stiffness `Z(ω) = K − ω²M + iωC` entry.
+    pub fn z(&self, i: usize, j: usize, w: f64) -> C64 {
+        let m = if i == j { self.m[i] } else { 0.0 };
+        C64::new(self.k(i, j) - w * w * m, w * self.c(i, j))
+    }
+
+    /// `(det Z_oo, det Z)`: the exciter's cofactor and the determinant, expanded along the
+    /// exciter's row and column (bordered form), so `H_ee = cof/det`.
+    pub fn cofactor_det(&self, w: f64) -> (C64, C64) {
+        let e = self.e;
+        let zee = self.z(e, e, w);
+        let ([a, b], n) = self.others();
+        match n {
+            0 => (C64::ONE, zee),
+            1 => {
+                let zaa = self.z(a, a, w);
+                let zae = self.z(a, e, w);
+                (zaa, zee * zaa - zae * zae)
+            }
+            _ => {
+                let zaa = self.z(a, a, w);
+                let zbb = self.z(b, b, w);
+                let zab = self.z(a, b, w);
+                let zae = self.z(a, e, w);
+                let zbe = self.z(b, e, w);
+                let cof = zaa * zbb - zab * zab;
+                // det = zee·cof − uᵀ·adj(Z_oo)·u with u = (zae, zbe).
+                let quad = zae * zae * zbb + zbe * zbe * zaa - C64::new(2.0, 0.0) * zae * zbe * zab;
+                (cof, zee * cof - quad)
+            }
+        }
+    }
+
+    /// Driving-point receptance `H_ee(ω)`, m/N.
+    pub fn receptance(&self, w: f64) -> C64 {
+        let (cof, det) = self.cofactor_det(w);
+        cof.div(det)
+    }
+
+    /// A polynomial in `ω` with the sign of `Re H_ee(ω)` and no poles:
+    /// `Re(cof · conj(det)) = |det|²·Re H_ee`. Positive: gathering; negative: balancing.
+    pub fn criterion(&self, w: f64) -> f64 {
+        let (cof, det) = self.cofactor_det(w);
+        (cof * det.conj()).re
+    }
+
+    /// The same system with masses divided by `m_s`, stiffness by `k_s` and damping by
+    /// `√(k_s·m_s)`: speeds in units of `√(k_s/m_s)`, receptance in units of `1/k_s`.
+    pub fn scaled(&self, k_s: f64, m_s: f64) -> System {
+        let c_s = libm::sqrt(k_s * m_s);
+        let mut s = *self;
+        for i in 0..MAX_PLATFORMS {
+            s.m[i] /= m_s;
+            s.ks[i] /= k_s;
+            s.cs[i] /= c_s;
+            for j in 0..MAX_PLATFORMS {
+                s.kc[i][j] /= k_s;
+                s.cc[i][j] /= c_s;
+            }
+        }
+        s
+    }
+}
+
+/// Eigenvalues `(lo, hi)` of two masses with supports `sa`, `sb` and coupling `kab`:
+/// `λ² − bλ + c = 0` with `b = pa + pb`, `c = (sa·(sb + kab) + kab·sb)/(ma·mb)`,
+/// `d = (pa − pb)² + 4·kab²/(ma·mb)`, `pa = (sa + kab)/ma`, `pb = (sb + kab)/mb`.
+fn two_dof(sa: f64, sb: f64, kab: f64, ma: f64, mb: f64) -> (f64, f64) {
+    let pa = (sa + kab) / ma;
+    let pb = (sb + kab) / mb;
+    let b = pa + pb;
+    let c = (sa * (sb + kab) / ma + kab * sb / ma) / mb;
+    let g = kab / libm::sqrt(ma * mb);
+    let d = (pa - pb) * (pa - pb) + 4.0 * g * g;
+    let hi = 0.5 * (b + libm::sqrt(d));
+    // Numerical stability: c and d are sums of positive terms and the small root is c/hi
+    // (Vieta), never (b − √d)/2, which cancels when the roots are far apart.
+    (c / hi, hi)
+}
+
+/// Eigenvalues of a symmetric 3×3 matrix, ascending, by cyclic Jacobi rotations with the
+/// relative stopping rule `|a_pq| ≤ ε·√(|a_pp·a_qq|)`.
+pub(crate) fn jacobi3(mut a: [[f64; 3]; 3]) -> [f64; 3] {
+    const PAIRS: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
+    for _sweep in 0..50 {
+        let mut rotated = false;
+        for &(p, q) in &PAIRS {
+            let apq = a[p][q];
+            if libm::fabs(apq) <= f64::EPSILON * libm::sqrt(libm::fabs(a[p][p] * a[q][q])) {
+                a[p][q] = 0.0;
+                a[q][p] = 0.0;
+                continue;
+            }
+            rotated = true;
+            let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+            // t = tan of the rotation angle, the smaller root of t² + 2θt − 1 = 0.
+            let t = if libm::fabs(theta) > 1e150 {
+                0.5 / theta
+            } else {
+                let s = libm::sqrt(theta * theta + 1.0);
+                let t = 1.0 / (libm::fabs(theta) + s);
+                if theta < 0.0 {
+                    -t
+                } else {
+                    t
+                }
+            };
+            let c = 1.0 / libm::sqrt(t * t + 1.0);
+            let s = t * c;
+            let r = 3 - p - q;
+            a[p][p] -= t * apq;
+            a[q][q] += t * apq;
+            a[p][q] = 0.0;
+            a[q][p] = 0.0;
+            let arp = a[r][p];
+            let arq = a[r][q];
+            a[r][p] = c * arp - s * arq;
+            a[p][r] = a[r][p];
+            a[r][q] = s * arp + c * arq;
+            a[q][r] = a[r][q];
+        }
+        if !rotated {
+            break;
+        }
+    }
+    let mut l = [a[0][0], a[1][1], a[2][2]];
+    // Sort three values ascending without a library sort.
+    if l[0] > l[1] {
+        l.swap(0, 1);
+    }
+    if l[1] > l[2] {
+        l.swap(1, 2);
+    }
+    if l[0] > l[1] {
+        l.swap(0, 1);
+    }
+    l
+}
