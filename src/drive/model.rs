@@ -353,7 +353,7 @@ impl DriveModel {
 
     /// ∂δ/∂J and ∂δ/∂M_m at the current design, analytic (envelope theorem: the derivative of
     /// an extremum is the partial derivative at the extremal angle). `None` without a steady
-    /// state.
+    /// state, or when the parameters are so extreme that the derivatives overflow f64.
     pub fn sensitivity(&self) -> Option<Sensitivity> {
         let ex = self.extremes();
         let (x2, y2) = (self.u_mean + ex.s_max, self.u_mean + ex.s_min);
@@ -394,6 +394,10 @@ impl DriveModel {
                 let (mut rj, mut ra) = (0.0, 0.0);
                 for c in &self.components {
                     let r = c.amplitude();
+                    // A vanishing (or underflowed) amplitude has no direction to differentiate.
+                    if r.is_nan() || r <= 0.0 {
+                        continue;
+                    }
                     rj += (c.c * c.dc_dj + c.d * c.dd_dj) / r;
                     ra += (c.c * c.dc_da + c.d * c.dd_da) / r;
                 }
@@ -404,9 +408,14 @@ impl DriveModel {
         // Scaling the motor by λ multiplies a and B by λ: ∂ū/∂λ = M1/a, ∂s/∂λ = a·∂s/∂a.
         let a = -self.motor.model().a();
         let d_lambda = a * (d_smax * smax_a + d_smin * smin_a) + d_umean * (self.mean_load / a);
+        let d_torque = d_lambda / self.motor.model().breakdown_torque();
+        // Parameters near the f64 range can overflow the intermediate products.
+        if !(d_inertia.is_finite() && d_torque.is_finite()) {
+            return None;
+        }
         Some(Sensitivity {
             d_delta_d_inertia: d_inertia,
-            d_delta_d_breakdown_torque: d_lambda / self.motor.model().breakdown_torque(),
+            d_delta_d_breakdown_torque: d_torque,
         })
     }
 
