@@ -1,7 +1,10 @@
 //! Design-time results of a scene, computed by the core (no simulation): predicted δ and the
 //! flywheel for the limit, the support unbalances and limits, the auto-balancer's zones.
 
-use crate::scene::{MotorSpec, Scene, SceneError};
+use crate::scene::{BalancerKindSpec, MotorSpec, Scene, SceneError};
+use drive_monitor::balancer::{
+    AutoBalancer, BalancerKind, Coupling, Machine, MachineConfig, Platform, SearchOptions,
+};
 use drive_monitor::drive::{DriveModel, Harmonic, Kloss, KlossFit, Load, Motor, Parabola};
 use drive_monitor::supports::{Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance};
 use drive_monitor::ConfigError;
@@ -112,6 +115,91 @@ pub fn rotor(
     Ok(Some((rotor, limits)))
 }
 
+/// The vibration machine with its auto-balancer (`None` without platforms).
+pub fn machine(scene: &Scene, file: &Path) -> Result<Option<Machine>, SceneError> {
+    let Some(ab) = &scene.autobalancer else {
+        return Ok(None);
+    };
+    let platforms: Vec<Platform> = scene
+        .platform
+        .iter()
+        .map(|p| Platform {
+            mass: p.mass,
+            stiffness: p.stiffness,
+            damping: p.damping,
+        })
+        .collect();
+    let couplings: Vec<Coupling> = scene
+        .coupling
+        .iter()
+        .map(|c| Coupling {
+            between: c.between,
+            stiffness: c.stiffness,
+            damping: c.damping,
+        })
+        .collect();
+    let kind = match ab.kind {
+        BalancerKindSpec::Ball => BalancerKind::Ball,
+        BalancerKindSpec::Roller => BalancerKind::Roller,
+        BalancerKindSpec::Pendulum => BalancerKind::Pendulum {
+            inertia: ab.pendulum_inertia.ok_or_else(|| SceneError::Value {
+                file: file.to_path_buf(),
+                key: "autobalancer.pendulum_inertia".into(),
+                message: "missing: a pendulum auto-balancer needs its pendulum inertia".into(),
+            })?,
+        },
+    };
+    let balancer = AutoBalancer {
+        kind,
+        platform: ab.platform,
+        loads: ab.loads as u16,
+        load_mass: ab.load_mass,
+        radius: ab.radius,
+        housing_mass: ab.housing_mass,
+        viscosity: ab.viscosity,
+    };
+    let config = MachineConfig::new(&platforms, &couplings, balancer)
+        .map_err(|e| value_error(file, "autobalancer", e))?;
+    Machine::new(config, SearchOptions::default())
+        .map(Some)
+        .map_err(|e| value_error(file, "autobalancer", e))
+}
+
+/// One zone of the regime map.
+#[derive(Debug, Clone, Serialize)]
+pub struct ZoneOut {
+    /// Lower end, rad/s.
+    pub from: f64,
+    /// Upper end, rad/s (null for the last, open zone).
+    pub to: Option<f64>,
+    /// "balancing" or "gathering".
+    pub regime: &'static str,
+}
+
+/// A speed interval where gathered loads can be captured below the rotor speed.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaptureOut {
+    /// Lowest rotor speed of the window, rad/s.
+    pub from: f64,
+    /// Rotor speed above which capture is impossible, rad/s.
+    pub until: f64,
+    /// Load speed at the upper end, rad/s.
+    pub at: f64,
+}
+
+/// `autobalancer` member of `predict --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct AutobalancerOut {
+    /// Undamped resonant speeds, ascending, rad/s.
+    pub resonant_speeds: Vec<f64>,
+    /// Undamped additional speeds, ascending, rad/s.
+    pub additional_speeds: Vec<f64>,
+    /// Zones with the scene's damping.
+    pub zones: Vec<ZoneOut>,
+    /// Sommerfeld capture windows (balancing locally stable, capture also possible).
+    pub capture: Vec<CaptureOut>,
+}
+
 /// `irregularity` member of `predict --json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct IrregularityOut {
@@ -161,6 +249,9 @@ pub struct Prediction {
     /// Support unbalances and limits (scenes with a rotor).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsOut>,
+    /// Auto-balancer characteristic speeds and zones (vibration-machine scenes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub autobalancer: Option<AutobalancerOut>,
 }
 
 /// Computes the design-time results of `scene`.
@@ -194,6 +285,30 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             max_speed: r.max_speed.filter(|v| v.is_finite()),
             static_load: [a.static_load[0].norm(), a.static_load[1].norm()],
             peak_load_at_service_speed: [loads[0].peak, loads[1].peak],
+        });
+    }
+    if let Some(m) = machine(scene, file)? {
+        p.autobalancer = Some(AutobalancerOut {
+            resonant_speeds: m.resonant_speeds().to_vec(),
+            additional_speeds: m.additional_speeds().to_vec(),
+            zones: m
+                .zones()
+                .iter()
+                .map(|z| ZoneOut {
+                    from: z.from,
+                    to: z.to,
+                    regime: z.kind.name(),
+                })
+                .collect(),
+            capture: m
+                .capture_windows()
+                .iter()
+                .map(|c| CaptureOut {
+                    from: c.from,
+                    until: c.until,
+                    at: c.at,
+                })
+                .collect(),
         });
     }
     Ok(p)

@@ -63,5 +63,43 @@ pub fn prediction_text(p: &Prediction) -> String {
             }
         }
     }
+    if let Some(a) = &p.autobalancer {
+        let _ = writeln!(s, "Auto-balancer regimes (seed 001)");
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.3}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let _ = writeln!(
+            s,
+            "  resonant speeds (undamped): {} rad/s",
+            list(&a.resonant_speeds)
+        );
+        if !a.additional_speeds.is_empty() {
+            let _ = writeln!(
+                s,
+                "  additional speeds (undamped): {} rad/s",
+                list(&a.additional_speeds)
+            );
+        }
+        for z in &a.zones {
+            match z.to {
+                Some(to) => {
+                    let _ = writeln!(s, "  {:>9.3} – {:<9.3} rad/s  {}", z.from, to, z.regime);
+                }
+                None => {
+                    let _ = writeln!(s, "  {:>9.3} – ∞         rad/s  {}", z.from, z.regime);
+                }
+            }
+        }
+        for c in &a.capture {
+            let _ = writeln!(
+                s,
+                "  capture possible from {:.3} up to {:.3} rad/s (loads held near {:.3} rad/s)",
+                c.from, c.until, c.at
+            );
+        }
+    }
     s
 }

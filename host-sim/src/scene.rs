@@ -536,6 +536,9 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "auger-overhung.toml",
         include_str!("../scenes/auger-overhung.toml"),
     ),
+    ("one-mass.toml", include_str!("../scenes/one-mass.toml")),
+    ("two-mass.toml", include_str!("../scenes/two-mass.toml")),
+    ("three-mass.toml", include_str!("../scenes/three-mass.toml")),
 ];
 
 /// The default scene of `drive-sim` without arguments.
