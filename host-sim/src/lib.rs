@@ -2,3 +2,4 @@
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
 pub mod model;
+pub mod ode;
