@@ -1,5 +1,8 @@
 //! Host-side simulator for `drive-monitor`: scene files, dynamics assembled from the effects a
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
+pub mod effects;
+pub mod encoder;
 pub mod model;
 pub mod ode;
+pub mod system;
