@@ -18,7 +18,7 @@
 //!
 //! Step-size control follows Hairer, Nørsett & Wanner (*Solving ODE I*, II.4 and the codes
 //! DOPRI5/DOP853): the RMS norm of the error scaled by `atol + rtol·max(|y₀|, |y₁|)`, safety 0.9,
-//! a bounded growth/shrink factor and (for DOPRI5) the β = 0.04 stabilisation; the first step
+//! a bounded growth/shrink factor and the β = 0.04 step-size stabilisation; the first step
 //! comes from the usual two-evaluation estimate. A component may declare a fixed magnitude for
 //! its relative tolerance ([`OdeSystem::error_reference`]): the shaft angle φ grows without
 //! bound, so its error is measured against one revolution, not against the angle accumulated
@@ -592,11 +592,12 @@ impl Solver {
         tol: Tol,
         tab: Tableau,
     ) -> Result<(), OdeError> {
-        let (order, beta, fac_shrink, fac_grow) = match tab {
-            Tableau::Dp5 => (5, 0.04, 0.2, 10.0),
-            Tableau::Dp853 => (8, 0.0, 0.333, 6.0),
+        // Hairer's parameters: order, β, weight of β in the exponent, shrink and growth limits.
+        let (order, beta, beta_weight, fac_shrink, fac_grow) = match tab {
+            Tableau::Dp5 => (5, 0.04, 0.75, 0.2, 10.0),
+            Tableau::Dp853 => (8, 0.04, 0.2, 0.333, 6.0),
         };
-        let expo = 1.0 / f64::from(order) - 0.75 * beta;
+        let expo = 1.0 / f64::from(order) - beta_weight * beta;
         if self.h <= 0.0 {
             self.h = self.initial_step(sys, tol, order, t_end - self.t);
         }
