@@ -20,7 +20,8 @@
 //! ticks = ⌊t·timer_hz⌋ + counter_start masked to `counter_bits`. Faults: each real edge is
 //! dropped with probability `drop_probability`; before each line edge a glitch edge is inserted
 //! with probability `glitch_probability`, at a uniformly random time since the previous line
-//! edge. All randomness comes from `seed` through independent ChaCha8 streams (jitter, drops,
+//! edge (glitches are quantised without jitter). Edges are delivered in true-time order; keep the
+//! jitter well below the edge spacing, or the captured ticks can run backwards. All randomness comes from `seed` through independent ChaCha8 streams (jitter, drops,
 //! glitches, pitch errors), so enabling one fault does not change the others' draws: the same
 //! seed gives identical ticks.
 
@@ -640,7 +641,10 @@ mod tests {
         let seg2 = line(1.0, 1.0, -0.5 * pitch, pitch);
         e.process(&seg2, &mut |ed| edges.push(*ed));
         let last = edges.last().unwrap();
-        assert_eq!((last.tooth, last.direction, last.revolution), (0, Direction::Forward, 0));
+        assert_eq!(
+            (last.tooth, last.direction, last.revolution),
+            (0, Direction::Forward, 0)
+        );
         assert!((last.true_time - 1.5).abs() < 1e-12);
         assert_eq!(e.stats().crossings, 4);
     }

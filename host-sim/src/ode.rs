@@ -278,17 +278,17 @@ impl DenseOutput {
         self.h = h;
         self.degree = m;
         self.y0.copy_from_slice(y0);
-        for i in 0..self.n {
+        let n = self.n;
+        for (i, &last) in f[m - 1].iter().enumerate().take(n) {
             // q holds polynomial coefficients q[0..=m] in θ.
             let mut q = [0.0f64; MAX_DENSE_DEGREE + 1];
-            q[0] = f[m - 1][i];
-            let mut deg = 0;
+            q[0] = last;
             for j in (0..m - 1).rev() {
+                // Degree of q before this multiplication.
+                let deg = m - 2 - j;
                 // Multiply by g_{j+1}: θ if j+1 is even, (1 − θ) if odd.
                 if (j + 1) % 2 == 0 {
-                    for k in (0..=deg).rev() {
-                        q[k + 1] = q[k];
-                    }
+                    q.copy_within(0..=deg, 1);
                     q[0] = 0.0;
                 } else {
                     q[deg + 1] = 0.0;
@@ -296,12 +296,11 @@ impl DenseOutput {
                         q[k] -= q[k - 1];
                     }
                 }
-                deg += 1;
                 q[0] += f[j][i];
             }
             // Final factor θ: coefficient of θ^(k+1) is q[k].
-            for k in 0..m {
-                self.a[k * self.n + i] = q[k];
+            for (k, &qk) in q.iter().enumerate().take(m) {
+                self.a[k * n + i] = qk;
             }
         }
     }
@@ -309,19 +308,9 @@ impl DenseOutput {
 
 #[derive(Debug, Clone, Copy)]
 enum Method {
-    Rk4 {
-        step: f64,
-    },
-    Dopri5 {
-        rtol: f64,
-        atol: f64,
-        max_step: f64,
-    },
-    Dop853 {
-        rtol: f64,
-        atol: f64,
-        max_step: f64,
-    },
+    Rk4 { step: f64 },
+    Dopri5 { rtol: f64, atol: f64, max_step: f64 },
+    Dop853 { rtol: f64, atol: f64, max_step: f64 },
 }
 
 /// A one-step-at-a-time integrator holding its state, work buffers and the dense output of the
@@ -454,12 +443,30 @@ impl Solver {
                 rtol,
                 atol,
                 max_step,
-            } => self.step_adaptive(sys, t_end, Tol { rtol, atol, max_step }, Tableau::Dp5),
+            } => self.step_adaptive(
+                sys,
+                t_end,
+                Tol {
+                    rtol,
+                    atol,
+                    max_step,
+                },
+                Tableau::Dp5,
+            ),
             Method::Dop853 {
                 rtol,
                 atol,
                 max_step,
-            } => self.step_adaptive(sys, t_end, Tol { rtol, atol, max_step }, Tableau::Dp853),
+            } => self.step_adaptive(
+                sys,
+                t_end,
+                Tol {
+                    rtol,
+                    atol,
+                    max_step,
+                },
+                Tableau::Dp853,
+            ),
         }
     }
 
@@ -618,7 +625,8 @@ impl Solver {
             };
             if err.is_finite() && err <= 1.0 {
                 let fac11 = err.powf(expo);
-                let fac = (fac11 / self.facold.powf(beta) / SAFETY).clamp(1.0 / fac_grow, 1.0 / fac_shrink);
+                let fac = (fac11 / self.facold.powf(beta) / SAFETY)
+                    .clamp(1.0 / fac_grow, 1.0 / fac_shrink);
                 let mut hnew = h / fac;
                 self.facold = err.max(1e-4);
                 if self.last_rejected {
@@ -887,6 +895,7 @@ const DP5_D: [f64; 7] = [
 
 // Dormand–Prince 8(5,3) (Hairer's DOP853): nodes, stages 1–12, row 12 = weights b,
 // rows 13–15 the extra stages of the dense output.
+#[allow(clippy::excessive_precision)]
 const DP8_C: [f64; 16] = [
     0.0,
     0.526001519587677318785587544488e-01,
@@ -906,6 +915,7 @@ const DP8_C: [f64; 16] = [
     0.777777777777777777777777777778,
 ];
 
+#[allow(clippy::excessive_precision)]
 const DP8_A: [[f64; 16]; 16] = {
     let mut a = [[0.0f64; 16]; 16];
     a[1][0] = 5.26001519587677318785587544488e-2;
@@ -994,6 +1004,7 @@ const DP8_A: [[f64; 16]; 16] = {
 };
 
 /// Weights of the embedded 3rd-order solution (b − ê₃ gives the 3rd-order error estimate).
+#[allow(clippy::excessive_precision)]
 const DP8_BHH: [f64; 12] = {
     let mut b = [0.0f64; 12];
     b[0] = 0.244094488188976377952755905512;
@@ -1002,6 +1013,7 @@ const DP8_BHH: [f64; 12] = {
     b
 };
 
+#[allow(clippy::excessive_precision)]
 const DP8_E5: [f64; 12] = [
     0.1312004499419488073250102996e-1,
     0.0,
@@ -1018,6 +1030,7 @@ const DP8_E5: [f64; 12] = [
 ];
 
 /// Coefficients of the 4th–7th nested blocks of DOP853's dense output, over the 16 stages.
+#[allow(clippy::excessive_precision)]
 const DP8_D: [[f64; 16]; 4] = {
     let mut d = [[0.0f64; 16]; 4];
     d[0][0] = -0.84289382761090128651353491142e1;
@@ -1110,7 +1123,9 @@ mod tests {
             }
         }
         assert_eq!(sys.evals, s.stats().rhs_evals);
-        let err = (s.y()[0] - t_end.cos()).abs().max((s.y()[1] + t_end.sin()).abs());
+        let err = (s.y()[0] - t_end.cos())
+            .abs()
+            .max((s.y()[1] + t_end.sin()).abs());
         (s, err, max_dense_err)
     }
 
@@ -1141,7 +1156,10 @@ mod tests {
             assert!(d < 50.0 * rtol, "rtol {rtol}: dense error {d}");
             let st = s.stats();
             // FSAL: 6 evaluations per attempted step, plus 2 to start.
-            assert_eq!(st.rhs_evals, 2 + 6 * (st.accepted_steps + st.rejected_steps));
+            assert_eq!(
+                st.rhs_evals,
+                2 + 6 * (st.accepted_steps + st.rejected_steps)
+            );
         }
     }
 
@@ -1191,7 +1209,8 @@ mod tests {
 
     #[test]
     fn scene_tables_deserialize_and_validate() {
-        let i: Integrator = toml::from_str("method = \"dopri5\"\nrtol = 1e-9\natol = 1e-9").unwrap();
+        let i: Integrator =
+            toml::from_str("method = \"dopri5\"\nrtol = 1e-9\natol = 1e-9").unwrap();
         assert!(i.validate().is_ok());
         assert_eq!(i.name(), "dopri5");
         let bad: Result<Integrator, _> = toml::from_str("method = \"rk4\"\nstep = 1e-3\nrtol = 1");

@@ -42,7 +42,9 @@ use drive_monitor::error::{finite, non_negative, positive, ConfigError};
 
 use crate::encoder::{Edge, Encoder, EncoderConfig, EncoderStats};
 use crate::model::{Effect, Shaft};
-use crate::ode::{ComponentPoly, DenseOutput, Integrator, OdeError, OdeSystem, Solver, SolverStats};
+use crate::ode::{
+    ComponentPoly, DenseOutput, Integrator, OdeError, OdeSystem, Solver, SolverStats,
+};
 
 /// A kinematic law for a prescribed shaft.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -223,7 +225,8 @@ impl DynamicShaft {
 
     /// Checks the parameters: J(φ) must stay positive for every φ.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let j = positive("shaft.inertia", self.inertia)? + non_negative("shaft.flywheel", self.flywheel)?;
+        let j = positive("shaft.inertia", self.inertia)?
+            + non_negative("shaft.flywheel", self.flywheel)?;
         let mut swing = 0.0;
         for h in &self.harmonics {
             swing += finite("shaft.harmonics.amplitude", h.amplitude)?.abs();
@@ -609,7 +612,11 @@ impl Simulation {
 
     /// Advances by `duration` seconds, calling `on_edge` for every edge in time order.
     /// May be called repeatedly to continue a run. Returns the cumulative counters.
-    pub fn run<F: FnMut(&Edge)>(&mut self, duration: f64, on_edge: F) -> Result<RunStats, SimError> {
+    pub fn run<F: FnMut(&Edge)>(
+        &mut self,
+        duration: f64,
+        on_edge: F,
+    ) -> Result<RunStats, SimError> {
         self.run_observed(duration, &mut EdgeFn(on_edge))
     }
 

@@ -10,7 +10,12 @@ use host_sim::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
 
 const LINES: u32 = 256;
 
-fn edges_of(shaft: ShaftModel, effects: Vec<Box<dyn host_sim::model::Effect>>, integrator: Integrator, duration: f64) -> Vec<Edge> {
+fn edges_of(
+    shaft: ShaftModel,
+    effects: Vec<Box<dyn host_sim::model::Effect>>,
+    integrator: Integrator,
+    duration: f64,
+) -> Vec<Edge> {
     let system = System::new(shaft, effects).unwrap();
     let mut sim = Simulation::new(system, integrator, EncoderConfig::ideal(LINES, 1e9)).unwrap();
     let mut v = Vec::new();
@@ -133,8 +138,14 @@ fn prescribed_reversal_gives_mirrored_backward_edges() {
         RK4,
         2.0 - 1e-9,
     );
-    let fwd: Vec<&Edge> = edges.iter().filter(|e| e.direction == Direction::Forward).collect();
-    let bwd: Vec<&Edge> = edges.iter().filter(|e| e.direction == Direction::Backward).collect();
+    let fwd: Vec<&Edge> = edges
+        .iter()
+        .filter(|e| e.direction == Direction::Forward)
+        .collect();
+    let bwd: Vec<&Edge> = edges
+        .iter()
+        .filter(|e| e.direction == Direction::Backward)
+        .collect();
     // Peak φ = 10 rad; marks 1 … ⌊10·256/2π⌋ forward, the same back down (mark 0 at t = 2 is
     // beyond the run).
     let marks = (10.0 / TAU * f64::from(LINES)).floor() as usize;
@@ -166,7 +177,11 @@ fn dynamic_constant_torque_matches_constant_acceleration() {
         check_sequence(&edges, (phi_end / TAU * f64::from(LINES)).floor() as usize);
         let err = max_error(&edges, |th| t_const_accel(omega0, alpha, th));
         // Rounding accumulated over up to 2000 steps of φ ≈ 50 rad: ≈ √N·ε·φ/ω.
-        assert!(err < 5e-13, "{}: max edge-time error {err:e} s", integrator.name());
+        assert!(
+            err < 5e-13,
+            "{}: max edge-time error {err:e} s",
+            integrator.name()
+        );
     }
 }
 
@@ -205,7 +220,11 @@ fn dynamic_exponential_speed_within_stated_tolerance() {
             3.0,
         );
         let err = max_error(&edges, exact);
-        assert!(err < tol, "{}: max edge-time error {err:e} s", integrator.name());
+        assert!(
+            err < tol,
+            "{}: max edge-time error {err:e} s",
+            integrator.name()
+        );
         assert!(edges.len() > 13_000);
     }
 }

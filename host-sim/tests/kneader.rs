@@ -184,7 +184,9 @@ fn full_scene_timing() {
         let mut checksum = 0u64;
         let start = Instant::now();
         let stats = sim
-            .run(30.0, |e| checksum = checksum.wrapping_add(u64::from(e.ticks)))
+            .run(30.0, |e| {
+                checksum = checksum.wrapping_add(u64::from(e.ticks))
+            })
             .unwrap();
         let wall = start.elapsed();
         println!(
