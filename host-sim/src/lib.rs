@@ -1,8 +1,12 @@
 //! Host-side simulator for `drive-monitor`: scene files, dynamics assembled from the effects a
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
+pub mod effects;
+pub mod encoder;
 pub mod model;
 pub mod plot;
 pub mod predict;
 pub mod report;
 pub mod scene;
+pub mod ode;
+pub mod system;

@@ -1,0 +1,201 @@
+//! The kneader drive of seed 000: parabolic motor, constant inertia, load 24 + 12·sin(φ/8).
+//! Its steady state is known exactly (eq. 11 with the corrected B), so the integrated solution
+//! can be checked point by point.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::time::Instant;
+
+use host_sim::effects::{LoadHarmonic, LoadTorque, ParabolaMotor};
+use host_sim::encoder::{EncoderConfig, Reference};
+use host_sim::ode::Integrator;
+use host_sim::system::{DynamicShaft, Observer, ShaftModel, Simulation, StepView, System};
+
+const J: f64 = 0.323;
+const OMEGA0: f64 = 145.0;
+const OMEGA_M: f64 = 36.0;
+const M_MAX: f64 = 158.0;
+const M1: f64 = 24.0;
+const M2: f64 = 12.0;
+const N: f64 = 0.125;
+
+fn kneader(integrator: Integrator, encoder: EncoderConfig) -> Simulation {
+    let motor = ParabolaMotor {
+        omega0: OMEGA0,
+        omega_m: OMEGA_M,
+        m_max: M_MAX,
+    };
+    motor.validate().unwrap();
+    let load = LoadTorque {
+        mean: M1,
+        harmonics: vec![LoadHarmonic {
+            amplitude: M2,
+            order: N,
+            phase: 0.0,
+        }],
+    };
+    load.validate().unwrap();
+    let system = System::new(
+        ShaftModel::Dynamic(DynamicShaft::constant(J)),
+        vec![Box::new(motor), Box::new(load)],
+    )
+    .unwrap();
+    Simulation::new(system, integrator, encoder).unwrap()
+}
+
+/// Steady state of seed 000, eq. 11: ω² as a function of φ.
+fn omega2_steady(phi: f64) -> f64 {
+    let k = (OMEGA0 - OMEGA_M) * (OMEGA0 + OMEGA_M);
+    let d1 = M_MAX / (J * k);
+    let d2 = (M_MAX * OMEGA0 * OMEGA0 - M1 * k) / (J * k);
+    let d3 = M2 / J;
+    let (s, c) = (N * phi).sin_cos();
+    d2 / d1 + 2.0 * d3 * (N * c - 2.0 * d1 * s) / (4.0 * d1 * d1 + N * N)
+}
+
+#[test]
+fn analytic_delta_of_the_kneader() {
+    // ω² extremes D2/D1 ± 2·D3/√(4·D1² + n²) (eq. 12), δ = 2(ωmax − ωmin)/(ωmax + ωmin).
+    let k = (OMEGA0 - OMEGA_M) * (OMEGA0 + OMEGA_M);
+    let d1 = M_MAX / (J * k);
+    let d2 = (M_MAX * OMEGA0 * OMEGA0 - M1 * k) / (J * k);
+    let amp = 2.0 * (M2 / J) / (4.0 * d1 * d1 + N * N).sqrt();
+    let (wmax, wmin) = ((d2 / d1 + amp).sqrt(), (d2 / d1 - amp).sqrt());
+    let delta = 2.0 * (wmax - wmin) / (wmax + wmin);
+    assert!((delta - 0.030656).abs() < 5e-7, "δ = {delta}");
+    // The extremes of eq. 11 sampled finely agree with eq. 12.
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for i in 0..100_000 {
+        let w2 = omega2_steady(16.0 * core::f64::consts::PI * f64::from(i) / 1e5);
+        lo = lo.min(w2);
+        hi = hi.max(w2);
+    }
+    assert!((hi.sqrt() - wmax).abs() < 1e-6 && (lo.sqrt() - wmin).abs() < 1e-6);
+}
+
+/// Records the largest relative deviation of ω² from eq. 11 after the start-up transient
+/// (decays like exp(−2·D1·φ), D1 ≈ 0.0248/rad: below 1e-20 after φ ≈ 930 rad, t ≈ 7.5 s).
+struct SteadyCheck {
+    from: f64,
+    /// At step ends (the integrator's own solution).
+    max_end: f64,
+    /// At θ = 1/4, 1/2, 3/4 of each step (the dense output).
+    max_dense: f64,
+    samples: usize,
+}
+
+impl Observer for SteadyCheck {
+    fn edge(&mut self, _edge: &host_sim::encoder::Edge) {}
+    fn step(&mut self, step: &StepView<'_>) {
+        if step.t0() < self.from {
+            return;
+        }
+        for i in 1..=4 {
+            let t = step.t0() + (step.t1() - step.t0()) * f64::from(i) / 4.0;
+            let s = step.shaft(t);
+            let rel = (s.omega * s.omega / omega2_steady(s.phi) - 1.0).abs();
+            if i == 4 {
+                self.max_end = self.max_end.max(rel);
+            } else {
+                self.max_dense = self.max_dense.max(rel);
+            }
+            self.samples += 1;
+        }
+    }
+}
+
+fn steady_error(integrator: Integrator) -> (f64, f64, u64) {
+    let mut sim = kneader(integrator, EncoderConfig::ideal(64, 1e6));
+    let mut check = SteadyCheck {
+        from: 8.0,
+        max_end: 0.0,
+        max_dense: 0.0,
+        samples: 0,
+    };
+    let stats = sim.run_observed(12.0, &mut check).unwrap();
+    assert!(check.samples > 100);
+    (check.max_end, check.max_dense, stats.solver.rhs_evals)
+}
+
+/// Stated tolerances on ω² (relative to eq. 11, steady state t ∈ [8, 12] s), at step ends and
+/// on the dense output inside steps (which is what the edge locator uses):
+/// DOPRI5 rtol 1e-10: 5e-10 / 5e-9 (its continuous extension is one order lower);
+/// DOP853 rtol 1e-12: 2e-12 / 5e-11; RK4 h = 1 ms: 5e-12 / 5e-11.
+#[test]
+fn reaches_the_analytic_steady_state() {
+    let cases = [
+        (
+            Integrator::Dopri5 {
+                rtol: 1e-10,
+                atol: 1e-10,
+                max_step: None,
+            },
+            5e-10,
+            5e-9,
+        ),
+        (
+            Integrator::Dop853 {
+                rtol: 1e-12,
+                atol: 1e-12,
+                max_step: None,
+            },
+            2e-12,
+            5e-11,
+        ),
+        (Integrator::Rk4 { step: 1e-3 }, 5e-12, 5e-11),
+    ];
+    for (integrator, tol_end, tol_dense) in cases {
+        let name = integrator.name();
+        let (end, dense, evals) = steady_error(integrator.clone());
+        assert!(end < tol_end, "{name}: step ends {end:e}");
+        assert!(dense < tol_dense, "{name}: dense output {dense:e}");
+        if let Integrator::Rk4 { .. } = integrator {
+            assert_eq!(evals, 1 + 4 * 12_000);
+        }
+    }
+}
+
+/// The full scene: 30 s, 1024 lines, 170 MHz timer, index. Prints wall time and work; run with
+/// `cargo test --release --test kneader -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing report; run in release"]
+fn full_scene_timing() {
+    let mut enc = EncoderConfig::ideal(1024, 170e6);
+    enc.reference = Reference::Index;
+    for integrator in [
+        Integrator::Dopri5 {
+            rtol: 1e-10,
+            atol: 1e-10,
+            max_step: None,
+        },
+        Integrator::Dopri5 {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_step: None,
+        },
+        Integrator::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+            max_step: None,
+        },
+        Integrator::Rk4 { step: 1e-3 },
+    ] {
+        let name = format!("{integrator:?}");
+        let mut sim = kneader(integrator, enc.clone());
+        let mut checksum = 0u64;
+        let start = Instant::now();
+        let stats = sim
+            .run(30.0, |e| {
+                checksum = checksum.wrapping_add(u64::from(e.ticks))
+            })
+            .unwrap();
+        let wall = start.elapsed();
+        println!(
+            "{name}: {:.1} ms, {} edges, {} rhs evals, {} steps ({} rejected), checksum {checksum}",
+            wall.as_secs_f64() * 1e3,
+            stats.encoder.edges,
+            stats.solver.rhs_evals,
+            stats.solver.accepted_steps,
+            stats.solver.rejected_steps
+        );
+    }
+}

@@ -1,0 +1,388 @@
+//! Composition (only the listed effects are evaluated), seeded faults, timer quantisation and
+//! reference marks.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+use host_sim::effects::{ConstantTorque, LoadTorque, ParabolaMotor, ViscousFriction};
+use host_sim::encoder::{Edge, EncoderConfig, Reference};
+use host_sim::model::{Effect, Shaft};
+use host_sim::ode::Integrator;
+use host_sim::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
+
+/// An effect with one state (a first-order lag of the speed) that counts its own calls.
+struct Probe {
+    calls: Arc<AtomicU64>,
+}
+
+impl Effect for Probe {
+    fn name(&self) -> &'static str {
+        "probe"
+    }
+    fn dim(&self) -> usize {
+        1
+    }
+    fn init(&self, y: &mut [f64]) {
+        y[0] = 0.0;
+    }
+    fn eval(&self, _t: f64, shaft: Shaft, y: &[f64], dy: &mut [f64]) -> f64 {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        dy[0] = (shaft.omega - y[0]) / 0.1;
+        0.0
+    }
+}
+
+const DP5: Integrator = Integrator::Dopri5 {
+    rtol: 1e-8,
+    atol: 1e-8,
+    max_step: None,
+};
+
+fn drive(with_probe: Option<Arc<AtomicU64>>, with_load: bool) -> System {
+    let mut effects: Vec<Box<dyn Effect>> = vec![Box::new(ParabolaMotor {
+        omega0: 145.0,
+        omega_m: 36.0,
+        m_max: 158.0,
+    })];
+    if with_load {
+        effects.push(Box::new(LoadTorque {
+            mean: 24.0,
+            harmonics: vec![],
+        }));
+    }
+    if let Some(calls) = with_probe {
+        effects.push(Box::new(Probe { calls }));
+    }
+    System::new(ShaftModel::Dynamic(DynamicShaft::constant(0.323)), effects).unwrap()
+}
+
+#[test]
+fn only_listed_effects_are_evaluated_once_per_rhs() {
+    let calls = Arc::new(AtomicU64::new(0));
+    let mut with = Simulation::new(
+        drive(Some(calls.clone()), true),
+        DP5,
+        EncoderConfig::ideal(64, 1e6),
+    )
+    .unwrap();
+    assert_eq!(with.system().dim(), 3);
+    let s = with.run(1.0, |_| {}).unwrap();
+    let n = s.solver.rhs_evals;
+    assert!(n > 0);
+    for name in ["shaft", "motor", "load", "probe"] {
+        assert_eq!(s.evaluations_of(name), n, "{name}");
+    }
+    assert_eq!(calls.load(Ordering::Relaxed), n);
+    // The probe's state followed ω: the lag is integrated, not ignored.
+    assert!((with.state()[2] - with.shaft().omega).abs() < 0.05 * with.shaft().omega);
+
+    let calls_b = Arc::new(AtomicU64::new(0));
+    let mut without =
+        Simulation::new(drive(None, false), DP5, EncoderConfig::ideal(64, 1e6)).unwrap();
+    assert_eq!(without.system().dim(), 2);
+    let s = without.run(1.0, |_| {}).unwrap();
+    assert!(s.solver.rhs_evals > 0);
+    assert_eq!(s.evaluations_of("load"), 0);
+    assert_eq!(s.evaluations_of("probe"), 0);
+    assert_eq!(
+        s.evaluations.iter().map(|c| c.name).collect::<Vec<_>>(),
+        vec!["shaft", "motor"]
+    );
+    assert_eq!(calls_b.load(Ordering::Relaxed), 0);
+}
+
+#[test]
+fn prescribed_shaft_without_states_evaluates_nothing() {
+    let system = System::new(
+        ShaftModel::Prescribed(SpeedLaw::Constant {
+            omega: 100.0,
+            phi0: 0.0,
+        }),
+        vec![Box::new(LoadTorque {
+            mean: 10.0,
+            harmonics: vec![],
+        })],
+    )
+    .unwrap();
+    let mut sim = Simulation::new(system, DP5, EncoderConfig::ideal(100, 1e6)).unwrap();
+    let s = sim.run(1.0, |_| {}).unwrap();
+    assert_eq!(s.solver.rhs_evals, 0);
+    assert_eq!(s.evaluations_of("load"), 0);
+    assert_eq!(s.encoder.edges, 1591); // ⌊100·100/2π⌋
+}
+
+#[test]
+fn prescribed_shaft_with_states_integrates_only_them() {
+    let calls = Arc::new(AtomicU64::new(0));
+    let system = System::new(
+        ShaftModel::Prescribed(SpeedLaw::Constant {
+            omega: 50.0,
+            phi0: 0.0,
+        }),
+        vec![Box::new(Probe {
+            calls: calls.clone(),
+        })],
+    )
+    .unwrap();
+    let mut sim = Simulation::new(system, DP5, EncoderConfig::ideal(16, 1e6)).unwrap();
+    let s = sim.run(2.0, |_| {}).unwrap();
+    assert_eq!(sim.system().dim(), 1);
+    assert_eq!(s.evaluations_of("probe"), s.solver.rhs_evals);
+    assert_eq!(s.evaluations_of("shaft"), 0);
+    // Lag of a constant input: 50·(1 − e^(−t/0.1)).
+    let exact = 50.0 * -(-2.0f64 / 0.1).exp_m1();
+    assert!((sim.state()[0] - exact).abs() < 1e-6);
+}
+
+fn faulty(seed: u64, drop: f64, glitch: f64, jitter: f64) -> EncoderConfig {
+    let mut c = EncoderConfig::ideal(256, 10e6);
+    c.seed = seed;
+    c.drop_probability = drop;
+    c.glitch_probability = glitch;
+    c.jitter = jitter;
+    c.pitch_error_std = 1e-4;
+    c.reference = Reference::Index;
+    c
+}
+
+fn run_prescribed(
+    encoder: EncoderConfig,
+    duration: f64,
+) -> (Vec<Edge>, host_sim::system::RunStats) {
+    let system = System::new(
+        ShaftModel::Prescribed(SpeedLaw::Ramp {
+            omega0: 50.0,
+            alpha: 20.0,
+            phi0: 0.3,
+        }),
+        vec![],
+    )
+    .unwrap();
+    let mut sim = Simulation::new(system, DP5, encoder).unwrap();
+    let mut v = Vec::new();
+    let s = sim.run(duration, |e| v.push(*e)).unwrap();
+    (v, s)
+}
+
+fn key(e: &Edge) -> (u32, bool, bool, u32, i64) {
+    (e.ticks, e.index, e.glitch, e.tooth, e.revolution)
+}
+
+#[test]
+fn faults_are_reproducible_per_seed_and_independent() {
+    let (a, sa) = run_prescribed(faulty(7, 0.02, 0.02, 2e-7), 2.0);
+    let (b, _) = run_prescribed(faulty(7, 0.02, 0.02, 2e-7), 2.0);
+    let (c, sc) = run_prescribed(faulty(8, 0.02, 0.02, 2e-7), 2.0);
+    assert_eq!(
+        a.iter().map(key).collect::<Vec<_>>(),
+        b.iter().map(key).collect::<Vec<_>>()
+    );
+    assert_ne!(
+        a.iter().map(key).collect::<Vec<_>>(),
+        c.iter().map(key).collect::<Vec<_>>()
+    );
+    // Same crossings (the motion does not depend on the seed), different faults.
+    assert_eq!(sa.encoder.crossings, sc.encoder.crossings);
+    let dropped = |v: &[Edge], s: &host_sim::system::RunStats| {
+        (
+            s.encoder.crossings - (v.len() as u64 - s.encoder.glitches),
+            s.encoder.dropped,
+        )
+    };
+    assert_eq!(dropped(&a, &sa).0, dropped(&a, &sa).1);
+    let n = sa.encoder.crossings as f64;
+    for s in [&sa, &sc] {
+        // Binomial counts within 5σ of p·n.
+        for count in [s.encoder.dropped, s.encoder.glitches] {
+            let (mean, sd) = (0.02 * n, (0.02 * 0.98 * n).sqrt());
+            assert!((count as f64 - mean).abs() < 5.0 * sd, "{count} vs {mean}");
+        }
+    }
+    // Glitches fall between the previous line edge and the one they precede.
+    let lines: Vec<&Edge> = a.iter().filter(|e| !e.index).collect();
+    for w in lines.windows(2) {
+        if w[1].glitch {
+            assert!(w[1].true_time >= w[0].true_time);
+        }
+    }
+    // Turning faults on does not change the jitter drawn for the edges that remain.
+    let (clean, _) = run_prescribed(faulty(7, 0.0, 0.0, 2e-7), 2.0);
+    let survivors: Vec<(u32, u32, i64)> = a
+        .iter()
+        .filter(|e| !e.glitch)
+        .map(|e| (e.ticks, e.tooth, e.revolution))
+        .collect();
+    let mut it = clean.iter().map(|e| (e.ticks, e.tooth, e.revolution));
+    for s in &survivors {
+        assert!(it.any(|c| c == *s), "edge {s:?} differs without faults");
+    }
+}
+
+#[test]
+fn jitter_has_the_configured_spread() {
+    let sigma = 3e-7;
+    let (edges, _) = run_prescribed(faulty(3, 0.0, 0.0, sigma), 2.0);
+    let timer = 10e6;
+    // Tick error relative to the true time: jitter plus uniform quantisation (var 1/12 tick²).
+    let errs: Vec<f64> = edges
+        .iter()
+        .map(|e| f64::from(e.ticks) / timer - e.true_time)
+        .collect();
+    let n = errs.len() as f64;
+    let mean = errs.iter().sum::<f64>() / n;
+    let var = errs.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n;
+    let expected = sigma * sigma + 1.0 / (12.0 * timer * timer);
+    assert!(
+        (var / expected - 1.0).abs() < 0.05,
+        "variance ratio {}",
+        var / expected
+    );
+    assert!((mean + 0.5 / timer).abs() < 5.0 * (expected / n).sqrt());
+}
+
+#[test]
+fn sixteen_bit_counter_wraps_like_the_timer() {
+    let mut c = EncoderConfig::ideal(128, 1e6);
+    c.counter_bits = 16;
+    c.counter_start = 60_000;
+    let (edges, _) = run_prescribed(c, 1.5);
+    // Many wraps: 1.5 s at 1 MHz is 23 times the 16-bit range.
+    let mut wraps = 0;
+    for w in edges.windows(2) {
+        let d_true = (w[1].true_time * 1e6).floor() - (w[0].true_time * 1e6).floor();
+        let d = w[1].ticks.wrapping_sub(w[0].ticks) & 0xFFFF;
+        assert_eq!(f64::from(d), d_true);
+        if w[1].ticks < w[0].ticks {
+            wraps += 1;
+        }
+    }
+    assert!(wraps >= 22);
+    for e in &edges {
+        let expect = ((e.true_time * 1e6).floor() as u64 + 60_000) & 0xFFFF;
+        assert_eq!(u64::from(e.ticks), expect);
+        assert!(e.ticks <= 0xFFFF);
+    }
+}
+
+#[test]
+fn reference_marks_frame_each_revolution() {
+    // Missing teeth: 60 − 2 lines per revolution, the gap where positions 0 and 1 would be.
+    let mut c = EncoderConfig::ideal(60, 1e6);
+    c.reference = Reference::MissingTeeth { count: 2 };
+    let (edges, _) = run_prescribed(c, 1.0);
+    let full_revs: Vec<i64> = {
+        let last = edges.last().unwrap().revolution;
+        (1..last).collect()
+    };
+    assert!(full_revs.len() >= 8);
+    for r in &full_revs {
+        let teeth: Vec<u32> = edges
+            .iter()
+            .filter(|e| e.revolution == *r)
+            .map(|e| e.tooth)
+            .collect();
+        assert_eq!(teeth, (2..60).collect::<Vec<_>>());
+    }
+    // Index: one pulse per revolution, between position 59 of the previous turn and 0.
+    let mut c = EncoderConfig::ideal(60, 1e6);
+    c.reference = Reference::Index;
+    let (edges, s) = run_prescribed(c, 1.0);
+    let idx: Vec<usize> = edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.index)
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(idx.len() as u64, s.encoder.index_pulses);
+    for &i in &idx {
+        assert_eq!(edges[i - 1].tooth, 59);
+        assert_eq!((edges[i + 1].tooth, edges[i + 1].index), (0, false));
+        assert_eq!(edges[i + 1].revolution, edges[i].revolution);
+    }
+}
+
+#[test]
+fn scene_tables_map_onto_the_structs() {
+    let shaft: ShaftModel = toml::from_str(
+        "kind = \"dynamic\"\ninertia = 0.323\nflywheel = 0.1\nomega0 = 130.0\n\
+         harmonics = [{ amplitude = 0.02, order = 2.0 }]",
+    )
+    .unwrap();
+    assert!(shaft.validate().is_ok());
+    let shaft: ShaftModel =
+        toml::from_str("kind = \"prescribed\"\nlaw = \"ramp\"\nomega0 = 0.0\nalpha = 10.0")
+            .unwrap();
+    assert_eq!(
+        shaft,
+        ShaftModel::Prescribed(SpeedLaw::Ramp {
+            omega0: 0.0,
+            alpha: 10.0,
+            phi0: 0.0
+        })
+    );
+    assert!(
+        toml::from_str::<ShaftModel>("kind = \"dynamic\"\ninertia = 1.0\ninertai = 2.0").is_err()
+    );
+    let bad: ShaftModel = toml::from_str(
+        "kind = \"dynamic\"\ninertia = 0.1\nharmonics = [{ amplitude = 0.2, order = 1.0 }]",
+    )
+    .unwrap();
+    assert!(bad.validate().is_err());
+    let enc: EncoderConfig = toml::from_str(
+        "lines = 1024\ntimer_hz = 170e6\ncounter_bits = 16\nreference = { kind = \"missing_teeth\", count = 2 }\n\
+         runout = { eccentricity = 5e-5, radius = 0.03 }\ndrop_probability = 1e-4\nseed = 9",
+    )
+    .unwrap();
+    assert_eq!(enc.reference, Reference::MissingTeeth { count: 2 });
+    assert!(toml::from_str::<EncoderConfig>("lines = 10\ntimer_hz = 1e6\nlinez = 3").is_err());
+    let f: ViscousFriction = toml::from_str("coefficient = 0.5").unwrap();
+    assert!(f.validate().is_ok());
+    let t: ConstantTorque = toml::from_str("torque = -3.0").unwrap();
+    assert!(t.validate().is_ok());
+}
+
+/// J(φ) with a harmonic: energy balance. With no torque, J(φ)·ω²/2 is conserved, which
+/// exercises the ½·ω²·dJ/dφ term (dropping it breaks conservation at the percent level).
+#[test]
+fn variable_inertia_conserves_kinetic_energy() {
+    let shaft = DynamicShaft {
+        inertia: 1.0,
+        flywheel: 0.2,
+        harmonics: vec![host_sim::system::InertiaHarmonic {
+            amplitude: 0.3,
+            order: 2.0,
+            phase: 0.4,
+        }],
+        phi0: 0.0,
+        omega0: 20.0,
+    };
+    let energy = |phi: f64, omega: f64| 0.5 * shaft.inertia_at(phi).0 * omega * omega;
+    let e0 = energy(0.0, 20.0);
+    let system = System::new(ShaftModel::Dynamic(shaft.clone()), vec![]).unwrap();
+    let mut sim = Simulation::new(
+        system,
+        Integrator::Dopri5 {
+            rtol: 1e-11,
+            atol: 1e-11,
+            max_step: None,
+        },
+        EncoderConfig::ideal(32, 1e6),
+    )
+    .unwrap();
+    let mut speeds = (f64::MAX, f64::MIN);
+    struct Obs<'a>(&'a mut (f64, f64), f64, &'a dyn Fn(f64, f64) -> f64);
+    impl host_sim::system::Observer for Obs<'_> {
+        fn edge(&mut self, _e: &Edge) {}
+        fn step(&mut self, s: &host_sim::system::StepView<'_>) {
+            let sh = s.shaft(0.5 * (s.t0() + s.t1()));
+            self.0 .0 = self.0 .0.min(sh.omega);
+            self.0 .1 = self.0 .1.max(sh.omega);
+            assert!(((self.2)(sh.phi, sh.omega) / self.1 - 1.0).abs() < 1e-9);
+        }
+    }
+    sim.run_observed(3.0, &mut Obs(&mut speeds, e0, &energy))
+        .unwrap();
+    // The speed does swing with J(φ): ω ∝ 1/√J, J between 0.9 and 1.5.
+    assert!(speeds.1 / speeds.0 > 1.25);
+}
