@@ -2,3 +2,5 @@
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
 pub mod model;
+pub mod rotor_loads;
+pub mod vibration;
