@@ -124,7 +124,10 @@ impl RotorLoads {
             let d = non_negative("unbalances.amount", u.amount)?;
             let a = finite("unbalances.angle", u.angle)?;
             let z = finite("unbalances.z", u.z)?;
-            add(&mut support_unbalance, split(za, zb, [d * a.cos(), d * a.sin()], z));
+            add(
+                &mut support_unbalance,
+                split(za, zb, [d * a.cos(), d * a.sin()], z),
+            );
         }
         let mut static_loads = [[0.0; 2]; 2];
         for s in &p.static_loads {
@@ -141,7 +144,10 @@ impl RotorLoads {
                     from,
                     to,
                 } => {
-                    let (z0, z1) = (finite("static_loads.from", from)?, finite("static_loads.to", to)?);
+                    let (z0, z1) = (
+                        finite("static_loads.from", from)?,
+                        finite("static_loads.to", to)?,
+                    );
                     if z1 < z0 {
                         return Err(ConfigError::Inconsistent("static_loads.to"));
                     }
@@ -224,6 +230,7 @@ impl Effect for RotorLoads {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -318,7 +325,11 @@ mod tests {
         let p = params();
         let r = RotorLoads::new(&p).unwrap();
         for &zc in &[0.8, 1.3, -0.4] {
-            let (la, lb, l) = (zc - p.support_a, p.support_b - zc, p.support_b - p.support_a);
+            let (la, lb, l) = (
+                zc - p.support_a,
+                p.support_b - zc,
+                p.support_b - p.support_a,
+            );
             let mut dst = [0.0; 2];
             let mut md = [0.0; 2];
             for u in &p.unbalances {

@@ -197,10 +197,16 @@ pub struct AutoBalancerParams {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(tag = "placement", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadPlacement {
-    /// All loads at one absolute angle, rad (the loads gathered together).
+    /// The loads gathered together: equally spaced over an arc of `spread` rad centred on
+    /// the absolute angle `angle`. With `spread = 0` the loads coincide, and since identical
+    /// loads obey identical equations they then stay together for ever (an invariant but
+    /// possibly unstable motion); a small spread lets them part when they tend to.
     Together {
-        /// The common angle, rad.
+        /// Centre of the group, rad.
         angle: f64,
+        /// Arc the loads span, rad (default 0).
+        #[serde(default)]
+        spread: f64,
     },
     /// The auto-balancing position ([`balancing_fan`]) for the initial rotor angle, with load 1
     /// turned forward by `perturbation` rad. Needs `N ≠ 1` (nothing to place for `N = 0`).
@@ -254,6 +260,82 @@ pub struct VibrationMachineParams {
     /// Initial conditions.
     #[serde(default)]
     pub initial: InitialParams,
+}
+
+/// A single-mass machine given by the seed's dimensionless groups (eq. 5–9) plus the physical
+/// scales they leave free. See [`VibrationMachineParams::from_seed_single_mass`].
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeedSingleMass {
+    /// Support damping ratio `h = b/(2·M_Σ·ω̃)`.
+    pub h: f64,
+    /// Load mass ratio `ε = N·m/(κ·M_Σ)`.
+    pub epsilon: f64,
+    /// Load viscosity `β = b_w·M_Σ/(N·m²·ω̃)`.
+    pub beta: f64,
+    /// Number of loads `N`.
+    pub loads: usize,
+    /// Type of the loads (fixes `κ`).
+    pub kind: LoadKind,
+    /// Natural frequency `ω̃ = √(k/M_Σ)`, rad/s.
+    pub omega_scale: f64,
+    /// Mass of one load `m`, kg.
+    pub load_mass: f64,
+    /// Load radius `R`, m.
+    pub radius: f64,
+    /// Housing mass `M_c`, kg.
+    pub housing_mass: f64,
+    /// Rotor unbalance `D`, kg·m (the seed has none: 0).
+    #[serde(default)]
+    pub rotor_unbalance: f64,
+}
+
+impl VibrationMachineParams {
+    /// The physical machine with the seed's groups: `M_Σ = N·m/(κ·ε)`, platform mass
+    /// `M = M_Σ − M_c − N·m`, `k = M_Σ·ω̃²`, `b = 2h·M_Σ·ω̃`, `b_w = β·N·m²·ω̃/M_Σ`.
+    /// Errors when an input is not positive/finite or the resulting platform mass is negative
+    /// (`ε` too large for the housing mass).
+    pub fn from_seed_single_mass(
+        g: &SeedSingleMass,
+        initial: InitialParams,
+    ) -> Result<Self, ConfigError> {
+        let m = positive("load_mass", g.load_mass)?;
+        let r = positive("radius", g.radius)?;
+        let w = positive("omega_scale", g.omega_scale)?;
+        let eps = positive("epsilon", g.epsilon)?;
+        let h = non_negative("h", g.h)?;
+        let beta = non_negative("beta", g.beta)?;
+        let housing = non_negative("housing_mass", g.housing_mass)?;
+        if g.loads == 0 {
+            return Err(ConfigError::NotPositive("loads"));
+        }
+        let nm = g.loads as f64 * m;
+        let total = nm / (g.kind.kappa(m, r) * eps);
+        let platform = total - housing - nm;
+        if platform < 0.0 {
+            return Err(ConfigError::Inconsistent("epsilon"));
+        }
+        Ok(VibrationMachineParams {
+            platforms: vec![PlatformParams {
+                mass: platform,
+                stiffness: total * w * w,
+                damping: 2.0 * h * total * w,
+            }],
+            couplings: Vec::new(),
+            balancer: AutoBalancerParams {
+                platform: None,
+                loads: g.loads,
+                load_mass: m,
+                radius: r,
+                kind: g.kind,
+                housing_mass: housing,
+                load_viscosity: beta * nm * m * w / total,
+                rotor_unbalance: g.rotor_unbalance,
+                rotor_unbalance_angle: 0.0,
+            },
+            initial,
+        })
+    }
 }
 
 /// The seed's dimensionless groups for a machine (see the module docs for the definitions).
@@ -397,9 +479,14 @@ impl VibrationMachine {
         let rotor = finite("initial.rotor_angle", ini.rotor_angle)?;
         let angles = &mut y[off..off + n];
         match &ini.loads {
-            LoadPlacement::Together { angle } => {
+            LoadPlacement::Together { angle, spread } => {
                 let a = finite("initial.loads.angle", *angle)?;
-                angles.iter_mut().for_each(|x| *x = a);
+                let s = finite("initial.loads.spread", *spread)?;
+                let centre = (n as f64 - 1.0) / 2.0;
+                let step = if n > 1 { s / (n as f64 - 1.0) } else { 0.0 };
+                for (k, x) in angles.iter_mut().enumerate() {
+                    *x = a + (k as f64 - centre) * step;
+                }
             }
             LoadPlacement::Balanced { perturbation } => {
                 let dp = finite("initial.loads.perturbation", *perturbation)?;
