@@ -10,3 +10,5 @@ pub mod report;
 pub mod scene;
 pub mod ode;
 pub mod system;
+pub mod rotor_loads;
+pub mod vibration;
