@@ -1,14 +1,15 @@
 //! Host-side simulator for `drive-monitor`: scene files, dynamics assembled from the effects a
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
+
 pub mod effects;
 pub mod encoder;
 pub mod model;
+pub mod ode;
 pub mod plot;
 pub mod predict;
 pub mod report;
-pub mod scene;
-pub mod ode;
-pub mod system;
 pub mod rotor_loads;
+pub mod scene;
+pub mod system;
 pub mod vibration;
