@@ -13,17 +13,14 @@
 //! J(φ) = J₀ + J_flywheel + Σ J_k·cos(k·φ + ψ_k).
 //!
 //! ```
-//! use host_sim::effects::{LoadTorque, LoadHarmonic, ParabolaMotor};
+//! use drive_monitor::drive::{Harmonic, Load, Motor, Parabola};
 //! use host_sim::encoder::EncoderConfig;
 //! use host_sim::ode::Integrator;
 //! use host_sim::system::{DynamicShaft, ShaftModel, Simulation, System};
 //!
 //! let shaft = ShaftModel::Dynamic(DynamicShaft::constant(0.323));
-//! let motor = ParabolaMotor { omega0: 145.0, omega_m: 36.0, m_max: 158.0 };
-//! let load = LoadTorque {
-//!     mean: 24.0,
-//!     harmonics: vec![LoadHarmonic { amplitude: 12.0, order: 0.125, phase: 0.0 }],
-//! };
+//! let motor = Motor::parabola(Parabola::new(145.0, 36.0, 158.0)?);
+//! let load = Load::new(24.0, &[Harmonic::new(0.125, 12.0, 0.0)?])?;
 //! let system = System::new(shaft, vec![Box::new(motor), Box::new(load)])?;
 //! let integrator = Integrator::Dopri5 { rtol: 1e-8, atol: 1e-8, max_step: None };
 //! let mut sim = Simulation::new(system, integrator, EncoderConfig::ideal(1024, 170e6))?;

@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use host_sim::effects::{LoadHarmonic, LoadTorque, ParabolaMotor};
+use drive_monitor::drive::{Harmonic, Load, Motor, Parabola};
 use host_sim::encoder::{EncoderConfig, Reference};
 use host_sim::ode::Integrator;
 use host_sim::system::{DynamicShaft, Observer, ShaftModel, Simulation, StepView, System};
@@ -19,21 +19,8 @@ const M2: f64 = 12.0;
 const N: f64 = 0.125;
 
 fn kneader(integrator: Integrator, encoder: EncoderConfig) -> Simulation {
-    let motor = ParabolaMotor {
-        omega0: OMEGA0,
-        omega_m: OMEGA_M,
-        m_max: M_MAX,
-    };
-    motor.validate().unwrap();
-    let load = LoadTorque {
-        mean: M1,
-        harmonics: vec![LoadHarmonic {
-            amplitude: M2,
-            order: N,
-            phase: 0.0,
-        }],
-    };
-    load.validate().unwrap();
+    let motor = Motor::parabola(Parabola::new(OMEGA0, OMEGA_M, M_MAX).unwrap());
+    let load = Load::new(M1, &[Harmonic::new(N, M2, 0.0).unwrap()]).unwrap();
     let system = System::new(
         ShaftModel::Dynamic(DynamicShaft::constant(J)),
         vec![Box::new(motor), Box::new(load)],

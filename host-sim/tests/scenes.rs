@@ -5,7 +5,8 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use host_sim::effects::{ConstantTorque, LoadTorque, ParabolaMotor, ViscousFriction};
+use drive_monitor::drive::{Load, Motor, Parabola};
+use host_sim::effects::{ConstantTorque, ViscousFriction};
 use host_sim::encoder::{Edge, EncoderConfig, Reference};
 use host_sim::model::{Effect, Shaft};
 use host_sim::ode::Integrator;
@@ -40,16 +41,11 @@ const DP5: Integrator = Integrator::Dopri5 {
 };
 
 fn drive(with_probe: Option<Arc<AtomicU64>>, with_load: bool) -> System {
-    let mut effects: Vec<Box<dyn Effect>> = vec![Box::new(ParabolaMotor {
-        omega0: 145.0,
-        omega_m: 36.0,
-        m_max: 158.0,
-    })];
+    let mut effects: Vec<Box<dyn Effect>> = vec![Box::new(Motor::parabola(
+        Parabola::new(145.0, 36.0, 158.0).unwrap(),
+    ))];
     if with_load {
-        effects.push(Box::new(LoadTorque {
-            mean: 24.0,
-            harmonics: vec![],
-        }));
+        effects.push(Box::new(Load::new(24.0, &[]).unwrap()));
     }
     if let Some(calls) = with_probe {
         effects.push(Box::new(Probe { calls }));
@@ -99,10 +95,7 @@ fn prescribed_shaft_without_states_evaluates_nothing() {
             omega: 100.0,
             phi0: 0.0,
         }),
-        vec![Box::new(LoadTorque {
-            mean: 10.0,
-            harmonics: vec![],
-        })],
+        vec![Box::new(Load::new(10.0, &[]).unwrap())],
     )
     .unwrap();
     let mut sim = Simulation::new(system, DP5, EncoderConfig::ideal(100, 1e6)).unwrap();

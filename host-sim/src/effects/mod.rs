@@ -1,14 +1,16 @@
 //! Drive effects: torques on the shaft from the motor and the working load (seed 000).
 //!
 //! Each type is one [`Effect`] with no states of its own; a scene lists the ones it needs.
-//! Parameters are plain fields (deserializable from a scene table); call `validate` once
-//! before use.
+//! The motor and the load are the core's [`drive_monitor::drive::Motor`] and
+//! [`drive_monitor::drive::Load`] (validated by their constructors): the model lives in one
+//! place, and the simulator integrates the same torques the prediction uses. The effects
+//! without a core counterpart here have plain fields (deserializable from a scene table);
+//! call `validate` once before use.
 
 pub mod load;
 pub mod motor;
 
-pub use load::{LoadHarmonic, LoadTorque, ViscousFriction};
-pub use motor::{KlossMotor, ParabolaMotor};
+pub use load::ViscousFriction;
 
 use serde::Deserialize;
 
