@@ -10,6 +10,7 @@ pub mod plot;
 pub mod predict;
 pub mod report;
 pub mod rotor_loads;
+pub mod run;
 pub mod scene;
 pub mod system;
 pub mod vibration;

@@ -1,7 +1,292 @@
 //! Readable text reports.
 
-use crate::predict::Prediction;
+use crate::plot::{write_svg, Chart, Mark, Series};
+use crate::predict::{self, Prediction};
+use crate::run::RunReport;
+use crate::scene::Scene;
 use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// A run as text.
+pub fn run_text(scene: &Scene, r: &RunReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "Scene {}", r.scene);
+    if let Some(d) = &scene.description {
+        let _ = writeln!(s, "  {d}");
+    }
+    let _ = writeln!(
+        s,
+        "Simulated {:.1} s with {} ({} effects: {}) in {:.3} s wall: {} RHS evaluations, {} steps ({} rejected), {} edges",
+        r.simulated_seconds,
+        r.integrator,
+        r.effects.len(),
+        r.effects.join(", "),
+        r.wall_seconds,
+        r.rhs_evaluations,
+        r.steps[0],
+        r.steps[1],
+        r.edges
+    );
+    if r.windows > 0 {
+        let _ = writeln!(s, "Measured by the core from the encoder edges");
+        let _ = writeln!(
+            s,
+            "  windows {} ({} invalid{}), edges rejected: {} glitches, {} missing, {} extra",
+            r.windows,
+            r.invalid_windows,
+            if r.invalid_reasons.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    ": {}",
+                    r.invalid_reasons
+                        .iter()
+                        .map(|(k, v)| format!("{v} {k}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            },
+            r.rejected_edges[0],
+            r.rejected_edges[1],
+            r.rejected_edges[2]
+        );
+        if let Some(w) = r.speed_measured {
+            let _ = writeln!(s, "  mean speed {w:.3} rad/s");
+        }
+        match (r.delta_measured, r.delta_predicted) {
+            (Some(m), Some(p)) => {
+                let _ = writeln!(
+                    s,
+                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}: {:+.2} %, noise floor {:.1e}",
+                    r.settle,
+                    100.0 * (m / p - 1.0),
+                    r.noise_floor.unwrap_or(f64::NAN)
+                );
+            }
+            (Some(m), None) => {
+                let _ = writeln!(
+                    s,
+                    "  δ measured {m:.6}, noise floor {:.1e}",
+                    r.noise_floor.unwrap_or(f64::NAN)
+                );
+            }
+            _ => {}
+        }
+        if let Some(l) = r.delta_limit {
+            if r.alarms.is_empty() {
+                let _ = writeln!(s, "  δ limit {l}: no alarm");
+            }
+            for a in &r.alarms {
+                let _ = writeln!(s, "  δ limit {l}: alarm {} at {:.2} s", a.event, a.time);
+            }
+        }
+    }
+    if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
+        let _ = writeln!(
+            s,
+            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {:.2e} of the rotor's)",
+            r.regime_class.unwrap_or("?"),
+            r.residual_relative.unwrap_or(f64::NAN)
+        );
+    }
+    if let Some(u) = &r.supports {
+        let _ = writeln!(
+            s,
+            "Supports at {:.2} rad/s: peak loads A {:.1} N ({}), B {:.1} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}",
+            u.speed,
+            u.peak_load[0],
+            u.load_level[0],
+            u.peak_load[1],
+            u.load_level[1],
+            u.simulated_peak_reaction[0],
+            u.simulated_peak_reaction[1],
+            u.unbalance_level[0],
+            u.unbalance_level[1]
+        );
+    }
+    s
+}
+
+/// Writes the plots a run calls for into `dir`; returns the files written.
+pub fn run_plots(
+    scene: &Scene,
+    file: &Path,
+    r: &RunReport,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut out = Vec::new();
+    let stem = file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string();
+    if !r.speed_trace.is_empty() {
+        let path = dir.join(format!("{stem}-speed.svg"));
+        let mut marks: Vec<Mark> = r
+            .window_list
+            .iter()
+            .filter(|w| !w.valid)
+            .map(|w| {
+                Mark::VLine(
+                    format!("invalid window ({})", w.fault.unwrap_or("?")),
+                    w.time,
+                )
+            })
+            .take(5)
+            .collect();
+        marks.push(Mark::Band("settling".into(), 0.0, r.settle, true));
+        write_svg(
+            &path,
+            &Chart {
+                title: "Shaft speed measured by the core (per speed sample)",
+                x_label: "time, s",
+                y_label: "ω, rad/s",
+                series: vec![Series {
+                    label: "ω".into(),
+                    points: r.speed_trace.clone(),
+                    markers: false,
+                }],
+                marks,
+            },
+        )?;
+        out.push(path);
+    }
+    if !r.window_list.is_empty() {
+        let path = dir.join(format!("{stem}-delta.svg"));
+        let mut marks = Vec::new();
+        if let Some(l) = r.delta_limit {
+            marks.push(Mark::HLine(format!("limit {l}"), l));
+        }
+        if let Some(p) = r.delta_predicted {
+            marks.push(Mark::HLine(format!("predicted {p:.5}"), p));
+        }
+        let valid: Vec<(f64, f64)> = r
+            .window_list
+            .iter()
+            .filter(|w| w.valid)
+            .map(|w| (w.time, w.delta))
+            .collect();
+        write_svg(
+            &path,
+            &Chart {
+                title: "δ per window (one load cycle each)",
+                x_label: "time, s",
+                y_label: "δ",
+                series: vec![Series {
+                    label: "δ measured".into(),
+                    points: valid,
+                    markers: true,
+                }],
+                marks,
+            },
+        )?;
+        out.push(path);
+    }
+    if let Some(machine) = predict::machine(scene, file).map_err(|e| e.to_string())? {
+        let path = dir.join(format!("{stem}-regimes.svg"));
+        let top = machine
+            .resonant_speeds()
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            * 1.6;
+        let mut marks: Vec<Mark> = machine
+            .zones()
+            .iter()
+            .map(|z| {
+                Mark::Band(
+                    z.kind.name().into(),
+                    z.from,
+                    z.to.unwrap_or(top),
+                    z.kind.name() == "gathering",
+                )
+            })
+            .collect();
+        if let Some(w) = r.speed_measured {
+            marks.push(Mark::VLine(format!("measured speed {w:.2} rad/s"), w));
+        }
+        let n = 400;
+        let re: Vec<(f64, f64)> = (1..=n)
+            .map(|i| {
+                let w = top * i as f64 / n as f64;
+                let (re, _) = machine.receptance(w);
+                (w, re)
+            })
+            .collect();
+        let scale = re.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(1e-300);
+        write_svg(
+            &path,
+            &Chart {
+                title: "Auto-balancer zones (criterion: balancing where Re H < 0)",
+                x_label: "rotor speed, rad/s",
+                y_label: "Re H / max |Re H|",
+                series: vec![Series {
+                    label: "Re H of the exciter platform".into(),
+                    points: re.into_iter().map(|(w, v)| (w, v / scale)).collect(),
+                    markers: false,
+                }],
+                marks,
+            },
+        )?;
+        out.push(path);
+    }
+    if let Some((rotor, limits)) = predict::rotor(scene, file).map_err(|e| e.to_string())? {
+        let path = dir.join(format!("{stem}-supports.svg"));
+        let analysis = drive_monitor::supports::SupportAnalysis::new(&rotor, &limits);
+        let top = analysis
+            .max_safe_speed()
+            .filter(|w| w.is_finite())
+            .unwrap_or(3.0 * limits.service_speed())
+            * 1.2;
+        let n = 300;
+        let curve = |k: usize| -> Vec<(f64, f64)> {
+            (0..=n)
+                .map(|i| {
+                    let w = top * i as f64 / n as f64;
+                    (w, rotor.loads(w)[k].peak)
+                })
+                .collect()
+        };
+        let mut marks = Vec::new();
+        if let Some(l) = scene.rotor.as_ref().and_then(|r| r.support_load_limit) {
+            marks.push(Mark::HLine(format!("limit A {} N", l[0]), l[0]));
+            if l[1] != l[0] {
+                marks.push(Mark::HLine(format!("limit B {} N", l[1]), l[1]));
+            }
+        }
+        marks.push(Mark::VLine(
+            format!("service speed {} rad/s", limits.service_speed()),
+            limits.service_speed(),
+        ));
+        if let Some(w) = r.speed_measured {
+            marks.push(Mark::VLine(format!("measured {w:.1} rad/s"), w));
+        }
+        write_svg(
+            &path,
+            &Chart {
+                title: "Peak support load per turn against speed",
+                x_label: "speed, rad/s",
+                y_label: "load, N",
+                series: vec![
+                    Series {
+                        label: "support A".into(),
+                        points: curve(0),
+                        markers: false,
+                    },
+                    Series {
+                        label: "support B".into(),
+                        points: curve(1),
+                        markers: false,
+                    },
+                ],
+                marks,
+            },
+        )?;
+        out.push(path);
+    }
+    Ok(out)
+}
 
 /// The design-time results as text.
 pub fn prediction_text(p: &Prediction) -> String {

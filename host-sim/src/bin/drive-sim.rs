@@ -18,6 +18,17 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Simulate a scene, feed its encoder edges to the core, report.
+    Run {
+        /// Scene file, or the name of a bundled scene.
+        scene: String,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Write SVG plots into this directory.
+        #[arg(long)]
+        plot: Option<std::path::PathBuf>,
+    },
     /// Design-time results only (no simulation): predicted δ, support limits, regime zones.
     Predict {
         /// Scene file, or the name of a bundled scene.
@@ -33,7 +44,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => predict_cmd(DEFAULT_SCENE, false),
+        None => run_cmd(DEFAULT_SCENE, false, None),
+        Some(Command::Run { scene, json, plot }) => run_cmd(&scene, json, plot.as_deref()),
         Some(Command::Predict { scene, json }) => predict_cmd(&scene, json),
         Some(Command::Scenes) => {
             for (name, text) in BUNDLED {
@@ -54,6 +66,31 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn run_cmd(name: &str, json: bool, plot: Option<&std::path::Path>) -> Result<(), String> {
+    let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
+    let report =
+        host_sim::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
+    if let Some(dir) = plot {
+        let files = host_sim::report::run_plots(&scene, &path, &report, dir)?;
+        if !json {
+            for f in files {
+                println!("plot: {}", f.display());
+            }
+        }
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        let p = predict(&scene, &path).map_err(|e| e.to_string())?;
+        print!("{}", host_sim::report::run_text(&scene, &report));
+        print!("{}", host_sim::report::prediction_text(&p));
+    }
+    Ok(())
 }
 
 fn predict_cmd(name: &str, json: bool) -> Result<(), String> {
