@@ -12,5 +12,6 @@ pub mod report;
 pub mod rotor_loads;
 pub mod run;
 pub mod scene;
+pub mod sweep;
 pub mod system;
 pub mod vibration;

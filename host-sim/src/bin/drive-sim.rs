@@ -37,6 +37,27 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run a vibration-machine scene at prescribed rotor speeds from A to B rad/s, in
+    /// parallel: the criterion's regime against what the loads did.
+    Sweep {
+        /// Scene file, or the name of a bundled scene.
+        scene: String,
+        /// Lowest speed, rad/s.
+        #[arg(long)]
+        from: f64,
+        /// Highest speed, rad/s.
+        #[arg(long)]
+        to: f64,
+        /// Number of speeds.
+        #[arg(long, default_value_t = 20)]
+        steps: usize,
+        /// Start the loads together at rest instead of near the balancing position.
+        #[arg(long)]
+        together: bool,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the bundled scenes.
     Scenes,
 }
@@ -47,6 +68,14 @@ fn main() -> ExitCode {
         None => run_cmd(DEFAULT_SCENE, false, None),
         Some(Command::Run { scene, json, plot }) => run_cmd(&scene, json, plot.as_deref()),
         Some(Command::Predict { scene, json }) => predict_cmd(&scene, json),
+        Some(Command::Sweep {
+            scene,
+            from,
+            to,
+            steps,
+            together,
+            json,
+        }) => sweep_cmd(&scene, from, to, steps, together, json),
         Some(Command::Scenes) => {
             for (name, text) in BUNDLED {
                 let desc = text
@@ -89,6 +118,52 @@ fn run_cmd(name: &str, json: bool, plot: Option<&std::path::Path>) -> Result<(),
         let p = predict(&scene, &path).map_err(|e| e.to_string())?;
         print!("{}", host_sim::report::run_text(&scene, &report));
         print!("{}", host_sim::report::prediction_text(&p));
+    }
+    Ok(())
+}
+
+fn sweep_cmd(
+    name: &str,
+    from: f64,
+    to: f64,
+    steps: usize,
+    together: bool,
+    json: bool,
+) -> Result<(), String> {
+    let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
+    let s = host_sim::sweep::sweep(&scene, &path, from, to, steps, together, true)
+        .map_err(|e| e.to_string())?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!(
+            "{:>10}  {:<10} {:<20} {:<10} {:>10}",
+            "speed", "criterion", "core class", "simulated", "residual"
+        );
+        for p in &s.points {
+            let mark = if p.regime_predicted == p.regime_simulated {
+                ""
+            } else {
+                "  ≠"
+            };
+            println!(
+                "{:>10.3}  {:<10} {:<20} {:<10} {:>10.2e}{mark}",
+                p.speed,
+                p.regime_predicted,
+                p.regime_class,
+                p.regime_simulated,
+                p.residual_relative
+            );
+        }
+        let agree = s
+            .points
+            .iter()
+            .filter(|p| p.regime_predicted == p.regime_simulated)
+            .count();
+        println!("agreement: {agree} of {} speeds", s.points.len());
     }
     Ok(())
 }
