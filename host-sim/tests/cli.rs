@@ -1,0 +1,168 @@
+//! The `drive-sim` command line: bundled scenes, JSON contracts, errors and exit codes.
+
+use std::process::Command;
+
+fn drive_sim(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
+        .args(args)
+        .output()
+        .expect("drive-sim runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let (ok, out, err) = drive_sim(args);
+    assert!(ok, "{args:?}: {err}");
+    serde_json::from_str(&out).expect("valid JSON")
+}
+
+#[test]
+fn no_arguments_runs_the_kneader_and_reports() {
+    let (ok, out, err) = drive_sim(&[]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("kneader.toml") && out.contains("δ measured"),
+        "{out}"
+    );
+    assert!(out.contains("0.030656"), "{out}");
+}
+
+#[test]
+fn scenes_lists_every_bundled_scene() {
+    let (ok, out, _) = drive_sim(&["scenes"]);
+    assert!(ok);
+    for s in [
+        "kneader",
+        "auger",
+        "auger-overhung",
+        "one-mass",
+        "two-mass",
+        "three-mass",
+    ] {
+        assert!(out.contains(&format!("{s}.toml")), "{s}: {out}");
+    }
+}
+
+#[test]
+fn predict_json_has_the_contracted_members() {
+    let v = json(&["predict", "kneader", "--json"]);
+    let i = &v["irregularity"];
+    assert!((i["delta"].as_f64().unwrap() - 0.030656).abs() < 1e-6);
+    assert!((i["omega_max"].as_f64().unwrap() - 136.311).abs() < 1e-3);
+    assert!((i["omega_min"].as_f64().unwrap() - 132.196).abs() < 1e-3);
+    assert_eq!(i["steady_state"], true);
+    assert_eq!(i["flywheel_for_limit"].as_f64(), Some(0.0));
+
+    let s = &json(&["predict", "auger", "--json"])["supports"];
+    for k in [
+        "unbalance_a",
+        "unbalance_b",
+        "permissible_a",
+        "permissible_b",
+        "max_speed",
+    ] {
+        assert!(s[k].as_f64().is_some(), "{k}: {s}");
+    }
+
+    let a = &json(&["predict", "two-mass", "--json"])["autobalancer"];
+    assert_eq!(a["resonant_speeds"].as_array().unwrap().len(), 2);
+    assert_eq!(a["additional_speeds"].as_array().unwrap().len(), 1);
+    let zones = a["zones"].as_array().unwrap();
+    assert_eq!(zones.first().unwrap()["regime"], "gathering");
+    assert!(zones.last().unwrap()["to"].is_null());
+}
+
+#[test]
+fn run_json_reports_measurement_prediction_and_cost() {
+    let v = json(&["run", "kneader", "--json"]);
+    let m = v["delta_measured"].as_f64().unwrap();
+    let p = v["delta_predicted"].as_f64().unwrap();
+    assert!((m / p - 1.0).abs() < 0.01);
+    for k in [
+        "windows",
+        "invalid_windows",
+        "noise_floor",
+        "alarms",
+        "wall_seconds",
+        "rhs_evaluations",
+        "edges",
+    ] {
+        assert!(!v[k].is_null(), "{k}");
+    }
+    let v = json(&["run", "one-mass", "--json"]);
+    assert_eq!(v["regime_predicted"], "balancing");
+    assert_eq!(v["regime_simulated"], "balancing");
+}
+
+#[test]
+fn sweep_json_keeps_its_contract() {
+    let v = json(&[
+        "sweep", "one-mass", "--from", "40", "--to", "110", "--steps", "3", "--json",
+    ]);
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    for p in points {
+        assert!(p["speed"].as_f64().is_some());
+        for k in ["regime_predicted", "regime_simulated"] {
+            let r = p[k].as_str().unwrap();
+            assert!(r == "balancing" || r == "gathering", "{k}: {r}");
+        }
+    }
+    assert_eq!(points[0]["regime_predicted"], "gathering");
+    assert_eq!(points[2]["regime_simulated"], "balancing");
+}
+
+#[test]
+fn plots_are_written() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-plots-{}", std::process::id()));
+    let (ok, _, err) = drive_sim(&["run", "kneader", "--plot", dir.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    for f in ["kneader-speed.svg", "kneader-delta.svg"] {
+        let svg = std::fs::read_to_string(dir.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.len() > 2000, "{f}");
+    }
+    let (ok, _, err) = drive_sim(&["run", "auger", "--plot", dir.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(dir.join("auger-supports.svg").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_scenes_name_the_file_and_key_and_fail() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = [
+        ("unknown.toml", "[shaft]\ninertia = 0.3\nflywhel = 1.0\n", "flywhel"),
+        ("missing.toml", "[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_torque = 158.0\n", "breakdown_speed"),
+        ("units.toml", "[encoder]\nlines = 1024\ntimer_hz = \"84 MHz\"\n", "timer_hz"),
+        (
+            "impossible.toml",
+            "[shaft]\ninertia = -0.3\n[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\nbreakdown_torque = 158.0\n[load]\nmean = 24.0\n",
+            "shaft.inertia",
+        ),
+        (
+            "stall.toml",
+            "[shaft]\ninertia = 0.3\n[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 150.0\nbreakdown_torque = 158.0\n[load]\nmean = 24.0\n",
+            "motor.",
+        ),
+    ];
+    for (file, text, key) in cases {
+        let path = dir.join(file);
+        std::fs::write(&path, text).unwrap();
+        for cmd in ["run", "predict"] {
+            let (ok, _, err) = drive_sim(&[cmd, path.to_str().unwrap()]);
+            assert!(!ok, "{file} {cmd} should fail");
+            assert!(
+                err.contains(file) && err.contains(key),
+                "{file} {cmd}: {err}"
+            );
+        }
+    }
+    let (ok, _, err) = drive_sim(&["run", "no-such-scene.toml"]);
+    assert!(!ok && err.contains("no-such-scene.toml"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
