@@ -145,13 +145,20 @@ pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), String> {
                 });
         }
     }
+    // Limits in red first, then other reference lines in green and grey.
+    let line_colors = [RED, RGBColor(0, 150, 0), RGBColor(90, 90, 90)];
+    let mut hlines = 0;
     for m in &chart.marks {
         match m {
             Mark::HLine(label, y) => {
-                c.draw_series(LineSeries::new([(x0, *y), (x1, *y)], RED.stroke_width(2)))
+                let color = line_colors[hlines % line_colors.len()];
+                hlines += 1;
+                c.draw_series(LineSeries::new([(x0, *y), (x1, *y)], color.stroke_width(2)))
                     .map_err(|e| e.to_string())?
                     .label(label.as_str())
-                    .legend(|(x, y)| PathElement::new([(x, y), (x + 15, y)], RED.stroke_width(2)));
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 15, y)], color.stroke_width(2))
+                    });
             }
             Mark::VLine(label, x) => {
                 c.draw_series(LineSeries::new([(*x, y0), (*x, y1)], BLACK.stroke_width(2)))

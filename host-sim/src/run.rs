@@ -437,7 +437,8 @@ impl Observer for Collector<'_> {
                 });
             }
         }
-        if self.edges % self.trace_every == 0 {
+        // The trace starts with the first speed sample (0 before it is "no sample yet").
+        if self.edges % self.trace_every == 0 && (m.speed() > 0.0 || !self.trace.is_empty()) {
             self.trace.push((edge.true_time, m.speed() as f64));
         }
     }
