@@ -11,6 +11,7 @@
 #![no_std]
 #![no_main]
 
+mod balancer_bench;
 mod bench;
 mod icount;
 mod math_bench;
@@ -32,6 +33,7 @@ fn main() -> ! {
     bench::calibrate();
     math_bench::run();
     monitor_bench::run();
+    balancer_bench::run();
 
     let (used, available) = stack::peak();
     hprintln!("stack: peak {} bytes (of {} available)", used, available);
