@@ -657,20 +657,27 @@ impl Solver {
         }
     }
 
+    /// `ytmp = y + h·Σ_j a_j·k_j` over the stages `j < a.len()` (zero coefficients skipped).
+    fn stage_input(&mut self, a: &[f64], h: f64) {
+        let n = self.n;
+        for i in 0..n {
+            let mut acc = 0.0;
+            for (j, aj) in a.iter().enumerate() {
+                if *aj != 0.0 {
+                    acc += aj * self.k[j * n + i];
+                }
+            }
+            self.ytmp[i] = self.y[i] + h * acc;
+        }
+    }
+
     fn attempt_dp5<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64, tol: Tol) -> f64 {
         let n = self.n;
         let t = self.t;
         // Stage s (1-based 2..6) in block s-1; block 0 mirrors f.
         self.k[..n].copy_from_slice(&self.f);
         for s in 1..6 {
-            let row = &DP5_A[s];
-            for i in 0..n {
-                let mut acc = 0.0;
-                for (j, a) in row.iter().enumerate().take(s) {
-                    acc += a * self.k[j * n + i];
-                }
-                self.ytmp[i] = self.y[i] + h * acc;
-            }
+            self.stage_input(&DP5_A[s][..s], h);
             self.eval(sys, t + DP5_C[s] * h, Buf::Stage, s);
         }
         for i in 0..n {
@@ -726,16 +733,7 @@ impl Solver {
         let t = self.t;
         self.k[..n].copy_from_slice(&self.f);
         for s in 1..12 {
-            let row = &DP8_A[s];
-            for i in 0..n {
-                let mut acc = 0.0;
-                for (j, a) in row.iter().enumerate().take(s) {
-                    if *a != 0.0 {
-                        acc += a * self.k[j * n + i];
-                    }
-                }
-                self.ytmp[i] = self.y[i] + h * acc;
-            }
+            self.stage_input(&DP8_A[s][..s], h);
             self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
         }
         for i in 0..n {
@@ -782,16 +780,7 @@ impl Solver {
         // Block 12 holds f(t + h, ynew); blocks 13..15 the three extra stages.
         self.k[12 * n..13 * n].copy_from_slice(&self.fnew);
         for s in 13..16 {
-            let row = &DP8_A[s];
-            for i in 0..n {
-                let mut acc = 0.0;
-                for (j, a) in row.iter().enumerate().take(s) {
-                    if *a != 0.0 {
-                        acc += a * self.k[j * n + i];
-                    }
-                }
-                self.ytmp[i] = self.y[i] + h * acc;
-            }
+            self.stage_input(&DP8_A[s][..s], h);
             self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
         }
         for i in 0..n {
