@@ -2,12 +2,14 @@
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
 
+pub mod cost;
 pub mod effects;
 pub mod encoder;
 pub mod model;
 pub mod ode;
 pub mod plot;
 pub mod predict;
+pub mod publish;
 pub mod report;
 pub mod rotor_loads;
 pub mod run;

@@ -58,6 +58,16 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Measure what accuracy costs and write Markdown tables and SVG plots into a directory.
+    Accuracy {
+        /// Output directory (e.g. docs/).
+        #[arg(long, default_value = "docs")]
+        out: std::path::PathBuf,
+        /// Also build and run the firmware under QEMU (needs the thumbv7em target and
+        /// qemu-system-arm) and include its instruction counts.
+        #[arg(long)]
+        target: bool,
+    },
     /// List the bundled scenes.
     Scenes,
 }
@@ -76,6 +86,13 @@ fn main() -> ExitCode {
             together,
             json,
         }) => sweep_cmd(&scene, from, to, steps, together, json),
+        Some(Command::Accuracy { out, target }) => {
+            host_sim::publish::accuracy(&out, target).map(|files| {
+                for f in files {
+                    println!("wrote {}", f.display());
+                }
+            })
+        }
         Some(Command::Scenes) => {
             for (name, text) in BUNDLED {
                 let desc = text

@@ -1,0 +1,366 @@
+//! What simulation accuracy costs: error against wall time for each integrator setting on
+//! scenes with a known answer, and how a run's cost scales with duration, encoder lines and
+//! effects.
+//!
+//! - Kneader (seed 000): the steady state is exact in closed form (ω² = u(φ), eq. 11), so the
+//!   error is max |ω²/u(φ) − 1| over the steady part, sampled at step ends and mid-steps (the
+//!   dense output is what edge location uses).
+//! - Two-mass auto-balancer at a prescribed 100 rad/s: no closed form; the reference is a
+//!   DOP853 run at rtol 1e-13, and the error is the largest deviation of any state from it at
+//!   200 instants, relative to that state's largest magnitude.
+//!
+//! Wall times are the minimum of three runs on the machine at hand (stated in the output).
+
+use crate::encoder::{EncoderConfig, Reference};
+use crate::model::Effect;
+use crate::ode::Integrator;
+use crate::run::{run, Overrides};
+use crate::scene::{resolve, Scene};
+use crate::system::{DynamicShaft, Observer, ShaftModel, Simulation, SpeedLaw, StepView, System};
+use crate::vibration::VibrationMachine;
+use drive_monitor::drive::DriveModel;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// One integrator setting on one scene.
+#[derive(Debug, Clone, Serialize)]
+pub struct ParetoRow {
+    /// Scene.
+    pub scene: &'static str,
+    /// Integrator and setting, e.g. `dopri5 rtol=1e-9`.
+    pub setting: String,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Wall time, ms (minimum of three runs).
+    pub wall_ms: f64,
+    /// Error (see the module docs).
+    pub error: f64,
+    /// On the Pareto front of its scene (no other setting is both faster and more accurate).
+    pub pareto: bool,
+}
+
+/// Integrator settings swept for each scene.
+fn settings(fine_step: f64) -> Vec<(String, Integrator)> {
+    let mut v = Vec::new();
+    for k in 0..4 {
+        let step = fine_step * f64::powi(2.0, 3 - k);
+        v.push((format!("rk4 h={step:.2e}"), Integrator::Rk4 { step }));
+    }
+    for rtol in [1e-6, 1e-8, 1e-10, 1e-12] {
+        v.push((
+            format!("dopri5 rtol={rtol:.0e}"),
+            Integrator::Dopri5 {
+                rtol,
+                atol: rtol * 1e-2,
+                max_step: None,
+            },
+        ));
+    }
+    for rtol in [1e-8, 1e-10, 1e-12] {
+        v.push((
+            format!("dop853 rtol={rtol:.0e}"),
+            Integrator::Dop853 {
+                rtol,
+                atol: rtol * 1e-2,
+                max_step: None,
+            },
+        ));
+    }
+    v
+}
+
+fn mark_pareto(rows: &mut [ParetoRow]) {
+    let copy: Vec<(f64, f64)> = rows.iter().map(|r| (r.wall_ms, r.error)).collect();
+    for r in rows.iter_mut() {
+        r.pareto = !copy.iter().any(|&(t, e)| t < r.wall_ms && e < r.error);
+    }
+}
+
+fn best_of_three<F: FnMut() -> f64>(mut f: F) -> (f64, f64) {
+    let mut best = f64::INFINITY;
+    let mut value = f64::NAN;
+    for _ in 0..3 {
+        let start = Instant::now();
+        value = f();
+        best = best.min(start.elapsed().as_secs_f64() * 1e3);
+    }
+    (best, value)
+}
+
+fn kneader_model() -> Result<DriveModel, String> {
+    let (scene, path) = resolve("kneader").map_err(|e| e.to_string())?;
+    crate::predict::drive_model(&scene, &path)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| "the kneader scene has no drive model".to_string())
+}
+
+struct KneaderError<'a> {
+    model: &'a DriveModel,
+    from: f64,
+    worst: f64,
+}
+
+impl Observer for KneaderError<'_> {
+    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn step(&mut self, step: &StepView<'_>) {
+        if step.t1() < self.from {
+            return;
+        }
+        for t in [0.5 * (step.t0() + step.t1()), step.t1()] {
+            let s = step.shaft(t);
+            let u = self.model.omega_squared(s.phi);
+            self.worst = self.worst.max((s.omega * s.omega / u - 1.0).abs());
+        }
+    }
+}
+
+fn kneader_simulation(
+    model: &DriveModel,
+    integrator: Integrator,
+    lines: u32,
+) -> Result<Simulation, String> {
+    let effects: Vec<Box<dyn Effect>> =
+        vec![Box::new(*model.motor()), Box::new(model.load().clone())];
+    let shaft = ShaftModel::Dynamic(DynamicShaft {
+        inertia: model.inertia(),
+        flywheel: model.flywheel(),
+        harmonics: Vec::new(),
+        phi0: 0.0,
+        omega0: model.u_mean().sqrt(),
+    });
+    let system = System::new(shaft, effects).map_err(|e| e.to_string())?;
+    let mut enc = EncoderConfig::ideal(lines, 84e6);
+    enc.reference = Reference::Index;
+    Simulation::new(system, integrator, enc).map_err(|e| e.to_string())
+}
+
+/// Error against wall time on the kneader scene (30 s, 1024 lines, edges generated).
+pub fn kneader_pareto() -> Result<Vec<ParetoRow>, String> {
+    let model = kneader_model()?;
+    let mut rows = Vec::new();
+    for (setting, integ) in settings(1.25e-4) {
+        let mut evals = 0;
+        let mut failure = None;
+        let (wall_ms, error) = best_of_three(|| {
+            let mut obs = KneaderError {
+                model: &model,
+                from: 10.0,
+                worst: 0.0,
+            };
+            let result = kneader_simulation(&model, integ.clone(), 1024)
+                .and_then(|mut sim| sim.run_observed(30.0, &mut obs).map_err(|e| e.to_string()));
+            match result {
+                Ok(stats) => evals = stats.solver.rhs_evals,
+                Err(e) => failure = Some(e),
+            }
+            obs.worst
+        });
+        if let Some(e) = failure {
+            return Err(format!("kneader with {setting}: {e}"));
+        }
+        rows.push(ParetoRow {
+            scene: "kneader",
+            setting,
+            rhs_evals: evals,
+            wall_ms,
+            error,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
+struct Sampler {
+    times: Vec<f64>,
+    next: usize,
+    out: Vec<Vec<f64>>,
+    buf: Vec<f64>,
+}
+
+impl Observer for Sampler {
+    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn step(&mut self, step: &StepView<'_>) {
+        while self.next < self.times.len() && self.times[self.next] <= step.t1() {
+            step.state_into(self.times[self.next], &mut self.buf);
+            self.out.push(self.buf.clone());
+            self.next += 1;
+        }
+    }
+}
+
+fn balancer_states(
+    scene: &Scene,
+    file: &Path,
+    integ: Integrator,
+    duration: f64,
+) -> Result<(u64, Vec<Vec<f64>>), String> {
+    let params = crate::run::vibration_params(scene, file, false)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| "the scene has no vibration machine".to_string())?;
+    let vm = VibrationMachine::new(&params).map_err(|e| e.to_string())?;
+    let system = System::new(
+        ShaftModel::Prescribed(SpeedLaw::Constant {
+            omega: 100.0,
+            phi0: 0.0,
+        }),
+        vec![Box::new(vm)],
+    )
+    .map_err(|e| e.to_string())?;
+    let dim = system.dim();
+    let mut sim =
+        Simulation::new(system, integ, EncoderConfig::ideal(4, 1e6)).map_err(|e| e.to_string())?;
+    let n = 200;
+    let mut obs = Sampler {
+        times: (1..=n).map(|k| duration * k as f64 / n as f64).collect(),
+        next: 0,
+        out: Vec::new(),
+        buf: vec![0.0; dim],
+    };
+    let stats = sim
+        .run_observed(duration, &mut obs)
+        .map_err(|e| e.to_string())?;
+    Ok((stats.solver.rhs_evals, obs.out))
+}
+
+/// Error against wall time on the two-mass auto-balancer at 100 rad/s (10 s), against a
+/// DOP853 rtol 1e-13 reference.
+pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
+    let (scene, path) = resolve("two-mass").map_err(|e| e.to_string())?;
+    let duration = 10.0;
+    let reference = Integrator::Dop853 {
+        rtol: 1e-13,
+        atol: 1e-16,
+        max_step: None,
+    };
+    let (_, reference) = balancer_states(&scene, &path, reference, duration)?;
+    let dim = reference.first().map_or(0, Vec::len);
+    let scale: Vec<f64> = (0..dim)
+        .map(|i| {
+            reference
+                .iter()
+                .map(|y| y[i].abs())
+                .fold(0.0, f64::max)
+                .max(1e-300)
+        })
+        .collect();
+    let mut rows = Vec::new();
+    for (setting, integ) in settings(2.5e-5) {
+        let mut evals = 0;
+        let mut failure = None;
+        let (wall_ms, error) =
+            best_of_three(
+                || match balancer_states(&scene, &path, integ.clone(), duration) {
+                    Ok((e, states)) if states.len() == reference.len() => {
+                        evals = e;
+                        let mut worst: f64 = 0.0;
+                        for (y, r) in states.iter().zip(&reference) {
+                            for i in 0..dim {
+                                worst = worst.max((y[i] - r[i]).abs() / scale[i]);
+                            }
+                        }
+                        worst
+                    }
+                    Ok(_) => f64::INFINITY,
+                    Err(e) => {
+                        failure = Some(e);
+                        f64::NAN
+                    }
+                },
+            );
+        if let Some(e) = failure {
+            return Err(format!("two-mass with {setting}: {e}"));
+        }
+        rows.push(ParetoRow {
+            scene: "two-mass",
+            setting,
+            rhs_evals: evals,
+            wall_ms,
+            error,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
+/// One point of a scaling series.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScalingRow {
+    /// What is varied: "duration", "lines" or "effects".
+    pub series: &'static str,
+    /// Its value (s, lines, or the effect list).
+    pub value: String,
+    /// Edges generated.
+    pub edges: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Wall time of the whole run (simulation and core), ms, minimum of three.
+    pub wall_ms: f64,
+    /// Wall time per edge, ns.
+    pub ns_per_edge: f64,
+}
+
+fn scaled_run(series: &'static str, value: String, text: &str) -> Result<ScalingRow, String> {
+    let file = Path::new("scaling.toml");
+    let scene = Scene::parse(text, file).map_err(|e| e.to_string())?;
+    let mut edges = 0;
+    let mut evals = 0;
+    let mut failure = None;
+    let (wall_ms, _) = best_of_three(|| {
+        match run(&scene, file, Overrides::default()) {
+            Ok(r) => {
+                edges = r.edges;
+                evals = r.rhs_evaluations;
+            }
+            Err(e) => failure = Some(e.to_string()),
+        }
+        0.0
+    });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    Ok(ScalingRow {
+        series,
+        value,
+        edges,
+        rhs_evals: evals,
+        wall_ms,
+        ns_per_edge: wall_ms * 1e6 / edges.max(1) as f64,
+    })
+}
+
+/// Cost of the kneader run against simulated duration, encoder lines and added effects.
+pub fn scaling() -> Result<Vec<ScalingRow>, String> {
+    let base = crate::scene::BUNDLED
+        .iter()
+        .find(|(n, _)| *n == "kneader.toml")
+        .map(|(_, t)| *t)
+        .ok_or("no bundled kneader scene")?;
+    let mut rows = Vec::new();
+    for d in [7.5, 15.0, 30.0, 60.0] {
+        let text = base
+            .replace("duration = 30.0", &format!("duration = {d}"))
+            .replace("settle = 10.0", &format!("settle = {}", d / 3.0));
+        rows.push(scaled_run("duration", format!("{d} s"), &text)?);
+    }
+    for lines in [256, 1024, 4096] {
+        let text = base.replace("lines = 1024", &format!("lines = {lines}"));
+        rows.push(scaled_run("lines", format!("{lines}"), &text)?);
+    }
+    let rotor = "\n[rotor]\nmass = 350.0\ncentre_of_mass = 1.9\nsupport_a = 0.0\nsupport_b = 4.0\ngrade = 6.3\nservice_speed = 134.0\n[[unbalance]]\nz = 1.2\namount = 2e-3\nangle = 30.0\n";
+    let vibration = "\n[[platform]]\nmass = 100.0\nstiffness = 4.0e5\ndamping = 200.0\n[autobalancer]\nkind = \"ball\"\nplatform = 1\nloads = 2\nload_mass = 0.5\nradius = 0.1\nhousing_mass = 5.0\nviscosity = 10.0\n";
+    rows.push(scaled_run("effects", "motor, load".into(), base)?);
+    rows.push(scaled_run(
+        "effects",
+        "motor, load, rotor-loads".into(),
+        &format!("{base}{rotor}"),
+    )?);
+    rows.push(scaled_run(
+        "effects",
+        "motor, load, vibration, rotor-loads".into(),
+        &format!("{base}{rotor}{vibration}"),
+    )?);
+    Ok(rows)
+}
