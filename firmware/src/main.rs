@@ -12,10 +12,12 @@
 #![no_main]
 
 mod bench;
+mod drive_bench;
 mod icount;
 mod math_bench;
 mod monitor_bench;
 mod stack;
+mod supports_bench;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
@@ -32,6 +34,8 @@ fn main() -> ! {
     bench::calibrate();
     math_bench::run();
     monitor_bench::run();
+    supports_bench::run();
+    drive_bench::run();
 
     let (used, available) = stack::peak();
     hprintln!("stack: peak {} bytes (of {} available)", used, available);
