@@ -12,7 +12,7 @@ use crate::encoder::Encoder;
 use crate::error::ConfigError;
 use crate::irregularity::{Window, WindowConfig, WindowReport, WindowState};
 use crate::learn::ToothLearner;
-use crate::speed::{Direction, EdgeCounters, Fault, ShaftState, SpeedTracker};
+use crate::speed::{Direction, EdgeCounters, Fault, ShaftState, SpeedSample, SpeedTracker};
 
 /// Everything the monitor counted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -49,7 +49,10 @@ pub struct DeltaMonitor<const N: usize> {
     state: WindowState,
     alarm: Option<DeltaAlarm>,
     learner: Option<ToothLearner<N>>,
-    last_speed: f32,
+    /// The latest speed sample as angle (rad) over ticks (0 ticks: none); converted to rad/s
+    /// only when asked for, so the per-edge path does not divide.
+    last_angle: f32,
+    last_ticks: u32,
     diag: Diagnostics,
 }
 
@@ -72,7 +75,8 @@ impl<const N: usize> DeltaMonitor<N> {
             state: WindowState::new(),
             alarm,
             learner: None,
-            last_speed: 0.0,
+            last_angle: 0.0,
+            last_ticks: 0,
             diag: Diagnostics::default(),
         })
     }
@@ -129,8 +133,13 @@ impl<const N: usize> DeltaMonitor<N> {
 
     /// The latest speed sample, rad/s (0 unless running).
     pub fn speed(&self) -> f32 {
-        if self.tracker.state() == ShaftState::Running {
-            self.last_speed
+        if self.tracker.state() == ShaftState::Running && self.last_ticks > 0 {
+            SpeedSample {
+                angle: self.last_angle,
+                ticks: self.last_ticks,
+                tooth: 0,
+            }
+            .omega(self.encoder.timer_hz())
         } else {
             0.0
         }
@@ -159,7 +168,8 @@ impl<const N: usize> DeltaMonitor<N> {
     pub fn on_edge(&mut self, ticks: u32, direction: Option<Direction>) -> Option<WindowOutcome> {
         let ev = self.tracker.on_edge(&self.encoder, ticks, direction);
         if let Some(s) = &ev.sample {
-            self.last_speed = s.omega(self.encoder.timer_hz());
+            self.last_angle = s.angle;
+            self.last_ticks = s.ticks;
         }
         if let Some(l) = self.learner.as_mut() {
             l.on_event(self.encoder.edges(), &ev);
@@ -173,7 +183,7 @@ impl<const N: usize> DeltaMonitor<N> {
     /// Checks for standstill at time `now` (ticks); returns the window cut short, if any.
     pub fn poll(&mut self, now: u32) -> Option<WindowOutcome> {
         let fault = self.tracker.poll(&self.encoder, now)?;
-        self.last_speed = 0.0;
+        self.last_ticks = 0;
         if let Some(l) = self.learner.as_mut() {
             l.on_event(
                 self.encoder.edges(),
@@ -189,6 +199,10 @@ impl<const N: usize> DeltaMonitor<N> {
         Some(self.finish(report))
     }
 
+    /// Counts a finished window and runs the alarm on it: once per window, kept out of line so
+    /// the per-edge path stays small.
+    #[cold]
+    #[inline(never)]
     fn finish(&mut self, report: WindowReport) -> WindowOutcome {
         if report.valid() {
             self.diag.valid_windows = self.diag.valid_windows.wrapping_add(1);

@@ -116,6 +116,23 @@ pub struct EdgeCounters {
     pub revolutions: u32,
 }
 
+/// The exact interval sum of a full ring of `k` intervals, from the sum modulo 2^32, saturated
+/// at `u32::MAX`.
+///
+/// Each interval is 1 to `timeout` ticks (0 is a glitch, more is a timeout) and the encoder
+/// checks K·timeout < 2^32 before rounding `timeout` up to whole ticks, so the exact sum is at
+/// least `k` and below 2^32 + `k`. A sum modulo 2^32 below `k` therefore means it wrapped, and
+/// the exact sum is at least 2^32: saturate. Keeping the running sum in one 32-bit word instead
+/// of a u64 pair keeps it in registers on the per-edge path.
+#[inline]
+fn full_ring_ticks(sum: u32, k: u16) -> u32 {
+    if sum < u32::from(k) {
+        u32::MAX
+    } else {
+        sum
+    }
+}
+
 /// Per-edge state of the timing front end. Total: every input sequence is handled without
 /// panicking, and every path is O(1).
 #[derive(Debug, Clone)]
@@ -133,7 +150,8 @@ pub struct SpeedTracker {
     ring: [u32; MAX_SPAN],
     ring_pos: u16,
     ring_fill: u16,
-    ring_sum: u64,
+    /// Sum of the ring's intervals modulo 2^32 (see [`full_ring_ticks`]).
+    ring_sum: u32,
     counters: EdgeCounters,
 }
 
@@ -187,12 +205,14 @@ impl SpeedTracker {
         self.counters
     }
 
+    #[cold]
     fn lose_sync(&mut self) {
         self.synced = false;
         self.index_pending = false;
         self.clear_ring();
     }
 
+    #[cold]
     fn count(&mut self, f: Fault) -> Fault {
         let c = &mut self.counters;
         let n = match f {
@@ -232,6 +252,7 @@ impl SpeedTracker {
         None
     }
 
+    #[cold]
     fn enter_standstill(&mut self) {
         self.state = ShaftState::Standstill;
         self.have_last = false;
@@ -247,8 +268,31 @@ impl SpeedTracker {
         ticks: u32,
         direction: Option<Direction>,
     ) -> EdgeEvent {
-        let mut ev = EdgeEvent::default();
         let ticks = ticks & enc.mask();
+        if direction == Some(Direction::Reverse)
+            || !self.have_last
+            || self.state == ShaftState::Reversed
+        {
+            return self.restart(enc, ticks, direction);
+        }
+        let dt = ticks.wrapping_sub(self.last) & enc.mask();
+        if dt > enc.timeout_ticks() {
+            return self.restart_after_timeout(ticks);
+        }
+        self.on_interval(enc, dt, ticks)
+    }
+
+    /// An edge that gives no interval: reverse rotation, or the first edge after start,
+    /// standstill or reversal. Off the per-edge path.
+    #[cold]
+    #[inline(never)]
+    fn restart<const N: usize>(
+        &mut self,
+        enc: &Encoder<N>,
+        ticks: u32,
+        direction: Option<Direction>,
+    ) -> EdgeEvent {
+        let mut ev = EdgeEvent::default();
         if direction == Some(Direction::Reverse) {
             if self.state != ShaftState::Reversed {
                 self.state = ShaftState::Reversed;
@@ -260,31 +304,39 @@ impl SpeedTracker {
             self.prev_dt = 0;
             return ev;
         }
-        if !self.have_last || self.state == ShaftState::Reversed {
-            // First edge after start, standstill or reversal: only a time reference, but an
-            // index pulse before it still frames it as tooth 0.
-            self.state = ShaftState::Running;
-            self.last = ticks;
-            self.have_last = true;
-            self.prev_dt = 0;
-            if self.index_pending && enc.config().framing == Framing::Index {
-                self.index_pending = false;
-                self.synced = true;
-                self.tooth = 0;
-                self.clear_ring();
-            }
-            return ev;
+        // First edge after start, standstill or reversal: only a time reference, but an
+        // index pulse before it still frames it as tooth 0.
+        self.state = ShaftState::Running;
+        self.last = ticks;
+        self.have_last = true;
+        self.prev_dt = 0;
+        if self.index_pending && enc.config().framing == Framing::Index {
+            self.index_pending = false;
+            self.synced = true;
+            self.tooth = 0;
+            self.clear_ring();
         }
-        let dt = ticks.wrapping_sub(self.last) & enc.mask();
-        if dt > enc.timeout_ticks() {
-            // The shaft stopped and restarted between two polls.
-            self.enter_standstill();
-            self.state = ShaftState::Running;
-            self.last = ticks;
-            self.have_last = true;
-            ev.fault = Some(Fault::Timeout);
-            return ev;
+        ev
+    }
+
+    /// The shaft stopped and restarted between two polls.
+    #[cold]
+    #[inline(never)]
+    fn restart_after_timeout(&mut self, ticks: u32) -> EdgeEvent {
+        self.enter_standstill();
+        self.state = ShaftState::Running;
+        self.last = ticks;
+        self.have_last = true;
+        EdgeEvent {
+            fault: Some(Fault::Timeout),
+            ..EdgeEvent::default()
         }
+    }
+
+    /// An edge `dt` ticks after the previous accepted one, at `ticks`.
+    #[inline(always)]
+    fn on_interval<const N: usize>(&mut self, enc: &Encoder<N>, dt: u32, ticks: u32) -> EdgeEvent {
+        let mut ev = EdgeEvent::default();
         let edges = enc.edges();
         let next = if self.synced {
             if self.tooth + 1 >= edges {
@@ -296,26 +348,30 @@ impl SpeedTracker {
             1
         };
         let uniform = enc.uniform_pitch();
-        let next_pitch = if self.synced {
-            enc.pitch(next)
+        let was_synced = self.synced;
+        let next_pitch = if was_synced { enc.pitch(next) } else { uniform };
+        // Interval relative to the one expected from the previous interval's speed, kept as the
+        // fraction `num / den` (1/1 without a previous interval) and compared by
+        // cross-multiplying: no division on the per-edge path.
+        let (num, den) = if self.prev_dt > 0 {
+            (
+                dt as f32 * self.prev_pitch,
+                self.prev_dt as f32 * next_pitch,
+            )
         } else {
-            uniform
-        };
-        // Interval relative to the one expected from the previous interval's speed.
-        let ratio = if self.prev_dt > 0 {
-            dt as f32 * self.prev_pitch / (self.prev_dt as f32 * next_pitch)
-        } else {
-            1.0
+            (1.0, 1.0)
         };
         let gap_framing = matches!(enc.config().framing, Framing::MissingTooth { .. });
+        let glitch_fraction = enc.config().glitch_fraction;
         // Unsynced on a gapped disc the next interval may be a gap or follow one: only an
-        // interval short even against that is a glitch.
-        let glitch_limit = if !self.synced && gap_framing {
-            enc.config().glitch_fraction / enc.gap_ratio() / 2.0
+        // interval short even against that (ratio below glitch_fraction / gap_ratio / 2) is a
+        // glitch.
+        let glitch = if !self.synced && gap_framing {
+            num * (2.0 * enc.gap_ratio()) < glitch_fraction * den
         } else {
-            enc.config().glitch_fraction
+            num < glitch_fraction * den
         };
-        if dt == 0 || ratio < glitch_limit {
+        if dt == 0 || glitch {
             ev.fault = Some(self.count(Fault::Glitch));
             return ev;
         }
@@ -324,16 +380,13 @@ impl SpeedTracker {
         self.state = ShaftState::Running;
 
         let mut tooth = next;
-        // Apparent pitch of this interval in uniform pitches: ≈1 for a tooth, ≈m+1 for a gap.
-        let apparent = if self.prev_dt > 0 {
-            dt as f32 * self.prev_pitch / (self.prev_dt as f32 * uniform)
-        } else {
-            1.0
-        };
-        let long = self.prev_dt > 0 && ratio > 1.5;
+        // Apparent pitch of this interval in uniform pitches, `num / uniform_den`: ≈1 for a
+        // tooth, ≈m+1 for a gap.
+        let uniform_den = self.prev_dt as f32 * uniform;
+        let long = self.prev_dt > 0 && num > 1.5 * den;
         match enc.config().framing {
             Framing::MissingTooth { .. } => {
-                let gap = self.prev_dt > 0 && apparent > enc.gap_ratio();
+                let gap = self.prev_dt > 0 && num > enc.gap_ratio() * uniform_den;
                 if self.synced {
                     if gap && next != 0 {
                         // Too few edges before the gap; the gap itself still frames tooth 0.
@@ -397,9 +450,18 @@ impl SpeedTracker {
             }
         }
         let pitch = if self.synced {
-            enc.pitch(tooth)
+            if was_synced && tooth == next {
+                next_pitch
+            } else {
+                enc.pitch(tooth)
+            }
         } else {
             // Unframed: the interval spanned a whole number of uniform pitches.
+            let apparent = if self.prev_dt > 0 {
+                num / uniform_den
+            } else {
+                1.0
+            };
             uniform * libm::roundf(apparent).max(1.0)
         };
         self.prev_dt = dt;
@@ -414,17 +476,17 @@ impl SpeedTracker {
         ev.interval = Some((dt, tooth));
         // K-edge ring: exact integer running sum (add the new interval, drop the oldest).
         let k = enc.samples_span().min(MAX_SPAN as u16);
-        let pos = self.ring_pos as usize % MAX_SPAN;
-        let oldest = self.ring.get(pos).copied().unwrap_or(0);
+        let pos = usize::from(self.ring_pos) % MAX_SPAN;
+        let oldest = match self.ring.get_mut(pos) {
+            Some(slot) => core::mem::replace(slot, dt),
+            None => 0,
+        };
         if self.ring_fill >= k {
-            self.ring_sum = self.ring_sum.wrapping_sub(oldest as u64);
+            self.ring_sum = self.ring_sum.wrapping_sub(oldest);
         } else {
             self.ring_fill += 1;
         }
-        if let Some(slot) = self.ring.get_mut(pos) {
-            *slot = dt;
-        }
-        self.ring_sum = self.ring_sum.wrapping_add(dt as u64);
+        self.ring_sum = self.ring_sum.wrapping_add(dt);
         self.ring_pos = if self.ring_pos + 1 >= k {
             0
         } else {
@@ -433,8 +495,7 @@ impl SpeedTracker {
         if self.ring_fill >= k {
             ev.sample = Some(SpeedSample {
                 angle: enc.span(tooth),
-                // K·timeout fits in u32 (checked by the encoder), so this never saturates.
-                ticks: self.ring_sum.min(u32::MAX as u64) as u32,
+                ticks: full_ring_ticks(self.ring_sum, k),
                 tooth,
             });
         }

@@ -13,10 +13,12 @@
 
 mod balancer_bench;
 mod bench;
+mod drive_bench;
 mod icount;
 mod math_bench;
 mod monitor_bench;
 mod stack;
+mod supports_bench;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
@@ -34,6 +36,8 @@ fn main() -> ! {
     math_bench::run();
     monitor_bench::run();
     balancer_bench::run();
+    supports_bench::run();
+    drive_bench::run();
 
     let (used, available) = stack::peak();
     hprintln!("stack: peak {} bytes (of {} available)", used, available);

@@ -2,6 +2,7 @@
 //! scene calls for, synthetic encoder edges, and reports computed by the same core code that
 //! runs on the target.
 
+pub mod accuracy;
 pub mod cost;
 pub mod effects;
 pub mod encoder;

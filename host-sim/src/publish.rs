@@ -103,10 +103,9 @@ fn target_benches() -> Result<(Vec<(String, String)>, String), String> {
         .lines()
         .filter_map(|l| l.strip_prefix("bench "))
         .filter_map(|l| {
-            let mut parts = l.split_whitespace();
-            let name = parts.next()?;
-            let n = parts.last()?;
-            Some((name.to_string(), n.to_string()))
+            // `bench <name, may contain spaces> <instructions>`
+            let (name, n) = l.trim_end().rsplit_once(char::is_whitespace)?;
+            Some((name.trim().to_string(), n.to_string()))
         })
         .collect();
     let footprint = text

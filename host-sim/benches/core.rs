@@ -1,0 +1,154 @@
+//! Host benchmarks of the core's hot paths (criterion), the counterparts of the firmware's
+//! instruction counts: the per-edge update over a 1024-line pulse stream, the window finish
+//! amortised over it, the support-load update, and the predicted δ.
+//!
+//! Kept quick (20 samples, short warm-up and measurement) so a full `cargo bench` stays within
+//! CI budgets; `cargo bench --no-run` only compiles them.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BatchSize, Criterion, Throughput};
+use drive_monitor::alarm::AlarmConfig;
+use drive_monitor::drive::{DriveModel, Harmonic, Load, Parabola};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
+use drive_monitor::irregularity::{WindowConfig, WindowLength};
+use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::speed::Direction;
+use drive_monitor::supports::{
+    Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, DEFAULT_WARNING_FRACTION,
+};
+
+const LINES: u16 = 1024;
+const TIMER_HZ: f64 = 84e6;
+const REVS: usize = 8 * 5 + 2;
+
+/// Capture timestamps of the kneader-like ripple ω = 134·(1 + 0.015·sin(φ/8)) rad/s on a
+/// 1024-line disc and an 84 MHz timer (as the firmware's monitor section).
+fn stream() -> Vec<u32> {
+    let pitch = std::f64::consts::TAU / f64::from(LINES);
+    let mut t = 0.0f64;
+    (0..usize::from(LINES) * REVS)
+        .map(|i| {
+            let mid = (i as f64 + 0.5) * pitch;
+            t += pitch / (134.0 * (1.0 + 0.015 * (mid / 8.0).sin()));
+            (t * TIMER_HZ) as u64 as u32
+        })
+        .collect()
+}
+
+fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
+    let mut c = EncoderConfig::new(LINES, TIMER_HZ);
+    c.estimator = Estimator::Edges(k);
+    c.min_speed = 10.0;
+    let enc = Encoder::new(c).expect("encoder");
+    let w = WindowConfig {
+        length: WindowLength::Revolutions(revs),
+        steady_tolerance: 0.02,
+    };
+    DeltaMonitor::new(enc, w, Some(AlarmConfig::new(0.06))).expect("monitor")
+}
+
+/// Feeds the whole stream (index pulse before every tooth 0); returns the windows reported.
+fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32]) -> u32 {
+    let mut windows = 0;
+    for (i, &t) in ticks.iter().enumerate() {
+        if i % usize::from(LINES) == 0 {
+            m.on_index();
+        }
+        if black_box(m.on_edge(black_box(t), Some(Direction::Forward))).is_some() {
+            windows += 1;
+        }
+    }
+    windows
+}
+
+fn bench_monitor(c: &mut Criterion) {
+    let ticks = stream();
+    let mut g = c.benchmark_group("monitor");
+    g.throughput(Throughput::Elements(ticks.len() as u64));
+    // k = 1 and k = 16 with 8-revolution windows: the per-edge cost; 1-revolution windows on
+    // the same edges finish 8× as many windows, so the difference is the window finish.
+    for (name, k, revs) in [
+        ("on_edge k=1", 1, 8),
+        ("on_edge k=16", 16, 8),
+        ("on_edge k=16 window=1", 16, 1),
+    ] {
+        let fresh = monitor(k, revs);
+        g.bench_function(name, |b| {
+            b.iter_batched_ref(|| fresh.clone(), |m| feed(m, &ticks), BatchSize::LargeInput)
+        });
+    }
+    g.finish();
+}
+
+fn bench_supports(c: &mut Criterion) {
+    let rotor: Rotor<4> = Rotor::new(
+        350.0,
+        1.9,
+        0.0,
+        4.0,
+        &[Unbalance::new(1.2, 2e-3, 30f64.to_radians())],
+        Some(ProcessLoad {
+            per_length: 400.0,
+            from: 0.5,
+            to: 3.5,
+            angle: 270f64.to_radians(),
+        }),
+    )
+    .expect("rotor");
+    let limits =
+        Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), DEFAULT_WARNING_FRACTION).expect("limits");
+    let monitor = SupportAnalysis::new(&rotor, &limits).monitor();
+    let speeds: Vec<f32> = (0..64).map(|i| 60.0 * i as f32).collect();
+    let mut g = c.benchmark_group("supports");
+    g.throughput(Throughput::Elements(speeds.len() as u64));
+    g.bench_function("update", |b| {
+        b.iter(|| {
+            for &w in &speeds {
+                black_box(monitor.update(black_box(w)));
+            }
+        })
+    });
+    g.finish();
+    c.bench_function("supports/analysis", |b| {
+        b.iter(|| black_box(SupportAnalysis::new(black_box(&rotor), &limits)))
+    });
+}
+
+fn bench_drive(c: &mut Criterion) {
+    let model = |harmonics: &[Harmonic]| {
+        DriveModel::new(
+            Parabola::new(145.0, 36.0, 158.0).expect("motor").into(),
+            Load::new(24.0, harmonics).expect("load"),
+            0.323,
+            0.0,
+        )
+        .expect("drive")
+    };
+    let h = |order, amplitude, phase| Harmonic::new(order, amplitude, phase).expect("harmonic");
+    let one = [h(0.125, 12.0, 0.0)];
+    let two = [h(0.125, 12.0, 0.0), h(0.5, 6.0, 1.0)];
+    let seed = model(&one);
+    c.bench_function("drive/new+predict 1 harmonic", |b| {
+        b.iter(|| black_box(model(black_box(&one)).predict()))
+    });
+    c.bench_function("drive/new+predict 2 harmonics", |b| {
+        b.iter(|| black_box(model(black_box(&two)).predict()))
+    });
+    c.bench_function("drive/flywheel_for 1 harmonic", |b| {
+        b.iter(|| black_box(black_box(&seed).flywheel_for(0.01)))
+    });
+}
+
+fn main() {
+    let mut c = Criterion::default()
+        .sample_size(20)
+        .warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_millis(600))
+        .configure_from_args();
+    bench_monitor(&mut c);
+    bench_supports(&mut c);
+    bench_drive(&mut c);
+    c.final_summary();
+}
