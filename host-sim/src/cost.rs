@@ -364,3 +364,126 @@ pub fn scaling() -> Result<Vec<ScalingRow>, String> {
     )?);
     Ok(rows)
 }
+
+/// The own DOPRI5 against the `ode_solvers` crate's on the same problem at the same
+/// tolerances.
+#[derive(Debug, Clone, Serialize)]
+pub struct CrateRow {
+    /// Which stepper.
+    pub stepper: &'static str,
+    /// Relative tolerance (absolute = rtol·1e-2).
+    pub rtol: f64,
+    /// Wall time, ms (minimum of three).
+    pub wall_ms: f64,
+    /// max |ω²/u(φ) − 1| at the 1 ms output points after 10 s.
+    pub error: f64,
+}
+
+struct KneaderOde {
+    model: DriveModel,
+}
+
+impl ode_solvers::System<f64, ode_solvers::Vector2<f64>> for KneaderOde {
+    fn system(&self, _t: f64, y: &ode_solvers::Vector2<f64>, dy: &mut ode_solvers::Vector2<f64>) {
+        let (phi, omega) = (y[0], y[1]);
+        dy[0] = omega;
+        dy[1] = (self.model.motor().torque(omega) - self.model.load().torque(phi))
+            / self.model.total_inertia();
+    }
+}
+
+struct Every {
+    dt: f64,
+    next: f64,
+    from: f64,
+    model: DriveModel,
+    worst: f64,
+}
+
+impl Observer for Every {
+    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn step(&mut self, step: &StepView<'_>) {
+        while self.next <= step.t1() {
+            if self.next >= self.from {
+                let s = step.shaft(self.next);
+                let u = self.model.omega_squared(s.phi);
+                self.worst = self.worst.max((s.omega * s.omega / u - 1.0).abs());
+            }
+            self.next += self.dt;
+        }
+    }
+}
+
+/// The kneader ODE for 30 s with output every 1 ms: the own DOPRI5 (dense output sampled at
+/// the same instants) against `ode_solvers::Dopri5` (its dense output), per tolerance.
+pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
+    let model = kneader_model()?;
+    let omega0 = model.u_mean().sqrt();
+    let mut rows = Vec::new();
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        let atol = rtol * 1e-2;
+        let mut failure = None;
+        let (wall_ms, error) = best_of_three(|| {
+            let mut solver = ode_solvers::Dopri5::new(
+                KneaderOde { model: model.clone() },
+                0.0,
+                30.0,
+                1e-3,
+                ode_solvers::Vector2::new(0.0, omega0),
+                rtol,
+                atol,
+            );
+            if let Err(e) = solver.integrate() {
+                failure = Some(e.to_string());
+            }
+            let mut worst: f64 = 0.0;
+            for (t, y) in solver.x_out().iter().zip(solver.y_out()) {
+                if *t >= 10.0 {
+                    let u = model.omega_squared(y[0]);
+                    worst = worst.max((y[1] * y[1] / u - 1.0).abs());
+                }
+            }
+            worst
+        });
+        if let Some(e) = failure {
+            return Err(format!("ode_solvers at rtol {rtol}: {e}"));
+        }
+        rows.push(CrateRow {
+            stepper: "ode_solvers::Dopri5",
+            rtol,
+            wall_ms,
+            error,
+        });
+        let (wall_ms, error) = best_of_three(|| {
+            let integ = Integrator::Dopri5 {
+                rtol,
+                atol,
+                max_step: None,
+            };
+            let mut obs = Every {
+                dt: 1e-3,
+                next: 0.0,
+                from: 10.0,
+                model: model.clone(),
+                worst: 0.0,
+            };
+            // One line per revolution: the encoder is all but idle, as in the crate's run.
+            let result = kneader_simulation(&model, integ, 1)
+                .and_then(|mut sim| sim.run_observed(30.0, &mut obs).map_err(|e| e.to_string()));
+            if let Err(e) = result {
+                failure = Some(e);
+            }
+            obs.worst
+        });
+        if let Some(e) = failure {
+            return Err(format!("own dopri5 at rtol {rtol}: {e}"));
+        }
+        rows.push(CrateRow {
+            stepper: "host-sim dopri5",
+            rtol,
+            wall_ms,
+            error,
+        });
+    }
+    Ok(rows)
+}
