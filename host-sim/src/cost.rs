@@ -425,7 +425,9 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
         let mut failure = None;
         let (wall_ms, error) = best_of_three(|| {
             let mut solver = ode_solvers::Dopri5::new(
-                KneaderOde { model: model.clone() },
+                KneaderOde {
+                    model: model.clone(),
+                },
                 0.0,
                 30.0,
                 1e-3,

@@ -88,8 +88,16 @@ fn pareto_plot(path: &Path, title: &str, rows: &[ParetoRow]) -> Result<(), Strin
     )
 }
 
-/// Runs the firmware under QEMU and returns its `bench` lines as (name, instructions).
-fn target_benches() -> Result<(Vec<(String, String)>, String), String> {
+/// What the firmware reported: `bench` lines as (name, instructions), its footprint line, and
+/// its `accuracy` and `delta:` lines (errors against f64 or exact references, on the target).
+struct TargetReport {
+    benches: Vec<(String, String)>,
+    footprint: String,
+    accuracy: Vec<String>,
+}
+
+/// Runs the firmware under QEMU and collects what it reports.
+fn target_benches() -> Result<TargetReport, String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let out = Command::new("bash")
         .arg(root.join("firmware/run.sh"))
@@ -116,7 +124,16 @@ fn target_benches() -> Result<(Vec<(String, String)>, String), String> {
         .find(|l| l.starts_with("footprint:"))
         .unwrap_or("")
         .to_string();
-    Ok((benches, footprint))
+    let accuracy = text
+        .lines()
+        .filter(|l| l.starts_with("accuracy ") || l.starts_with("delta: "))
+        .map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "))
+        .collect();
+    Ok(TargetReport {
+        benches,
+        footprint,
+        accuracy,
+    })
 }
 
 /// Measures everything and writes `accuracy.md` and the SVG plots into `out`.
@@ -139,7 +156,11 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
     let mut per_edge: Option<f64> = None;
     let mut target_section = String::new();
     if target {
-        let (benches, footprint) = target_benches()?;
+        let TargetReport {
+            benches,
+            footprint,
+            accuracy,
+        } = target_benches()?;
         per_edge = benches
             .iter()
             .find(|(n, _)| n == "monitor::on_edge k=16")
@@ -157,10 +178,21 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
         for (name, n) in benches {
             let _ = writeln!(md, "| `{name}` | {n} |");
         }
+        let _ = writeln!(
+            md,
+            "\nThe error each variant buys, measured on the target against an f64 (or exact) \
+             reference on the same inputs:\n"
+        );
+        for line in accuracy {
+            let _ = writeln!(md, "- `{line}`");
+        }
         let _ = writeln!(md);
     }
-    let _ = writeln!(md, "## Recommended configuration
-");
+    let _ = writeln!(
+        md,
+        "## Recommended configuration
+"
+    );
     let _ = writeln!(
         md,
         "A 1024-line encoder with an index pulse on a 170 MHz 32-bit capture timer, speed \
@@ -168,7 +200,10 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
          {edges_per_s:.0} edges/s) on the kneader's ripple (δ = {:.4}):\n",
         2.0 * AccuracySweep::default().epsilon
     );
-    let _ = writeln!(md, "| K | δ error | quantization floor | averaging bias |\n|---:|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "| K | δ error | quantization floor | averaging bias |\n|---:|---:|---:|---:|"
+    );
     for k in [1u16, 4, 16] {
         let r = measure_case(omega, AccuracySweep::default().epsilon, 1024, 170e6, k, 3)
             .map_err(|e| e.to_string())?;
@@ -201,7 +236,10 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
         }
     }
     md.push_str(&target_section);
-    let _ = writeln!(md, "## δ accuracy against encoder lines, timer clock and K\n");
+    let _ = writeln!(
+        md,
+        "## δ accuracy against encoder lines, timer clock and K\n"
+    );
     let _ = writeln!(
         md,
         "Measured by `DeltaMonitor` (the target's code, run on the host) from an exact pulse train \
@@ -252,7 +290,10 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
          its DOPRI5 and `ode_solvers::Dopri5` (0.6) integrate the same kneader ODE for 30 s with \
          output every 1 ms; error = max |ω²/u(φ) − 1| at those instants after 10 s.\n"
     );
-    let _ = writeln!(md, "| stepper | rtol | wall, ms | error |\n|---|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "| stepper | rtol | wall, ms | error |\n|---|---:|---:|---:|"
+    );
     for r in crate_comparison()? {
         let _ = writeln!(
             md,
