@@ -489,3 +489,33 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
     }
     Ok(rows)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(wall_ms: f64, error: f64) -> ParetoRow {
+        ParetoRow {
+            scene: "t",
+            setting: String::new(),
+            rhs_evals: 0,
+            wall_ms,
+            error,
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn pareto_front_keeps_only_undominated_settings() {
+        let mut rows = vec![
+            row(1.0, 1e-3),
+            row(2.0, 1e-6),
+            row(3.0, 1e-5),
+            row(0.5, 1e-2),
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        // (3 ms, 1e-5) is beaten by (2 ms, 1e-6) on both counts.
+        assert_eq!(front, vec![true, true, false, true]);
+    }
+}

@@ -96,6 +96,13 @@ struct TargetReport {
     accuracy: Vec<String>,
 }
 
+/// `bench <name, may contain spaces> <instructions>` as (name, instructions).
+fn bench_line(line: &str) -> Option<(String, String)> {
+    let rest = line.strip_prefix("bench ")?;
+    let (name, n) = rest.trim_end().rsplit_once(char::is_whitespace)?;
+    Some((name.trim().to_string(), n.to_string()))
+}
+
 /// Runs the firmware under QEMU and collects what it reports.
 fn target_benches() -> Result<TargetReport, String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -110,15 +117,7 @@ fn target_benches() -> Result<TargetReport, String> {
             String::from_utf8_lossy(&out.stderr)
         ));
     }
-    let benches = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("bench "))
-        .filter_map(|l| {
-            // `bench <name, may contain spaces> <instructions>`
-            let (name, n) = l.trim_end().rsplit_once(char::is_whitespace)?;
-            Some((name.trim().to_string(), n.to_string()))
-        })
-        .collect();
+    let benches = text.lines().filter_map(bench_line).collect();
     let footprint = text
         .lines()
         .find(|l| l.starts_with("footprint:"))
@@ -316,4 +315,22 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
     std::fs::write(&path, md).map_err(|e| format!("{}: {e}", path.display()))?;
     files.push(path);
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_lines_keep_names_with_spaces() {
+        assert_eq!(
+            bench_line("bench supports::set_unbalance micromath      71"),
+            Some(("supports::set_unbalance micromath".into(), "71".into()))
+        );
+        assert_eq!(
+            bench_line("bench monitor::on_edge k=16            267"),
+            Some(("monitor::on_edge k=16".into(), "267".into()))
+        );
+        assert_eq!(bench_line("accuracy libm::sqrt 5e-8"), None);
+    }
 }
