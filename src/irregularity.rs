@@ -156,13 +156,23 @@ impl Default for WindowState {
     }
 }
 
-/// a1·t2 − a2·t1 to within about one rounding of the result (Kahan's difference of products:
-/// the product a2·t1 is split exactly with a fused multiply-add, so equal speeds cancel to 0).
-fn cross(a1: f32, t2: f32, a2: f32, t1: f32) -> f32 {
-    let w = a2 * t1;
-    let e = libm::fmaf(-a2, t1, w);
-    let f = libm::fmaf(a1, t2, -w);
-    f + e
+/// A tick count as an f32 head (its rounding) plus the exact remainder (|rem| ≤ 128).
+fn split_ticks(t: u32) -> (f32, f32) {
+    let head = t as f32;
+    (head, (i64::from(t) - head as i64) as f32)
+}
+
+/// a1·t2 − a2·t1 for integer tick counts, to within about one rounding of the result.
+/// Stability: counts above 2²⁴ round in f32, so each is split exactly into head + remainder;
+/// the head products are differenced error-free (Kahan: a2·h1 split with an FMA), the small
+/// remainder products added after, and equal speeds cancel to exactly 0.
+fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
+    let (h2, l2) = split_ticks(t2);
+    let (h1, l1) = split_ticks(t1);
+    let w = a2 * h1;
+    let e = libm::fmaf(-a2, h1, w);
+    let f = libm::fmaf(a1, h2, -w);
+    (f + e) + (a1 * l2 - a2 * l1)
 }
 
 impl WindowState {
@@ -208,15 +218,26 @@ impl WindowState {
             self.min = self.max;
             return;
         }
-        // Compare angle/ticks by cross-multiplying: no division per edge.
+        // Compare angle/ticks by cross-multiplying: no division per edge. Equal angles (a
+        // uniform disc) compare the exact integer counts, which round in f32 above 2²⁴.
         let t = s.ticks as f32;
-        if s.angle * self.max.ticks as f32 > self.max.angle * t {
+        let faster = if s.angle == self.max.angle {
+            s.ticks < self.max.ticks
+        } else {
+            s.angle * self.max.ticks as f32 > self.max.angle * t
+        };
+        if faster {
             self.max = Extreme {
                 angle: s.angle,
                 ticks: s.ticks,
             };
         }
-        if s.angle * (self.min.ticks as f32) < self.min.angle * t {
+        let slower = if s.angle == self.min.angle {
+            s.ticks > self.min.ticks
+        } else {
+            s.angle * (self.min.ticks as f32) < self.min.angle * t
+        };
+        if slower {
             self.min = Extreme {
                 angle: s.angle,
                 ticks: s.ticks,
@@ -231,7 +252,7 @@ impl WindowState {
         let omega_min = if t2 > 0.0 { a2 * timer_hz / t2 } else { 0.0 };
         // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1): the numerator
         // from exact integer ticks and an FMA difference, never by subtracting two speeds.
-        let num = cross(a1, t2, a2, t1);
+        let num = cross(a1, self.min.ticks, a2, self.max.ticks);
         let den = a1 * t2 + a2 * t1;
         let delta = if den > 0.0 { 2.0 * num / den } else { 0.0 };
         let omega_mean = if self.ticks > 0 {
@@ -341,14 +362,19 @@ mod tests {
 
     #[test]
     fn cross_product_difference_is_exact_for_close_speeds() {
-        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding.
+        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding;
+        // nor one tick in 3e9, where each count rounds to a multiple of 256 in f32.
         let a = 0.006_135_923_f32;
-        let (t1, t2) = (10_000_000f32, 10_000_001f32);
-        let num = cross(a, t2, a, t1);
-        let exact = a as f64 * 1.0;
-        assert!(
-            (num as f64 - exact).abs() <= 1e-7 * exact,
-            "{num} vs {exact}"
-        );
+        for (t1, t2) in [
+            (10_000_000u32, 10_000_001u32),
+            (3_000_000_001, 3_000_000_002),
+        ] {
+            let num = cross(a, t2, a, t1);
+            let exact = a as f64 * 1.0;
+            assert!(
+                (num as f64 - exact).abs() <= 1e-7 * exact,
+                "{num} vs {exact}"
+            );
+        }
     }
 }

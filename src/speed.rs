@@ -301,11 +301,16 @@ impl SpeedTracker {
         } else {
             uniform
         };
-        // Interval relative to the one expected from the previous interval's speed.
-        let ratio = if self.prev_dt > 0 {
-            dt as f32 * self.prev_pitch / (self.prev_dt as f32 * next_pitch)
+        // Interval relative to the one expected from the previous interval's speed, as the
+        // range the ±1-tick quantization of both counts allows: a coarse timer's rounding is
+        // then neither a glitch (only a ratio below the limit even at its largest is) nor a
+        // missing edge (only one above 1.5 even at its smallest is).
+        let (ratio_lo, ratio_hi) = if self.prev_dt > 0 {
+            let (d, p) = (dt as f32, self.prev_dt as f32);
+            let scale = self.prev_pitch / next_pitch;
+            ((d - 1.0) / (p + 1.0) * scale, (d + 1.0) / (p - 1.0) * scale)
         } else {
-            1.0
+            (1.0, 1.0)
         };
         let gap_framing = matches!(enc.config().framing, Framing::MissingTooth { .. });
         // Unsynced on a gapped disc the next interval may be a gap or follow one: only an
@@ -315,7 +320,7 @@ impl SpeedTracker {
         } else {
             enc.config().glitch_fraction
         };
-        if dt == 0 || ratio < glitch_limit {
+        if dt == 0 || ratio_hi < glitch_limit {
             ev.fault = Some(self.count(Fault::Glitch));
             return ev;
         }
@@ -330,7 +335,7 @@ impl SpeedTracker {
         } else {
             1.0
         };
-        let long = self.prev_dt > 0 && ratio > 1.5;
+        let long = self.prev_dt > 0 && ratio_lo > 1.5;
         match enc.config().framing {
             Framing::MissingTooth { .. } => {
                 let gap = self.prev_dt > 0 && apparent > enc.gap_ratio();

@@ -1,0 +1,736 @@
+//! Hard cases: inputs where a naive evaluation of a formula loses its digits, divides by zero
+//! or returns NaN, each checked through the public API against a more careful reference with a
+//! stated tolerance (issue 8). Sections: predicted δ, measured δ and timing, characteristic
+//! speeds of auto-balancer machines, support unbalance, validation, and totality of every
+//! runtime entry point.
+//!
+//! Every test comment names the case, the reference, the tolerance and why that tolerance.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+#[path = "../src/testutil.rs"]
+mod testutil;
+
+use drive_monitor::alarm::AlarmConfig;
+use drive_monitor::balancer::{
+    AutoBalancer, BalancerKind, Classifier, Coupling, Machine, MachineConfig, Platform, Regime,
+    RegimeTracker, SearchOptions, ZoneKind,
+};
+use drive_monitor::drive::{
+    DriveModel, Harmonic, Horizon, Kloss, Load, Motor, Parabola, Prediction, SteadyState,
+};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
+use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
+use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::speed::{Direction, Fault};
+use drive_monitor::supports::{
+    equivalent_planes, Level, Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, Vec2,
+};
+use drive_monitor::{ConfigError, Libm, Micromath};
+use proptest::prelude::*;
+use std::collections::VecDeque;
+use std::f64::consts::{PI, TAU};
+use testutil::{BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE};
+
+/// Unit roundoff of f32 (half an ulp of 1).
+const U32: f64 = f32::EPSILON as f64 / 2.0;
+/// Unit roundoff of f64.
+const U64: f64 = f64::EPSILON / 2.0;
+
+fn rel(a: f64, b: f64) -> f64 {
+    if a == b {
+        0.0
+    } else {
+        (a - b).abs() / b.abs()
+    }
+}
+
+// =============================================================================================
+// Predicted δ (drive model, seed 000 eq. 11–13)
+// =============================================================================================
+
+const W0: f64 = 145.0;
+const WM: f64 = 36.0;
+const MM: f64 = 158.0;
+const J: f64 = 0.323;
+const M1: f64 = 24.0;
+
+fn seed_motor() -> Motor {
+    Parabola::new(W0, WM, MM).unwrap().into()
+}
+
+fn h(order: f64, amplitude: f64, phase: f64) -> Harmonic {
+    Harmonic::new(order, amplitude, phase).unwrap()
+}
+
+fn drive(harmonics: &[Harmonic], inertia: f64) -> DriveModel {
+    DriveModel::new(
+        seed_motor(),
+        Load::new(M1, harmonics).unwrap(),
+        inertia,
+        0.0,
+    )
+    .unwrap()
+}
+
+fn steady(m: &DriveModel) -> SteadyState {
+    *m.predict().steady().expect("steady state")
+}
+
+/// The reference for one harmonic, in the paper's own coefficients (eq. 10–12, B's sign
+/// corrected), written independently of the model's `hypot` form: `(ū, R)` with ū = D2/D1 and
+/// R = 2·D3/√(4·D1² + n²) the amplitude of ω².
+fn paper_terms(m2: f64, n: f64, j: f64) -> (f64, f64) {
+    let k = W0 * W0 - WM * WM;
+    let d1 = MM / (j * k);
+    let d2 = (MM * W0 * W0 - M1 * k) / (j * k);
+    let d3 = m2 / j;
+    (d2 / d1, 2.0 * d3 / (4.0 * d1 * d1 + n * n).sqrt())
+}
+
+/// δ from r = R/ū without cancellation: ωmax,min = √ū·√(1 ± r), so
+/// δ = 2(√(1+r) − √(1−r))/(√(1+r) + √(1−r)) = 2r/(1 + √(1 − r²)).
+fn delta_of_r(r: f64) -> f64 {
+    2.0 * r / (1.0 + ((1.0 - r) * (1.0 + r)).sqrt())
+}
+
+/// Case: tiny predicted δ (1e-7 … 1e-13) where ωmax − ωmin cancels, reached by a small load
+/// amplitude M2 (not by a large J, which the unit tests cover).
+/// Reference: the cancellation-free exact form 2r/(1 + √(1 − r²)) on the paper's coefficients.
+/// Tolerance 1e-12 relative: both sides are a handful of correctly rounded f64 operations on
+/// the same inputs, with no subtraction of nearly equal numbers (the model takes ωmax − ωmin
+/// as (smax − smin)/(ωmax + ωmin)); 1e-12 leaves 4 decades above f64 rounding.
+/// Second check, several orders (a searched, not closed-form, extremum): scaling every
+/// amplitude by λ scales the oscillation of ω² exactly by λ, so δ·(ωmax + ωmin)²/2 = λ·Δs₁
+/// with Δs₁ = ωmax² − ωmin² at λ = 1 (no cancellation there, δ ≈ 0.04); 1e-12 again.
+#[test]
+fn predicted_tiny_delta_keeps_its_digits() {
+    let seed_delta = steady(&drive(&[h(0.125, 12.0, 0.0)], J)).delta;
+    for target in [1e-7, 1e-10, 1e-13] {
+        let m2 = 12.0 * target / seed_delta;
+        let s = steady(&drive(&[h(0.125, m2, 0.0)], J));
+        let (ubar, r_amp) = paper_terms(m2, 0.125, J);
+        let reference = delta_of_r(r_amp / ubar);
+        assert!(rel(s.delta, target) < 1e-3, "{} vs {target}", s.delta);
+        assert!(
+            rel(s.delta, reference) < 1e-12,
+            "δ {} vs {reference}",
+            s.delta
+        );
+    }
+    let hs = |lambda: f64| {
+        [
+            h(0.125, 12.0 * lambda, 0.0),
+            h(0.5, 6.0 * lambda, 1.0),
+            h(1.0, 9.0 * lambda, -0.4),
+        ]
+    };
+    let one = steady(&drive(&hs(1.0), J));
+    assert!(matches!(one.horizon, Horizon::Period { .. }));
+    let ds1 = one.omega_max.powi(2) - one.omega_min.powi(2);
+    for lambda in [1e-5, 1e-8, 1e-11] {
+        let s = steady(&drive(&hs(lambda), J));
+        let w = s.omega_max + s.omega_min;
+        let ds = s.delta * w * w / 2.0;
+        assert!(
+            rel(ds, lambda * ds1) < 1e-12,
+            "λ {lambda}: {ds} vs {}",
+            lambda * ds1
+        );
+    }
+}
+
+/// Case: a drive at the edge of stalling (no steady state): the peak load amplitude crosses
+/// M2* = ū·√(4a² + n²J²)/2, where the periodic ω² first touches zero.
+/// Reference: M2* from the paper's coefficients (R(M2*) = ū exactly), and δ from 2r/(1+√(1−r²)).
+/// Tolerances: the prediction switches from `Steady` to `Stalls` between M2*·(1 − 1e-9) and
+/// M2*·(1 + 1e-9) (1e-9 is 10⁷ ulps: far above the rounding of either M2* computation, far
+/// below any physical meaning). Just below, δ is within 1e-9 relative of the reference: the
+/// problem's condition number there is 1/√(1 − r²) ≈ 2·10⁴, so f64 rounding allows ~1e-11.
+/// Every number stays finite (no NaN from √ of a negative ω²), the host summary reports δ = 2
+/// and ωmin = 0, sensitivities are absent, and the closed-form flywheel makes δ exactly the
+/// limit again (1e-12).
+#[test]
+fn stalled_drive_is_a_state_not_a_nan() {
+    let n = 0.125;
+    let (ubar, r1) = paper_terms(1.0, n, J);
+    let m2_star = ubar / r1;
+    let below = drive(&[h(n, m2_star * (1.0 - 1e-9), 0.0)], J);
+    let above = drive(&[h(n, m2_star * (1.0 + 1e-9), 0.0)], J);
+    let s = steady(&below);
+    assert!(s.omega_min > 0.0 && s.omega_min.is_finite());
+    let (_, r_amp) = paper_terms(m2_star * (1.0 - 1e-9), n, J);
+    let reference = delta_of_r(r_amp / ubar);
+    assert!(rel(s.delta, reference) < 1e-9, "{} vs {reference}", s.delta);
+    assert!(s.delta < 2.0 && s.delta > 1.999);
+    let Prediction::Stalls(st) = above.predict() else {
+        panic!("expected a stall above M2*")
+    };
+    assert!(st.u_min <= 0.0 && st.u_min > -1e-7 * ubar && st.u_mean.is_finite());
+    assert!(above.sensitivity().is_none());
+    let irr = above.irregularity(Some(0.06)).unwrap();
+    assert!(!irr.steady_state);
+    assert_eq!((irr.omega_min, irr.delta), (0.0, 2.0));
+    assert!(irr.omega_max.is_finite() && irr.omega_max > 0.0);
+    for phi in [0.0, 1.0, 1e6, f64::MAX] {
+        assert!(!above.omega_squared(phi).is_nan());
+    }
+    let extra = above.flywheel_for(0.06).unwrap();
+    let fixed = steady(&above.with_flywheel(extra).unwrap());
+    assert!(rel(fixed.delta, 0.06) < 1e-12, "{}", fixed.delta);
+    // The mean load above the motor's stall torque B: u_mean ≤ 0, no flywheel helps.
+    let b = seed_motor().model().b();
+    let over = DriveModel::new(
+        seed_motor(),
+        Load::new(b * (1.0 + 1e-12), &[]).unwrap(),
+        J,
+        0.0,
+    )
+    .unwrap();
+    assert!(matches!(over.predict(), Prediction::Stalls(s) if s.u_mean <= 0.0));
+}
+
+/// Case: J → ∞ in eq. 11 (a huge flywheel), J from 10³ to 10³⁰⁰ kg·m².
+/// Reference: the asymptote δ∞ = 2·M2/(n·J·ū) with its two known relative corrections:
+/// −(2a/(nJ))²/2 from √(4a² + n²J²) and +r²/4 from the δ(r) series, so
+/// |δ/δ∞ − 1| ≤ (2a/(nJ))² + r² (a safe bound on both) plus 1e-13 for rounding.
+/// Nothing may underflow to 0 or overflow on the way (δ ≈ 1e-302 at J = 1e300 is still a
+/// normal f64), and the angles of the extremes stay finite.
+#[test]
+fn huge_inertia_limit_of_eq_11() {
+    let a = MM / (W0 * W0 - WM * WM);
+    let ubar = W0 * W0 - M1 / a;
+    for e in [3, 6, 12, 24, 50, 100, 200, 300] {
+        let j = 10f64.powi(e);
+        let s = steady(&drive(&[h(0.125, 12.0, 0.0)], j));
+        let asym = 2.0 * 12.0 / (0.125 * j * ubar);
+        let bound = (2.0 * a / (0.125 * j)).powi(2) + asym * asym + 1e-13;
+        assert!(s.delta > 0.0 && s.delta.is_normal(), "J {j}: {}", s.delta);
+        assert!(rel(s.delta, asym) < bound, "J {j}: {} vs {asym}", s.delta);
+        assert!(s.phi_max.unwrap().is_finite() && s.phi_min.unwrap().is_finite());
+    }
+}
+
+/// Case: n → 0 in eq. 11 (a quasi-static load: the harmonic is so slow that the drive follows
+/// the torque balance), n from 1e-2 down to the smallest normal f64.
+/// Reference: the quasi-static limit, u = ū − (M2/a)·sin(nφ), i.e. r = M2/(a·ū) and
+/// δ = 2r/(1 + √(1 − r²)), whose relative correction is (nJ/(2a))²·(…) ≤ (nJ/2a)²·10;
+/// tolerance that bound plus 1e-13 (rounding). The extremal angles scale like 1/n and must
+/// come out finite or absent, never NaN (2π/n overflows for n < 3.5e-308), and the
+/// sensitivities must still exist.
+#[test]
+fn quasi_static_limit_of_eq_11() {
+    let a = MM / (W0 * W0 - WM * WM);
+    let ubar = W0 * W0 - M1 / a;
+    let quasi = delta_of_r(12.0 / a / ubar);
+    for n in [
+        1e-2,
+        1e-4,
+        1e-8,
+        1e-30,
+        1e-200,
+        1e-300,
+        1e-307,
+        f64::MIN_POSITIVE,
+    ] {
+        let m = drive(&[h(n, 12.0, 0.3)], J);
+        let s = steady(&m);
+        let bound = 10.0 * (n * J / (2.0 * a)).powi(2) + 1e-13;
+        assert!(rel(s.delta, quasi) < bound, "n {n}: {} vs {quasi}", s.delta);
+        for p in [s.phi_max, s.phi_min].into_iter().flatten() {
+            assert!(p.is_finite() && p >= 0.0, "n {n}: {s:?}");
+        }
+        let sens = m.sensitivity().expect("steady state has sensitivities");
+        assert!(sens.d_delta_d_inertia.is_finite() && sens.d_delta_d_breakdown_torque.is_finite());
+    }
+}
+
+// =============================================================================================
+// Measured δ and timing: exact pulse trains
+// =============================================================================================
+
+/// What a window of an exact pulse train must report, computed from the integer timestamps in
+/// f64 (every quantity below is exact integer arithmetic followed by one or two roundings).
+#[derive(Debug, Clone, Copy)]
+struct Exact {
+    delta: f64,
+    omega_max: f64,
+    omega_min: f64,
+    omega_mean: f64,
+    noise_floor: f64,
+    samples: usize,
+}
+
+/// Exact reference for a uniform disc with an index pulse: the last `positions·revs` accepted
+/// edges form the window; a speed sample spans `k` edges (all spans are the same angle, so
+/// δ = 2(Smax − Smin)/(Smax + Smin) in the integer K-edge sums S).
+struct ExactTrain {
+    positions: usize,
+    revs: usize,
+    k: usize,
+    timer_hz: f64,
+    hist: VecDeque<u64>,
+}
+
+impl ExactTrain {
+    fn new(positions: usize, revs: usize, k: usize, timer_hz: f64) -> Self {
+        ExactTrain {
+            positions,
+            revs,
+            k,
+            timer_hz,
+            hist: VecDeque::new(),
+        }
+    }
+
+    fn push(&mut self, t: u64) {
+        self.hist.push_back(t);
+        if self.hist.len() > self.positions * self.revs + self.k + 1 {
+            self.hist.pop_front();
+        }
+    }
+
+    fn window(&self) -> Exact {
+        let n = self.positions * self.revs;
+        let h = &self.hist;
+        let last = h.len() - 1;
+        let (mut smax, mut smin, mut ssum) = (0u64, u64::MAX, 0u64);
+        for j in last + 1 - n..=last {
+            let s = h[j] - h[j - self.k];
+            smax = smax.max(s);
+            smin = smin.min(s);
+            ssum += s;
+        }
+        let span = self.k as f64 * TAU / self.positions as f64;
+        let f = self.timer_hz;
+        Exact {
+            delta: 2.0 * (smax - smin) as f64 / (smax + smin) as f64,
+            omega_max: span * f / smin as f64,
+            omega_min: span * f / smax as f64,
+            omega_mean: self.revs as f64 * TAU * f / (h[last] - h[last - n]) as f64,
+            noise_floor: 2.0 * n as f64 / ssum as f64,
+            samples: n,
+        }
+    }
+}
+
+/// A window report against the exact values of its train, at f32 precision.
+/// Speeds: five f32 roundings at most (angle or 2π, timer rate, tick count, product, quotient):
+/// 5·2⁻²⁴ = 3.0e-7. δ: computed as 2·(a·t2 − a·t1)/(a·t2 + a·t1) from exact integer ticks,
+/// the difference of products error-free (FMA) — a few roundings relative to δ itself
+/// (tolerance 8 roundings, 4.8e-7), however small δ is.
+fn assert_matches_exact(r: &WindowReport, e: &Exact, what: &str) {
+    assert!(r.valid(), "{what}: {r:?}");
+    assert_eq!(r.samples as usize, e.samples, "{what}");
+    let speed_tol = 5.0 * U32 * 1.0001;
+    assert!(
+        rel(r.omega_mean as f64, e.omega_mean) <= speed_tol,
+        "{what}: mean {} vs {}",
+        r.omega_mean,
+        e.omega_mean
+    );
+    assert!(
+        rel(r.omega_max as f64, e.omega_max) <= speed_tol,
+        "{what}: max {} vs {}",
+        r.omega_max,
+        e.omega_max
+    );
+    assert!(
+        rel(r.omega_min as f64, e.omega_min) <= speed_tol,
+        "{what}: min {} vs {}",
+        r.omega_min,
+        e.omega_min
+    );
+    assert!(
+        (r.delta as f64 - e.delta).abs() <= 8.0 * U32 * e.delta,
+        "{what}: δ {} vs exact {} (rel {:e})",
+        r.delta,
+        e.delta,
+        rel(r.delta as f64, e.delta)
+    );
+    assert!(
+        rel(r.noise_floor as f64, e.noise_floor) <= 3.0 * U32,
+        "{what}: floor"
+    );
+}
+
+fn encoder_config(
+    positions: u16,
+    timer_hz: f64,
+    bits: u8,
+    k: u16,
+    min_speed: f64,
+) -> EncoderConfig {
+    let mut c = EncoderConfig::new(positions, timer_hz);
+    c.counter_bits = bits;
+    c.estimator = Estimator::Edges(k);
+    c.min_speed = min_speed;
+    c
+}
+
+fn monitor<const N: usize>(c: EncoderConfig, revs: u16) -> DeltaMonitor<N> {
+    let w = WindowConfig {
+        length: WindowLength::Revolutions(revs),
+        steady_tolerance: 0.02,
+    };
+    DeltaMonitor::new(Encoder::new(c).unwrap(), w, None).unwrap()
+}
+
+/// Feeds `edges` edges (index pulse before every tooth 0, edge 0 is tooth 0) at the unwrapped
+/// integer timestamps `t(k)`, offset by `start` and masked to the counter; every valid window
+/// is checked against the exact train. Returns the reports.
+#[allow(clippy::too_many_arguments)]
+fn run_exact<const N: usize>(
+    m: &mut DeltaMonitor<N>,
+    k: usize,
+    edges: u64,
+    start: u64,
+    mask: u64,
+    mut t: impl FnMut(u64) -> u64,
+    what: &str,
+) -> Vec<(WindowReport, Exact)> {
+    let positions = m.encoder().edges() as usize;
+    let revs = m.window_revolutions() as usize;
+    let timer_hz = m.encoder().config().timer_hz;
+    let mut exact = ExactTrain::new(positions, revs, k, timer_hz);
+    let mut out = Vec::new();
+    for e in 0..edges {
+        let tk = t(e) + start;
+        exact.push(tk);
+        if e % positions as u64 == 0 {
+            m.on_index();
+        }
+        if let Some(o) = m.on_edge((tk & mask) as u32, Some(Direction::Forward)) {
+            let x = exact.window();
+            assert_matches_exact(&o.report, &x, what);
+            out.push((o.report, x));
+        }
+    }
+    out
+}
+
+/// Unwrapped integer timestamps from a periodic integer interval pattern.
+fn pattern_times(intervals: &[u64]) -> impl FnMut(u64) -> u64 + '_ {
+    let period: u64 = intervals.iter().sum();
+    let mut prefix = vec![0u64; intervals.len()];
+    for i in 1..intervals.len() {
+        prefix[i] = prefix[i - 1] + intervals[i];
+    }
+    move |e: u64| {
+        let n = intervals.len() as u64;
+        (e / n) * period + prefix[(e % n) as usize]
+    }
+}
+
+/// Capture times (s) of the edges of a uniform `positions`-line disc within one period of the
+/// speed ω(φ) = ω̄·(1 + ε·sin(order·φ)), edge 0 at φ = 0: t(φ) = ∫dφ/ω by Simpson's rule,
+/// 16 panels per pitch (truncation error ~1e-16 of a pitch's time: far below a tick).
+/// Returns the times of edges 0..E (E edges per period) and the period.
+fn ripple_times(positions: usize, omega: f64, eps: f64, order: f64) -> (Vec<f64>, f64) {
+    let per_period = (positions as f64 / order).round() as usize;
+    let pitch = TAU / positions as f64;
+    let inv = |phi: f64| 1.0 / (omega * (1.0 + eps * (order * phi).sin()));
+    let mut t = vec![0.0; per_period + 1];
+    for i in 0..per_period {
+        let (a, n) = (i as f64 * pitch, 16);
+        let hh = pitch / n as f64;
+        let mut s = inv(a) + inv(a + pitch);
+        for j in 1..n {
+            s += if j % 2 == 1 { 4.0 } else { 2.0 } * inv(a + j as f64 * hh);
+        }
+        t[i + 1] = t[i] + s * hh / 3.0;
+    }
+    let period = t[per_period];
+    t.truncate(per_period);
+    (t, period)
+}
+
+/// Integer capture timestamps (floor of time × rate, as a capture timer counts) of a shaft
+/// running at ω(φ) = ω̄(1 + ε·sin(order·φ)).
+fn shaft_ticks(
+    positions: usize,
+    omega: f64,
+    eps: f64,
+    order: f64,
+    timer_hz: f64,
+) -> impl FnMut(u64) -> u64 {
+    let (t, period) = ripple_times(positions, omega, eps, order);
+    move |e: u64| {
+        let n = t.len() as u64;
+        (((e / n) as f64 * period + t[(e % n) as usize]) * timer_hz).floor() as u64
+    }
+}
+
+/// Case: a tiny measured δ (1e-5 … 1e-7) with a very fast timer (1 GHz and 200 MHz) and long
+/// intervals (K-edge sums of 4·10⁷ … 2·10⁸ ticks, beyond f32's 2²⁴ exact integers), where
+/// ωmax − ωmin cancels in f32 and each tick count rounds when converted to f32.
+/// Reference: the exact δ of the integer pulse train, 2(Smax − Smin)/(Smax + Smin).
+/// Tolerance (see `assert_matches_exact`): 8 f32 roundings relative to δ itself. The reported
+/// quantization floor 2/S must be far below δ (resolvable): checked at < δ/4.
+#[test]
+fn measured_tiny_delta_equals_the_exact_delta_of_the_train() {
+    // 16 lines, K = 4, one-revolution windows; interval pattern T0 + round(A·sin(2πi/16)).
+    for (timer_hz, t0, amps) in [
+        (1e9, 50_000_000u64, [300.0, 28.0, 3.0]),
+        (200e6, 10_000_000u64, [60.0, 6.0, 3.0]),
+    ] {
+        for amp in amps {
+            let intervals: Vec<u64> = (0..16)
+                .map(|i| (t0 as f64 + (amp * (TAU * i as f64 / 16.0).sin()).round()) as u64)
+                .collect();
+            let c = encoder_config(16, timer_hz, 32, 4, 1.0);
+            let mut m = monitor::<16>(c, 1);
+            let what = format!("{timer_hz} Hz, A = {amp}");
+            let out = run_exact(
+                &mut m,
+                4,
+                16 * 6 + 1,
+                0,
+                u32::MAX as u64,
+                pattern_times(&intervals),
+                &what,
+            );
+            assert_eq!(out.len(), 5, "{what}");
+            let (r, x) = out[4];
+            assert!(x.delta > 0.0 && x.delta < 3e-5, "{what}: {x:?}");
+            assert!(r.noise_floor < (x.delta / 4.0) as f32, "{what}: {r:?}");
+        }
+    }
+}
+
+/// Case: δ over a long run: 2 hours at 100 rad/s on a 64-line disc (7.3 million edges, 84 MHz
+/// 32-bit timer wrapping 140 times), load order 1/8 (8-revolution windows), δ = 0.02, with the
+/// capture timer's own rounding (timestamps are floor(t·f) of the exact time, so intervals
+/// are not a repeating pattern).
+/// Reference: each window's exact values from its integer timestamps (`assert_matches_exact`,
+/// f32 precision), and the first window: after 2 hours the mean speed must equal the first
+/// window's to 2 f32 ulps (the exact means differ by ≤ 1 tick in 4.3·10⁷), and δ within the
+/// reported quantization floor. A running f32 sum of time would have drifted by whole
+/// percent; integer interval sums cannot.
+#[test]
+fn delta_after_two_hours_equals_delta_at_the_start() {
+    let (positions, omega, timer_hz) = (64usize, 100.0, 84e6);
+    let edges = (7200.0 * omega / TAU * positions as f64) as u64;
+    let edges = edges - edges % (8 * 64);
+    let c = encoder_config(64, timer_hz, 32, 8, 10.0);
+    let w = WindowConfig {
+        length: WindowLength::LoadOrder(0.125),
+        steady_tolerance: 0.02,
+    };
+    let mut m =
+        DeltaMonitor::<64>::new(Encoder::new(c).unwrap(), w, Some(AlarmConfig::new(0.06))).unwrap();
+    let t = shaft_ticks(positions, omega, 0.01, 0.125, timer_hz);
+    let out = run_exact(&mut m, 8, edges, 0, u32::MAX as u64, t, "2 h run");
+    assert_eq!(out.len() as u64, edges / 512 - 1);
+    assert_eq!(m.diagnostics().invalid_windows, 0);
+    let (first, _) = out[0];
+    let (last, _) = *out.last().unwrap();
+    assert!(rel(last.omega_mean as f64, first.omega_mean as f64) <= 4.0 * U32);
+    assert!((last.delta - first.delta).abs() <= last.noise_floor);
+    // The true δ of the shaft is 2ε = 0.02; sampling 8 of 512 edges and the floor bound it.
+    assert!((last.delta as f64 - 0.02).abs() < 2e-5 + last.noise_floor as f64);
+    assert!(out.iter().skip(1).all(|(r, _)| r.steady));
+}
+
+/// Case: the capture counter wraps at 2¹⁶ (every three edges) and at 2³² (once, mid-window).
+/// Reference: the same integer intervals fed without any wrap (32-bit counter starting at 0).
+/// Tolerance: none — the reports must be identical, since intervals are taken modulo the
+/// counter before anything else. Each run is also checked against the exact train.
+#[test]
+fn counter_wrap_inside_a_window_changes_nothing() {
+    // 32 lines at 10 MHz: ~20 000-tick intervals, δ ≈ 0.01, windows of 2 revolutions, K = 4.
+    let intervals: Vec<u64> = (0..64)
+        .map(|i| 20_000 + (100.0 * (TAU * i as f64 / 64.0).sin()).round() as u64)
+        .collect();
+    let run = |bits: u8, start: u64| {
+        let c = encoder_config(32, 10e6, bits, 4, 40.0);
+        let mut m = monitor::<32>(c, 2);
+        let mask = (1u64 << bits) - 1;
+        let out = run_exact(
+            &mut m,
+            4,
+            32 * 20,
+            start,
+            mask,
+            pattern_times(&intervals),
+            "wrap",
+        );
+        (
+            out.into_iter().map(|(r, _)| r).collect::<Vec<_>>(),
+            m.diagnostics(),
+        )
+    };
+    let (plain, d0) = run(32, 0);
+    assert_eq!(plain.len(), 9);
+    // The 2³² wrap lands inside the 5th window (between edges 300 and 301).
+    let period: u64 = intervals.iter().sum();
+    let t300 = 4 * period + intervals[..44].iter().sum::<u64>();
+    let wrapped32 = run(32, (1u64 << 32) - t300 - 7_000);
+    let wrapped16 = run(16, 12_345);
+    assert_eq!(plain, wrapped32.0);
+    assert_eq!(plain, wrapped16.0);
+    assert_eq!(d0, wrapped32.1);
+    assert_eq!(d0, wrapped16.1);
+}
+
+/// Case: a one-tick interval (a glitch one tick after a real edge), and a zero-tick one.
+/// Reference: the glitch is rejected and counted, the window holding it is invalid with
+/// `Fault::Glitch`, and the next real interval is measured from the last real edge, so every
+/// later valid window matches the exact train of the real edges (f32 precision, as above).
+#[test]
+fn one_tick_interval_is_a_counted_glitch() {
+    let intervals: Vec<u64> = (0..32)
+        .map(|i| 50_000 + (300.0 * (TAU * i as f64 / 32.0).sin()).round() as u64)
+        .collect();
+    for extra in [1u64, 0] {
+        let c = encoder_config(32, 10e6, 32, 4, 10.0);
+        let mut m = monitor::<32>(c, 1);
+        let mut t = pattern_times(&intervals);
+        let mut exact = ExactTrain::new(32, 1, 4, 10e6);
+        let (mut faults, mut valid) = (Vec::new(), 0);
+        for e in 0..32 * 12u64 {
+            let tk = t(e);
+            exact.push(tk);
+            if e % 32 == 0 {
+                m.on_index();
+            }
+            for (ticks, real) in [(tk, true), (tk + extra, false)] {
+                if !real && e != 32 * 5 + 7 {
+                    continue;
+                }
+                if let Some(o) = m.on_edge(ticks as u32, Some(Direction::Forward)) {
+                    match o.report.fault {
+                        None => {
+                            assert_matches_exact(&o.report, &exact.window(), "after glitch");
+                            valid += 1;
+                        }
+                        Some(f) => faults.push(f),
+                    }
+                }
+            }
+        }
+        assert_eq!(faults, [Fault::Glitch], "extra {extra}");
+        assert_eq!(m.diagnostics().edges.glitches, 1);
+        assert_eq!(m.diagnostics().edges.accepted, 32 * 12 - 1);
+        assert_eq!(valid, 9, "extra {extra}");
+    }
+}
+
+/// Case: an interval of nearly the whole counter range, on a 16-bit counter at 1 MHz (65 000 of
+/// 65 535 ticks) and a 32-bit counter at 1 GHz (4.29·10⁹ of 4.295·10⁹), with `min_speed` set just
+/// low enough for the timeout to fit the counter.
+/// Reference: exact train (f32 precision). One tick more than the timeout is a standstill
+/// (`Fault::Timeout`), never an aliased short interval; a `min_speed` whose timeout would
+/// exceed the counter is a typed error.
+#[test]
+fn interval_of_nearly_the_whole_counter_range() {
+    // 8 lines at 1 MHz on 16 bits: timeout = (2π/8)/12 rad/s·1e6 = 65 450 ticks < 65 535.
+    let c16 = encoder_config(8, 1e6, 16, 1, 12.0);
+    assert_eq!(Encoder::<8>::new(c16).unwrap().timeout_ticks(), 65_450);
+    let intervals: Vec<u64> = (0..8).map(|i| 65_000 + 50 * (i % 3)).collect();
+    let mut m = monitor::<8>(c16, 1);
+    let out = run_exact(
+        &mut m,
+        1,
+        8 * 6,
+        999,
+        0xFFFF,
+        pattern_times(&intervals),
+        "16 bit",
+    );
+    assert_eq!(out.len(), 4);
+    let mut bad = c16;
+    bad.min_speed = 11.9;
+    assert_eq!(
+        Encoder::<8>::new(bad).unwrap_err(),
+        ConfigError::Inconsistent("min_speed")
+    );
+    // 4 lines at 1 GHz on 32 bits: min_speed 0.3658 rad/s gives a timeout of 4.2941e9 ticks.
+    let c32 = encoder_config(4, 1e9, 32, 1, 0.3658);
+    let intervals: Vec<u64> = vec![4_290_000_000, 4_280_000_000, 4_294_000_000, 4_285_000_000];
+    let mut m = monitor::<4>(c32, 1);
+    let out = run_exact(
+        &mut m,
+        1,
+        4 * 5,
+        0,
+        u32::MAX as u64,
+        pattern_times(&intervals),
+        "32 bit",
+    );
+    assert_eq!(out.len(), 3);
+    // Past the timeout: standstill, counted; the window in progress is cut short.
+    let mut m = monitor::<8>(c16, 1);
+    let mut t = 0u64;
+    for e in 0..20 {
+        if e % 8 == 0 {
+            m.on_index();
+        }
+        t += 65_000;
+        m.on_edge((t & 0xFFFF) as u32, Some(Direction::Forward));
+    }
+    let o = m.on_edge(((t + 65_451) & 0xFFFF) as u32, Some(Direction::Forward));
+    assert_eq!(o.map(|o| o.report.fault), Some(Some(Fault::Timeout)));
+    assert_eq!(m.diagnostics().edges.timeouts, 1);
+}
+
+/// Case: very slow and very fast shafts, 1 rpm and 30 000 rpm, on a 1024-line disc, with 1 kHz,
+/// 1 MHz, 84 MHz and 200 MHz timers on 16- and 32-bit counters; `min_speed` is half the shaft
+/// speed, speed ripple δ = 0.01 (order 1, one-revolution windows), K = 16.
+/// Rejected with a typed error: configurations whose timeout does not fit the counter
+/// (`Inconsistent("min_speed")`: 1 rpm on 16 bits from 1 MHz up) and whose timer cannot
+/// time one pitch at the minimum speed (`Inconsistent("timer_hz")`: 30 000 rpm at 1 kHz, a
+/// pitch lasts 0.002 ticks).
+/// Accepted ones are checked (1) against the exact train at f32 precision and (2) against the
+/// true shaft: |δ − 0.01| ≤ reported floor + 1e-3·δ (K = 16 of 1024 edges attenuates the
+/// ripple by (16π/1024)²/6 = 4e-4 relative), mean speed within one tick per revolution plus
+/// 5 f32 roundings.
+#[test]
+fn one_rpm_and_thirty_thousand_rpm_from_1_khz_to_200_mhz() {
+    let rpm = |n: f64| n * TAU / 60.0;
+    let mut accepted = Vec::new();
+    for speed in [rpm(1.0), rpm(30_000.0)] {
+        for timer_hz in [1e3, 1e6, 84e6, 200e6] {
+            for bits in [16u8, 32] {
+                let c = encoder_config(1024, timer_hz, bits, 16, speed / 2.0);
+                let case = format!("{:.0} rpm, {timer_hz:e} Hz, {bits} bit", speed * 60.0 / TAU);
+                let enc = Encoder::<1024>::new(c);
+                let slow_pitch_ticks = TAU / 1024.0 / (speed / 2.0) * timer_hz;
+                let expect = if slow_pitch_ticks < 2.0 {
+                    Err(ConfigError::Inconsistent("timer_hz"))
+                } else if slow_pitch_ticks >= ((1u64 << bits) - 1) as f64 {
+                    Err(ConfigError::Inconsistent("min_speed"))
+                } else {
+                    Ok(())
+                };
+                assert_eq!(enc.as_ref().map(|_| ()).map_err(|e| *e), expect, "{case}");
+                if enc.is_err() {
+                    continue;
+                }
+                accepted.push(case.clone());
+                let mut m = monitor::<1024>(c, 1);
+                let mask = (1u64 << bits) - 1;
+                let t = shaft_ticks(1024, speed, 0.005, 1.0, timer_hz);
+                let out = run_exact(&mut m, 16, 1024 * 4 + 1, 0, mask, t, &case);
+                assert_eq!(out.len(), 3, "{case}: {:?}", m.diagnostics());
+                assert_eq!(m.diagnostics().invalid_windows, 0, "{case}");
+                for (r, _) in out {
+                    let floor = r.noise_floor as f64;
+                    assert!(
+                        (r.delta as f64 - 0.01).abs() <= floor + 1e-5,
+                        "{case}: δ {} floor {floor}",
+                        r.delta
+                    );
+                    let true_mean = speed * (1.0 - 0.005f64 * 0.005).sqrt();
+                    let rev_ticks = TAU / speed * timer_hz;
+                    assert!(
+                        rel(r.omega_mean as f64, true_mean) <= 1.0 / rev_ticks + 5.0 * U32,
+                        "{case}: mean {}",
+                        r.omega_mean
+                    );
+                }
+            }
+        }
+    }
+    assert_eq!(accepted.len(), 11, "{accepted:?}");
+}
