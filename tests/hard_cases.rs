@@ -734,3 +734,750 @@ fn one_rpm_and_thirty_thousand_rpm_from_1_khz_to_200_mhz() {
     }
     assert_eq!(accepted.len(), 11, "{accepted:?}");
 }
+
+// =============================================================================================
+// Characteristic speeds of auto-balancer machines (seed 001)
+// =============================================================================================
+
+fn platform(mass: f64, stiffness: f64, damping: f64) -> Platform {
+    Platform {
+        mass,
+        stiffness,
+        damping,
+    }
+}
+
+fn coupling(a: u8, b: u8, stiffness: f64, damping: f64) -> Coupling {
+    Coupling {
+        between: [a, b],
+        stiffness,
+        damping,
+    }
+}
+
+/// Two balls of 0.5 kg on radius 0.1 m, no housing: the exciter platform moves 1 kg more than
+/// its own mass.
+fn balancer(platform: u8) -> AutoBalancer {
+    AutoBalancer {
+        kind: BalancerKind::Ball,
+        platform,
+        loads: 2,
+        load_mass: 0.5,
+        radius: 0.1,
+        housing_mass: 0.0,
+        viscosity: 0.01,
+    }
+}
+
+/// Zone search with a 1e-14 bisection bracket, so the search's own resolution is negligible
+/// next to the tolerances below.
+fn fine() -> SearchOptions {
+    SearchOptions::new(4.0, 256, 1e-14).unwrap()
+}
+
+fn machine(p: &[Platform], c: &[Coupling], b: AutoBalancer) -> Machine {
+    Machine::new(MachineConfig::new(p, c, b).unwrap(), fine()).unwrap()
+}
+
+fn boundaries(m: &Machine) -> Vec<f64> {
+    m.zones().iter().skip(1).map(|z| z.from).collect()
+}
+
+fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+fn assert_all_close(got: &[f64], want: &[f64], tol: f64, what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: {got:?} vs {want:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            rel(*g, *w) <= tol,
+            "{what}: {got:?} vs {want:?} (tol {tol:e})"
+        );
+    }
+}
+
+/// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
+fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
+    let n = cfg.platforms().len();
+    let mut k = [[0.0; 3]; 3];
+    let mut m = [0.0; 3];
+    for (i, p) in cfg.platforms().iter().enumerate() {
+        k[i][i] += p.stiffness;
+        m[i] = cfg.moving_mass(i);
+    }
+    for c in cfg.couplings() {
+        let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
+        k[a][a] += c.stiffness;
+        k[b][b] += c.stiffness;
+        k[a][b] -= c.stiffness;
+        k[b][a] -= c.stiffness;
+    }
+    (k, m, n)
+}
+
+/// Eigenvalues of (K, M) restricted to the indices `idx`, by bisection on Sylvester's inertia:
+/// the number of negative pivots of the LDLᵀ factorisation of K − λM is the number of
+/// eigenvalues below λ. A second method, independent of the closed forms and Jacobi rotations
+/// the core uses; each eigenvalue is bracketed down to adjacent doubles.
+fn inertia_eigenvalues(k: &[[f64; 3]; 3], m: &[f64; 3], idx: &[usize]) -> Vec<f64> {
+    let n = idx.len();
+    let below = |lambda: f64| {
+        let mut a = [[0.0; 3]; 3];
+        for i in 0..n {
+            for j in 0..n {
+                a[i][j] = k[idx[i]][idx[j]] - if i == j { lambda * m[idx[i]] } else { 0.0 };
+            }
+        }
+        let mut neg = 0;
+        for p in 0..n {
+            let d = a[p][p];
+            if d < 0.0 {
+                neg += 1;
+            }
+            let d = if d == 0.0 { f64::MIN_POSITIVE } else { d };
+            for i in p + 1..n {
+                let l = a[i][p] / d;
+                for j in p + 1..n {
+                    a[i][j] -= l * a[p][j];
+                }
+            }
+        }
+        neg
+    };
+    let hi0 = (0..n)
+        .map(|i| (0..n).map(|j| k[idx[i]][idx[j]].abs()).sum::<f64>() / m[idx[i]])
+        .fold(0.0, f64::max)
+        * 2.0;
+    (0..n)
+        .map(|i| {
+            let (mut lo, mut hi) = (0.0, hi0);
+            loop {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break hi;
+                }
+                if below(mid) > i {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+        })
+        .map(f64::sqrt)
+        .collect()
+}
+
+/// Resonant and additional speeds of a machine by the inertia method.
+fn reference_speeds(cfg: &MachineConfig) -> (Vec<f64>, Vec<f64>) {
+    let (k, m, n) = km(cfg);
+    let all: Vec<usize> = (0..n).collect();
+    let others: Vec<usize> = (0..n).filter(|&i| i != cfg.exciter_index()).collect();
+    (
+        inertia_eigenvalues(&k, &m, &all),
+        inertia_eigenvalues(&k, &m, &others),
+    )
+}
+
+/// Case: zero coupling. Platform 3 is attached to nothing (a coupling of zero stiffness and
+/// damping), so it must not change what the exciter platform sees.
+/// Reference: the two-platform machine without it, plus √(k3/M3) as an extra resonance and an
+/// extra additional speed. Tolerances: √(k3/M3) to 2 f64 roundings (a diagonal matrix entry
+/// and its square root: the zero coupling must give an exactly diagonal problem); the other
+/// speeds 4 roundings; receptances 1e-13 (the 3×3 bordered determinant has a few more
+/// roundings than the 2×2); zone boundaries 1e-12 (bisection to 1e-14 on criteria that differ
+/// by the positive factor |Z33|²).
+#[test]
+fn zero_coupling_is_exact() {
+    let p = [
+        platform(80.0, 3e5, 30.0),
+        platform(99.0, 4e5, 50.0),
+        platform(30.0, 5e5, 10.0),
+    ];
+    let c12 = coupling(1, 2, 1e5, 20.0);
+    let three = machine(&p, &[c12, coupling(2, 3, 0.0, 0.0)], balancer(2));
+    let two = machine(&p[..2], &[c12], balancer(2));
+    let w3 = (5e5f64 / 30.0).sqrt();
+    let with_w3 = |v: &[f64]| sorted(v.iter().copied().chain([w3]).collect());
+    assert_all_close(
+        three.resonant_speeds(),
+        &with_w3(two.resonant_speeds()),
+        4.0 * U64,
+        "resonant",
+    );
+    assert_all_close(
+        three.additional_speeds(),
+        &with_w3(two.additional_speeds()),
+        4.0 * U64,
+        "additional",
+    );
+    assert!(three
+        .resonant_speeds()
+        .iter()
+        .any(|&w| rel(w, w3) <= 2.0 * U64));
+    for w in [5.0, 40.0, 63.0, 70.0, 129.0, 500.0] {
+        let (a, b) = (three.receptance(w), two.receptance(w));
+        assert!(rel(a.0, b.0) < 1e-13 && rel(a.1, b.1) < 1e-13, "ω {w}");
+    }
+    assert_all_close(&boundaries(&three), &boundaries(&two), 1e-12, "zones");
+}
+
+/// Case: equal partial frequencies, coupling from 1 down to 1e-12 of the supports and 0:
+/// (a) two equal platforms: eigenvalues s/M and (s + 2k)/M, additional (s + k)/M;
+/// (b) three equal platforms coupled all to all: s/M and a double (s + 3k)/M, additional
+///     (s + k)/M and (s + 3k)/M. A cubic or the quadratic formula loses half the digits of a
+///     double root; the core must not.
+/// Reference: those closed forms. Tolerances: each speed 8 f64 roundings; the splitting
+/// ω₂² − ω₁² = 2k/M (3k/M) to 20ε·s/k (the roundings of eigenvalues of size s/M, relative to
+/// a splitting of size k/M); with k = 0, a single boundary (two zones).
+/// Undamped zones of (b) at k = s/10 and s/1000: boundaries at √(s/M), √((s + k)/M),
+/// √((s + 3k)/M) (the double pole at (s + 3k)/M cancels against the zero there, leaving a
+/// simple pole), to 1e-12.
+#[test]
+fn equal_partial_frequencies_double_roots() {
+    let (s, mass) = (4e5, 100.0);
+    for rho in [1.0, 1e-3, 1e-6, 1e-9, 1e-12, 0.0] {
+        let k = s * rho;
+        // Two platforms (exciter 2: 99 kg + 1 kg of balls).
+        let p = [platform(mass, s, 0.0), platform(mass - 1.0, s, 0.0)];
+        let m2 = machine(&p, &[coupling(1, 2, k, 0.0)], balancer(2));
+        let want = [(s / mass).sqrt(), ((s + 2.0 * k) / mass).sqrt()];
+        assert_all_close(m2.resonant_speeds(), &want, 8.0 * U64, "two");
+        assert_all_close(
+            m2.additional_speeds(),
+            &[((s + k) / mass).sqrt()],
+            8.0 * U64,
+            "two, additional",
+        );
+        let r = m2.resonant_speeds();
+        if k > 0.0 {
+            let split = (r[1] * r[1] - r[0] * r[0]) / (2.0 * k / mass);
+            assert!(
+                (split - 1.0).abs() <= 20.0 * f64::EPSILON / rho,
+                "ρ {rho}: {split}"
+            );
+        } else {
+            assert_eq!(m2.zones().len(), 2);
+        }
+        // Three platforms, all pairs coupled (exciter 2).
+        let p3 = [
+            platform(mass, s, 0.0),
+            platform(mass - 1.0, s, 0.0),
+            platform(mass, s, 0.0),
+        ];
+        let cs = [
+            coupling(1, 2, k, 0.0),
+            coupling(2, 3, k, 0.0),
+            coupling(1, 3, k, 0.0),
+        ];
+        let m3 = machine(&p3, &cs, balancer(2));
+        let d = ((s + 3.0 * k) / mass).sqrt();
+        assert_all_close(
+            m3.resonant_speeds(),
+            &[(s / mass).sqrt(), d, d],
+            8.0 * U64,
+            "three",
+        );
+        assert_all_close(
+            m3.additional_speeds(),
+            &[((s + k) / mass).sqrt(), d],
+            8.0 * U64,
+            "three, additional",
+        );
+        let r = m3.resonant_speeds();
+        if k > 0.0 {
+            let split = (r[1] * r[1] - r[0] * r[0]) / (3.0 * k / mass);
+            assert!(
+                (split - 1.0).abs() <= 20.0 * f64::EPSILON / rho,
+                "ρ {rho}: {split}"
+            );
+        }
+        if rho == 1e-3 || rho == 1.0 {
+            let want = [(s / mass).sqrt(), ((s + k) / mass).sqrt(), d];
+            assert_all_close(&boundaries(&m3), &want, 1e-12, "three, zones");
+        }
+    }
+}
+
+/// Case: a platform mass 10⁶ times another's (both ways, exciter heavy or light), with weak and
+/// strong couplings, two and three platforms.
+/// Reference: the inertia-bisection eigenvalues (an independent method). Tolerance 1e-13:
+/// both methods are accurate relative to each eigenvalue for these graded problems (the
+/// reference brackets to adjacent doubles in a backward-stable factorisation); 1e-13 allows a
+/// condition number of ~500. Also: Cauchy interlacing q1 ≤ q̃1 ≤ q2 ≤ q̃2 ≤ q3 and, with zero
+/// damping, zone boundaries at exactly those speeds (1e-12).
+#[test]
+fn platform_mass_a_million_times_another() {
+    for (m1, m2, m3) in [
+        (1e6, 1.0, 30.0),
+        (1.0, 1e6, 1.0),
+        (1e-3, 1e3, 1e3),
+        (1e3, 1e-3, 1e-3),
+    ] {
+        for kc in [1e-2, 1e3, 1e6] {
+            let p = [
+                platform(m1, 1e4, 0.0),
+                platform(m2, 2e4, 0.0),
+                platform(m3, 5e3, 0.0),
+            ];
+            let cs = [
+                coupling(1, 2, kc, 0.0),
+                coupling(2, 3, 0.5 * kc, 0.0),
+                coupling(1, 3, 0.3 * kc, 0.0),
+            ];
+            let mut b = balancer(2);
+            b.load_mass = 1e-6;
+            for n in 2..=3 {
+                let cfg = MachineConfig::new(&p[..n], &cs[..2 * n - 3], b).unwrap();
+                let m = Machine::new(cfg, fine()).unwrap();
+                let what = format!("{m1} {m2} {m3}, kc {kc}, {n} platforms");
+                let (res, add) = reference_speeds(&cfg);
+                assert_all_close(m.resonant_speeds(), &res, 1e-13, &what);
+                assert_all_close(m.additional_speeds(), &add, 1e-13, &what);
+                let all = sorted(res.iter().chain(&add).copied().collect());
+                for (i, w) in all.windows(2).enumerate() {
+                    assert!(w[0] <= w[1] * (1.0 + 1e-15), "{what}: interlacing {i}");
+                }
+                // Distinct speeds bound zones; coinciding ones (weak coupling) may cancel.
+                if all.windows(2).all(|w| rel(w[0], w[1]) > 1e-6) {
+                    assert_all_close(&boundaries(&m), &all, 1e-12, &what);
+                }
+            }
+        }
+    }
+}
+
+/// The sign function of Re H_ee for two platforms (exciter e, other a), written out as a real
+/// cubic in x = ω² (derived by hand, independent of the core's complex arithmetic), for an
+/// undamped exciter platform (its damping would add terms in Ce):
+/// g(x) = (T − Wx)·((u − vx)² + x·Ca²) − (u − vx)·(kc² − x·cc²) − 2x·Ca·kc·cc,
+/// T = k_e + kc, W = M_e, u = k_a + kc, v = m_a, Ca = c_a + cc. Returns its coefficients
+/// (c3, c2, c1, c0), in units of the given stiffness and mass scales.
+fn two_platform_cubic(
+    (ke, me): (f64, f64),
+    (ka, ca, ma): (f64, f64, f64),
+    (kc, cc): (f64, f64),
+) -> [f64; 4] {
+    let (t, w, u, v) = (ke + kc, me, ka + kc, ma);
+    let big_ca = ca + cc;
+    // (T − Wx)(u² + (Ca² − 2uv)x + v²x²) − (u − vx)(kc² − x cc²) − 2x Ca kc cc
+    let c3 = -w * v * v;
+    let c2 = t * v * v - w * (big_ca * big_ca - 2.0 * u * v) - v * cc * cc;
+    let c1 = t * (big_ca * big_ca - 2.0 * u * v) - w * u * u + u * cc * cc + v * kc * kc
+        - 2.0 * big_ca * kc * cc;
+    let c0 = t * u * u - u * kc * kc;
+    [c3, c2, c1, c0]
+}
+
+/// The positive roots of the cubic `c` (x from 1e-4 to 1e4, a 20 000-point log grid, each sign
+/// change bisected to adjacent doubles).
+fn positive_roots(c: [f64; 4]) -> Vec<f64> {
+    let g = |x: f64| ((c[0] * x + c[1]) * x + c[2]) * x + c[3];
+    let n = 20_000;
+    let (lo, hi): (f64, f64) = (1e-4, 1e4);
+    let mut roots = Vec::new();
+    let mut prev = (0.0, g(0.0));
+    for i in 0..=n {
+        let x = lo * (hi / lo).powf(i as f64 / n as f64);
+        let gx = g(x);
+        if (gx > 0.0) != (prev.1 > 0.0) {
+            let (mut a, mut b) = (prev.0, x);
+            loop {
+                let mid = 0.5 * (a + b);
+                if mid <= a || mid >= b {
+                    break;
+                }
+                if (g(mid) > 0.0) == (prev.1 > 0.0) {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            roots.push(0.5 * (a + b));
+        }
+        prev = (x, gx);
+    }
+    roots
+}
+
+fn discriminant([a, b, c, d]: [f64; 4]) -> f64 {
+    18.0 * a * b * c * d - 4.0 * b * b * b * d + b * b * c * c
+        - 4.0 * a * c * c * c
+        - 27.0 * a * a * d * d
+}
+
+/// Case: damping → 0 and damping large enough to erase a zone, on a two-platform machine
+/// (exciter undamped; the other platform's support and the coupling damped).
+/// Reference: the sign changes of the hand-derived real cubic g(x) above (x = ω², in units of
+/// 1e5 N/m and 100 kg), bisected to adjacent doubles; the critical damping where two zones
+/// vanish is the zero of the cubic's discriminant. Tolerances: boundaries 1e-10 (the core
+/// brackets to 1e-14 but evaluates a complex product; both are limited by the roots'
+/// condition, ~ε·Σ|terms|/|g'|, ≤ 1e-12 here); damping → 0 must converge to the undamped
+/// speeds (closed form: x = u/v and the roots of (T − Wx)(u − vx) = kc²) with error ≤ 1e-12 at
+/// damping 1e-8 of nominal, monotonically. Zones: 4 at c*·(1 − 1e-3), 2 at c*·(1 + 1e-3).
+#[test]
+fn damping_to_zero_and_damping_that_erases_a_zone() {
+    let (ks, ms): (f64, f64) = (1e5, 100.0);
+    let cs = (ks * ms).sqrt();
+    let build = |ca: f64, cc: f64| {
+        let p = [platform(150.0, 3e5, ca), platform(99.0, 4e5, 0.0)];
+        machine(&p, &[coupling(1, 2, 1e5, cc)], balancer(2))
+    };
+    let cubic = |ca: f64, cc: f64| {
+        two_platform_cubic(
+            (4e5 / ks, 100.0 / ms),
+            (3e5 / ks, ca / cs, 150.0 / ms),
+            (1e5 / ks, cc / cs),
+        )
+    };
+    let omega = |x: f64| (x * ks / ms).sqrt();
+    // Undamped closed form (in scaled units): additional u/v, resonances by Vieta.
+    let (t, w, u, v, kc): (f64, f64, f64, f64, f64) = (5.0, 1.0, 4.0, 1.5, 1.0);
+    let (qa, qb, qc) = (w * v, t * v + w * u, t * u - kc * kc);
+    let big = (qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
+    let undamped = sorted(vec![omega(qc / (qa * big)), omega(u / v), omega(big)]);
+    let mut prev_err = f64::INFINITY;
+    for f in [1.0, 1e-2, 1e-4, 1e-8, 0.0] {
+        let (ca, cc) = (800.0 * f, 300.0 * f);
+        let m = build(ca, cc);
+        let want: Vec<f64> = positive_roots(cubic(ca, cc))
+            .into_iter()
+            .map(omega)
+            .collect();
+        assert_all_close(&boundaries(&m), &want, 1e-10, &format!("damping ×{f}"));
+        let err = boundaries(&m)
+            .iter()
+            .zip(&undamped)
+            .map(|(a, b)| rel(*a, *b))
+            .fold(0.0, f64::max);
+        assert!(err <= prev_err, "×{f}: {err} after {prev_err}");
+        prev_err = err;
+        if f <= 1e-8 {
+            assert!(err <= 1e-12, "×{f}: {err}");
+        }
+    }
+    // Erasing: the support damping of platform 1 that merges the two middle boundaries.
+    let disc = |ca: f64| discriminant(cubic(ca, 0.0));
+    // Δ > 0 at light damping (three positive roots) and < 0 past c* (one real root); far
+    // beyond, Δ > 0 again with two negative roots, so the bracket stops at 1e4 N·s/m.
+    let (mut lo, mut hi) = (1.0, 1e4);
+    assert!(disc(lo) > 0.0 && disc(hi) < 0.0);
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if disc(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let c_star = lo;
+    let before = build(c_star * (1.0 - 1e-3), 0.0);
+    let after = build(c_star * (1.0 + 1e-3), 0.0);
+    assert_eq!(
+        before.zones().len(),
+        4,
+        "c* = {c_star}: {:?}",
+        before.zones()
+    );
+    assert_eq!(after.zones().len(), 2, "c* = {c_star}: {:?}", after.zones());
+    let want: Vec<f64> = positive_roots(cubic(c_star * (1.0 - 1e-3), 0.0))
+        .into_iter()
+        .map(omega)
+        .collect();
+    assert_all_close(&boundaries(&before), &want, 1e-9, "just before erasing");
+    let want: Vec<f64> = positive_roots(cubic(c_star * (1.0 + 1e-3), 0.0))
+        .into_iter()
+        .map(omega)
+        .collect();
+    assert_all_close(&boundaries(&after), &want, 1e-10, "just after erasing");
+}
+
+/// A machine with every mass ×`ms`, stiffness ×`ks` and damping (and load viscosity) ×`cs`.
+fn scaled_machine(cfg: &MachineConfig, ms: f64, ks: f64, cs: f64) -> Machine {
+    let p: Vec<Platform> = cfg
+        .platforms()
+        .iter()
+        .map(|p| platform(p.mass * ms, p.stiffness * ks, p.damping * cs))
+        .collect();
+    let c: Vec<Coupling> = cfg
+        .couplings()
+        .iter()
+        .map(|c| coupling(c.between[0], c.between[1], c.stiffness * ks, c.damping * cs))
+        .collect();
+    let mut b = *cfg.balancer();
+    b.load_mass *= ms;
+    b.housing_mass *= ms;
+    b.viscosity *= cs;
+    machine(&p, &c, b)
+}
+
+/// Case: parameters scaled by 10^±6 and by 2^±20. (i) masses, stiffness, damping and load
+/// viscosity all ×s: every speed is unchanged; (ii) stiffness ×s², damping and viscosity ×s:
+/// every speed ×s (Z(sω) = s²·Z(ω)).
+/// Reference: the unscaled machine. Tolerances: for powers of two, none — every result must
+/// be bit-identical (all operations scale exactly); for 10^±6, 1e-12 relative on resonant and
+/// additional speeds, zone boundaries and capture limits (`until`), and 1e-6 on the location
+/// of a capture maximum (`at`: the argument of a flat maximum is determined only to about
+/// √ε of its value's precision).
+#[test]
+fn scaling_by_a_million_scales_the_results_exactly() {
+    let p = [
+        platform(100.0, 4e5, 200.0),
+        platform(99.0, 4e5, 200.0),
+        platform(150.0, 3e5, 100.0),
+    ];
+    let cs = [coupling(1, 2, 1e5, 50.0), coupling(2, 3, 1e5, 50.0)];
+    for n in 1..=3 {
+        let cfg = MachineConfig::new(&p[..n], &cs[..n - 1], balancer(if n == 1 { 1 } else { 2 }))
+            .unwrap();
+        let base = Machine::new(cfg, fine()).unwrap();
+        for s in [1e6, 1e-6, 1048576.0, 1.0 / 1048576.0] {
+            let exact = s == 1048576.0 || s == 1.0 / 1048576.0;
+            for (ms, ks, cs, speed) in [(s, s, s, 1.0), (1.0, s * s, s, s)] {
+                let m = scaled_machine(&cfg, ms, ks, cs);
+                let what = format!("{n} platforms, s = {s:e}, speed ×{speed:e}");
+                let scale = |v: &[f64]| v.iter().map(|x| x * speed).collect::<Vec<_>>();
+                let tol = if exact { 0.0 } else { 1e-12 };
+                assert_all_close(
+                    m.resonant_speeds(),
+                    &scale(base.resonant_speeds()),
+                    tol,
+                    &what,
+                );
+                assert_all_close(
+                    m.additional_speeds(),
+                    &scale(base.additional_speeds()),
+                    tol,
+                    &what,
+                );
+                assert_all_close(&boundaries(&m), &scale(&boundaries(&base)), tol, &what);
+                assert_eq!(m.capture_windows().len(), base.capture_windows().len());
+                for (a, b) in m.capture_windows().iter().zip(base.capture_windows()) {
+                    assert!(rel(a.until, b.until * speed) <= tol, "{what}: {a:?} {b:?}");
+                    let at_tol = if exact { 0.0 } else { 1e-6 };
+                    assert!(rel(a.at, b.at * speed) <= at_tol, "{what}: {a:?} {b:?}");
+                }
+                let (d, d0) = (m.config().dimensionless(), cfg.dimensionless());
+                assert!(
+                    rel(d.epsilon, d0.epsilon) <= 4.0 * U64 && rel(d.beta, d0.beta) <= 4.0 * U64
+                );
+            }
+        }
+    }
+}
+
+// =============================================================================================
+// Supports: unbalance split onto two planes (seed 002)
+// =============================================================================================
+
+/// Double-double number hi + lo (about 106 bits), for the exact-ish references.
+#[derive(Debug, Clone, Copy)]
+struct Dd(f64, f64);
+
+impl Dd {
+    fn new(x: f64) -> Dd {
+        Dd(x, 0.0)
+    }
+    fn two_sum(a: f64, b: f64) -> Dd {
+        let s = a + b;
+        let bp = s - a;
+        Dd(s, (a - (s - bp)) + (b - bp))
+    }
+    fn norm(hi: f64, lo: f64) -> Dd {
+        let s = hi + lo;
+        Dd(s, lo - (s - hi))
+    }
+    fn add(self, o: Dd) -> Dd {
+        let s = Dd::two_sum(self.0, o.0);
+        let t = Dd::two_sum(self.1, o.1);
+        let s = Dd::norm(s.0, s.1 + t.0);
+        Dd::norm(s.0, s.1 + t.1)
+    }
+    fn neg(self) -> Dd {
+        Dd(-self.0, -self.1)
+    }
+    fn sub(self, o: Dd) -> Dd {
+        self.add(o.neg())
+    }
+    fn mul(self, o: Dd) -> Dd {
+        let p = self.0 * o.0;
+        let e = self.0.mul_add(o.0, -p) + (self.0 * o.1 + self.1 * o.0);
+        Dd::norm(p, e)
+    }
+    fn div(self, o: Dd) -> Dd {
+        let q1 = self.0 / o.0;
+        let r = self.sub(o.mul(Dd::new(q1)));
+        let q2 = r.0 / o.0;
+        let r = r.sub(o.mul(Dd::new(q2)));
+        let q3 = r.0 / o.0;
+        Dd::norm(q1, q2).add(Dd::new(q3))
+    }
+    fn f64(self) -> f64 {
+        self.0 + self.1
+    }
+}
+
+/// Reference for the equivalent of `(z_i, v_i)` in planes z1, z2, by a second method: moments
+/// about the origin, M = Σ z_i·v_i, then E2 = (M − z1·F)/(z2 − z1), E1 = F − E2, all in
+/// double-double (the core sums lever arms (z2 − z_i) instead, in compensated f64).
+fn dd_split(items: &[(f64, Vec2)], z1: f64, z2: f64) -> [Vec2; 2] {
+    let comp = |pick: fn(&Vec2) -> f64| {
+        let mut f = Dd::new(0.0);
+        let mut m = Dd::new(0.0);
+        for (z, v) in items {
+            f = f.add(Dd::new(pick(v)));
+            m = m.add(Dd::new(*z).mul(Dd::new(pick(v))));
+        }
+        let e2 = m.sub(Dd::new(z1).mul(f)).div(Dd::new(z2).sub(Dd::new(z1)));
+        (f.sub(e2).f64(), e2.f64())
+    };
+    let (x1, x2) = comp(|v| v.x);
+    let (y1, y2) = comp(|v| v.y);
+    [Vec2::new(x1, y1), Vec2::new(x2, y2)]
+}
+
+/// Per component: |got − want| ≤ tol·|want| (so an exactly zero component must be zero).
+fn assert_vec_rel(got: [Vec2; 2], want: [Vec2; 2], tol: f64, what: &str) {
+    for (g, w) in got.iter().zip(&want) {
+        for (a, b) in [(g.x, w.x), (g.y, w.y)] {
+            assert!(
+                (a - b).abs() <= tol * b.abs(),
+                "{what}: {got:?} vs {want:?} (rel {:e})",
+                rel(a, b)
+            );
+        }
+    }
+}
+
+fn pairs(us: &[Unbalance]) -> Vec<(f64, Vec2)> {
+    us.iter().map(|u| (u.z, u.vector())).collect()
+}
+
+/// Case: nearly coincident support planes, 2.5e-6 m apart on a model 2 m long (the separation
+/// limit is 1e-6 of the largest coordinate: 2e-6 m), and 1.9e-6 m (rejected).
+/// Reference: the double-double moment method. Tolerance 6 f64 roundings per component,
+/// relative to the component: the split's condition number (2 m / 2.5 µm ≈ 10⁶) must not
+/// appear, because the core's lever arms and sums are exact before the final division.
+#[test]
+fn nearly_coincident_support_planes() {
+    let (za, zb) = (1.0, 1.0 + 2.5e-6);
+    let us = [
+        Unbalance::new(0.37, 1e-3, 0.4),
+        Unbalance::new(1.7, 2e-3, -2.0),
+        Unbalance::new(2.0, 5e-4, 3.0),
+    ];
+    let r = Rotor::<3>::new(10.0, 1.2, za, zb, &us, None).unwrap();
+    assert_vec_rel(
+        r.support_unbalance(),
+        dd_split(&pairs(&us), za, zb),
+        6.0 * U64,
+        "supports",
+    );
+    assert_eq!(
+        Rotor::<3>::new(10.0, 1.2, za, 1.0 + 1.9e-6, &us, None).unwrap_err(),
+        ConfigError::Inconsistent("support_b")
+    );
+    // The same two planes as correction planes of a rotor on a normal span.
+    let r = Rotor::<3>::new(10.0, 1.2, 0.0, 2.0, &us, None).unwrap();
+    assert_vec_rel(
+        r.equivalent_in(za, zb).unwrap(),
+        dd_split(&pairs(&us), za, zb),
+        6.0 * U64,
+        "correction planes",
+    );
+}
+
+/// Case: unbalances at three different planes whose resultant and moment cancel to about
+/// 1e-15 of their size (x components exact, the y component that of a·sin(π) ≈ 1.2e-16·a).
+/// Reference: the double-double moment method on the same f64 vectors and positions.
+/// Tolerance 6 roundings relative to each (tiny) result: a lever arm z_B − z_i rounded once
+/// would already be off by 1e-16 of a term 10¹⁵ times larger than the result.
+#[test]
+fn unbalances_cancelling_to_1e_15_keep_their_digits() {
+    let (z1, z2, z3) = (0.3, 1.7, 2.9);
+    let a = 0.61;
+    let b = a * (z3 - z1) / (z3 - z2);
+    let c = a * (z2 - z1) / (z3 - z2) * (1.0 + 4.0 * f64::EPSILON);
+    let us = [
+        Unbalance::new(z1, a, 0.0),
+        Unbalance::new(z2, b, PI),
+        Unbalance::new(z3, c, 0.0),
+    ];
+    let r = Rotor::<3>::new(50.0, 2.0, 0.0, 4.0, &us, None).unwrap();
+    let want = dd_split(&pairs(&us), 0.0, 4.0);
+    let size = want.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    assert!(size < 1e-14 * a && size > 1e-17 * a, "{want:?}");
+    assert_vec_rel(r.support_unbalance(), want, 6.0 * U64, "cancelling");
+    // The resultant and the moment unbalance, too (compensated sums of exact products).
+    let f = want[0] + want[1];
+    let st = r.static_unbalance();
+    assert!(
+        (st.x - f.x).abs() <= 6.0 * U64 * f.x.abs() + 1e-40,
+        "{st:?} vs {f:?}"
+    );
+    let m_ref = {
+        let mut m = Dd::new(0.0);
+        for (z, v) in pairs(&us) {
+            m = m.add(Dd::new(z).sub(Dd::new(2.0)).mul(Dd::new(v.x)));
+        }
+        m.f64()
+    };
+    let m = r.moment_unbalance();
+    assert!(
+        (m.x - m_ref).abs() <= 6.0 * U64 * m_ref.abs(),
+        "{m:?} vs {m_ref}"
+    );
+}
+
+/// Case: a pure couple, ±v exactly opposite at z = −3 m and z = 5 m, both outside the span
+/// [0, 1] (one on each side), split onto the support planes.
+/// Reference: the double-double moment method. The static part is exactly zero, so
+/// E_A = −E_B to 2 roundings of E_A; each to 4 roundings of itself.
+#[test]
+fn pure_couple_outside_the_span() {
+    let v = Vec2::from_polar(3e-3, 0.7);
+    let items = [(-3.0, v), (5.0, -v)];
+    let e = equivalent_planes(&items, [0.0, 1.0]).unwrap();
+    assert_vec_rel(e, dd_split(&items, 0.0, 1.0), 4.0 * U64, "couple");
+    let sum = e[0] + e[1];
+    assert!(sum.norm() <= 2.0 * U64 * e[0].norm(), "{e:?}");
+    assert!(rel(e[0].norm(), 8.0 * 3e-3) <= 4.0 * U64);
+}
+
+/// Case: overhung planes far outside the span: an unbalance 10⁵ spans beyond supports 1 m
+/// apart (the separation limit is then 0.1 m: accepted), 2·10⁶ spans (rejected: planes closer
+/// than 1e-6 of the coordinates are the same plane), and correction planes 10⁴ m away on the
+/// other side.
+/// Reference: the double-double moment method (4 roundings per component); the corrections
+/// must cancel the rotor's resultant and moment to 4 roundings of the largest term.
+#[test]
+fn overhung_planes_far_outside_the_span() {
+    let u = Unbalance::new(1e5, 1e-3, 0.3);
+    let r = Rotor::<1>::new(10.0, 0.5, 0.0, 1.0, &[u], None).unwrap();
+    assert_vec_rel(
+        r.support_unbalance(),
+        dd_split(&pairs(&[u]), 0.0, 1.0),
+        4.0 * U64,
+        "far",
+    );
+    let far = Unbalance::new(2e6, 1e-3, 0.3);
+    assert_eq!(
+        Rotor::<1>::new(10.0, 0.5, 0.0, 1.0, &[far], None).unwrap_err(),
+        ConfigError::Inconsistent("support_b")
+    );
+    let (p1, p2) = (-1e4, -1e4 + 2.0);
+    let [c1, c2] = r.corrections(p1, p2).unwrap();
+    for pick in [|v: &Vec2| v.x, |v: &Vec2| v.y] {
+        let terms = [(1e5, pick(&u.vector())), (p1, pick(&c1)), (p2, pick(&c2))];
+        let (mut f, mut m, mut scale_f, mut scale_m) = (Dd::new(0.0), Dd::new(0.0), 0.0, 0.0);
+        for (z, x) in terms {
+            f = f.add(Dd::new(x));
+            m = m.add(Dd::new(z).mul(Dd::new(x)));
+            scale_f += x.abs();
+            scale_m += (z * x).abs();
+        }
+        assert!(f.f64().abs() <= 4.0 * U64 * scale_f, "force {f:?}");
+        assert!(m.f64().abs() <= 4.0 * U64 * scale_m, "moment {m:?}");
+    }
+}
