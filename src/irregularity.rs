@@ -11,7 +11,7 @@
 //! reason, and whether the speed was steady. No filtering happens before δ: a low-pass would
 //! remove exactly the ripple δ measures.
 
-use crate::error::{positive, ConfigError};
+use crate::error::{positive, positive_f32, ConfigError};
 use crate::speed::{EdgeEvent, Fault, SpeedSample};
 
 /// Largest window, in revolutions.
@@ -78,7 +78,7 @@ impl WindowConfig {
     /// Checks the settings.
     pub fn validate(self) -> Result<Window, ConfigError> {
         let revolutions = self.length.revolutions()?;
-        let t = positive("steady_tolerance", self.steady_tolerance as f64)?;
+        let t = positive_f32("steady_tolerance", self.steady_tolerance)?;
         if t >= 1.0 {
             return Err(ConfigError::OutOfRange("steady_tolerance"));
         }

@@ -6,7 +6,12 @@
 //!
 //! Every test comment names the case, the reference, the tolerance and why that tolerance.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::needless_range_loop
+)]
 
 #[path = "../src/testutil.rs"]
 mod testutil;
@@ -1479,5 +1484,774 @@ fn overhung_planes_far_outside_the_span() {
         }
         assert!(f.f64().abs() <= 4.0 * U64 * scale_f, "force {f:?}");
         assert!(m.f64().abs() <= 4.0 * U64 * scale_m, "moment {m:?}");
+    }
+}
+
+// =============================================================================================
+// Validation: every public constructor names the bad parameter
+// =============================================================================================
+
+/// What a parameter accepts.
+#[derive(Clone, Copy, PartialEq)]
+enum Domain {
+    /// Finite, > 0, not subnormal: every value of `BAD` is rejected.
+    Positive,
+    /// Finite, ≥ 0, not subnormal: all of `BAD` but 0.
+    NonNegative,
+    /// Any finite value (a coordinate, an angle, a signed torque): NaN and ±∞ only.
+    Finite,
+}
+
+type Check = Box<dyn Fn(f64) -> Result<(), ConfigError>>;
+type Check32 = Box<dyn Fn(f32) -> Result<(), ConfigError>>;
+
+fn ok<T>(r: Result<T, ConfigError>) -> Result<(), ConfigError> {
+    r.map(|_| ())
+}
+
+fn rejected(domain: Domain, x: f64) -> bool {
+    match domain {
+        Domain::Positive => BAD.iter().any(|b| b.to_bits() == x.to_bits()),
+        Domain::NonNegative => BAD_NON_NEGATIVE.iter().any(|b| b.to_bits() == x.to_bits()),
+        Domain::Finite => !x.is_finite(),
+    }
+}
+
+/// Every f64 parameter of every public constructor, with its domain and the name its error
+/// must carry.
+fn f64_parameters() -> Vec<(&'static str, Domain, Check)> {
+    use Domain::*;
+    let enc = |f: fn(&mut EncoderConfig, f64)| -> Check {
+        Box::new(move |x| {
+            let mut c = EncoderConfig::new(64, 1e6);
+            f(&mut c, x);
+            ok(Encoder::<64>::new(c))
+        })
+    };
+    let machine_cfg =
+        |f: fn(&mut [Platform; 2], &mut [Coupling; 1], &mut AutoBalancer, f64)| -> Check {
+            Box::new(move |x| {
+                let mut p = [platform(100.0, 4e5, 200.0), platform(99.0, 4e5, 200.0)];
+                let mut c = [coupling(1, 2, 1e5, 50.0)];
+                let mut b = balancer(2);
+                f(&mut p, &mut c, &mut b, x);
+                ok(MachineConfig::new(&p, &c, b))
+            })
+        };
+    let u = Unbalance::new(1.0, 1e-3, 0.5);
+    let pl = ProcessLoad {
+        per_length: 100.0,
+        from: 0.5,
+        to: 3.5,
+        angle: 1.0,
+    };
+    let rotor = move |m: f64, zm: f64, za: f64, zb: f64, u: Unbalance, p: Option<ProcessLoad>| {
+        ok(Rotor::<2>::new(m, zm, za, zb, &[u], p))
+    };
+    let base = move || Rotor::<2>::new(10.0, 2.0, 0.0, 4.0, &[u], None).unwrap();
+    let model = |x: f64, fly: f64| {
+        ok(DriveModel::new(
+            seed_motor(),
+            Load::new(M1, &[h(0.125, 12.0, 0.0)]).unwrap(),
+            x,
+            fly,
+        ))
+    };
+    vec![
+        ("timer_hz", Positive, enc(|c, x| c.timer_hz = x)),
+        ("min_speed", Positive, enc(|c, x| c.min_speed = x)),
+        (
+            "window.load_order",
+            Positive,
+            Box::new(|x| {
+                ok(WindowConfig {
+                    length: WindowLength::LoadOrder(x),
+                    steady_tolerance: 0.02,
+                }
+                .validate())
+            }),
+        ),
+        (
+            "no_load_speed",
+            Positive,
+            Box::new(|x| ok(Parabola::new(x, 36.0, MM))),
+        ),
+        (
+            "breakdown_speed",
+            NonNegative,
+            Box::new(|x| ok(Parabola::new(W0, x, MM))),
+        ),
+        (
+            "breakdown_torque",
+            Positive,
+            Box::new(|x| ok(Parabola::new(W0, WM, x))),
+        ),
+        (
+            "synchronous_speed",
+            Positive,
+            Box::new(|x| ok(Kloss::new(x, 0.2, MM))),
+        ),
+        (
+            "breakdown_slip",
+            Positive,
+            Box::new(|x| ok(Kloss::new(157.0, x, MM))),
+        ),
+        (
+            "breakdown_torque",
+            Positive,
+            Box::new(|x| ok(Kloss::new(157.0, 0.2, x))),
+        ),
+        (
+            "harmonic.order",
+            NonNegative,
+            Box::new(|x| ok(Harmonic::new(x, 1.0, 0.0))),
+        ),
+        (
+            "harmonic.amplitude",
+            Finite,
+            Box::new(|x| ok(Harmonic::new(1.0, x, 0.0))),
+        ),
+        (
+            "harmonic.phase",
+            Finite,
+            Box::new(|x| ok(Harmonic::new(1.0, 1.0, x))),
+        ),
+        ("load.mean", Finite, Box::new(|x| ok(Load::new(x, &[])))),
+        ("inertia", Positive, Box::new(move |x| model(x, 0.0))),
+        ("flywheel", NonNegative, Box::new(move |x| model(J, x))),
+        (
+            "delta_limit",
+            Positive,
+            Box::new(|x| ok(drive(&[h(0.125, 12.0, 0.0)], J).irregularity(Some(x)))),
+        ),
+        (
+            "platform mass",
+            Positive,
+            machine_cfg(|p, _, _, x| p[0].mass = x),
+        ),
+        (
+            "platform stiffness",
+            Positive,
+            machine_cfg(|p, _, _, x| p[1].stiffness = x),
+        ),
+        (
+            "platform damping",
+            NonNegative,
+            machine_cfg(|p, _, _, x| p[0].damping = x),
+        ),
+        (
+            "coupling stiffness",
+            NonNegative,
+            machine_cfg(|_, c, _, x| c[0].stiffness = x),
+        ),
+        (
+            "coupling damping",
+            NonNegative,
+            machine_cfg(|_, c, _, x| c[0].damping = x),
+        ),
+        (
+            "load mass",
+            Positive,
+            machine_cfg(|_, _, b, x| b.load_mass = x),
+        ),
+        ("radius", Positive, machine_cfg(|_, _, b, x| b.radius = x)),
+        (
+            "housing mass",
+            NonNegative,
+            machine_cfg(|_, _, b, x| b.housing_mass = x),
+        ),
+        (
+            "load viscosity",
+            Positive,
+            machine_cfg(|_, _, b, x| b.viscosity = x),
+        ),
+        (
+            "pendulum inertia",
+            NonNegative,
+            machine_cfg(|_, _, b, x| b.kind = BalancerKind::Pendulum { inertia: x }),
+        ),
+        (
+            "max_factor",
+            Positive,
+            Box::new(|x| ok(SearchOptions::new(x, 256, 1e-12))),
+        ),
+        (
+            "rel_tol",
+            Positive,
+            Box::new(|x| ok(SearchOptions::new(4.0, 256, x))),
+        ),
+        (
+            "mass",
+            Positive,
+            Box::new(move |x| rotor(x, 2.0, 0.0, 4.0, u, None)),
+        ),
+        (
+            "centre_of_mass",
+            Finite,
+            Box::new(move |x| rotor(10.0, x, 0.0, 4.0, u, None)),
+        ),
+        (
+            "support_a",
+            Finite,
+            Box::new(move |x| rotor(10.0, 2.0, x, 4.0, u, None)),
+        ),
+        (
+            "support_b",
+            Finite,
+            Box::new(move |x| rotor(10.0, 2.0, -4.0, x, u, None)),
+        ),
+        (
+            "unbalance.z",
+            Finite,
+            Box::new(move |x| rotor(10.0, 2.0, 0.0, 4.0, Unbalance::new(x, 1e-3, 0.5), None)),
+        ),
+        (
+            "unbalance.amount",
+            NonNegative,
+            Box::new(move |x| rotor(10.0, 2.0, 0.0, 4.0, Unbalance::new(1.0, x, 0.5), None)),
+        ),
+        (
+            "unbalance.angle",
+            Finite,
+            Box::new(move |x| rotor(10.0, 2.0, 0.0, 4.0, Unbalance::new(1.0, 1e-3, x), None)),
+        ),
+        (
+            "process_load.per_length",
+            NonNegative,
+            Box::new(move |x| {
+                rotor(
+                    10.0,
+                    2.0,
+                    0.0,
+                    4.0,
+                    u,
+                    Some(ProcessLoad {
+                        per_length: x,
+                        ..pl
+                    }),
+                )
+            }),
+        ),
+        (
+            "process_load.from",
+            Finite,
+            Box::new(move |x| {
+                rotor(
+                    10.0,
+                    2.0,
+                    0.0,
+                    4.0,
+                    u,
+                    Some(ProcessLoad {
+                        from: x,
+                        to: 1e300,
+                        ..pl
+                    }),
+                )
+            }),
+        ),
+        (
+            "process_load.to",
+            Finite,
+            Box::new(move |x| {
+                rotor(
+                    10.0,
+                    2.0,
+                    0.0,
+                    4.0,
+                    u,
+                    Some(ProcessLoad {
+                        from: -1e300,
+                        to: x,
+                        ..pl
+                    }),
+                )
+            }),
+        ),
+        (
+            "process_load.angle",
+            Finite,
+            Box::new(move |x| rotor(10.0, 2.0, 0.0, 4.0, u, Some(ProcessLoad { angle: x, ..pl }))),
+        ),
+        (
+            "gravity",
+            NonNegative,
+            Box::new(move |x| ok(base().with_gravity(x, 0.0))),
+        ),
+        (
+            "gravity.angle",
+            Finite,
+            Box::new(move |x| ok(base().with_gravity(9.8, x))),
+        ),
+        (
+            "correction_plane_1",
+            Finite,
+            Box::new(move |x| ok(base().equivalent_in(x, 1e300))),
+        ),
+        (
+            "correction_plane_2",
+            Finite,
+            Box::new(move |x| ok(base().equivalent_in(-1e300, x))),
+        ),
+        (
+            "grade",
+            Positive,
+            Box::new(|x| ok(Limits::new(x, 60.0, None, 0.8))),
+        ),
+        (
+            "service_speed",
+            Positive,
+            Box::new(|x| ok(Limits::new(6.3, x, None, 0.8))),
+        ),
+        (
+            "support_load_limit.a",
+            Positive,
+            Box::new(|x| ok(Limits::new(6.3, 60.0, Some([x, 1.0]), 0.8))),
+        ),
+        (
+            "support_load_limit.b",
+            Positive,
+            Box::new(|x| ok(Limits::new(6.3, 60.0, Some([1.0, x]), 0.8))),
+        ),
+        (
+            "warning_fraction",
+            Positive,
+            Box::new(|x| ok(Limits::new(6.3, 60.0, None, x))),
+        ),
+    ]
+}
+
+/// Every f32 parameter of every public constructor (tuning values of the run-time paths).
+fn f32_parameters() -> Vec<(&'static str, Domain, Check32)> {
+    use Domain::*;
+    let m = machine(
+        &[platform(100.0, 4e5, 200.0), platform(99.0, 4e5, 200.0)],
+        &[coupling(1, 2, 1e5, 50.0)],
+        balancer(2),
+    );
+    let m2 = m;
+    let alarm = |f: fn(&mut AlarmConfig, f32)| -> Check32 {
+        Box::new(move |x| {
+            let mut a = AlarmConfig::new(0.06);
+            f(&mut a, x);
+            ok(a.validate())
+        })
+    };
+    vec![
+        (
+            "glitch_fraction",
+            Positive,
+            Box::new(|x| {
+                let mut c = EncoderConfig::new(64, 1e6);
+                c.glitch_fraction = x;
+                ok(Encoder::<64>::new(c))
+            }),
+        ),
+        (
+            "steady_tolerance",
+            Positive,
+            Box::new(|x| {
+                ok(WindowConfig {
+                    length: WindowLength::Revolutions(8),
+                    steady_tolerance: x,
+                }
+                .validate())
+            }),
+        ),
+        ("delta_limit", Positive, alarm(|a, x| a.limit = x)),
+        ("hysteresis", NonNegative, alarm(|a, x| a.hysteresis = x)),
+        (
+            "floor_fraction",
+            Positive,
+            alarm(|a, x| a.floor_fraction = x),
+        ),
+        (
+            "margin",
+            NonNegative,
+            Box::new(move |x| ok(Classifier::new(&m, x, 0.01))),
+        ),
+        (
+            "hysteresis",
+            NonNegative,
+            Box::new(move |x| ok(Classifier::new(&m2, 0.03, x))),
+        ),
+        (
+            "pitches",
+            Positive,
+            Box::new(|x| {
+                let e = Encoder::<8>::new(EncoderConfig::new(8, 1e6)).unwrap();
+                let mut t = [(TAU / 8.0) as f32; 8];
+                t[3] = x;
+                ok(e.with_pitches(&t))
+            }),
+        ),
+    ]
+}
+
+/// Case: every public constructor fed NaN, ±∞, zero, a negative and a subnormal value (1e-310
+/// as f64, 1e-40 as f32) in each of its numeric parameters.
+/// Reference: the parameter's domain. Each value outside it must be a typed `ConfigError`
+/// whose `parameter()` names exactly that parameter (nothing may panic, nothing may be
+/// accepted silently); the values inside a wider domain (0 for a non-negative parameter, any
+/// finite value for a coordinate) must not be rejected in that parameter's name.
+#[test]
+fn every_constructor_rejects_bad_numbers_by_name() {
+    for (name, domain, check) in f64_parameters() {
+        for x in BAD {
+            let r = check(x);
+            if rejected(domain, x) {
+                let e = r.expect_err(&format!("{name} = {x:e} accepted"));
+                assert_eq!(e.parameter(), name, "{name} = {x:e}: {e:?}");
+            } else if let Err(e) = r {
+                assert_ne!(
+                    e.parameter(),
+                    name,
+                    "{name} = {x:e} is in its domain: {e:?}"
+                );
+            }
+        }
+    }
+    for (name, domain, check) in f32_parameters() {
+        for x in BAD_F32 {
+            let r = check(x);
+            let out = match domain {
+                Domain::Positive => true,
+                _ => BAD_F32_NON_NEGATIVE
+                    .iter()
+                    .any(|b| b.to_bits() == x.to_bits()),
+            };
+            if out {
+                let e = r.expect_err(&format!("{name} = {x:e} accepted"));
+                assert_eq!(e.parameter(), name, "{name} = {x:e}: {e:?}");
+            } else {
+                assert!(r.is_ok(), "{name} = {x:e}: {r:?}");
+            }
+        }
+    }
+}
+
+// =============================================================================================
+// Totality: no public function panics, on arbitrary inputs
+// =============================================================================================
+
+/// f64 values that break formulas: specials, extremes, and log-uniform magnitudes of both signs.
+fn nasty_f64() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        Just(0.0),
+        Just(-0.0),
+        Just(1e-310),
+        Just(f64::MAX),
+        Just(f64::MIN_POSITIVE),
+        any::<f64>(),
+        (-300.0..300.0f64, any::<bool>()).prop_map(|(e, neg)| if neg {
+            -(10f64.powf(e))
+        } else {
+            10f64.powf(e)
+        }),
+    ]
+}
+
+/// A magnitude 10^lo … 10^hi, log-uniform.
+fn magnitude(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo..hi).prop_map(|e| 10f64.powf(e))
+}
+
+#[derive(Debug, Clone)]
+enum Op {
+    /// `revs` whole revolutions as the disc produces them (index pulse or gap, every edge),
+    /// with a speed ripple of relative amplitude `ripple` per revolution.
+    Revs(u8, f64),
+    /// An edge `f` nominal intervals after the previous one, with a direction input.
+    Edge(f64, Option<bool>),
+    /// An edge `dt` ticks after the previous one (any u32: wraps, zero, huge).
+    RawEdge(u32, Option<bool>),
+    Index,
+    Poll(u32),
+    Pitches(Vec<f32>),
+    Learn(f32),
+    Finish(u16),
+}
+
+fn op() -> impl Strategy<Value = Op> {
+    prop_oneof![
+        12 => (1u8..6, 0.0f64..0.2).prop_map(|(r, a)| Op::Revs(r, a)),
+        2 => (0.0f64..3.0, proptest::option::of(any::<bool>())).prop_map(|(f, d)| Op::Edge(f, d)),
+        1 => (any::<u32>(), proptest::option::of(any::<bool>())).prop_map(|(t, d)| Op::RawEdge(t, d)),
+        2 => Just(Op::Index),
+        1 => any::<u32>().prop_map(Op::Poll),
+        1 => proptest::collection::vec(any::<f32>(), 0..40).prop_map(Op::Pitches),
+        1 => any::<f32>().prop_map(Op::Learn),
+        1 => any::<u16>().prop_map(Op::Finish),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 192, ..ProptestConfig::default() })]
+
+    /// `DeltaMonitor::on_edge`, `poll`, `on_index` (and the learning and pitch-table calls) on
+    /// arbitrary configurations — every one either a typed error or a monitor — and arbitrary
+    /// streams: nothing panics, the speed is always finite and ≥ 0, every valid window has
+    /// finite numbers with 0 ≤ δ < 2 and ωmin ≤ ωmax.
+    #[test]
+    fn delta_monitor_is_total(
+        positions in prop_oneof![1 => 0u16..40, 8 => 4u16..32],
+        framing in prop_oneof![Just(Framing::None), Just(Framing::Index),
+                               (0u8..5).prop_map(|missing| Framing::MissingTooth { missing })],
+        timer_hz in prop_oneof![1 => nasty_f64(), 6 => magnitude(3.0, 9.5)],
+        bits in prop_oneof![1 => 14u8..34, 3 => Just(32u8), 2 => Just(16u8), 1 => Just(24u8)],
+        k in prop_oneof![1 => 0u16..70, 6 => 1u16..5],
+        min_speed in proptest::option::weighted(0.15, nasty_f64()),
+        glitch in prop_oneof![1 => any::<f32>(), 6 => 0.05f32..0.95],
+        steady in prop_oneof![1 => any::<f32>(), 6 => 0.001f32..0.5],
+        limit in prop_oneof![1 => any::<f32>(), 6 => 0.001f32..0.5],
+        revs in 0u16..4,
+        nominal in 20u32..20_000,
+        ops in proptest::collection::vec(op(), 0..40),
+    ) {
+        let mut c = EncoderConfig::new(positions, timer_hz);
+        c.framing = framing;
+        c.counter_bits = bits;
+        c.estimator = Estimator::Edges(k);
+        // By default the timeout is twice the longest nominal interval.
+        c.min_speed = min_speed.unwrap_or(TAU / f64::from(positions.max(1)) * timer_hz / (2.0 * f64::from(nominal)));
+        c.glitch_fraction = glitch;
+        let Ok(enc) = Encoder::<32>::new(c) else { return Ok(()); };
+        let w = WindowConfig { length: WindowLength::Revolutions(revs), steady_tolerance: steady };
+        let Ok(mut m) = DeltaMonitor::new(enc, w, Some(AlarmConfig::new(limit))) else {
+            return Ok(());
+        };
+        let mut t = 0u32;
+        let missing = match framing {
+            Framing::MissingTooth { missing } => u32::from(missing),
+            _ => 0,
+        };
+        let mut windows = Vec::new();
+        for o in ops {
+            let out = match o {
+                Op::Revs(revs, ripple) => {
+                    for r in 0..u32::from(revs) {
+                        for tooth in missing..u32::from(positions) {
+                            let phase = TAU * (tooth as f64 / positions as f64 + r as f64 * 0.37);
+                            let f = 1.0 + ripple * phase.sin();
+                            let gap = if tooth == missing { missing + 1 } else { 1 };
+                            if tooth == missing && framing == Framing::Index {
+                                m.on_index();
+                            }
+                            let dt = (nominal as f64 * gap as f64 / f) as u32;
+                            t = t.wrapping_add(dt);
+                            windows.extend(m.on_edge(t, Some(Direction::Forward)));
+                        }
+                    }
+                    windows.pop()
+                }
+                Op::Edge(f, d) => {
+                    t = t.wrapping_add((f * f64::from(nominal)) as u32);
+                    let d = d.map(|f| if f { Direction::Forward } else { Direction::Reverse });
+                    m.on_edge(t, d)
+                }
+                Op::RawEdge(dt, d) => {
+                    t = t.wrapping_add(dt);
+                    let d = d.map(|f| if f { Direction::Forward } else { Direction::Reverse });
+                    m.on_edge(t, d)
+                }
+                Op::Index => {
+                    m.on_index();
+                    None
+                }
+                Op::Poll(dt) => m.poll(t.wrapping_add(dt)),
+                Op::Pitches(p) => {
+                    let _ = m.set_pitches(&p);
+                    None
+                }
+                Op::Learn(tol) => {
+                    m.start_learning(tol);
+                    None
+                }
+                Op::Finish(n) => {
+                    let mut table = [0.0f32; 32];
+                    let _ = m.finish_learning(n, &mut table);
+                    None
+                }
+            };
+            prop_assert!(m.speed().is_finite() && m.speed() >= 0.0);
+            for o in windows.drain(..).chain(out) {
+                let r = o.report;
+                if r.valid() {
+                    prop_assert!(r.delta.is_finite() && (0.0..2.0).contains(&r.delta), "{:?}", r);
+                    prop_assert!(r.omega_min >= 0.0 && r.omega_min <= r.omega_max, "{:?}", r);
+                    prop_assert!(r.omega_max.is_finite() && r.omega_mean.is_finite(), "{:?}", r);
+                    prop_assert!(r.noise_floor.is_finite() && r.noise_floor >= 0.0);
+                }
+            }
+        }
+        let d = m.diagnostics();
+        prop_assert!(d.alarms_raised <= d.valid_windows);
+    }
+
+    /// `Classifier::classify`/`advice` and `RegimeTracker::update` (and the `Machine` queries)
+    /// on arbitrary valid machines (1–3 platforms, masses 1e-3…1e3 kg, stiffness 1…1e8 N/m,
+    /// damping 0 or 1e-3…1e4, any coupling pattern and exciter platform) and arbitrary f32
+    /// speeds and settings: typed errors or results, `Unknown` exactly for non-finite speeds,
+    /// the regime independent of the sign of the speed, bands with from < to.
+    #[test]
+    fn regime_classification_is_total(
+        n in 1usize..=3,
+        exciter in 1u8..=3,
+        ps in proptest::collection::vec(
+            (magnitude(-3.0, 3.0), magnitude(0.0, 8.0),
+             prop_oneof![Just(0.0), magnitude(-3.0, 4.0)]), 3),
+        cs in proptest::collection::vec(
+            (prop_oneof![Just(0.0), magnitude(0.0, 8.0)], prop_oneof![Just(0.0), magnitude(-3.0, 4.0)]), 3),
+        pattern in 0u8..8,
+        kind in 0u8..3,
+        margin in prop_oneof![any::<f32>(), 0.0f32..0.4],
+        hysteresis in prop_oneof![any::<f32>(), 0.0f32..0.4],
+        speeds in proptest::collection::vec(any::<u32>(), 1..24),
+        probe in nasty_f64(),
+    ) {
+        let platforms: Vec<Platform> = ps.iter().take(n).map(|&(m, k, c)| platform(m, k, c)).collect();
+        let pairs = [(1u8, 2u8), (2, 3), (1, 3)];
+        let couplings: Vec<Coupling> = pairs
+            .iter()
+            .zip(&cs)
+            .enumerate()
+            .filter(|(i, ((a, b), _))| pattern & (1 << i) != 0 && (*a as usize) <= n && (*b as usize) <= n)
+            .map(|(_, ((a, b), &(k, c)))| coupling(*a, *b, k, c))
+            .collect();
+        let mut b = balancer(exciter.min(n as u8));
+        b.kind = match kind {
+            0 => BalancerKind::Ball,
+            1 => BalancerKind::Roller,
+            _ => BalancerKind::Pendulum { inertia: 1e-3 },
+        };
+        let cfg = MachineConfig::new(&platforms, &couplings, b);
+        prop_assert!(cfg.is_ok(), "{:?}", cfg);
+        let Ok(m) = Machine::new(cfg.unwrap(), SearchOptions::default()) else { return Ok(()); };
+        prop_assert!(m.zones().first().map(|z| z.kind) == Some(ZoneKind::Gathering));
+        let _ = (m.zone_kind_at(probe), m.receptance(probe), m.capture_lag(probe), m.capture_speed(probe));
+        let Ok(c) = Classifier::new(&m, margin, hysteresis) else { return Ok(()); };
+        let mut t = RegimeTracker::new();
+        for bits in speeds {
+            let x = f32::from_bits(bits);
+            let r = c.classify(x);
+            prop_assert_eq!(r == Regime::Unknown, !x.is_finite());
+            prop_assert_eq!(c.classify(-x), r);
+            let a = c.advice(x);
+            if let Some(band) = a.exciter_band {
+                prop_assert!(band.from < band.to);
+            }
+            let st = t.update(&c, x);
+            prop_assert_eq!(st.regime == Regime::Unknown, !x.is_finite());
+        }
+    }
+
+    /// `SupportMonitor::update` and `set_unbalance` (both math backends), and the rotor's
+    /// queries, on arbitrary rotors and limits (every f64 nasty) and arbitrary f32 speeds:
+    /// typed errors or results; `speed_valid` exactly when the speed is not NaN; for a finite
+    /// speed with finite loads, peak ≥ min ≥ 0; `set_unbalance` accepts exactly finite,
+    /// non-negative values.
+    #[test]
+    fn support_monitor_is_total(
+        mass in prop_oneof![1 => nasty_f64(), 6 => magnitude(-2.0, 5.0)],
+        coords in proptest::collection::vec(prop_oneof![1 => nasty_f64(), 12 => -10.0..10.0f64], 4),
+        amount in prop_oneof![1 => nasty_f64(), 6 => magnitude(-9.0, 0.0)],
+        angle in prop_oneof![1 => nasty_f64(), 6 => -7.0..7.0f64],
+        q in prop_oneof![1 => nasty_f64(), 6 => magnitude(0.0, 4.0)],
+        limits in proptest::collection::vec(prop_oneof![1 => nasty_f64(), 12 => magnitude(-1.0, 6.0)], 4),
+        w in any::<u32>(),
+        a in any::<u32>(),
+        b in any::<u32>(),
+    ) {
+        let u = Unbalance::new(coords[3], amount, angle);
+        let p = ProcessLoad { per_length: q, from: coords[0].min(coords[3]), to: coords[0].max(coords[3]) + 1.0, angle };
+        let Ok(r) = Rotor::<2>::new(mass, coords[0], coords[1], coords[2], &[u, u], Some(p)) else {
+            return Ok(());
+        };
+        let _ = (r.loads(f64::from(f32::from_bits(w))), r.plane_split(), r.equivalent_in(coords[3], angle));
+        let Ok(l) = Limits::new(limits[0], limits[1], Some([limits[2], limits[3]]), 0.8) else {
+            return Ok(());
+        };
+        let an = SupportAnalysis::new(&r, &l);
+        let _ = an.report();
+        let mut mon = an.monitor();
+        let (w, a, b) = (f32::from_bits(w), f32::from_bits(a), f32::from_bits(b));
+        for k in 0..2 {
+            let accepted = if k == 0 { mon.set_unbalance::<Libm>(a, b) } else { mon.set_unbalance::<Micromath>(a, b) };
+            prop_assert_eq!(accepted, a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0);
+            let st = mon.update(w);
+            prop_assert_eq!(st.speed_valid, !w.is_nan());
+            for i in 0..2 {
+                let (pk, mn) = (st.peak_load[i], st.min_load[i]);
+                if w.is_finite() && pk.is_finite() && mn.is_finite() {
+                    prop_assert!(pk >= mn && mn >= 0.0, "{:?}", st);
+                }
+                if st.speed_valid && !pk.is_nan() {
+                    prop_assert!(st.load[i] != Level::Unknown);
+                }
+            }
+            if let Some(s) = mon.max_safe_speed() {
+                prop_assert!(s >= 0.0);
+            }
+        }
+    }
+
+    /// `DriveModel::predict`, `flywheel_for`, `sensitivity`, `irregularity` and the steady
+    /// speed on arbitrary valid models (speeds 1e-3…1e6 rad/s, torques and inertias over 12
+    /// decades, up to four harmonics of mixed orders) and arbitrary targets: a steady state
+    /// has finite speeds 0 < ωmin ≤ ωmax and 0 ≤ δ < 2 agreeing with eq. 13 from those speeds
+    /// (1e-9 where δ > 1e-6: no cancellation there); a stall has ω²min ≤ 0; a flywheel found
+    /// is finite, ≥ 0 and meets the target (1e-9).
+    #[test]
+    fn drive_prediction_is_total(
+        w0 in magnitude(-3.0, 6.0),
+        wm_frac in 0.0..0.999f64,
+        mm in magnitude(-6.0, 6.0),
+        load_frac in -2.0..1.5f64,
+        j in magnitude(-6.0, 6.0),
+        fly in prop_oneof![Just(0.0), magnitude(-6.0, 6.0)],
+        hs in proptest::collection::vec(
+            (prop_oneof![Just(0.0), Just(0.125), Just(0.5), Just(1.0), Just(3.0),
+                         Just(std::f64::consts::SQRT_2), Just(1e-6), Just(1e3)],
+             -1.5..1.5f64, -7.0..7.0f64), 0..4),
+        target in prop_oneof![nasty_f64(), 1e-6..1.5f64],
+        phi in nasty_f64(),
+    ) {
+        let Ok(p) = Parabola::new(w0, wm_frac * w0, mm) else { return Ok(()); };
+        let b = p.b();
+        let hs: Vec<Harmonic> = hs.iter().map(|&(n, a, ph)| h(n, a * b, ph)).collect();
+        let Ok(m) = DriveModel::new(p.into(), Load::new(load_frac * b, &hs).unwrap(), j, fly) else {
+            return Ok(());
+        };
+        match m.predict() {
+            Prediction::Steady(s) => {
+                prop_assert!(s.omega_max.is_finite() && s.omega_min > 0.0 && s.omega_min <= s.omega_max, "{:?}", s);
+                prop_assert!(s.delta.is_finite() && (0.0..2.0).contains(&s.delta), "{:?}", s);
+                if s.delta > 1e-6 {
+                    let naive = 2.0 * (s.omega_max - s.omega_min) / (s.omega_max + s.omega_min);
+                    prop_assert!(rel(s.delta, naive) < 1e-9, "{:?} vs {}", s, naive);
+                }
+                if let Some(sens) = m.sensitivity() {
+                    prop_assert!(sens.d_delta_d_inertia.is_finite() && sens.d_delta_d_breakdown_torque.is_finite());
+                }
+            }
+            Prediction::Stalls(st) => prop_assert!(st.u_min <= 0.0 && !st.u_mean.is_nan(), "{:?}", st),
+        }
+        if let Ok(extra) = m.flywheel_for(target) {
+            prop_assert!(extra.is_finite() && extra >= 0.0);
+            if extra > 0.0 {
+                if let Ok(fixed) = m.with_flywheel(m.flywheel() + extra) {
+                    let s = fixed.predict();
+                    let d = s.steady().map(|s| s.delta);
+                    prop_assert!(d.is_some_and(|d| d <= target * (1.0 + 1e-9)), "{:?} for {}", s, target);
+                }
+            }
+        }
+        if let Ok(irr) = m.irregularity(Some(target)) {
+            prop_assert!(irr.delta.is_finite() && irr.omega_max.is_finite());
+        }
+        let _ = (m.steady_omega(phi), m.omega_squared(phi));
     }
 }

@@ -180,12 +180,13 @@ impl System {
             a.swap(p, piv);
             y.swap(p, piv);
             let inv = C64::ONE.div(a[p][p]);
+            let (pivot_row, yp) = (a[p], y[p]);
             for i in p + 1..n {
                 let l = a[i][p] * inv;
-                for j in p + 1..n {
-                    a[i][j] = a[i][j] - l * a[p][j];
+                for (x, &u) in a[i].iter_mut().zip(&pivot_row).take(n).skip(p + 1) {
+                    *x = *x - l * u;
                 }
-                y[i] = y[i] - l * y[p];
+                y[i] = y[i] - l * yp;
             }
         }
         y[n - 1].div(a[n - 1][n - 1])
