@@ -7,7 +7,7 @@
 //! last `m` counted windows exceed the limit, and clears when at least `n` of the last `m` are
 //! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter.
 
-use crate::error::{positive, ConfigError};
+use crate::error::{non_negative_f32, positive_f32, ConfigError};
 use crate::irregularity::WindowReport;
 use embedded_hal::digital::OutputPin;
 
@@ -41,21 +41,18 @@ impl AlarmConfig {
 
     /// Checks the settings.
     pub fn validate(self) -> Result<DeltaAlarm, ConfigError> {
-        positive("delta_limit", self.limit as f64)?;
+        positive_f32("delta_limit", self.limit)?;
         if self.of_last == 0 || self.of_last > 32 {
             return Err(ConfigError::OutOfRange("of_last"));
         }
         if self.raise_after == 0 || self.raise_after > self.of_last {
             return Err(ConfigError::OutOfRange("raise_after"));
         }
-        let h = self.hysteresis;
-        if !h.is_finite() {
-            return Err(ConfigError::NonFinite("hysteresis"));
-        }
-        if !(0.0..=0.9).contains(&h) {
+        let h = non_negative_f32("hysteresis", self.hysteresis)?;
+        if h > 0.9 {
             return Err(ConfigError::OutOfRange("hysteresis"));
         }
-        let f = positive("floor_fraction", self.floor_fraction as f64)?;
+        let f = positive_f32("floor_fraction", self.floor_fraction)?;
         if f > 1.0 {
             return Err(ConfigError::OutOfRange("floor_fraction"));
         }

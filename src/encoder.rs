@@ -103,6 +103,10 @@ pub struct Encoder<const N: usize> {
 
 impl<const N: usize> Encoder<N> {
     /// Validates `config` and builds the uniform tables.
+    ///
+    /// Besides each field's range, the timer must fit the speed range: the longest pitch at
+    /// `min_speed` must last fewer ticks than the counter holds (`Inconsistent("min_speed")`)
+    /// and at least 2 ticks (`Inconsistent("timer_hz")`).
     pub fn new(config: EncoderConfig) -> Result<Self, ConfigError> {
         let missing = match config.framing {
             Framing::MissingTooth { missing } => {
@@ -153,6 +157,11 @@ impl<const N: usize> Encoder<N> {
         // Intervals are measured modulo the counter: a timeout beyond its range cannot be seen.
         if !timeout.is_finite() || timeout >= mask as f64 {
             return Err(ConfigError::Inconsistent("min_speed"));
+        }
+        // A pitch at the minimum speed shorter than 2 ticks carries no speed information: every
+        // interval the tracker accepts would be a single tick.
+        if timeout < 2.0 {
+            return Err(ConfigError::Inconsistent("timer_hz"));
         }
         // A K-edge sample must fit in u32 ticks even at the slowest speed.
         if timeout * k as f64 >= u32::MAX as f64 {

@@ -72,6 +72,27 @@ pub fn non_negative(name: &'static str, x: f64) -> Result<f64, ConfigError> {
     }
 }
 
+/// `x` if it is finite and positive as an f32: like [`positive`], with f32's own subnormals
+/// (below `f32::MIN_POSITIVE`, normal once widened to f64) rejected.
+pub fn positive_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
+    positive(name, f64::from(x))?;
+    if x >= f32::MIN_POSITIVE {
+        Ok(x)
+    } else {
+        Err(ConfigError::NotPositive(name))
+    }
+}
+
+/// `x` if it is finite and not negative as an f32 (an f32 subnormal is rejected).
+pub fn non_negative_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
+    non_negative(name, f64::from(x))?;
+    if x == 0.0 || x >= f32::MIN_POSITIVE {
+        Ok(x)
+    } else {
+        Err(ConfigError::OutOfRange(name))
+    }
+}
+
 /// `x` if it is finite.
 pub fn finite(name: &'static str, x: f64) -> Result<f64, ConfigError> {
     if x.is_finite() {
@@ -109,5 +130,15 @@ mod tests {
         assert_eq!(non_negative("c", -0.5), Err(ConfigError::Negative("c")));
         assert_eq!(non_negative("c", 1e-310), Err(ConfigError::OutOfRange("c")));
         assert_eq!(ConfigError::Negative("c").parameter(), "c");
+        assert_eq!(positive_f32("f", 1e-40), Err(ConfigError::NotPositive("f")));
+        assert_eq!(
+            non_negative_f32("f", 1e-40),
+            Err(ConfigError::OutOfRange("f"))
+        );
+        assert_eq!(non_negative_f32("f", 0.0), Ok(0.0));
+        assert_eq!(
+            positive_f32("f", f32::NAN),
+            Err(ConfigError::NonFinite("f"))
+        );
     }
 }

@@ -11,7 +11,7 @@
 //! reason, and whether the speed was steady. No filtering happens before δ: a low-pass would
 //! remove exactly the ripple δ measures.
 
-use crate::error::{positive, ConfigError};
+use crate::error::{positive, positive_f32, ConfigError};
 use crate::speed::{EdgeEvent, Fault, SpeedSample};
 
 /// Largest window, in revolutions.
@@ -78,7 +78,7 @@ impl WindowConfig {
     /// Checks the settings.
     pub fn validate(self) -> Result<Window, ConfigError> {
         let revolutions = self.length.revolutions()?;
-        let t = positive("steady_tolerance", self.steady_tolerance as f64)?;
+        let t = positive_f32("steady_tolerance", self.steady_tolerance)?;
         if t >= 1.0 {
             return Err(ConfigError::OutOfRange("steady_tolerance"));
         }
@@ -135,7 +135,7 @@ impl WindowReport {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Extreme {
     angle: f32,
-    ticks: f32,
+    ticks: u32,
 }
 
 /// Per-window accumulation state.
@@ -194,15 +194,34 @@ fn two_product(x: f32, y: f32) -> (f32, f32) {
     (p, e)
 }
 
-/// a1·t2 − a2·t1 to within about one rounding of the result: both products are split exactly
-/// (Dekker) and the differences taken term by term, so equal speeds cancel to exactly 0. This
-/// is plain f32 arithmetic: on a Cortex-M4F it costs ~40 FPU instructions, against ~400 for
-/// two software `libm::fmaf` calls (no fused multiply-add is reachable from stable `core`) and
-/// ~250 for the same difference in soft-float f64 (products exact in f64).
-fn cross(a1: f32, t2: f32, a2: f32, t1: f32) -> f32 {
-    let (p1, e1) = two_product(a1, t2);
-    let (p2, e2) = two_product(a2, t1);
-    (p1 - p2) + (e1 - e2)
+/// A tick count as an f32 head (its rounding) plus the exact remainder (|rem| ≤ 128).
+#[inline]
+fn split_ticks(t: u32) -> (f32, f32) {
+    #[cold]
+    #[inline(never)]
+    fn wide(t: u32) -> (f32, f32) {
+        let head = t as f32;
+        (head, (i64::from(t) - head as i64) as f32)
+    }
+    if t < 1 << 24 {
+        (t as f32, 0.0)
+    } else {
+        wide(t)
+    }
+}
+
+/// a1·t2 − a2·t1 for integer tick counts, to within about one rounding of the result.
+/// Stability: counts above 2²⁴ round in f32, so each is split exactly into head + remainder;
+/// the head products are split exactly (Dekker) and differenced term by term, the small
+/// remainder products added after, so equal speeds cancel to exactly 0. Plain f32 arithmetic:
+/// on a Cortex-M4F ~40 FPU instructions, against ~400 for two software `libm::fmaf` calls (no
+/// fused multiply-add is reachable from stable `core`).
+fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
+    let (h2, l2) = split_ticks(t2);
+    let (h1, l1) = split_ticks(t1);
+    let (p1, e1) = two_product(a1, h2);
+    let (p2, e2) = two_product(a2, h1);
+    ((p1 - p2) + (e1 - e2)) + (a1 * l2 - a2 * l1)
 }
 
 impl WindowState {
@@ -216,11 +235,11 @@ impl WindowState {
             sample_ticks: 0,
             max: Extreme {
                 angle: 0.0,
-                ticks: 0.0,
+                ticks: 0,
             },
             min: Extreme {
                 angle: 0.0,
-                ticks: 0.0,
+                ticks: 0,
             },
             prev_mean: 0.0,
         }
@@ -242,33 +261,50 @@ impl WindowState {
         // neither count can reach its type's limit: plain wrapping adds are exact.
         self.samples = self.samples.wrapping_add(1);
         self.sample_ticks = self.sample_ticks.wrapping_add(s.ticks as u64);
-        // Compare angle/ticks by cross-multiplying: no division per edge.
-        let t = s.ticks as f32;
-        let e = Extreme {
-            angle: s.angle,
-            ticks: t,
-        };
         if self.samples == 1 {
-            self.max = e;
-            self.min = e;
+            self.max = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
+            self.min = self.max;
             return;
         }
-        if s.angle * self.max.ticks > self.max.angle * t {
-            self.max = e;
+        // Compare angle/ticks by cross-multiplying: no division per edge. Equal angles (a
+        // uniform disc) compare the exact integer counts, which round in f32 above 2²⁴.
+        let t = s.ticks as f32;
+        let faster = if s.angle == self.max.angle {
+            s.ticks < self.max.ticks
+        } else {
+            s.angle * self.max.ticks as f32 > self.max.angle * t
+        };
+        if faster {
+            self.max = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
         }
-        if s.angle * self.min.ticks < self.min.angle * t {
-            self.min = e;
+        let slower = if s.angle == self.min.angle {
+            s.ticks > self.min.ticks
+        } else {
+            s.angle * (self.min.ticks as f32) < self.min.angle * t
+        };
+        if slower {
+            self.min = Extreme {
+                angle: s.angle,
+                ticks: s.ticks,
+            };
         }
     }
 
     fn report(&self, window: &Window, timer_hz: f32, fault: Option<Fault>) -> WindowReport {
-        let (a1, t1) = (self.max.angle, self.max.ticks);
-        let (a2, t2) = (self.min.angle, self.min.ticks);
+        let (a1, t1) = (self.max.angle, self.max.ticks as f32);
+        let (a2, t2) = (self.min.angle, self.min.ticks as f32);
         let omega_max = if t1 > 0.0 { a1 * timer_hz / t1 } else { 0.0 };
         let omega_min = if t2 > 0.0 { a2 * timer_hz / t2 } else { 0.0 };
         // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1): the numerator
-        // from exact integer ticks and an FMA difference, never by subtracting two speeds.
-        let num = cross(a1, t2, a2, t1);
+        // from exact integer ticks and an error-free product difference, never by subtracting
+        // two speeds.
+        let num = cross(a1, self.min.ticks, a2, self.max.ticks);
         let den = a1 * t2 + a2 * t1;
         let delta = if den > 0.0 { 2.0 * num / den } else { 0.0 };
         let omega_mean = if self.ticks > 0 {
@@ -392,8 +428,9 @@ mod tests {
         for _ in 0..20_000 {
             let a1 = 1e-3 + (next() % 1_000_000) as f32 * 1e-7;
             let a2 = a1 * (1.0 + ((next() % 2001) as f32 - 1000.0) * 1e-5);
-            let t1 = (1_000 + next() % 50_000_000) as f32;
-            let t2 = t1 + ((next() % 20_001) as f32 - 10_000.0);
+            // Counts on both sides of 2^24, where f32 stops holding them exactly.
+            let t1 = 1_000 + next() % 50_000_000;
+            let t2 = (t1 + next() % 20_001).saturating_sub(10_000).max(1);
             let exact = a1 as f64 * t2 as f64 - a2 as f64 * t1 as f64;
             let scale = (a1 as f64 * t2 as f64)
                 .abs()
@@ -407,7 +444,7 @@ mod tests {
             assert_eq!(cross(a1, t1, a1, t1), 0.0);
         }
         // Equal products from different factors cancel too.
-        assert_eq!(cross(0.5, 6.0, 1.5, 2.0), 0.0);
+        assert_eq!(cross(0.5, 6, 1.5, 2), 0.0);
     }
 
     #[test]
@@ -426,14 +463,19 @@ mod tests {
 
     #[test]
     fn cross_product_difference_is_exact_for_close_speeds() {
-        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding.
+        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding;
+        // nor one tick in 3e9, where each count rounds to a multiple of 256 in f32.
         let a = 0.006_135_923_f32;
-        let (t1, t2) = (10_000_000f32, 10_000_001f32);
-        let num = cross(a, t2, a, t1);
-        let exact = a as f64 * 1.0;
-        assert!(
-            (num as f64 - exact).abs() <= 1e-7 * exact,
-            "{num} vs {exact}"
-        );
+        for (t1, t2) in [
+            (10_000_000u32, 10_000_001u32),
+            (3_000_000_001, 3_000_000_002),
+        ] {
+            let num = cross(a, t2, a, t1);
+            let exact = a as f64 * 1.0;
+            assert!(
+                (num as f64 - exact).abs() <= 1e-7 * exact,
+                "{num} vs {exact}"
+            );
+        }
     }
 }

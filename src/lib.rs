@@ -18,6 +18,8 @@ pub mod math;
 pub mod monitor;
 pub mod speed;
 pub mod supports;
+#[cfg(test)]
+pub(crate) mod testutil;
 
 pub use error::ConfigError;
 pub use math::{Libm, Math, Micromath};

@@ -350,26 +350,38 @@ impl SpeedTracker {
         let uniform = enc.uniform_pitch();
         let was_synced = self.synced;
         let next_pitch = if was_synced { enc.pitch(next) } else { uniform };
-        // Interval relative to the one expected from the previous interval's speed, kept as the
-        // fraction `num / den` (1/1 without a previous interval) and compared by
-        // cross-multiplying: no division on the per-edge path.
-        let (num, den) = if self.prev_dt > 0 {
-            (
-                dt as f32 * self.prev_pitch,
-                self.prev_dt as f32 * next_pitch,
-            )
+        // This interval's ticks scaled by the previous pitch, `num`: against
+        // `prev_dt·uniform` it is the apparent pitch in uniform pitches (compared by
+        // cross-multiplying: no division on the per-edge path).
+        let num = if self.prev_dt > 0 {
+            dt as f32 * self.prev_pitch
         } else {
-            (1.0, 1.0)
+            1.0
         };
         let gap_framing = matches!(enc.config().framing, Framing::MissingTooth { .. });
         let glitch_fraction = enc.config().glitch_fraction;
         // Unsynced on a gapped disc the next interval may be a gap or follow one: only an
         // interval short even against that (ratio below glitch_fraction / gap_ratio / 2) is a
         // glitch.
-        let glitch = if !self.synced && gap_framing {
-            num * (2.0 * enc.gap_ratio()) < glitch_fraction * den
+        // Both counts are quantized to ±1 tick: an interval is a glitch only if its ratio is
+        // below the limit even at its largest, (dt + 1)/(prev − 1), and "long" (a missing edge)
+        // only if above 1.5 even at its smallest, (dt − 1)/(prev + 1); a coarse timer's
+        // rounding is then neither.
+        let (num_hi, den_lo, num_lo, den_hi) = if self.prev_dt > 0 {
+            let (d, p) = (dt as f32, self.prev_dt as f32);
+            (
+                (d + 1.0) * self.prev_pitch,
+                (p - 1.0) * next_pitch,
+                (d - 1.0) * self.prev_pitch,
+                (p + 1.0) * next_pitch,
+            )
         } else {
-            num < glitch_fraction * den
+            (1.0, 1.0, 1.0, 1.0)
+        };
+        let glitch = if !self.synced && gap_framing {
+            num_hi * (2.0 * enc.gap_ratio()) < glitch_fraction * den_lo
+        } else {
+            num_hi < glitch_fraction * den_lo
         };
         if dt == 0 || glitch {
             ev.fault = Some(self.count(Fault::Glitch));
@@ -383,7 +395,7 @@ impl SpeedTracker {
         // Apparent pitch of this interval in uniform pitches, `num / uniform_den`: ≈1 for a
         // tooth, ≈m+1 for a gap.
         let uniform_den = self.prev_dt as f32 * uniform;
-        let long = self.prev_dt > 0 && num > 1.5 * den;
+        let long = self.prev_dt > 0 && num_lo > 1.5 * den_hi;
         match enc.config().framing {
             Framing::MissingTooth { .. } => {
                 let gap = self.prev_dt > 0 && num > enc.gap_ratio() * uniform_den;

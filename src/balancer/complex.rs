@@ -11,6 +11,7 @@ pub(crate) struct C64 {
 
 impl C64 {
     pub const ONE: C64 = C64 { re: 1.0, im: 0.0 };
+    pub const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
     pub const fn new(re: f64, im: f64) -> Self {
         C64 { re, im }

@@ -149,44 +149,56 @@ impl System {
         C64::new(self.k(i, j) - w * w * m, w * self.c(i, j))
     }
 
-    /// `(det Z_oo, det Z)`: the exciter's cofactor and the determinant, expanded along the
-    /// exciter's row and column (bordered form), so `H_ee = cof/det`.
-    pub fn cofactor_det(&self, w: f64) -> (C64, C64) {
-        let e = self.e;
-        let zee = self.z(e, e, w);
-        let ([a, b], n) = self.others();
-        match n {
-            0 => (C64::ONE, zee),
-            1 => {
-                let zaa = self.z(a, a, w);
-                let zae = self.z(a, e, w);
-                (zaa, zee * zaa - zae * zae)
-            }
-            _ => {
-                let zaa = self.z(a, a, w);
-                let zbb = self.z(b, b, w);
-                let zab = self.z(a, b, w);
-                let zae = self.z(a, e, w);
-                let zbe = self.z(b, e, w);
-                let cof = zaa * zbb - zab * zab;
-                // det = zee·cof − uᵀ·adj(Z_oo)·u with u = (zae, zbe).
-                let quad = zae * zae * zbb + zbe * zbe * zaa - C64::new(2.0, 0.0) * zae * zbe * zab;
-                (cof, zee * cof - quad)
+    /// Driving-point receptance `H_ee(ω) = [Z(ω)⁻¹]_ee`, m/N: the exciter's entry of the
+    /// solution of `Z·y = e_e`, by complex Gaussian elimination with partial pivoting. The
+    /// exciter is ordered last, so its unknown is the last pivot's quotient (no back
+    /// substitution).
+    pub fn receptance(&self, w: f64) -> C64 {
+        let ([a0, a1], n_others) = self.others();
+        let order = match n_others {
+            0 => [self.e, 0, 0],
+            1 => [a0, self.e, 0],
+            _ => [a0, a1, self.e],
+        };
+        let n = n_others.min(2) + 1;
+        let idx = order.get(..n).unwrap_or(&[]);
+        let mut a = [[C64::ZERO; MAX_PLATFORMS]; MAX_PLATFORMS];
+        let mut y = [C64::ZERO; MAX_PLATFORMS];
+        for (i, &ri) in idx.iter().enumerate() {
+            for (j, &cj) in idx.iter().enumerate() {
+                a[i][j] = self.z(ri, cj, w);
             }
         }
+        y[n - 1] = C64::ONE;
+        for p in 0..n - 1 {
+            let mut piv = p;
+            for i in p + 1..n {
+                if a[i][p].norm_sq() > a[piv][p].norm_sq() {
+                    piv = i;
+                }
+            }
+            a.swap(p, piv);
+            y.swap(p, piv);
+            let inv = C64::ONE.div(a[p][p]);
+            let (pivot_row, yp) = (a[p], y[p]);
+            for i in p + 1..n {
+                let l = a[i][p] * inv;
+                for (x, &u) in a[i].iter_mut().zip(&pivot_row).take(n).skip(p + 1) {
+                    *x = *x - l * u;
+                }
+                y[i] = y[i] - l * yp;
+            }
+        }
+        y[n - 1].div(a[n - 1][n - 1])
     }
 
-    /// Driving-point receptance `H_ee(ω)`, m/N.
-    pub fn receptance(&self, w: f64) -> C64 {
-        let (cof, det) = self.cofactor_det(w);
-        cof.div(det)
-    }
-
-    /// A polynomial in `ω` with the sign of `Re H_ee(ω)` and no poles:
-    /// `Re(cof · conj(det)) = |det|²·Re H_ee`. Positive: gathering; negative: balancing.
+    /// `Re H_ee(ω)`: positive where the loads gather, negative where balancing is stable.
+    /// Stability: taken from the pivoted solve, which is backward stable, so its sign changes
+    /// lie within rounding of a nearby machine's poles and zeros, never from the determinant
+    /// form `Re(det Z_oo·conj(det Z))`, which has a triple root where a double pole cancels
+    /// against a zero (equal partial frequencies) and loses two thirds of its digits there.
     pub fn criterion(&self, w: f64) -> f64 {
-        let (cof, det) = self.cofactor_det(w);
-        (cof * det.conj()).re
+        self.receptance(w).re
     }
 
     /// The same system with masses divided by `m_s`, stiffness by `k_s` and damping by

@@ -1,7 +1,7 @@
 //! Run-time classification of a measured speed (f32, O(log zones), total).
 
 use super::{Machine, ZoneKind, MAX_PLATFORMS, MAX_ZONES};
-use crate::error::{finite, ConfigError};
+use crate::error::{non_negative_f32, ConfigError};
 
 /// Segments: the zones, with balancing zones split where a capture window ends.
 const MAX_SEGMENTS: usize = MAX_ZONES + MAX_PLATFORMS;
@@ -72,12 +72,12 @@ impl Classifier {
     /// `hysteresis`: relative distance past a boundary the speed must go before
     /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`.
     pub fn new(machine: &Machine, margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
-        let margin = finite("margin", f64::from(margin))? as f32;
-        let hysteresis = finite("hysteresis", f64::from(hysteresis))? as f32;
-        if !(0.0..0.5).contains(&margin) {
+        let margin = non_negative_f32("margin", margin)?;
+        let hysteresis = non_negative_f32("hysteresis", hysteresis)?;
+        if margin >= 0.5 {
             return Err(ConfigError::OutOfRange("margin"));
         }
-        if !(0.0..0.5).contains(&hysteresis) {
+        if hysteresis >= 0.5 {
             return Err(ConfigError::OutOfRange("hysteresis"));
         }
         let mut c = Classifier {

@@ -1146,15 +1146,8 @@ fn every_bad_parameter_gives_a_typed_error() {
     let c = [coupling(1, 2, 1e5, 50.0)];
     let b = balancer(2);
     assert!(MachineConfig::new(&p, &c, b).is_ok());
-    let bad_positive = [
-        f64::NAN,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        0.0,
-        -1.0,
-        1e-310,
-    ];
-    let bad_nonneg = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -1.0, 1e-310];
+    let bad_positive = crate::testutil::BAD;
+    let bad_nonneg = crate::testutil::BAD_NON_NEGATIVE;
     type Setter = fn(&mut [Platform; 2], &mut [Coupling; 1], &mut AutoBalancer, f64);
     let positive_fields: [(&str, Setter); 5] = [
         ("platform mass", |p, _, _, x| p[0].mass = x),

@@ -79,7 +79,8 @@ pub struct SteadyState {
     /// RMS speed `√ū` (ū is the mean of ω² over the period), rad/s.
     pub omega_rms: f64,
     /// Shaft angle of ωmax within the period, rad (`None` for [`Horizon::Unbounded`] and
-    /// [`Horizon::Constant`]).
+    /// [`Horizon::Constant`], and for an order below about 3.5e-308, whose period 2π/n is
+    /// beyond f64).
     pub phi_max: Option<f64>,
     /// Shaft angle of ωmin, rad (as `phi_max`).
     pub phi_min: Option<f64>,
@@ -545,15 +546,20 @@ impl DriveModel {
                     alpha += 2.0 * PI;
                 }
                 let phi_max = alpha / c.order;
-                let mut phi_min = phi_max + period / 2.0;
-                if phi_min >= period {
-                    phi_min -= period;
-                }
+                // Half a period back or forward, never beyond the period (no overflow); an
+                // order so slow that 2π/n overflows f64 has no representable angle at all.
+                let half = period / 2.0;
+                let phi_min = if phi_max >= half {
+                    phi_max - half
+                } else {
+                    phi_max + half
+                };
+                let angles = period.is_finite() && phi_max.is_finite() && phi_min.is_finite();
                 Extremes {
                     s_max: r,
                     s_min: -r,
-                    phi_max: Some(phi_max),
-                    phi_min: Some(phi_min),
+                    phi_max: angles.then_some(phi_max),
+                    phi_min: angles.then_some(phi_min),
                 }
             }
             (Horizon::Period { radians, samples }, _) => self.search(radians, samples),

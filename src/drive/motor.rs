@@ -312,15 +312,7 @@ impl From<Parabola> for Motor {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    const BAD: [f64; 6] = [
-        f64::NAN,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        0.0,
-        -1.0,
-        1e-310,
-    ];
+    use crate::testutil::BAD;
 
     #[test]
     fn parabola_passes_through_its_two_points() {

@@ -412,14 +412,7 @@ fn horizons() {
 #[test]
 fn invalid_inputs_are_typed_errors() {
     let load = || Load::new(24.0, &[h(0.125, 12.0, 0.0)]).unwrap();
-    for x in [
-        f64::NAN,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        0.0,
-        -1.0,
-        1e-310,
-    ] {
+    for x in crate::testutil::BAD {
         let e = DriveModel::new(seed_motor(), load(), x, 0.0).unwrap_err();
         assert_eq!(e.parameter(), "inertia");
         if x != 0.0 {

@@ -38,9 +38,10 @@
 //!   [`Rotor::static_load`] for the consistent model used instead.
 //!
 //! # Numerics
-//! Plane shares are formed as `Σ D_i·(z_B − z_i) / (z_B − z_A)` with single coordinate
-//! differences and a compensated (twice-working-precision) sum, so a pure couple or
-//! unbalances that cancel to 1e-15 keep their true small result. Two planes closer than
+//! Plane shares are formed as `Σ D_i·(z_B − z_i) / (z_B − z_A)` with the lever arms taken
+//! exactly (each difference as its rounded value plus its rounding error) and a compensated
+//! (twice-working-precision) sum, so a pure couple or unbalances that cancel to 1e-15, at
+//! the same or at different planes, keep their true small result. Two planes closer than
 //! [`MIN_PLANE_SEPARATION`] times the model's largest absolute axial coordinate are a
 //! typed error ([`crate::ConfigError::Inconsistent`]).
 

@@ -11,6 +11,7 @@
 use super::*;
 use crate::error::ConfigError;
 use crate::math::{Libm, Micromath};
+use crate::testutil::BAD;
 use core::f64::consts::PI;
 use proptest::prelude::*;
 
@@ -877,15 +878,6 @@ fn runtime_special_speeds() {
     assert_eq!(st.max_safe_speed, None);
     assert!(st.peak_load[0] > 2400.0);
 }
-
-const BAD: [f64; 6] = [
-    f64::NAN,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    0.0,
-    -1.0,
-    1e-310,
-];
 
 fn rotor_with(
     mass: f64,

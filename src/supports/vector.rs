@@ -129,6 +129,14 @@ impl VecDot2 {
         self.x.add(v.x, k);
         self.y.add(v.y, k);
     }
+    /// Adds `v·(a − b)` with the lever arm `a − b` taken exactly (as a rounded difference
+    /// plus its rounding error), so no lever rounding enters a sum that cancels.
+    #[inline]
+    pub(crate) fn add_lever(&mut self, v: Vec2, a: f64, b: f64) {
+        let (d, e) = two_sum(a, -b);
+        self.add(v, d);
+        self.add(v, e);
+    }
     #[inline]
     pub(crate) fn value(self) -> Vec2 {
         Vec2::new(self.x.value(), self.y.value())
@@ -148,7 +156,7 @@ pub(crate) fn resultant<I: IntoIterator<Item = (f64, Vec2)>>(items: I) -> Vec2 {
 pub(crate) fn moment<I: IntoIterator<Item = (f64, Vec2)>>(items: I, about: f64) -> Vec2 {
     let mut acc = VecDot2::default();
     for (z, v) in items {
-        acc.add(v, z - about);
+        acc.add_lever(v, z, about);
     }
     acc.value()
 }
@@ -161,9 +169,9 @@ pub(crate) fn split<I: IntoIterator<Item = (f64, Vec2)>>(items: I, z1: f64, z2: 
     let mut e1 = VecDot2::default();
     let mut e2 = VecDot2::default();
     for (z, v) in items {
-        // Stability: lever arms are single differences of coordinates (exact when close, by Sterbenz) and the sums are compensated, never 1 − share or products of absolute coordinates.
-        e1.add(v, z2 - z);
-        e2.add(v, z - z1);
+        // Stability: lever arms are exact differences of coordinates (rounded difference plus its error) and the sums are compensated, never 1 − share or products of absolute coordinates.
+        e1.add_lever(v, z2, z);
+        e2.add_lever(v, z, z1);
     }
     let (a, b) = (e1.value(), e2.value());
     [
