@@ -77,15 +77,16 @@ fn mark_pareto(rows: &mut [ParetoRow]) {
     }
 }
 
-fn best_of_three<F: FnMut() -> f64>(mut f: F) -> (f64, f64) {
+/// Runs `f` three times: the shortest wall time in ms, and the last result.
+fn best_of_three<T, F: FnMut() -> Result<T, String>>(mut f: F) -> Result<(f64, T), String> {
     let mut best = f64::INFINITY;
-    let mut value = f64::NAN;
+    let mut value = None;
     for _ in 0..3 {
         let start = Instant::now();
-        value = f();
+        value = Some(f()?);
         best = best.min(start.elapsed().as_secs_f64() * 1e3);
     }
-    (best, value)
+    value.map(|v| (best, v)).ok_or_else(|| "no run".to_string())
 }
 
 fn kneader_model() -> Result<DriveModel, String> {
@@ -140,25 +141,19 @@ pub fn kneader_pareto() -> Result<Vec<ParetoRow>, String> {
     let model = kneader_model()?;
     let mut rows = Vec::new();
     for (setting, integ) in settings(1.25e-4) {
-        let mut evals = 0;
-        let mut failure = None;
-        let (wall_ms, error) = best_of_three(|| {
+        let (wall_ms, (evals, error)) = best_of_three(|| {
             let mut obs = KneaderError {
                 model: &model,
                 from: 10.0,
                 worst: 0.0,
             };
-            let result = kneader_simulation(&model, integ.clone(), 1024)
-                .and_then(|mut sim| sim.run_observed(30.0, &mut obs).map_err(|e| e.to_string()));
-            match result {
-                Ok(stats) => evals = stats.solver.rhs_evals,
-                Err(e) => failure = Some(e),
-            }
-            obs.worst
-        });
-        if let Some(e) = failure {
-            return Err(format!("kneader with {setting}: {e}"));
-        }
+            let mut sim = kneader_simulation(&model, integ.clone(), 1024)?;
+            let stats = sim
+                .run_observed(30.0, &mut obs)
+                .map_err(|e| e.to_string())?;
+            Ok((stats.solver.rhs_evals, obs.worst))
+        })
+        .map_err(|e| format!("kneader with {setting}: {e}"))?;
         rows.push(ParetoRow {
             scene: "kneader",
             setting,
@@ -247,31 +242,20 @@ pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
         .collect();
     let mut rows = Vec::new();
     for (setting, integ) in settings(2.5e-5) {
-        let mut evals = 0;
-        let mut failure = None;
-        let (wall_ms, error) =
-            best_of_three(
-                || match balancer_states(&scene, &path, integ.clone(), duration) {
-                    Ok((e, states)) if states.len() == reference.len() => {
-                        evals = e;
-                        let mut worst: f64 = 0.0;
-                        for (y, r) in states.iter().zip(&reference) {
-                            for i in 0..dim {
-                                worst = worst.max((y[i] - r[i]).abs() / scale[i]);
-                            }
-                        }
-                        worst
-                    }
-                    Ok(_) => f64::INFINITY,
-                    Err(e) => {
-                        failure = Some(e);
-                        f64::NAN
-                    }
-                },
-            );
-        if let Some(e) = failure {
-            return Err(format!("two-mass with {setting}: {e}"));
-        }
+        let (wall_ms, (evals, error)) = best_of_three(|| {
+            let (evals, states) = balancer_states(&scene, &path, integ.clone(), duration)?;
+            if states.len() != reference.len() {
+                return Ok((evals, f64::INFINITY));
+            }
+            let mut worst: f64 = 0.0;
+            for (y, r) in states.iter().zip(&reference) {
+                for i in 0..dim {
+                    worst = worst.max((y[i] - r[i]).abs() / scale[i]);
+                }
+            }
+            Ok((evals, worst))
+        })
+        .map_err(|e| format!("two-mass with {setting}: {e}"))?;
         rows.push(ParetoRow {
             scene: "two-mass",
             setting,
@@ -305,22 +289,11 @@ pub struct ScalingRow {
 fn scaled_run(series: &'static str, value: String, text: &str) -> Result<ScalingRow, String> {
     let file = Path::new("scaling.toml");
     let scene = Scene::parse(text, file).map_err(|e| e.to_string())?;
-    let mut edges = 0;
-    let mut evals = 0;
-    let mut failure = None;
-    let (wall_ms, _) = best_of_three(|| {
-        match run(&scene, file, Overrides::default()) {
-            Ok(r) => {
-                edges = r.edges;
-                evals = r.rhs_evaluations;
-            }
-            Err(e) => failure = Some(e.to_string()),
-        }
-        0.0
-    });
-    if let Some(e) = failure {
-        return Err(e);
-    }
+    let (wall_ms, (edges, evals)) = best_of_three(|| {
+        run(&scene, file, Overrides::default())
+            .map(|r| (r.edges, r.rhs_evaluations))
+            .map_err(|e| e.to_string())
+    })?;
     Ok(ScalingRow {
         series,
         value,
@@ -422,7 +395,6 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
     let mut rows = Vec::new();
     for rtol in [1e-6, 1e-8, 1e-10] {
         let atol = rtol * 1e-2;
-        let mut failure = None;
         let (wall_ms, error) = best_of_three(|| {
             let mut solver = ode_solvers::Dopri5::new(
                 KneaderOde {
@@ -435,9 +407,7 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
                 rtol,
                 atol,
             );
-            if let Err(e) = solver.integrate() {
-                failure = Some(e.to_string());
-            }
+            solver.integrate().map_err(|e| e.to_string())?;
             let mut worst: f64 = 0.0;
             for (t, y) in solver.x_out().iter().zip(solver.y_out()) {
                 if *t >= 10.0 {
@@ -445,11 +415,9 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
                     worst = worst.max((y[1] * y[1] / u - 1.0).abs());
                 }
             }
-            worst
-        });
-        if let Some(e) = failure {
-            return Err(format!("ode_solvers at rtol {rtol}: {e}"));
-        }
+            Ok(worst)
+        })
+        .map_err(|e| format!("ode_solvers at rtol {rtol}: {e}"))?;
         rows.push(CrateRow {
             stepper: "ode_solvers::Dopri5",
             rtol,
@@ -470,16 +438,12 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
                 worst: 0.0,
             };
             // One line per revolution: the encoder is all but idle, as in the crate's run.
-            let result = kneader_simulation(&model, integ, 1)
-                .and_then(|mut sim| sim.run_observed(30.0, &mut obs).map_err(|e| e.to_string()));
-            if let Err(e) = result {
-                failure = Some(e);
-            }
-            obs.worst
-        });
-        if let Some(e) = failure {
-            return Err(format!("own dopri5 at rtol {rtol}: {e}"));
-        }
+            let mut sim = kneader_simulation(&model, integ, 1)?;
+            sim.run_observed(30.0, &mut obs)
+                .map_err(|e| e.to_string())?;
+            Ok(obs.worst)
+        })
+        .map_err(|e| format!("own dopri5 at rtol {rtol}: {e}"))?;
         rows.push(CrateRow {
             stepper: "host-sim dopri5",
             rtol,
