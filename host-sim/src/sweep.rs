@@ -33,6 +33,90 @@ pub struct SweepPoint {
 pub struct Sweep {
     /// The points, by ascending speed.
     pub points: Vec<SweepPoint>,
+    /// Points outside the margin band around every damped characteristic speed.
+    pub away_from_characteristic: usize,
+    /// Of those, the points where the criterion and the simulation agree.
+    pub agreeing: usize,
+    /// The damped characteristic speeds (zone boundaries), rad/s.
+    #[serde(skip)]
+    pub boundaries: Vec<f64>,
+    /// The zones (from, to, regime) for plotting.
+    #[serde(skip)]
+    pub zones: Vec<(f64, Option<f64>, &'static str)>,
+}
+
+impl Sweep {
+    /// The regime map as a Markdown table, with the agreement line.
+    pub fn markdown(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::from(
+            "| speed, rad/s | criterion | core class | simulated | residual / rotor unbalance |\n\
+             |---:|---|---|---|---:|\n",
+        );
+        for p in &self.points {
+            let _ = writeln!(
+                s,
+                "| {:.2} | {} | {} | {}{} | {:.2e} |",
+                p.speed,
+                p.regime_predicted,
+                p.regime_class,
+                p.regime_simulated,
+                if p.regime_predicted == p.regime_simulated {
+                    ""
+                } else {
+                    " ≠"
+                },
+                p.residual_relative
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\nAway from the characteristic speeds (outside the margin band): {} of {} speeds agree.",
+            self.agreeing, self.away_from_characteristic
+        );
+        s
+    }
+
+    /// The regime map as an SVG: zones along the speed axis, simulated outcomes as points
+    /// (1 = balancing, 0 = gathering) with the final residual unbalance.
+    pub fn write_svg(&self, path: &Path, title: &str) -> Result<(), String> {
+        use crate::plot::{write_svg, Chart, Mark, Series};
+        let top = self.points.last().map_or(1.0, |p| p.speed);
+        let mut marks: Vec<Mark> = self
+            .zones
+            .iter()
+            .map(|&(from, to, regime)| {
+                Mark::Band(
+                    format!("criterion: {regime}"),
+                    from,
+                    to.unwrap_or(top * 2.0),
+                    regime == "gathering",
+                )
+            })
+            .collect();
+        marks.push(Mark::HLine("simulated balancing".into(), 1.0));
+        let outcome = |p: &SweepPoint| {
+            if p.regime_simulated == "balancing" {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        write_svg(
+            path,
+            &Chart {
+                title,
+                x_label: "rotor speed, rad/s",
+                y_label: "simulated: 1 balancing, 0 gathering",
+                series: vec![Series {
+                    label: "simulated outcome".into(),
+                    points: self.points.iter().map(|p| (p.speed, outcome(p))).collect(),
+                    markers: true,
+                }],
+                marks,
+            },
+        )
+    }
 }
 
 /// Runs `scene` at `steps` speeds from `from` to `to` (inclusive), in parallel.
@@ -116,5 +200,29 @@ pub fn sweep(
         })
         .collect();
     bar.finish_and_clear();
-    Ok(Sweep { points: points? })
+    let points = points?;
+    let boundaries: Vec<f64> = classifier
+        .characteristic_speeds()
+        .iter()
+        .map(|&b| f64::from(b))
+        .collect();
+    let margin = f64::from(margin);
+    let away: Vec<&SweepPoint> = points
+        .iter()
+        .filter(|p| boundaries.iter().all(|&b| (p.speed - b).abs() > margin * b))
+        .collect();
+    Ok(Sweep {
+        away_from_characteristic: away.len(),
+        agreeing: away
+            .iter()
+            .filter(|p| p.regime_predicted == p.regime_simulated)
+            .count(),
+        boundaries,
+        zones: machine
+            .zones()
+            .iter()
+            .map(|z| (z.from, z.to, z.kind.name()))
+            .collect(),
+        points,
+    })
 }

@@ -114,6 +114,10 @@ fn sweep_json_keeps_its_contract() {
     }
     assert_eq!(points[0]["regime_predicted"], "gathering");
     assert_eq!(points[2]["regime_simulated"], "balancing");
+    // 40 and 110 rad/s are far from the resonance at 61.4 rad/s and agree; 75 rad/s is
+    // outside the band too.
+    assert_eq!(v["away_from_characteristic"], 3);
+    assert_eq!(v["agreeing"], 3);
 }
 
 #[test]
