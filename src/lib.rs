@@ -18,6 +18,9 @@ pub mod math;
 pub mod monitor;
 pub mod speed;
 pub mod supports;
+// Lets `testutil` name the crate the same way from unit tests and from `tests/hard_cases.rs`.
+#[cfg(test)]
+extern crate self as drive_monitor;
 #[cfg(test)]
 pub(crate) mod testutil;
 

@@ -22,7 +22,7 @@ use drive_monitor::balancer::{
     RegimeTracker, SearchOptions, ZoneKind,
 };
 use drive_monitor::drive::{
-    DriveModel, Harmonic, Horizon, Kloss, Load, Motor, Parabola, Prediction, SteadyState,
+    DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction, SteadyState,
 };
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
@@ -35,7 +35,10 @@ use drive_monitor::{ConfigError, Libm, Micromath};
 use proptest::prelude::*;
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
-use testutil::{BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE};
+use testutil::{
+    coupling, drive, h, platform, seed_motor, BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE,
+    J, M1, MM, W0, WM,
+};
 
 /// Unit roundoff of f32 (half an ulp of 1).
 const U32: f64 = f32::EPSILON as f64 / 2.0;
@@ -53,30 +56,6 @@ fn rel(a: f64, b: f64) -> f64 {
 // =============================================================================================
 // Predicted δ (drive model, seed 000 eq. 11–13)
 // =============================================================================================
-
-const W0: f64 = 145.0;
-const WM: f64 = 36.0;
-const MM: f64 = 158.0;
-const J: f64 = 0.323;
-const M1: f64 = 24.0;
-
-fn seed_motor() -> Motor {
-    Parabola::new(W0, WM, MM).unwrap().into()
-}
-
-fn h(order: f64, amplitude: f64, phase: f64) -> Harmonic {
-    Harmonic::new(order, amplitude, phase).unwrap()
-}
-
-fn drive(harmonics: &[Harmonic], inertia: f64) -> DriveModel {
-    DriveModel::new(
-        seed_motor(),
-        Load::new(M1, harmonics).unwrap(),
-        inertia,
-        0.0,
-    )
-    .unwrap()
-}
 
 fn steady(m: &DriveModel) -> SteadyState {
     *m.predict().steady().expect("steady state")
@@ -743,22 +722,6 @@ fn one_rpm_and_thirty_thousand_rpm_from_1_khz_to_200_mhz() {
 // =============================================================================================
 // Characteristic speeds of auto-balancer machines (seed 001)
 // =============================================================================================
-
-fn platform(mass: f64, stiffness: f64, damping: f64) -> Platform {
-    Platform {
-        mass,
-        stiffness,
-        damping,
-    }
-}
-
-fn coupling(a: u8, b: u8, stiffness: f64, damping: f64) -> Coupling {
-    Coupling {
-        between: [a, b],
-        stiffness,
-        damping,
-    }
-}
 
 /// Two balls of 0.5 kg on radius 0.1 m, no housing: the exciter platform moves 1 kg more than
 /// its own mass.

@@ -13,6 +13,7 @@ extern crate std;
 use super::complex::C64;
 use super::modal::System;
 use super::*;
+use crate::testutil::{coupling, platform};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------------------
@@ -52,22 +53,6 @@ fn balancer(platform: u8) -> AutoBalancer {
         radius: 0.1,
         housing_mass: 5.0,
         viscosity: 0.01,
-    }
-}
-
-fn platform(mass: f64, stiffness: f64, damping: f64) -> Platform {
-    Platform {
-        mass,
-        stiffness,
-        damping,
-    }
-}
-
-fn coupling(a: u8, b: u8, stiffness: f64, damping: f64) -> Coupling {
-    Coupling {
-        between: [a, b],
-        stiffness,
-        damping,
     }
 }
 

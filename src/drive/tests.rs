@@ -3,31 +3,9 @@
 
 use super::*;
 use crate::error::ConfigError;
+use crate::testutil::{drive, h, seed_motor, J, MM, W0, WM};
 use core::f64::consts::PI;
 use proptest::prelude::*;
-
-const W0: f64 = 145.0;
-const WM: f64 = 36.0;
-const MM: f64 = 158.0;
-const J: f64 = 0.323;
-
-fn seed_motor() -> Motor {
-    Parabola::new(W0, WM, MM).unwrap().into()
-}
-
-fn h(order: f64, amplitude: f64, phase: f64) -> Harmonic {
-    Harmonic::new(order, amplitude, phase).unwrap()
-}
-
-fn drive(harmonics: &[Harmonic], inertia: f64) -> DriveModel {
-    DriveModel::new(
-        seed_motor(),
-        Load::new(24.0, harmonics).unwrap(),
-        inertia,
-        0.0,
-    )
-    .unwrap()
-}
 
 fn seed() -> DriveModel {
     drive(&[h(0.125, 12.0, 0.0)], J)
