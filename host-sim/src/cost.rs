@@ -187,12 +187,10 @@ impl Observer for Sampler {
 
 fn balancer_states(
     scene: &Scene,
-    file: &Path,
     integ: Integrator,
     duration: f64,
 ) -> Result<(u64, Vec<Vec<f64>>), String> {
-    let params = crate::run::vibration_params(scene, file, false)
-        .map_err(|e| e.to_string())?
+    let params = crate::run::vibration_params(scene, false)
         .ok_or_else(|| "the scene has no vibration machine".to_string())?;
     let vm = VibrationMachine::new(&params).map_err(|e| e.to_string())?;
     let system = System::new(
@@ -222,14 +220,14 @@ fn balancer_states(
 /// Error against wall time on the two-mass auto-balancer at 100 rad/s (10 s), against a
 /// DOP853 rtol 1e-13 reference.
 pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
-    let (scene, path) = resolve("two-mass").map_err(|e| e.to_string())?;
+    let (scene, _) = resolve("two-mass").map_err(|e| e.to_string())?;
     let duration = 10.0;
     let reference = Integrator::Dop853 {
         rtol: 1e-13,
         atol: 1e-16,
         max_step: None,
     };
-    let (_, reference) = balancer_states(&scene, &path, reference, duration)?;
+    let (_, reference) = balancer_states(&scene, reference, duration)?;
     let dim = reference.first().map_or(0, Vec::len);
     let scale: Vec<f64> = (0..dim)
         .map(|i| {
@@ -243,7 +241,7 @@ pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
     let mut rows = Vec::new();
     for (setting, integ) in settings(2.5e-5) {
         let (wall_ms, (evals, error)) = best_of_three(|| {
-            let (evals, states) = balancer_states(&scene, &path, integ.clone(), duration)?;
+            let (evals, states) = balancer_states(&scene, integ.clone(), duration)?;
             if states.len() != reference.len() {
                 return Ok((evals, f64::INFINITY));
             }

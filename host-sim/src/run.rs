@@ -182,15 +182,10 @@ fn integrator(scene: &Scene) -> Integrator {
     }
 }
 
-/// The vibration machine of a scene, in the simulator's terms.
-pub fn vibration_params(
-    scene: &Scene,
-    file: &Path,
-    together: bool,
-) -> Result<Option<VibrationMachineParams>, SceneError> {
-    let Some(ab) = &scene.autobalancer else {
-        return Ok(None);
-    };
+/// The vibration machine of a scene, in the simulator's terms (checked when the caller builds
+/// the [`VibrationMachine`] from it).
+pub fn vibration_params(scene: &Scene, together: bool) -> Option<VibrationMachineParams> {
+    let ab = scene.autobalancer.as_ref()?;
     let kind = match ab.kind {
         BalancerKindSpec::Ball => LoadKind::Ball,
         BalancerKindSpec::Roller => LoadKind::Roller,
@@ -207,7 +202,7 @@ pub fn vibration_params(
     } else {
         LoadPlacement::Balanced { perturbation: 0.05 }
     };
-    Ok(Some(VibrationMachineParams {
+    Some(VibrationMachineParams {
         platforms: scene
             .platform
             .iter()
@@ -246,12 +241,6 @@ pub fn vibration_params(
             load_speed: 0.0,
             rotor_angle: 0.0,
         },
-    }))
-    .and_then(|p| {
-        if let Some(p) = &p {
-            VibrationMachine::new(p).map_err(|e| value_error(file, "autobalancer", e))?;
-        }
-        Ok(p)
     })
 }
 
@@ -535,7 +524,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         effects.push(Box::new(model.load().clone()));
         names.push("load");
     }
-    let vib_params = vibration_params(scene, file, over.loads_together)?;
+    let vib_params = vibration_params(scene, over.loads_together);
     let vib_machine = match &vib_params {
         Some(p) => {
             Some(VibrationMachine::new(p).map_err(|e| value_error(file, "autobalancer", e))?)

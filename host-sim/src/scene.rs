@@ -105,7 +105,7 @@ pub struct SimulationSpec {
     /// Absolute tolerance (adaptive integrators).
     #[serde(default = "default_atol")]
     pub atol: f64,
-    /// Step, s (RK4), or the largest step (adaptive).
+    /// Step of RK4, s; the adaptive integrators cap their step at 100 times this.
     #[serde(default = "default_step")]
     pub step: f64,
     /// Seed of every random effect (jitter, faults, perturbations).
