@@ -190,7 +190,7 @@ fn balancer_states(
     integ: Integrator,
     duration: f64,
 ) -> Result<(u64, Vec<Vec<f64>>), String> {
-    let params = crate::run::vibration_params(scene, false)
+    let params = crate::run::vibration_params(scene, false, 100.0)
         .ok_or_else(|| "the scene has no vibration machine".to_string())?;
     let vm = VibrationMachine::new(&params).map_err(|e| e.to_string())?;
     let system = System::new(

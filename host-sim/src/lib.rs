@@ -15,6 +15,7 @@ pub mod report;
 pub mod rotor_loads;
 pub mod run;
 pub mod scene;
+pub mod study;
 pub mod sweep;
 pub mod system;
 pub mod vibration;

@@ -17,10 +17,11 @@ use crate::system::{
 };
 use crate::vibration::{
     classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind, LoadPlacement,
-    PlatformParams, RegimeCriteria, RegimeSample, VibrationMachine, VibrationMachineParams,
+    PlatformParams, RegimeCriteria, RegimeReport, RegimeSample, VibrationMachine,
+    VibrationMachineParams,
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
-use drive_monitor::balancer::{Classifier, Regime};
+use drive_monitor::balancer::{Classifier, Regime, DEFAULT_MARGIN};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
@@ -130,6 +131,9 @@ pub struct RunReport {
     /// Residual unbalance at the end relative to the rotor unbalance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_relative: Option<f64>,
+    /// The whole classification of what the loads did (initial residual, coherence, speeds).
+    #[serde(skip)]
+    pub regime_detail: Option<RegimeReport>,
     /// Support results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsRunOut>,
@@ -183,8 +187,14 @@ fn integrator(scene: &Scene) -> Integrator {
 }
 
 /// The vibration machine of a scene, in the simulator's terms (checked when the caller builds
-/// the [`VibrationMachine`] from it).
-pub fn vibration_params(scene: &Scene, together: bool) -> Option<VibrationMachineParams> {
+/// the [`VibrationMachine`] from it). `rotor_speed` is the shaft's speed at `t = 0`, rad/s:
+/// loads started near the balancing position turn with the rotor (the balancing position is
+/// a co-rotating state); loads started together are at rest.
+pub fn vibration_params(
+    scene: &Scene,
+    together: bool,
+    rotor_speed: f64,
+) -> Option<VibrationMachineParams> {
     let ab = scene.autobalancer.as_ref()?;
     let kind = match ab.kind {
         BalancerKindSpec::Ball => LoadKind::Ball,
@@ -238,7 +248,7 @@ pub fn vibration_params(scene: &Scene, together: bool) -> Option<VibrationMachin
         },
         initial: InitialParams {
             loads,
-            load_speed: 0.0,
+            load_speed: if together { 0.0 } else { rotor_speed },
             rotor_angle: 0.0,
         },
     })
@@ -524,7 +534,11 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         effects.push(Box::new(model.load().clone()));
         names.push("load");
     }
-    let vib_params = vibration_params(scene, over.loads_together);
+    let rotor_speed0 = match &shaft {
+        ShaftModel::Prescribed(law) => law.shaft(0.0).omega,
+        ShaftModel::Dynamic(d) => d.omega0,
+    };
+    let vib_params = vibration_params(scene, over.loads_together, rotor_speed0);
     let vib_machine = match &vib_params {
         Some(p) => {
             Some(VibrationMachine::new(p).map_err(|e| value_error(file, "autobalancer", e))?)
@@ -627,7 +641,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
             .monitor
             .as_ref()
             .and_then(|m| m.regime_margin)
-            .unwrap_or(0.02);
+            .unwrap_or(f64::from(DEFAULT_MARGIN));
         let classifier = Classifier::new(&machine, margin as f32, 0.5 * margin as f32)
             .map_err(|e| value_error(file, "monitor", e))?;
         if let Some(w) = report.speed_measured {
@@ -649,6 +663,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         if let Some(r) = classify(&col.samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());
             report.residual_relative = Some(r.residual_relative);
+            report.regime_detail = Some(r);
         }
     }
     if let Some((rotor, limits)) = predict::rotor(scene, file)? {

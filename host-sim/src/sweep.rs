@@ -4,7 +4,7 @@
 use crate::predict;
 use crate::run::{run, Overrides};
 use crate::scene::{Scene, SceneError};
-use drive_monitor::balancer::{Classifier, Regime};
+use drive_monitor::balancer::{Classifier, Regime, DEFAULT_MARGIN};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -156,7 +156,7 @@ pub fn sweep(
         .monitor
         .as_ref()
         .and_then(|m| m.regime_margin)
-        .unwrap_or(0.02) as f32;
+        .map_or(DEFAULT_MARGIN, |m| m as f32);
     let classifier = Classifier::new(&machine, margin, 0.5 * margin)
         .map_err(|e| predict::value_error(file, "monitor", e))?;
     // The sweep judges the loads, not δ: no encoder, so no edges to generate.

@@ -57,7 +57,7 @@ mod runtime;
 mod tests;
 
 pub use runtime::{
-    Advice, Classifier, Regime, RegimeEvent, RegimeStatus, RegimeTracker, SpeedBand,
+    Advice, Classifier, Regime, RegimeEvent, RegimeStatus, RegimeTracker, SpeedBand, DEFAULT_MARGIN,
 };
 
 use crate::error::{finite, non_negative, positive, ConfigError};

@@ -61,6 +61,22 @@ enum Command {
         #[arg(long)]
         out: Option<std::path::PathBuf>,
     },
+    /// Check the auto-balancing criterion against simulation on randomised machines (seed 001):
+    /// agreement, simulated boundary shifts and the margin band they need.
+    Criterion {
+        /// Number of machines (platforms cycle 1, 2, 3).
+        #[arg(long, default_value_t = 30)]
+        machines: usize,
+        /// Seed of the draws.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Write the report (Markdown and SVG) into this directory.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
     /// Measure what accuracy costs and write Markdown tables and SVG plots into a directory.
     Accuracy {
         /// Output directory (e.g. docs/).
@@ -90,6 +106,12 @@ fn main() -> ExitCode {
             json,
             out,
         }) => sweep_cmd(&scene, from, to, steps, together, json, out.as_deref()),
+        Some(Command::Criterion {
+            machines,
+            seed,
+            json,
+            out,
+        }) => criterion_cmd(machines, seed, json, out.as_deref()),
         Some(Command::Accuracy { out, target }) => {
             host_sim::publish::accuracy(&out, target).map(|files| {
                 for f in files {
@@ -218,6 +240,31 @@ fn sweep_cmd(
             s.agreeing,
             s.away_from_characteristic
         );
+    }
+    Ok(())
+}
+
+fn criterion_cmd(
+    machines: usize,
+    seed: u64,
+    json: bool,
+    out: Option<&std::path::Path>,
+) -> Result<(), String> {
+    let s = host_sim::study::study(seed, machines, true).map_err(|e| e.to_string())?;
+    if let Some(dir) = out {
+        for f in host_sim::study::publish(&s, dir)? {
+            if !json {
+                println!("wrote {}", f.display());
+            }
+        }
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", host_sim::study::summary_text(&s));
     }
     Ok(())
 }
