@@ -197,26 +197,36 @@ fn two_product(x: f32, y: f32) -> (f32, f32) {
 /// A tick count as an f32 head (its rounding) plus the exact remainder (|rem| ≤ 128).
 #[inline]
 fn split_ticks(t: u32) -> (f32, f32) {
-    #[cold]
-    #[inline(never)]
-    fn wide(t: u32) -> (f32, f32) {
-        let head = t as f32;
-        (head, (i64::from(t) - head as i64) as f32)
-    }
-    if t < 1 << 24 {
-        (t as f32, 0.0)
+    let head = t as f32;
+    (head, (i64::from(t) - head as i64) as f32)
+}
+
+/// a1·t2 − a2·t1 for integer tick counts, to within about one rounding of the result: both
+/// products are split exactly (Dekker) and differenced term by term, so equal speeds cancel to
+/// exactly 0. Plain f32 arithmetic: on a Cortex-M4F ~40 FPU instructions, against ~400 for
+/// two software `libm::fmaf` calls (no fused multiply-add is reachable from stable `core`).
+///
+/// Counts below 2²⁴ are exact in f32 and take this path alone; larger ones round in f32 and go
+/// to [`cross_wide`], out of line. Splitting every count instead (remainders then 0) made the
+/// window finish 241 instructions instead of 232 (`monitor::window_finish`, firmware/run.sh).
+#[inline]
+fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
+    if (t1 | t2) < 1 << 24 {
+        let (p1, e1) = two_product(a1, t2 as f32);
+        let (p2, e2) = two_product(a2, t1 as f32);
+        (p1 - p2) + (e1 - e2)
     } else {
-        wide(t)
+        cross_wide(a1, t2, a2, t1)
     }
 }
 
-/// a1·t2 − a2·t1 for integer tick counts, to within about one rounding of the result.
-/// Stability: counts above 2²⁴ round in f32, so each is split exactly into head + remainder;
-/// the head products are split exactly (Dekker) and differenced term by term, the small
-/// remainder products added after, so equal speeds cancel to exactly 0. Plain f32 arithmetic:
-/// on a Cortex-M4F ~40 FPU instructions, against ~400 for two software `libm::fmaf` calls (no
-/// fused multiply-add is reachable from stable `core`).
-fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
+/// [`cross`] for counts of 2²⁴ and above, which round in f32: each count is split exactly into
+/// its f32 head and the remainder; the head products go through Dekker as in [`cross`], and the
+/// small remainder products (|remainder| ≤ 128) are added after, so equal speeds still cancel
+/// to exactly 0.
+#[cold]
+#[inline(never)]
+fn cross_wide(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
     let (h2, l2) = split_ticks(t2);
     let (h1, l1) = split_ticks(t1);
     let (p1, e1) = two_product(a1, h2);

@@ -136,6 +136,30 @@ fn plots_are_written() {
 }
 
 #[test]
+fn predict_rejects_a_delta_limit_below_f64_resolution() {
+    // The kneader with a δ limit far below what f64 resolves (2.2e-16): an error naming the
+    // file and the key, not a flywheel of 1e19 kg·m².
+    let dir = std::env::temp_dir().join(format!("drive-sim-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kneader.toml");
+    let text = std::fs::read_to_string(scene).unwrap();
+    assert!(text.contains("delta_limit = 0.06"));
+    let path = dir.join("tiny-limit.toml");
+    std::fs::write(
+        &path,
+        text.replace("delta_limit = 0.06", "delta_limit = 1e-20"),
+    )
+    .unwrap();
+    let (ok, _, err) = drive_sim(&["predict", path.to_str().unwrap()]);
+    assert!(!ok, "predict should fail");
+    assert!(
+        err.contains("tiny-limit.toml") && err.contains("delta_limit"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn bad_scenes_name_the_file_and_key_and_fail() {
     let dir = std::env::temp_dir().join(format!("drive-sim-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -15,6 +15,6 @@ mod tests;
 pub use load::{Harmonic, Load, MAX_HARMONICS, MAX_ORDER};
 pub use model::{
     DesignError, DriveModel, Horizon, Irregularity, Prediction, Sensitivity, Stall, SteadyState,
-    MAX_DENOMINATOR, MAX_SAMPLES, SAMPLES_PER_CYCLE,
+    MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET, SAMPLES_PER_CYCLE,
 };
 pub use motor::{Kloss, KlossFit, Motor, Parabola};

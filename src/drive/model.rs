@@ -41,6 +41,16 @@ pub const MAX_SAMPLES: u64 = 1 << 16;
 pub const MAX_DENOMINATOR: u64 = 1024;
 /// Golden-section iterations per refined extremum (bracket shrinks by 0.618⁶⁴ ≈ 4e-14).
 const GOLDEN_ITERATIONS: u32 = 64;
+/// Smallest target δ that [`DriveModel::flywheel_for`] accepts: `f64::EPSILON` ≈ 2.2e-16.
+/// Below it ωmax and ωmin would differ by less than about two units in the last place of ω
+/// itself, and the oscillation of ω² would be smaller than the rounding of its mean ū: no f64
+/// computation could tell whether such a target is met.
+pub const MIN_DELTA_TARGET: f64 = f64::EPSILON;
+/// Doublings of the closed-form upper inertia bound allowed in [`DriveModel::flywheel_for`]
+/// before it gives up (the bound is rigorous; they only absorb rounding).
+const MAX_CONFIRM_DOUBLINGS: u32 = 8;
+/// Bisection steps in [`DriveModel::flywheel_for`] at most.
+const MAX_BISECTIONS: u32 = 200;
 
 /// Over which range of φ the extrema of ω were taken.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,12 +149,38 @@ pub struct Sensitivity {
 pub enum DesignError {
     /// The target δ is not a finite number in (0, 2).
     InvalidTarget,
+    /// The target δ is below [`MIN_DELTA_TARGET`]: finer than f64 resolves the speed.
+    TargetBelowResolution,
     /// The mean load exceeds the motor's stall torque: no inertia gives a steady state.
     MeanLoadExceedsMotor,
     /// No finite inertia reaches the target (an order-0-only load cannot oscillate, so this
-    /// means the numbers left the f64 range).
+    /// means the needed inertia is beyond the f64 range).
     Unreachable,
 }
+
+impl core::fmt::Display for DesignError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            DesignError::InvalidTarget => {
+                write!(f, "`delta_target` must be a finite number in (0, 2)")
+            }
+            DesignError::TargetBelowResolution => write!(
+                f,
+                "`delta_target` is below {MIN_DELTA_TARGET:e}, finer than f64 resolves the speed"
+            ),
+            DesignError::MeanLoadExceedsMotor => write!(
+                f,
+                "the mean load exceeds the motor's stall torque: no flywheel gives a steady state"
+            ),
+            DesignError::Unreachable => write!(
+                f,
+                "`delta_target` needs a flywheel beyond the f64 range of the inertia"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for DesignError {}
 
 /// What the host reports as the `irregularity` member of `predict --json`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -423,18 +459,41 @@ impl DriveModel {
     /// The extra flywheel inertia (kg·m², on top of the current flywheel) that brings δ down
     /// to `delta_target`; 0 if δ is already within.
     ///
+    /// `delta_target` must be finite, below 2 and at least [`MIN_DELTA_TARGET`] (≈ 2.2e-16):
+    /// a smaller δ asks for a speed ripple below the f64 resolution of the speed itself and is
+    /// rejected with [`DesignError::TargetBelowResolution`]. A target that needs more inertia
+    /// than f64 holds is [`DesignError::Unreachable`], never a huge or infinite number.
+    ///
     /// One oscillating order: closed form. With `r = δ/(1 + δ²/4)` (the inverse of
     /// `δ = 2r/(1 + √(1 − r²))`, `r = R/ū`) the needed amplitude is `R = r·ū`, and
     /// `R = 2|M2|/√(4a² + n²J²)` gives `J = √((2|M2|/R − 2a)(2|M2|/R + 2a))/n`, since `ū`
-    /// does not depend on `J`. Several orders: bisection in J between an inertia where the
-    /// target is missed and one where it is met (found by doubling); it returns the upper end,
-    /// where δ ≤ target holds, once the bracket is within 1e-10 relative. δ(J) falls
-    /// monotonically for one order and for [`Horizon::Unbounded`]; with several commensurate
-    /// orders the phases also move with J, and the answer is the first crossing the bracket
-    /// finds.
+    /// does not depend on `J`.
+    ///
+    /// Several orders: bisection in J between the current inertia, where the target is missed,
+    /// and an upper end where it is met for certain, found in closed form: each order's
+    /// amplitude `R_k = 2|M2k|/√(4a² + n_k²J²)` is at most `2|M2k|/(n_k·J)`, and the
+    /// conservative extrema `ū ± Σ R_k` (those of [`Horizon::Unbounded`]) bound δ from above,
+    /// so the inertia that brings `Σ R_k` to `r·ū` (less 1e-6 for rounding) meets the target
+    /// whatever the phases. Bisection returns the upper end of the bracket, where δ ≤ target
+    /// holds, once the bracket is within 1e-10 relative. δ(J) falls monotonically for one order
+    /// and for [`Horizon::Unbounded`]; with several commensurate orders the phases also move
+    /// with J, and the answer is the first crossing the bracket finds.
+    ///
+    /// Cost, for any input: at most 210 steady-state predictions (1 at the current inertia, up
+    /// to 9 to confirm the upper end, up to 200 bisection steps), each a search over at most
+    /// [`MAX_SAMPLES`] samples; typically 36. The upper end is confirmed at the first try
+    /// unless rounding defeats the bound (up to 8 doublings absorb that; past them the target
+    /// counts as unreachable). Bisection stops once the bracket is within 1e-10 relative, after
+    /// about `log2(upper end / answer) + 34` steps; the bound is within a small factor of the
+    /// answer except where δ barely depends on J, so 200 steps are reached only when the
+    /// answer is below about 2⁻¹⁶⁶ of the upper end, and then the returned flywheel still
+    /// meets the target, a little oversized.
     pub fn flywheel_for(&self, delta_target: f64) -> Result<f64, DesignError> {
         if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
             return Err(DesignError::InvalidTarget);
+        }
+        if delta_target < MIN_DELTA_TARGET {
+            return Err(DesignError::TargetBelowResolution);
         }
         if !exceeds(self.u_mean, 0.0) {
             return Err(DesignError::MeanLoadExceedsMotor);
@@ -446,34 +505,72 @@ impl DriveModel {
         if meets(self) {
             return Ok(0.0);
         }
+        let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
         let j = self.total_inertia();
+        let a = -self.motor.model().a();
+        // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
+        let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
         if let ([c], Horizon::ClosedForm) = (self.components.as_slice(), self.horizon) {
-            let a = -self.motor.model().a();
             let n = c.order;
             let h = libm::hypot(2.0 * a, n * j);
             // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
             let m2 = c.amplitude() * h / 2.0;
-            let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
             let h_needed = 2.0 * m2 / (r * self.u_mean);
             if !exceeds(h_needed, 2.0 * a) {
                 return Ok(0.0);
             }
-            let j_needed = libm::sqrt((h_needed - 2.0 * a) * (h_needed + 2.0 * a)) / n;
+            // As two roots: the product overflows beyond 1.3e154.
+            let j_needed = libm::sqrt(h_needed - 2.0 * a) * libm::sqrt(h_needed + 2.0 * a) / n;
             let extra = j_needed - j;
-            return if extra.is_finite() {
-                Ok(if extra > 0.0 { extra } else { 0.0 })
-            } else {
+            // n·J stays below h_needed, so the model holds this inertia if it is finite.
+            return if !(self.inertia + (self.flywheel + extra)).is_finite() {
                 Err(DesignError::Unreachable)
+            } else if extra <= 0.0 {
+                Ok(0.0)
+            } else {
+                Ok(extra)
             };
         }
-        let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
+        // Upper end of the bracket: with `S = Σ 2|M2k|/n_k` and the budget `B = r·ū`, order k
+        // gets the share `(2|M2k|/n_k)/S` of B, reached where `√(4a² + n_k²J²) = n_k·S/B`,
+        // i.e. at `J_k = √((S/B)² − (2a/n_k)²)`; at `max_k J_k` every share holds, so
+        // `Σ R_k ≤ B`. `2|M2k| = R_k·h_k` at the current inertia.
+        let budget = r * self.u_mean * (1.0 - 1e-6);
+        let s: f64 = self
+            .components
+            .iter()
+            .map(|c| c.amplitude() * (libm::hypot(2.0 * a, c.order * j) / c.order))
+            .sum();
+        let x = s / budget;
+        let j_bound = self
+            .components
+            .iter()
+            .map(|c| {
+                let y = 2.0 * a / c.order;
+                if x > y {
+                    libm::sqrt(x - y) * libm::sqrt(x + y)
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max);
+        // Beyond f64: start from the largest flywheel the model can hold (n·J must stay
+        // finite); no larger than J through rounding: from J itself.
+        let n_max = self.components.iter().map(|c| c.order).fold(1.0, f64::max);
+        let cap = f64::MAX / 4.0 / n_max;
+        let mut hi = if !j_bound.is_finite() || j_bound > cap {
+            cap
+        } else if j_bound > j {
+            j_bound - j
+        } else {
+            j
+        };
         let mut lo = 0.0;
-        let mut hi = j;
-        let mut found = false;
-        for _ in 0..2100 {
+        let mut confirmed = false;
+        for _ in 0..=MAX_CONFIRM_DOUBLINGS {
             match at(hi) {
                 Some(m) if meets(&m) => {
-                    found = true;
+                    confirmed = true;
                     break;
                 }
                 Some(_) => {
@@ -483,14 +580,14 @@ impl DriveModel {
                 None => return Err(DesignError::Unreachable),
             }
         }
-        if !found {
+        if !confirmed {
             return Err(DesignError::Unreachable);
         }
-        for _ in 0..200 {
-            if hi - lo <= 1e-10 * hi {
+        for _ in 0..MAX_BISECTIONS {
+            let mid = lo + (hi - lo) / 2.0;
+            if hi - lo <= 1e-10 * hi || mid <= lo || mid >= hi {
                 break;
             }
-            let mid = lo + (hi - lo) / 2.0;
             match at(mid) {
                 Some(m) if meets(&m) => hi = mid,
                 Some(_) => lo = mid,
@@ -501,11 +598,11 @@ impl DriveModel {
     }
 
     /// The `irregularity` summary the host prints, with the flywheel for `delta_limit` when
-    /// one is given (it must be finite and in (0, 2)).
+    /// one is given (it must be finite, at least [`MIN_DELTA_TARGET`] and below 2).
     pub fn irregularity(&self, delta_limit: Option<f64>) -> Result<Irregularity, ConfigError> {
         if let Some(l) = delta_limit {
             let l = positive("delta_limit", l)?;
-            if l >= 2.0 {
+            if !(MIN_DELTA_TARGET..2.0).contains(&l) {
                 return Err(ConfigError::OutOfRange("delta_limit"));
             }
         }

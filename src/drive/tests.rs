@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::error::ConfigError;
-use crate::testutil::{drive, h, seed_motor, J, MM, W0, WM};
+use crate::testutil::{drive, h, seed_motor, J, M1, MM, W0, WM};
 use core::f64::consts::PI;
 use proptest::prelude::*;
 
@@ -309,6 +309,153 @@ fn flywheel_closed_form_and_bisection_agree() {
         assert_eq!(m.flywheel_for(bad), Err(DesignError::InvalidTarget));
         assert!(m.irregularity(Some(bad)).is_err());
     }
+}
+
+/// δ of the seed's motor with mean load M1 and `harmonics` (order, amplitude, phase) at total
+/// inertia `j`, independent of the model: ω² in the paper's D-coefficients (eq. 11, summed
+/// over the harmonics), its extrema by brute force over `samples` points of `period` with a
+/// parabolic vertex at each local extremum, δ from the difference of squares. The brute force
+/// misses an extremum by at most `½·C·(step/2)²` before the vertex refinement,
+/// `C = Σ amplitude·n²` of ω².
+fn reference_delta(harmonics: &[(f64, f64, f64)], j: f64, period: f64, samples: usize) -> f64 {
+    let k = W0 * W0 - WM * WM;
+    // D1 = M_m/(J·K), D2 = (M_m·ω0² − M1·K)/(J·K); J cancels from D2/D1 (and J·K would
+    // overflow for the largest inertias).
+    let d1 = MM / k / j;
+    let ubar = (MM * W0 * W0 - M1 * k) / MM;
+    let s = |phi: f64| -> f64 {
+        harmonics
+            .iter()
+            .map(|&(n, m2, psi)| {
+                let d3 = m2 / j;
+                let th = n * phi + psi;
+                2.0 * d3 * (n * th.cos() - 2.0 * d1 * th.sin()) / (4.0 * d1 * d1 + n * n)
+            })
+            .sum()
+    };
+    let step = period / samples as f64;
+    let (mut smax, mut smin) = (f64::MIN, f64::MAX);
+    let (mut y0, mut y1) = (s(-step), s(0.0));
+    for i in 0..samples {
+        let y2 = s((i + 1) as f64 * step);
+        let den = y0 - 2.0 * y1 + y2;
+        let vertex = if den != 0.0 {
+            y1 - (y2 - y0) * (y2 - y0) / (8.0 * den)
+        } else {
+            y1
+        };
+        if y1 >= y0 && y1 >= y2 {
+            smax = smax.max(vertex);
+        }
+        if y1 <= y0 && y1 <= y2 {
+            smin = smin.min(vertex);
+        }
+        (y0, y1) = (y1, y2);
+    }
+    let w = (ubar + smax).sqrt() + (ubar + smin).sqrt();
+    2.0 * (smax - smin) / (w * w)
+}
+
+/// A load with orders 3 and 1000: a common period of 32 000 samples, the slowest prediction.
+fn slow_drive() -> DriveModel {
+    drive(&[h(3.0, 12.0, 0.0), h(1000.0, 6.0, 1.0)], J)
+}
+
+#[test]
+fn flywheel_target_below_resolution_is_rejected() {
+    let slow = slow_drive();
+    assert_eq!(
+        slow.horizon(),
+        Horizon::Period {
+            radians: 2.0 * PI,
+            samples: 32_000
+        }
+    );
+    // Tiny targets, subnormal ones included, and one just below the floor: an error naming
+    // the target, before any search (these once doubled the inertia a thousand times).
+    let below = MIN_DELTA_TARGET * (1.0 - f64::EPSILON);
+    for m in [seed(), slow] {
+        for tiny in [
+            1e-308,
+            1e-30,
+            1e-310,
+            f64::MIN_POSITIVE,
+            5e-324,
+            1e-17,
+            below,
+        ] {
+            assert_eq!(
+                m.flywheel_for(tiny),
+                Err(DesignError::TargetBelowResolution),
+                "{tiny}"
+            );
+            let e = m.irregularity(Some(tiny)).unwrap_err();
+            assert_eq!(e.parameter(), "delta_limit", "{tiny}");
+        }
+    }
+    let msg = DesignError::TargetBelowResolution.to_string();
+    assert!(
+        msg.contains("delta_target") && msg.contains("2.220446049250313e-16"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn flywheel_for_smallest_target_meets_it() {
+    // The floor itself is accepted. Closed form: δ equals the target to rounding.
+    let m = seed();
+    let extra = m.flywheel_for(MIN_DELTA_TARGET).unwrap();
+    let s = steady(&m.with_flywheel(extra).unwrap());
+    assert!(rel(s.delta, MIN_DELTA_TARGET) < 1e-12, "{}", s.delta);
+    // Bisection, 32 000-sample period: δ ≤ target at the answer and, the bracket being within
+    // 1e-10 and δ ∝ 1/J this far out, within 1e-9 of it.
+    let slow = slow_drive();
+    let extra = slow.flywheel_for(MIN_DELTA_TARGET).unwrap();
+    assert!(extra.is_finite() && extra > 1e10, "{extra}");
+    let d = steady(&slow.with_flywheel(extra).unwrap()).delta;
+    assert!(
+        d <= MIN_DELTA_TARGET && rel(d, MIN_DELTA_TARGET) < 1e-9,
+        "{d}"
+    );
+    // The same against the independent brute-force reference (orders 1 and 3, 2π period,
+    // 200 000 points: vertex error far below 1e-9 of the swing).
+    let harmonics = [(1.0, 12.0, 0.0), (3.0, 9.0, 2.0)];
+    let hs: Vec<Harmonic> = harmonics.iter().map(|&(n, a, p)| h(n, a, p)).collect();
+    let m = drive(&hs, J);
+    assert!(steady(&m).delta > 0.004);
+    for target in [0.004, 1e-9, MIN_DELTA_TARGET] {
+        let extra = m.flywheel_for(target).unwrap();
+        let reference = reference_delta(&harmonics, J + extra, 2.0 * PI, 200_000);
+        assert!(rel(reference, target) < 1e-8, "{target}: {reference}");
+        assert!(steady(&m.with_flywheel(extra).unwrap()).delta <= target);
+    }
+}
+
+#[test]
+fn flywheel_beyond_f64_is_unreachable() {
+    // Harmonics of 1e300 N·m: the needed inertia grows like 1/δ, ≈ 1.1e307 kg·m² at
+    // δ = 1e-11 (just inside f64), ≈ 1e309 at 1e-13 (beyond it).
+    let harmonics = [(1.0, 1e300, 0.0), (3.0, 5e299, 2.0)];
+    let hs: Vec<Harmonic> = harmonics.iter().map(|&(n, a, p)| h(n, a, p)).collect();
+    let m = drive(&hs, J);
+    assert!(m.predict().steady().is_none());
+    let extra = m.flywheel_for(1e-11).unwrap();
+    assert!(extra.is_finite() && extra > 1e307, "{extra}");
+    let reference = reference_delta(&harmonics, J + extra, 2.0 * PI, 200_000);
+    assert!(rel(reference, 1e-11) < 1e-8, "{reference}");
+    // No f64 inertia reaches 1e-13: even the largest flywheel the model holds leaves δ above it.
+    assert_eq!(m.flywheel_for(1e-13), Err(DesignError::Unreachable));
+    // (n·J must stay finite: order 3 caps J below f64::MAX / 3.)
+    let largest = m.with_flywheel(f64::MAX / 4.0).unwrap();
+    assert!(steady(&largest).delta > 1e-13);
+    assert_eq!(
+        m.irregularity(Some(1e-13)).unwrap().flywheel_for_limit,
+        None
+    );
+    // One order (closed form) likewise.
+    let one = drive(&[h(1.0, 1e300, 0.0)], J);
+    assert!(one.flywheel_for(1e-11).unwrap() > 1e307);
+    assert_eq!(one.flywheel_for(1e-13), Err(DesignError::Unreachable));
 }
 
 /// Central differences with a relative step of 1e-5 (≈ ε^(1/3)·10 balances the O(h²)
