@@ -3,6 +3,7 @@
 //! runs on the target.
 
 pub mod accuracy;
+pub mod capture;
 pub mod cost;
 pub mod effects;
 pub mod encoder;

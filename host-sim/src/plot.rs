@@ -92,6 +92,16 @@ fn bounds(chart: &Chart) -> (f64, f64, f64, f64) {
 
 /// Writes `chart` as an SVG file.
 pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), String> {
+    write_svg_with_legend(path, chart, None)
+}
+
+/// Writes `chart` as an SVG file with the legend at `legend` (plotters' default place when
+/// `None`), for charts whose data fill that place.
+pub fn write_svg_with_legend(
+    path: &Path,
+    chart: &Chart,
+    legend: Option<SeriesLabelPosition>,
+) -> Result<(), String> {
     let root = SVGBackend::new(path, (960, 540)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let (x0, x1, y0, y1) = bounds(chart);
@@ -171,7 +181,11 @@ pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), String> {
             Mark::Band(..) => {}
         }
     }
-    c.configure_series_labels()
+    let mut labels = c.configure_series_labels();
+    if let Some(at) = legend {
+        labels.position(at);
+    }
+    labels
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()

@@ -89,6 +89,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             r.residual_relative.unwrap_or(f64::NAN)
         );
     }
+    if let Some(c) = &r.capture {
+        s.push_str(&crate::capture::summary(c));
+    }
     if let Some(u) = &r.supports {
         let _ = writeln!(
             s,
@@ -181,6 +184,22 @@ pub fn run_plots(
                 marks,
             },
         )?;
+        out.push(path);
+    }
+    if let (Some(c), Some(machine)) = (
+        &r.capture,
+        predict::machine(scene, file).map_err(|e| e.to_string())?,
+    ) {
+        let path = dir.join(format!("{stem}-capture.svg"));
+        crate::capture::write_capture_svg(
+            &path,
+            "Loads' speed against the rotor's (Sommerfeld capture)",
+            &[("simulated".into(), c)],
+            &machine,
+        )?;
+        out.push(path);
+        let path = dir.join(format!("{stem}-capture-time.svg"));
+        crate::capture::write_time_svg(&path, "Rotor and loads' speeds", c)?;
         out.push(path);
     }
     if let Some(machine) = predict::machine(scene, file).map_err(|e| e.to_string())? {

@@ -137,6 +137,10 @@ pub struct RunReport {
     /// Support results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsRunOut>,
+    /// Sommerfeld capture of loads started together ([`crate::capture`]): where they were
+    /// captured and released, against the core's capture window.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture: Option<crate::capture::CaptureReport>,
     /// Every window (for plots).
     #[serde(skip)]
     pub window_list: Vec<WindowOut>,
@@ -189,13 +193,15 @@ fn integrator(scene: &Scene) -> Integrator {
 /// The vibration machine of a scene, in the simulator's terms (checked when the caller builds
 /// the [`VibrationMachine`] from it). `rotor_speed` is the shaft's speed at `t = 0`, rad/s:
 /// loads started near the balancing position turn with the rotor (the balancing position is
-/// a co-rotating state); loads started together are at rest.
+/// a co-rotating state); loads started together are at rest. The loads start together when
+/// the scene asks for it (`[autobalancer] start = "together"`) or `together` forces it.
 pub fn vibration_params(
     scene: &Scene,
     together: bool,
     rotor_speed: f64,
 ) -> Option<VibrationMachineParams> {
     let ab = scene.autobalancer.as_ref()?;
+    let together = together || ab.start == crate::scene::LoadStart::Together;
     let kind = match ab.kind {
         BalancerKindSpec::Ball => LoadKind::Ball,
         BalancerKindSpec::Roller => LoadKind::Roller,
@@ -464,6 +470,21 @@ impl Observer for Collector<'_> {
     }
 }
 
+/// The capture analysis of a run whose loads started together (`None` otherwise).
+fn capture_analysis(
+    scene: &Scene,
+    file: &Path,
+    params: Option<&VibrationMachineParams>,
+    samples: &[RegimeSample],
+) -> Result<Option<crate::capture::CaptureReport>, SceneError> {
+    let together =
+        params.is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
+    if !together {
+        return Ok(None);
+    }
+    Ok(predict::machine(scene, file)?.and_then(|m| crate::capture::analyse(samples, &m)))
+}
+
 /// Simulates `scene` and reports.
 pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, SceneError> {
     let started = Instant::now();
@@ -585,7 +606,8 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         last_window: None,
         vibration: vib_machine.as_ref().zip(vib_range),
         samples: Vec::new(),
-        sample_every: duration / 4000.0,
+        // 4000 samples a run, and at least 100 a second (a capture's slip beats need them).
+        sample_every: (duration / 4000.0).min(0.01),
         next_sample: 0.0,
         rotor,
         reactions: [0.0; 2],
@@ -666,6 +688,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
             report.regime_detail = Some(r);
         }
     }
+    report.capture = capture_analysis(scene, file, vib_params.as_ref(), &col.samples)?;
     if let Some((rotor, limits)) = predict::rotor(scene, file)? {
         let analysis = SupportAnalysis::new(&rotor, &limits);
         let speed = report.speed_measured.unwrap_or(limits.service_speed());

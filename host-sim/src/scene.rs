@@ -363,6 +363,23 @@ pub struct AutobalancerSpec {
     /// Rotor static unbalance the loads are to balance, kg·m.
     #[serde(default)]
     pub rotor_unbalance: Option<f64>,
+    /// Where the loads start: `"balanced"` (the default: near the balancing position, load 1
+    /// turned 0.05 rad forward) or `"together"` (gathered within 0.01 rad at rest, for the
+    /// Sommerfeld capture of a run-up). The run's `loads_together` override (`sweep
+    /// --together`) forces `"together"`.
+    #[serde(default)]
+    pub start: LoadStart,
+}
+
+/// `[autobalancer] start`: where the loads are at `t = 0` (always at rest).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LoadStart {
+    /// Near the auto-balancing position with a small perturbation.
+    #[default]
+    Balanced,
+    /// Gathered together on the unbalance's side.
+    Together,
 }
 
 /// `[rotor]`.
@@ -537,6 +554,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         include_str!("../scenes/auger-overhung.toml"),
     ),
     ("one-mass.toml", include_str!("../scenes/one-mass.toml")),
+    (
+        "one-mass-runup.toml",
+        include_str!("../scenes/one-mass-runup.toml"),
+    ),
     ("two-mass.toml", include_str!("../scenes/two-mass.toml")),
     ("three-mass.toml", include_str!("../scenes/three-mass.toml")),
 ];

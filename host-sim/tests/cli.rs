@@ -40,6 +40,7 @@ fn scenes_lists_every_bundled_scene() {
         "auger",
         "auger-overhung",
         "one-mass",
+        "one-mass-runup",
         "two-mass",
         "three-mass",
     ] {
@@ -156,6 +157,27 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
         err.contains("tiny-limit.toml") && err.contains("delta_limit"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn runup_reports_the_capture_and_out_needs_loads_together() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-capture-{}", std::process::id()));
+    let (ok, out, err) = drive_sim(&["run", "one-mass-runup", "--plot", dir.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("loads captured near") && out.contains("core predicts until 90.41"),
+        "{out}"
+    );
+    for f in [
+        "one-mass-runup-capture.svg",
+        "one-mass-runup-capture-time.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("capture"), "{f}");
+    }
+    let (ok, _, err) = drive_sim(&["run", "one-mass", "--out", dir.to_str().unwrap()]);
+    assert!(!ok && err.contains("start = \"together\""), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

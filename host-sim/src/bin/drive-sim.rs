@@ -28,6 +28,10 @@ enum Command {
         /// Write SVG plots into this directory.
         #[arg(long)]
         plot: Option<std::path::PathBuf>,
+        /// Write the capture page of a run-up (loads together, prescribed ramp) into this
+        /// directory: Markdown and SVGs, the scene repeated at slower and faster ramps.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
     },
     /// Design-time results only (no simulation): predicted δ, support limits, regime zones.
     Predict {
@@ -94,8 +98,13 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => run_cmd(DEFAULT_SCENE, false, None),
-        Some(Command::Run { scene, json, plot }) => run_cmd(&scene, json, plot.as_deref()),
+        None => run_cmd(DEFAULT_SCENE, false, None, None),
+        Some(Command::Run {
+            scene,
+            json,
+            plot,
+            out,
+        }) => run_cmd(&scene, json, plot.as_deref(), out.as_deref()),
         Some(Command::Predict { scene, json }) => predict_cmd(&scene, json),
         Some(Command::Sweep {
             scene,
@@ -140,10 +149,23 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_cmd(name: &str, json: bool, plot: Option<&std::path::Path>) -> Result<(), String> {
+fn run_cmd(
+    name: &str,
+    json: bool,
+    plot: Option<&std::path::Path>,
+    out: Option<&std::path::Path>,
+) -> Result<(), String> {
     let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
     let report =
         host_sim::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
+    if let Some(dir) = out {
+        let files = capture_page(name, &scene, &path, &report, dir)?;
+        if !json {
+            for f in files {
+                println!("wrote {}", f.display());
+            }
+        }
+    }
     if let Some(dir) = plot {
         let files = host_sim::report::run_plots(&scene, &path, &report, dir)?;
         if !json {
@@ -163,6 +185,79 @@ fn run_cmd(name: &str, json: bool, plot: Option<&std::path::Path>) -> Result<(),
         print!("{}", host_sim::report::prediction_text(&p));
     }
     Ok(())
+}
+
+/// Ramp times of the capture page, relative to the scene's (slower ramps for the convergence
+/// of the release speed, two faster ones for contrast).
+const RAMP_FACTORS: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+
+fn capture_page(
+    name: &str,
+    scene: &host_sim::scene::Scene,
+    path: &std::path::Path,
+    report: &host_sim::run::RunReport,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>, String> {
+    use host_sim::capture;
+    if report.capture.is_none() {
+        return Err(format!(
+            "{}: --out writes the capture page of a run-up: the loads must start together \
+             (`[autobalancer] start = \"together\"`)",
+            path.display()
+        ));
+    }
+    let machine = host_sim::predict::machine(scene, path)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| format!("{}: no auto-balancer", path.display()))?;
+    let runs = capture::ramp_rates(scene, path, &RAMP_FACTORS).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string();
+    let title =
+        format!("{stem}: Sommerfeld capture in a run-up, against the core's capture window");
+    let speeds = format!("capture-{stem}.svg");
+    let time = format!("capture-{stem}-time.svg");
+    // Three ramps on the Ω-against-ω plot: the fastest, the scene's and the slowest.
+    let shown: Vec<(String, &capture::CaptureReport)> = [runs.first(), runs.get(2), runs.last()]
+        .into_iter()
+        .flatten()
+        .filter_map(|r| {
+            r.capture.as_ref().map(|c| {
+                (
+                    format!("simulated, ramp {} rad/s²", capture::rate_text(r.rate)),
+                    c,
+                )
+            })
+        })
+        .collect();
+    capture::write_capture_svg(&dir.join(&speeds), &title, &shown, &machine)?;
+    if let Some(c) = &report.capture {
+        capture::write_time_svg(
+            &dir.join(&time),
+            &format!("{stem}: speeds in the run-up"),
+            c,
+        )?;
+    }
+    let md = dir.join(format!("capture-{stem}.md"));
+    let command = format!(
+        "cargo run --release -p host-sim -- run {name} --out {}",
+        dir.display()
+    );
+    let held = capture::held_run(scene, path).map_err(|e| e.to_string())?;
+    let text = capture::markdown(
+        &title,
+        &command,
+        [&speeds, &time],
+        report,
+        &runs,
+        &machine,
+        held.as_ref(),
+    );
+    std::fs::write(&md, text).map_err(|e| format!("{}: {e}", md.display()))?;
+    Ok(vec![md, dir.join(speeds), dir.join(time)])
 }
 
 fn sweep_cmd(

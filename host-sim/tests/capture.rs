@@ -1,0 +1,167 @@
+//! Sommerfeld capture in a run-up, simulated, against the core's capture window.
+//!
+//! The bundled `one-mass-runup` scene starts the loads of the one-mass machine together at rest
+//! and ramps the rotor at 1 rad/s² from 0 to 130 rad/s. The core predicts capture possible from
+//! 61.43 up to 90.41 rad/s. Measured (`drive-sim run one-mass-runup --out docs`, eight ramp
+//! rates from 4 to 1/32 rad/s²): released 3.83, 1.34, 0.74, 0.19 % above `until` at 4, 1,
+//! 1/4 and 1/32 rad/s²; the excess falls as rate^0.65 (a slow passage through a fold gives
+//! 2/3), a fit `release = a + b·rate^(2/3)` puts the quasi-static release at 90.42 rad/s
+//! (+0.02 %) with residuals within 0.23 %; the captured load speed, averaged over whole slip
+//! turns, is within 0.2 % of `capture_speed(ω)` at 1 rad/s² and slower (0.52 % at 4 rad/s²).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use host_sim::capture::{self, CaptureReport, RampRun};
+use host_sim::run::{run, vibration_params, Overrides};
+use host_sim::scene::{resolve, LoadStart, Scene};
+use host_sim::vibration::LoadPlacement;
+use std::path::Path;
+
+fn runup(factor: f64) -> (RampRun, host_sim::run::RunReport) {
+    let (scene, path) = resolve("one-mass-runup").unwrap();
+    let mut s = capture::with_ramp_stretched(&scene, &path, factor).unwrap();
+    s.encoder = None;
+    let r = run(&s, &path, Overrides::default()).unwrap();
+    let rate = 130.0 / (130.0 * factor);
+    (
+        RampRun {
+            rate,
+            capture: r.capture.clone(),
+        },
+        r,
+    )
+}
+
+fn released(c: &CaptureReport) -> f64 {
+    assert!(c.captured && c.released, "{c:?}");
+    c.release_speed.unwrap()
+}
+
+#[test]
+fn start_key_is_validated_and_names_the_bad_value() {
+    let (runup, _) = resolve("one-mass-runup").unwrap();
+    assert_eq!(
+        runup.autobalancer.as_ref().unwrap().start,
+        LoadStart::Together
+    );
+    let together = vibration_params(&runup, false).unwrap();
+    assert!(matches!(
+        together.initial.loads,
+        LoadPlacement::Together { .. }
+    ));
+    // The default is the balanced start; the run's override still forces together.
+    let (one, _) = resolve("one-mass").unwrap();
+    assert_eq!(
+        one.autobalancer.as_ref().unwrap().start,
+        LoadStart::Balanced
+    );
+    assert!(matches!(
+        vibration_params(&one, false).unwrap().initial.loads,
+        LoadPlacement::Balanced { .. }
+    ));
+    assert!(matches!(
+        vibration_params(&one, true).unwrap().initial.loads,
+        LoadPlacement::Together { .. }
+    ));
+    let text = host_sim::scene::BUNDLED
+        .iter()
+        .find(|(n, _)| *n == "one-mass-runup.toml")
+        .unwrap()
+        .1
+        .replace("start = \"together\"", "start = \"sideways\"");
+    let e = Scene::parse(&text, Path::new("bad.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("bad.toml") && e.contains("start") && e.contains("sideways"),
+        "{e}"
+    );
+}
+
+#[test]
+fn balanced_start_has_no_capture_report() {
+    let (scene, path) = resolve("one-mass").unwrap();
+    let mut s = scene.clone();
+    s.encoder = None;
+    s.simulation.duration = 5.0;
+    let r = run(&s, &path, Overrides::default()).unwrap();
+    assert!(r.capture.is_none());
+    let json = serde_json::to_value(&r).unwrap();
+    assert!(json.get("capture").is_none());
+}
+
+/// The scene's 1 rad/s² run: captured at the zone boundary, held below it while the rotor
+/// runs ~30 rad/s faster, released just above the core's `until`.
+#[test]
+fn runup_is_captured_then_released() {
+    let (r, report) = runup(1.0);
+    let c = r.capture.unwrap();
+    let b = released(&c);
+    // Captured as soon as the rotor passes the boundary: measured 61.72 against 61.43 (the
+    // slip beat of the rotor's own unbalance moves the first 2 % lag by a few tenths).
+    let a = c.captured_from.unwrap()[1];
+    assert!(a > c.predicted_from && a < 1.01 * c.predicted_from, "{a}");
+    // Held below the boundary while captured.
+    let held = c.captured_load_speed_median.unwrap();
+    assert!(
+        held < c.predicted_from && held > 0.95 * c.predicted_from,
+        "{held}"
+    );
+    // Released after `until` (no captured state exists above it) and within 2 % of it
+    // (measured +1.34 %: the finite-rate delay; the slow-ramp test below bounds it tighter).
+    assert!(b > c.predicted_until && b < 1.02 * c.predicted_until, "{b}");
+    assert!((c.ramp_rate.unwrap() - 1.0).abs() < 1e-3);
+    // Then the loads turn with the rotor.
+    let last = c.trace.last().unwrap();
+    assert!((last.load / last.rotor - 1.0).abs() < 1e-3, "{last:?}");
+    // In JSON the report carries the analysis.
+    let json = serde_json::to_value(&report).unwrap();
+    assert_eq!(json["capture"]["released"], true);
+    assert!(json["capture"]["release_speed"].as_f64().unwrap() > 90.0);
+}
+
+/// The release speed converges on `until` as the ramp slows, and the captured load speed
+/// follows `capture_speed(ω)`.
+///
+/// Tolerances, from the eight-rate study in the module docs:
+/// - at 1/4 rad/s² the release lies within [−0.3 %, +1.0 %] of `until`: the fold of the
+///   averaged balance is 0.05 % above `until`, the rate^(2/3) fit puts the finite-rate delay at
+///   0.57 % there, and single releases scatter about the fit by up to 0.23 % (the rotor's
+///   unbalance beats against the captured loads);
+/// - the excess over `until` falls strictly from 4 to 1 to 1/4 rad/s²;
+/// - the fitted quasi-static release (`a` of `a + b·rate^(2/3)` over the three rates) is within
+///   0.5 % of `until` (measured +0.02 %; the scatter of 0.23 % per release, extrapolated);
+/// - the captured load speed, averaged over two slip turns, is within 0.4 % of
+///   `capture_speed(ω)` at 1 and 1/4 rad/s² (measured at most 0.16 %: the averaging leaves a
+///   little of the beat, the ramp drags the captured state).
+#[test]
+fn release_converges_on_until_and_captured_speed_matches_the_core() {
+    let runs: Vec<RampRun> = [0.25, 1.0, 4.0].into_iter().map(|f| runup(f).0).collect();
+    let until = runs[0].capture.as_ref().unwrap().predicted_until;
+    let excess: Vec<f64> = runs
+        .iter()
+        .map(|r| released(r.capture.as_ref().unwrap()) / until - 1.0)
+        .collect();
+    assert!(excess[0] > excess[1] && excess[1] > excess[2], "{excess:?}");
+    let slow = excess[2];
+    assert!((-0.003..0.010).contains(&slow), "{slow}");
+    let (a, b) = capture::release_fit(&runs).unwrap();
+    assert!((a / until - 1.0).abs() < 0.005 && b > 0.0, "{a} {b}");
+    for r in &runs[1..] {
+        let c = r.capture.as_ref().unwrap();
+        assert_eq!(c.checks.len(), 4);
+        for k in &c.checks {
+            let e = k.relative_error.unwrap();
+            assert!(e.abs() < 0.004, "rate {}: {k:?}", r.rate);
+        }
+    }
+    // The page built from these runs carries the table and the fit.
+    let (scene, path) = resolve("one-mass-runup").unwrap();
+    let machine = host_sim::predict::machine(&scene, &path).unwrap().unwrap();
+    let (_, main) = runup(1.0);
+    let page = capture::markdown("t", "cmd", ["a.svg", "b.svg"], &main, &runs, &machine, None);
+    assert!(
+        page.contains("| 0.25 |") && page.contains("| 4 |"),
+        "{page}"
+    );
+    assert!(page.contains(&format!("a = {a:.2} rad/s")), "{page}");
+}
