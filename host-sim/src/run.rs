@@ -332,6 +332,17 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
         length: revs,
         steady_tolerance: m.steady_tolerance.unwrap_or(0.02) as f32,
     };
+    // The same floor as the design-time check (`predict`): a limit finer than f64 resolves
+    // the speed cannot be met or monitored.
+    if let Some(l) = m.delta_limit {
+        if l < drive_monitor::drive::MIN_DELTA_TARGET {
+            return Err(value_error(
+                file,
+                "monitor",
+                drive_monitor::ConfigError::OutOfRange("delta_limit"),
+            ));
+        }
+    }
     let alarm = m.delta_limit.map(|l| AlarmConfig::new(l as f32));
     DeltaMonitor::new(enc, window, alarm)
         .map(Some)

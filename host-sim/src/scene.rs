@@ -294,7 +294,8 @@ pub struct MonitorSpec {
     pub min_speed: Option<f64>,
     /// Steady-speed tolerance between windows (fraction).
     pub steady_tolerance: Option<f64>,
-    /// Relative margin band around each characteristic speed of the auto-balancer.
+    /// Relative margin band around each characteristic speed of the auto-balancer (default
+    /// `drive_monitor::balancer::DEFAULT_MARGIN`, 5 %, sized in `docs/criterion.md`).
     pub regime_margin: Option<f64>,
     /// Warning band of the support limits, as a fraction of each limit.
     pub warning_fraction: Option<f64>,

@@ -768,7 +768,7 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         let _ = writeln!(
             t,
             "- machine {} ({} platforms, ε = {:.4}, h = {:.3}, β = {:.2}), boundary {} at {:.2} rad/s: \
-             balancing from {}{:+.1} %, capture window to {}",
+             balancing {} {:+.1} %, capture window to {}",
             p.id,
             p.platforms,
             p.epsilon,
@@ -776,7 +776,7 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
             p.beta,
             k + 1,
             b.predicted,
-            if b.beyond_grid { "not reached up to " } else { "" },
+            if b.beyond_grid { "not reached up to" } else { "from" },
             100.0 * b.shift_high,
             b.capture_until
                 .map_or("none".into(), |u| format!("{:+.1} %", 100.0 * (u / b.predicted - 1.0)))

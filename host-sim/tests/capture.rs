@@ -43,7 +43,7 @@ fn start_key_is_validated_and_names_the_bad_value() {
         runup.autobalancer.as_ref().unwrap().start,
         LoadStart::Together
     );
-    let together = vibration_params(&runup, false).unwrap();
+    let together = vibration_params(&runup, false, 50.0).unwrap();
     assert!(matches!(
         together.initial.loads,
         LoadPlacement::Together { .. }
@@ -54,14 +54,20 @@ fn start_key_is_validated_and_names_the_bad_value() {
         one.autobalancer.as_ref().unwrap().start,
         LoadStart::Balanced
     );
+    let balanced = vibration_params(&one, false, 100.0).unwrap();
     assert!(matches!(
-        vibration_params(&one, false).unwrap().initial.loads,
+        balanced.initial.loads,
         LoadPlacement::Balanced { .. }
     ));
+    // Loads at the balancing position turn with the rotor; loads together start at rest.
+    assert_eq!(balanced.initial.load_speed, 100.0);
+    assert_eq!(together.initial.load_speed, 0.0);
+    let forced = vibration_params(&one, true, 100.0).unwrap();
     assert!(matches!(
-        vibration_params(&one, true).unwrap().initial.loads,
+        forced.initial.loads,
         LoadPlacement::Together { .. }
     ));
+    assert_eq!(forced.initial.load_speed, 0.0);
     let text = host_sim::scene::BUNDLED
         .iter()
         .find(|(n, _)| *n == "one-mass-runup.toml")

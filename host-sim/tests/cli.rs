@@ -151,12 +151,14 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
         text.replace("delta_limit = 0.06", "delta_limit = 1e-20"),
     )
     .unwrap();
-    let (ok, _, err) = drive_sim(&["predict", path.to_str().unwrap()]);
-    assert!(!ok, "predict should fail");
-    assert!(
-        err.contains("tiny-limit.toml") && err.contains("delta_limit"),
-        "{err}"
-    );
+    for cmd in ["predict", "run"] {
+        let (ok, _, err) = drive_sim(&[cmd, path.to_str().unwrap()]);
+        assert!(!ok, "{cmd} should fail");
+        assert!(
+            err.contains("tiny-limit.toml") && err.contains("delta_limit"),
+            "{cmd}: {err}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

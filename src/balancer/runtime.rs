@@ -75,8 +75,8 @@ pub struct Classifier {
 /// with `ε` in [0.005, 0.1], `h` in [0.01, 0.2] and `β` in [1, 50], the band an additional
 /// speed's boundary (balancing below, gathering above) needs for the classifier to match the
 /// simulation on both sides was 0.3 % at the median and 2.0 % at the 90th percentile; 5 %
-/// covers 68 of the 71 boundaries (the other three are narrow gathering zones that vanish in
-/// simulation). The needed band did not change measurably with `ε` (medians and maxima flat
+/// covers 69 of the 71 boundaries (in the other two the gathering zone above the additional
+/// speed shrinks or vanishes in simulation). The needed band did not change measurably with `ε` (medians and maxima flat
 /// across the range; a power-law fit gives `ε^−0.01`), so it is one constant, not a function
 /// of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
 /// capture band ([`Regime::Bistable`]), not by this margin.
