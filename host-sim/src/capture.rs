@@ -37,7 +37,7 @@ use drive_monitor::balancer::Machine;
 use plotters::prelude::SeriesLabelPosition;
 use serde::Serialize;
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Turns at the zone boundary the speed window spans (short: the release is a jump).
 const WINDOW_TURNS: f64 = 2.0;
@@ -523,6 +523,12 @@ pub fn release_fit(runs: &[RampRun]) -> Option<(f64, f64)> {
             Some((r.rate.powf(2.0 / 3.0), v))
         })
         .collect();
+    line_fit(&pts)
+}
+
+/// Least-squares line `y = a + b·x` through `pts`: `(a, b)`; `None` with fewer than two
+/// points or no spread in `x`.
+fn line_fit(pts: &[(f64, f64)]) -> Option<(f64, f64)> {
     if pts.len() < 2 {
         return None;
     }
@@ -547,15 +553,7 @@ pub fn release_slope(runs: &[RampRun], fold_speed: f64) -> Option<f64> {
             (v > fold_speed && r.rate > 0.0).then(|| (r.rate.ln(), (v - fold_speed).ln()))
         })
         .collect();
-    if pts.len() < 2 {
-        return None;
-    }
-    let n = pts.len() as f64;
-    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
+    line_fit(&pts).map(|(_, slope)| slope)
 }
 
 /// A ramp rate (rad/s²) as text: up to five decimals, trailing zeros dropped.
@@ -723,6 +721,73 @@ pub fn markdown(
         }
     }
     s
+}
+
+/// Ramp times of the capture page, relative to the scene's (slower ramps for the convergence
+/// of the release speed, two faster ones for contrast).
+const RAMP_FACTORS: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+
+/// Writes the capture page of a run-up (`run SCENE --out DIR`): the Markdown page, the
+/// Ω-against-ω plot over several ramp rates and the scene's speeds against time.
+pub fn publish(
+    name: &str,
+    scene: &Scene,
+    path: &Path,
+    report: &RunReport,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    if report.capture.is_none() {
+        return Err(format!(
+            "{}: --out writes the capture page of a run-up: the loads must start together \
+             (`[autobalancer] start = \"together\"`)",
+            path.display()
+        ));
+    }
+    let machine = crate::predict::machine(scene, path)
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| format!("{}: no auto-balancer", path.display()))?;
+    let runs = ramp_rates(scene, path, &RAMP_FACTORS).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let stem = crate::run::scene_stem(path);
+    let title =
+        format!("{stem}: Sommerfeld capture in a run-up, against the core's capture window");
+    let speeds = format!("capture-{stem}.svg");
+    let time = format!("capture-{stem}-time.svg");
+    // Three ramps on the Ω-against-ω plot: the fastest, the scene's and the slowest.
+    let shown: Vec<(String, &CaptureReport)> = [runs.first(), runs.get(2), runs.last()]
+        .into_iter()
+        .flatten()
+        .filter_map(|r| {
+            r.capture
+                .as_ref()
+                .map(|c| (format!("simulated, ramp {} rad/s²", rate_text(r.rate)), c))
+        })
+        .collect();
+    write_capture_svg(&dir.join(&speeds), &title, &shown, &machine)?;
+    if let Some(c) = &report.capture {
+        write_time_svg(
+            &dir.join(&time),
+            &format!("{stem}: speeds in the run-up"),
+            c,
+        )?;
+    }
+    let md = dir.join(format!("capture-{stem}.md"));
+    let command = format!(
+        "cargo run --release -p host-sim -- run {name} --out {}",
+        dir.display()
+    );
+    let held = held_run(scene, path).map_err(|e| e.to_string())?;
+    let text = markdown(
+        &title,
+        &command,
+        [&speeds, &time],
+        report,
+        &runs,
+        &machine,
+        held.as_ref(),
+    );
+    std::fs::write(&md, text).map_err(|e| format!("{}: {e}", md.display()))?;
+    Ok(vec![md, dir.join(speeds), dir.join(time)])
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@ use crate::vibration::{
     VibrationMachineParams,
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
-use drive_monitor::balancer::{Classifier, Regime, DEFAULT_MARGIN};
+use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
@@ -496,6 +496,32 @@ fn capture_analysis(
     Ok(predict::machine(scene, file)?.and_then(|m| crate::capture::analyse(samples, &m)))
 }
 
+/// The scene's file name without its extension ("scene" if it has none): the stem of the
+/// pages and plots written for it.
+pub fn scene_stem(path: &Path) -> String {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string()
+}
+
+/// The core's regime classifier for `machine` with the scene's `[monitor] regime_margin`
+/// (default [`DEFAULT_MARGIN`]) and half of it as hysteresis, and that margin.
+pub fn regime_classifier(
+    scene: &Scene,
+    file: &Path,
+    machine: &Machine,
+) -> Result<(Classifier, f32), SceneError> {
+    let margin = scene
+        .monitor
+        .as_ref()
+        .and_then(|m| m.regime_margin)
+        .map_or(DEFAULT_MARGIN, |m| m as f32);
+    let classifier = Classifier::new(machine, margin, 0.5 * margin)
+        .map_err(|e| value_error(file, "monitor", e))?;
+    Ok((classifier, margin))
+}
+
 /// Simulates `scene` and reports.
 pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, SceneError> {
     let started = Instant::now();
@@ -670,24 +696,10 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
     }
     if let Some(machine) = predict::machine(scene, file)? {
-        let margin = scene
-            .monitor
-            .as_ref()
-            .and_then(|m| m.regime_margin)
-            .unwrap_or(f64::from(DEFAULT_MARGIN));
-        let classifier = Classifier::new(&machine, margin as f32, 0.5 * margin as f32)
-            .map_err(|e| value_error(file, "monitor", e))?;
+        let (classifier, _) = regime_classifier(scene, file, &machine)?;
         if let Some(w) = report.speed_measured {
-            let class = classifier.classify(w as f32);
-            report.regime_class = Some(match class {
-                Regime::Balancing => "balancing",
-                Regime::Gathering => "gathering",
-                Regime::Bistable => "bistable",
-                Regime::NearCharacteristic => "near-characteristic",
-                Regime::Unknown => "unknown",
-            });
-            // The criterion's zone at the measured speed (bistable counts as balancing: the
-            // balanced state is locally stable there).
+            report.regime_class = Some(classifier.classify(w as f32).name());
+            // The criterion's own zone at the measured speed (no margin, no capture check).
             report.regime_predicted = Some(machine.zone_kind_at(w).name());
         }
     }

@@ -218,3 +218,34 @@ fn bad_scenes_name_the_file_and_key_and_fail() {
     assert!(!ok && err.contains("no-such-scene.toml"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn criterion_writes_its_page_and_json() {
+    // One machine (a single platform, so one boundary): the page names the command that
+    // regenerates it, and the JSON carries the machine, its grid and its boundary.
+    let dir = std::env::temp_dir().join(format!("drive-sim-criterion-{}", std::process::id()));
+    let (ok, out, err) = drive_sim(&[
+        "criterion",
+        "--machines",
+        "1",
+        "--seed",
+        "3",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let m = &v["machines"][0];
+    assert_eq!(m["sample"]["platforms"], 1);
+    assert_eq!(m["points"].as_array().unwrap().len(), 40);
+    assert_eq!(m["boundaries"][0]["kind"], "resonance");
+    let md = std::fs::read_to_string(dir.join("criterion.md")).unwrap();
+    assert!(md.contains("criterion --machines 1 --seed 3 --out"), "{md}");
+    for f in ["criterion-resonance.svg", "criterion-additional.svg"] {
+        assert!(std::fs::read_to_string(dir.join(f))
+            .unwrap()
+            .starts_with("<svg"));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -29,6 +29,20 @@ pub enum Regime {
     Unknown,
 }
 
+impl Regime {
+    /// Lower-case name as used in the host's JSON: `"balancing"`, `"gathering"`,
+    /// `"bistable"`, `"near-characteristic"` or `"unknown"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Regime::Balancing => "balancing",
+            Regime::Gathering => "gathering",
+            Regime::Bistable => "bistable",
+            Regime::NearCharacteristic => "near-characteristic",
+            Regime::Unknown => "unknown",
+        }
+    }
+}
+
 /// A band of speeds `[from, to)`, rad/s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

@@ -122,11 +122,7 @@ fn main() -> ExitCode {
             out,
         }) => criterion_cmd(machines, seed, json, out.as_deref()),
         Some(Command::Accuracy { out, target }) => {
-            host_sim::publish::accuracy(&out, target).map(|files| {
-                for f in files {
-                    println!("wrote {}", f.display());
-                }
-            })
+            host_sim::publish::accuracy(&out, target).map(|files| list(&files, "wrote"))
         }
         Some(Command::Scenes) => {
             for (name, text) in BUNDLED {
@@ -159,105 +155,25 @@ fn run_cmd(
     let report =
         host_sim::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
     if let Some(dir) = out {
-        let files = capture_page(name, &scene, &path, &report, dir)?;
+        let files = host_sim::capture::publish(name, &scene, &path, &report, dir)?;
         if !json {
-            for f in files {
-                println!("wrote {}", f.display());
-            }
+            list(&files, "wrote");
         }
     }
     if let Some(dir) = plot {
         let files = host_sim::report::run_plots(&scene, &path, &report, dir)?;
         if !json {
-            for f in files {
-                println!("plot: {}", f.display());
-            }
+            list(&files, "plot:");
         }
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
+        print_json(&report)?;
     } else {
         let p = predict(&scene, &path).map_err(|e| e.to_string())?;
         print!("{}", host_sim::report::run_text(&scene, &report));
         print!("{}", host_sim::report::prediction_text(&p));
     }
     Ok(())
-}
-
-/// Ramp times of the capture page, relative to the scene's (slower ramps for the convergence
-/// of the release speed, two faster ones for contrast).
-const RAMP_FACTORS: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
-
-fn capture_page(
-    name: &str,
-    scene: &host_sim::scene::Scene,
-    path: &std::path::Path,
-    report: &host_sim::run::RunReport,
-    dir: &std::path::Path,
-) -> Result<Vec<std::path::PathBuf>, String> {
-    use host_sim::capture;
-    if report.capture.is_none() {
-        return Err(format!(
-            "{}: --out writes the capture page of a run-up: the loads must start together \
-             (`[autobalancer] start = \"together\"`)",
-            path.display()
-        ));
-    }
-    let machine = host_sim::predict::machine(scene, path)
-        .map_err(|e| e.to_string())?
-        .ok_or_else(|| format!("{}: no auto-balancer", path.display()))?;
-    let runs = capture::ramp_rates(scene, path, &RAMP_FACTORS).map_err(|e| e.to_string())?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let stem = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("scene")
-        .to_string();
-    let title =
-        format!("{stem}: Sommerfeld capture in a run-up, against the core's capture window");
-    let speeds = format!("capture-{stem}.svg");
-    let time = format!("capture-{stem}-time.svg");
-    // Three ramps on the Ω-against-ω plot: the fastest, the scene's and the slowest.
-    let shown: Vec<(String, &capture::CaptureReport)> = [runs.first(), runs.get(2), runs.last()]
-        .into_iter()
-        .flatten()
-        .filter_map(|r| {
-            r.capture.as_ref().map(|c| {
-                (
-                    format!("simulated, ramp {} rad/s²", capture::rate_text(r.rate)),
-                    c,
-                )
-            })
-        })
-        .collect();
-    capture::write_capture_svg(&dir.join(&speeds), &title, &shown, &machine)?;
-    if let Some(c) = &report.capture {
-        capture::write_time_svg(
-            &dir.join(&time),
-            &format!("{stem}: speeds in the run-up"),
-            c,
-        )?;
-    }
-    let md = dir.join(format!("capture-{stem}.md"));
-    let command = format!(
-        "cargo run --release -p host-sim -- run {name} --out {}",
-        dir.display()
-    );
-    let held = capture::held_run(scene, path).map_err(|e| e.to_string())?;
-    let text = capture::markdown(
-        &title,
-        &command,
-        [&speeds, &time],
-        report,
-        &runs,
-        &machine,
-        held.as_ref(),
-    );
-    std::fs::write(&md, text).map_err(|e| format!("{}: {e}", md.display()))?;
-    Ok(vec![md, dir.join(speeds), dir.join(time)])
 }
 
 fn sweep_cmd(
@@ -270,40 +186,21 @@ fn sweep_cmd(
     out: Option<&std::path::Path>,
 ) -> Result<(), String> {
     let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
-    let s = host_sim::sweep::sweep(&scene, &path, from, to, steps, together, true)
-        .map_err(|e| e.to_string())?;
+    let request = host_sim::sweep::SweepRequest {
+        from,
+        to,
+        steps,
+        together,
+    };
+    let s = host_sim::sweep::sweep(&scene, &path, &request, true).map_err(|e| e.to_string())?;
     if let Some(dir) = out {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let stem = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scene")
-            .to_string();
-        let start = if together {
-            "loads together at rest"
-        } else {
-            "near the balancing position"
-        };
-        let title = format!("{stem}: criterion zones and simulated outcome (start {start})");
-        let svg = dir.join(format!("regimes-{stem}.svg"));
-        s.write_svg(&svg, &title)?;
-        let md = dir.join(format!("regimes-{stem}.md"));
-        let text = format!(
-            "# {title}\n\nRegenerated by `cargo run --release -p host-sim -- sweep {name} --from {from} --to {to} --steps {steps}{} --out {}`.\n\n![regime map](regimes-{stem}.svg)\n\n{}",
-            if together { " --together" } else { "" },
-            dir.display(),
-            s.markdown()
-        );
-        std::fs::write(&md, text).map_err(|e| format!("{}: {e}", md.display()))?;
+        let files = s.publish(name, &path, dir)?;
         if !json {
-            println!("wrote {} and {}", md.display(), svg.display());
+            list(&files, "wrote");
         }
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
-        );
+        print_json(&s)?;
     } else {
         println!(
             "{:>10}  {:<10} {:<20} {:<10} {:>10}",
@@ -347,17 +244,13 @@ fn criterion_cmd(
 ) -> Result<(), String> {
     let s = host_sim::study::study(seed, machines, true).map_err(|e| e.to_string())?;
     if let Some(dir) = out {
-        for f in host_sim::study::publish(&s, dir)? {
-            if !json {
-                println!("wrote {}", f.display());
-            }
+        let files = host_sim::study::publish(&s, dir)?;
+        if !json {
+            list(&files, "wrote");
         }
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&s).map_err(|e| e.to_string())?
-        );
+        print_json(&s)?;
     } else {
         print!("{}", host_sim::study::summary_text(&s));
     }
@@ -368,12 +261,23 @@ fn predict_cmd(name: &str, json: bool) -> Result<(), String> {
     let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
     let p = predict(&scene, &path).map_err(|e| e.to_string())?;
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?
-        );
+        print_json(&p)?;
     } else {
         println!("{}", host_sim::report::prediction_text(&p));
     }
     Ok(())
+}
+
+/// Prints `value` as pretty JSON on stdout.
+fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
+    println!("{text}");
+    Ok(())
+}
+
+/// Prints one line per file written: `what path`.
+fn list(files: &[std::path::PathBuf], what: &str) {
+    for f in files {
+        println!("{what} {}", f.display());
+    }
 }

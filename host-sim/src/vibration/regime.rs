@@ -114,6 +114,8 @@ pub struct RegimeReport {
     pub residual_relative: f64,
     /// Residual unbalance at the first sample, kg·m.
     pub residual_initial: f64,
+    /// `residual_initial` relative to the reference.
+    pub residual_initial_relative: f64,
     /// Smallest coherence over the final window.
     pub coherence_min: f64,
     /// The loads stayed together over the final window.
@@ -153,6 +155,7 @@ pub fn classify(samples: &[RegimeSample], c: &RegimeCriteria) -> Option<RegimeRe
         residual_max,
         residual_relative: residual_max / c.reference,
         residual_initial: first.residual,
+        residual_initial_relative: first.residual / c.reference,
         coherence_min,
         gathered: coherence_min >= c.gathered_coherence,
         load_speed,
