@@ -309,8 +309,7 @@ impl DenseOutput {
 #[derive(Debug, Clone, Copy)]
 enum Method {
     Rk4 { step: f64 },
-    Dopri5 { rtol: f64, atol: f64, max_step: f64 },
-    Dop853 { rtol: f64, atol: f64, max_step: f64 },
+    Adaptive { tol: Tol, tableau: Tableau },
 }
 
 /// A one-step-at-a-time integrator holding its state, work buffers and the dense output of the
@@ -344,26 +343,26 @@ const SAFETY: f64 = 0.9;
 impl Solver {
     /// A solver for an `n`-dimensional system. `integrator` must have been validated.
     pub fn new(integrator: &Integrator, n: usize) -> Self {
+        let adaptive = |rtol, atol, max_step: Option<f64>, tableau| Method::Adaptive {
+            tol: Tol {
+                rtol,
+                atol,
+                max_step: max_step.unwrap_or(f64::INFINITY),
+            },
+            tableau,
+        };
         let method = match *integrator {
             Integrator::Rk4 { step } => Method::Rk4 { step },
             Integrator::Dopri5 {
                 rtol,
                 atol,
                 max_step,
-            } => Method::Dopri5 {
-                rtol,
-                atol,
-                max_step: max_step.unwrap_or(f64::INFINITY),
-            },
+            } => adaptive(rtol, atol, max_step, Tableau::Dp5),
             Integrator::Dop853 {
                 rtol,
                 atol,
                 max_step,
-            } => Method::Dop853 {
-                rtol,
-                atol,
-                max_step: max_step.unwrap_or(f64::INFINITY),
-            },
+            } => adaptive(rtol, atol, max_step, Tableau::Dp853),
         };
         Solver {
             method,
@@ -439,34 +438,7 @@ impl Solver {
         }
         match self.method {
             Method::Rk4 { step } => self.step_rk4(sys, t_end, step),
-            Method::Dopri5 {
-                rtol,
-                atol,
-                max_step,
-            } => self.step_adaptive(
-                sys,
-                t_end,
-                Tol {
-                    rtol,
-                    atol,
-                    max_step,
-                },
-                Tableau::Dp5,
-            ),
-            Method::Dop853 {
-                rtol,
-                atol,
-                max_step,
-            } => self.step_adaptive(
-                sys,
-                t_end,
-                Tol {
-                    rtol,
-                    atol,
-                    max_step,
-                },
-                Tableau::Dp853,
-            ),
+            Method::Adaptive { tol, tableau } => self.step_adaptive(sys, t_end, tol, tableau),
         }
     }
 
@@ -478,12 +450,7 @@ impl Solver {
     ) -> Result<(), OdeError> {
         let n = self.n;
         let t = self.t;
-        // Avoid a sliver of a last step: stretch by up to 1 % instead.
-        let h = if t + 1.01 * step >= t_end {
-            t_end - t
-        } else {
-            step
-        };
+        let h = last_step(t, step, t_end);
         // k0 = f (already), k1..k3 in stage blocks 1..3.
         for i in 0..n {
             self.ytmp[i] = self.y[i] + 0.5 * h * self.f[i];
@@ -611,10 +578,7 @@ impl Solver {
         loop {
             let t = self.t;
             let proposed = self.h.min(tol.max_step);
-            let mut h = proposed;
-            if t + 1.01 * h >= t_end {
-                h = t_end - t;
-            }
+            let h = last_step(t, proposed, t_end);
             let clipped = h < proposed;
             if h <= 16.0 * f64::EPSILON * t.abs().max(1e-300) {
                 return Err(OdeError::StepSizeUnderflow { t });
@@ -808,6 +772,16 @@ impl Solver {
             &self.nested[6 * n..7 * n],
         ];
         self.dense.set_from_nested(t, h, &self.y, &blocks);
+    }
+}
+
+/// The step to take from `t` towards `t_end` when `h` is proposed: `h`, or exactly what is left
+/// when that is at most 1 % more than `h` (no sliver of a last step).
+fn last_step(t: f64, h: f64, t_end: f64) -> f64 {
+    if t + 1.01 * h >= t_end {
+        t_end - t
+    } else {
+        h
     }
 }
 
