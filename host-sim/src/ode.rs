@@ -271,18 +271,18 @@ impl DenseOutput {
     }
 
     /// Fills the power-form coefficients from the nested form used by the DOPRI codes:
-    /// y = y₀ + θ(F₀ + (1−θ)(F₁ + θ(F₂ + (1−θ)(F₃ + …)))), `f[j]` holding Fⱼ (length n each).
-    fn set_from_nested(&mut self, t0: f64, h: f64, y0: &[f64], f: &[&[f64]]) {
-        let m = f.len();
+    /// y = y₀ + θ(F₀ + (1−θ)(F₁ + θ(F₂ + (1−θ)(F₃ + …)))), the `m` blocks Fⱼ (length n each)
+    /// stored one after the other in `f` (Fⱼ at `j·n`).
+    fn set_from_nested(&mut self, t0: f64, h: f64, y0: &[f64], f: &[f64], m: usize) {
         self.t0 = t0;
         self.h = h;
         self.degree = m;
         self.y0.copy_from_slice(y0);
         let n = self.n;
-        for (i, &last) in f[m - 1].iter().enumerate().take(n) {
+        for i in 0..n {
             // q holds polynomial coefficients q[0..=m] in θ.
             let mut q = [0.0f64; MAX_DENSE_DEGREE + 1];
-            q[0] = last;
+            q[0] = f[(m - 1) * n + i];
             for j in (0..m - 1).rev() {
                 // Degree of q before this multiplication.
                 let deg = m - 2 - j;
@@ -296,7 +296,7 @@ impl DenseOutput {
                         q[k] -= q[k - 1];
                     }
                 }
-                q[0] += f[j][i];
+                q[0] += f[j * n + i];
             }
             // Final factor θ: coefficient of θ^(k+1) is q[k].
             for (k, &qk) in q.iter().enumerate().take(m) {
@@ -473,26 +473,29 @@ impl Solver {
             return Err(OdeError::NonFinite { t });
         }
         self.eval(sys, t + h, Buf::FNew, 0);
-        self.hermite_dense(t, h);
+        self.hermite_blocks(h);
+        self.set_dense(t, h, 3);
         self.accept(t + h);
         Ok(())
     }
 
-    /// Cubic Hermite on (y, f) at both ends, in the nested form
-    /// y₀ + θ(Δ + (1−θ)(h f₀ − Δ + θ(2Δ − h(f₀ + f₁)))).
-    fn hermite_dense(&mut self, t: f64, h: f64) {
+    /// Nested blocks 0–2: the cubic Hermite interpolant on (y, f) at both ends of the step,
+    /// y₀ + θ(Δ + (1−θ)(h f₀ − Δ + θ(2Δ − h(f₀ + f₁)))) — RK4's whole dense output and the
+    /// start of DOP853's.
+    fn hermite_blocks(&mut self, h: f64) {
         let n = self.n;
-        let (b0, rest) = self.nested.split_at_mut(n);
-        let (b1, rest) = rest.split_at_mut(n);
-        let b2 = &mut rest[..n];
         for i in 0..n {
             let d = self.ynew[i] - self.y[i];
-            b0[i] = d;
-            b1[i] = h * self.f[i] - d;
-            b2[i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
+            self.nested[i] = d;
+            self.nested[n + i] = h * self.f[i] - d;
+            self.nested[2 * n + i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
         }
+    }
+
+    /// The dense output of the step [t, t + h] from the first `blocks` nested blocks.
+    fn set_dense(&mut self, t: f64, h: f64, blocks: usize) {
         self.dense
-            .set_from_nested(t, h, &self.y, &[&b0[..], &b1[..], &b2[..]]);
+            .set_from_nested(t, h, &self.y, &self.nested[..blocks * self.n], blocks);
     }
 
     fn accept(&mut self, t_new: f64) {
@@ -670,26 +673,23 @@ impl Solver {
         (sum / n as f64).sqrt()
     }
 
+    /// Shampine's continuous extension in Hairer's DOPRI5 form (its block 2 is the Hermite
+    /// term written as Δ − h f₁ − (h f₀ − Δ), rounded as there).
     fn dense_dp5(&mut self, t: f64, h: f64) {
         let n = self.n;
-        let (b0, rest) = self.nested.split_at_mut(n);
-        let (b1, rest) = rest.split_at_mut(n);
-        let (b2, rest) = rest.split_at_mut(n);
-        let b3 = &mut rest[..n];
         for i in 0..n {
             let d = self.ynew[i] - self.y[i];
             let bspl = h * self.f[i] - d;
-            b0[i] = d;
-            b1[i] = bspl;
-            b2[i] = d - h * self.fnew[i] - bspl;
+            self.nested[i] = d;
+            self.nested[n + i] = bspl;
+            self.nested[2 * n + i] = d - h * self.fnew[i] - bspl;
             let mut acc = DP5_D[6] * self.fnew[i];
             for (j, dj) in DP5_D.iter().enumerate().take(6) {
                 acc += dj * self.k[j * n + i];
             }
-            b3[i] = h * acc;
+            self.nested[3 * n + i] = h * acc;
         }
-        self.dense
-            .set_from_nested(t, h, &self.y, &[&b0[..], &b1[..], &b2[..], &b3[..]]);
+        self.set_dense(t, h, 4);
     }
 
     fn attempt_dp853<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64, tol: Tol) -> f64 {
@@ -747,11 +747,8 @@ impl Solver {
             self.stage_input(&DP8_A[s][..s], h);
             self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
         }
+        self.hermite_blocks(h);
         for i in 0..n {
-            let d = self.ynew[i] - self.y[i];
-            self.nested[i] = d;
-            self.nested[n + i] = h * self.f[i] - d;
-            self.nested[2 * n + i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
             for (r, drow) in DP8_D.iter().enumerate() {
                 let mut acc = 0.0;
                 for (j, dj) in drow.iter().enumerate() {
@@ -762,16 +759,7 @@ impl Solver {
                 self.nested[(3 + r) * n + i] = h * acc;
             }
         }
-        let blocks: [&[f64]; 7] = [
-            &self.nested[..n],
-            &self.nested[n..2 * n],
-            &self.nested[2 * n..3 * n],
-            &self.nested[3 * n..4 * n],
-            &self.nested[4 * n..5 * n],
-            &self.nested[5 * n..6 * n],
-            &self.nested[6 * n..7 * n],
-        ];
-        self.dense.set_from_nested(t, h, &self.y, &blocks);
+        self.set_dense(t, h, 7);
     }
 }
 
