@@ -1080,6 +1080,22 @@ mod tests {
         (s, err, max_dense_err)
     }
 
+    fn dopri5(rtol: f64) -> Integrator {
+        Integrator::Dopri5 {
+            rtol,
+            atol: rtol,
+            max_step: None,
+        }
+    }
+
+    fn dop853(rtol: f64) -> Integrator {
+        Integrator::Dop853 {
+            rtol,
+            atol: rtol,
+            max_step: None,
+        }
+    }
+
     #[test]
     fn rk4_is_fourth_order() {
         let (_, e1, d1) = run(Integrator::Rk4 { step: 0.02 }, 10.0);
@@ -1095,14 +1111,7 @@ mod tests {
     #[test]
     fn dopri5_meets_tolerance_with_dense_output() {
         for rtol in [1e-6, 1e-9, 1e-11] {
-            let (s, e, d) = run(
-                Integrator::Dopri5 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s, e, d) = run(dopri5(rtol), 10.0);
             assert!(e < 50.0 * rtol, "rtol {rtol}: end error {e}");
             assert!(d < 50.0 * rtol, "rtol {rtol}: dense error {d}");
             let st = s.stats();
@@ -1117,24 +1126,10 @@ mod tests {
     #[test]
     fn dop853_meets_tolerance_with_fewer_steps() {
         for rtol in [1e-8, 1e-11, 1e-13] {
-            let (s8, e, d) = run(
-                Integrator::Dop853 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s8, e, d) = run(dop853(rtol), 10.0);
             assert!(e < 50.0 * rtol, "rtol {rtol}: end error {e}");
             assert!(d < 50.0 * rtol, "rtol {rtol}: dense error {d}");
-            let (s5, _, _) = run(
-                Integrator::Dopri5 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s5, _, _) = run(dopri5(rtol), 10.0);
             assert!(s8.stats().accepted_steps * 2 < s5.stats().accepted_steps);
         }
     }
