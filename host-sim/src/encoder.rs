@@ -319,11 +319,8 @@ impl Encoder {
         rng_drop.set_stream(1);
         let mut rng_glitch = ChaCha8Rng::seed_from_u64(config.seed);
         rng_glitch.set_stream(2);
-        let mask = if config.counter_bits == 64 {
-            u64::MAX
-        } else {
-            (1u64 << config.counter_bits) - 1
-        };
+        // counter_bits ≤ 32 (checked above): the shift cannot overflow.
+        let mask = (1u64 << config.counter_bits) - 1;
         Ok(Encoder {
             config,
             marks,
