@@ -70,6 +70,33 @@ fn settings(fine_step: f64) -> Vec<(String, Integrator)> {
     v
 }
 
+/// Runs every setting of [`settings`]`(fine_step)` on `scene` through `run` (best of three,
+/// which returns the right-hand-side evaluations and the error) and marks the Pareto front.
+fn pareto_sweep<F>(
+    scene: &'static str,
+    fine_step: f64,
+    mut run: F,
+) -> Result<Vec<ParetoRow>, String>
+where
+    F: FnMut(Integrator) -> Result<(u64, f64), String>,
+{
+    let mut rows = Vec::new();
+    for (setting, integ) in settings(fine_step) {
+        let (wall_ms, (rhs_evals, error)) = best_of_three(|| run(integ.clone()))
+            .map_err(|e| format!("{scene} with {setting}: {e}"))?;
+        rows.push(ParetoRow {
+            scene,
+            setting,
+            rhs_evals,
+            wall_ms,
+            error,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
 fn mark_pareto(rows: &mut [ParetoRow]) {
     let copy: Vec<(f64, f64)> = rows.iter().map(|r| (r.wall_ms, r.error)).collect();
     for r in rows.iter_mut() {
@@ -139,32 +166,18 @@ fn kneader_simulation(
 /// Error against wall time on the kneader scene (30 s, 1024 lines, edges generated).
 pub fn kneader_pareto() -> Result<Vec<ParetoRow>, String> {
     let model = kneader_model()?;
-    let mut rows = Vec::new();
-    for (setting, integ) in settings(1.25e-4) {
-        let (wall_ms, (evals, error)) = best_of_three(|| {
-            let mut obs = KneaderError {
-                model: &model,
-                from: 10.0,
-                worst: 0.0,
-            };
-            let mut sim = kneader_simulation(&model, integ.clone(), 1024)?;
-            let stats = sim
-                .run_observed(30.0, &mut obs)
-                .map_err(|e| e.to_string())?;
-            Ok((stats.solver.rhs_evals, obs.worst))
-        })
-        .map_err(|e| format!("kneader with {setting}: {e}"))?;
-        rows.push(ParetoRow {
-            scene: "kneader",
-            setting,
-            rhs_evals: evals,
-            wall_ms,
-            error,
-            pareto: false,
-        });
-    }
-    mark_pareto(&mut rows);
-    Ok(rows)
+    pareto_sweep("kneader", 1.25e-4, |integ| {
+        let mut obs = KneaderError {
+            model: &model,
+            from: 10.0,
+            worst: 0.0,
+        };
+        let mut sim = kneader_simulation(&model, integ, 1024)?;
+        let stats = sim
+            .run_observed(30.0, &mut obs)
+            .map_err(|e| e.to_string())?;
+        Ok((stats.solver.rhs_evals, obs.worst))
+    })
 }
 
 struct Sampler {
@@ -238,33 +251,19 @@ pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
                 .max(1e-300)
         })
         .collect();
-    let mut rows = Vec::new();
-    for (setting, integ) in settings(2.5e-5) {
-        let (wall_ms, (evals, error)) = best_of_three(|| {
-            let (evals, states) = balancer_states(&scene, integ.clone(), duration)?;
-            if states.len() != reference.len() {
-                return Ok((evals, f64::INFINITY));
+    pareto_sweep("two-mass", 2.5e-5, |integ| {
+        let (evals, states) = balancer_states(&scene, integ, duration)?;
+        if states.len() != reference.len() {
+            return Ok((evals, f64::INFINITY));
+        }
+        let mut worst: f64 = 0.0;
+        for (y, r) in states.iter().zip(&reference) {
+            for i in 0..dim {
+                worst = worst.max((y[i] - r[i]).abs() / scale[i]);
             }
-            let mut worst: f64 = 0.0;
-            for (y, r) in states.iter().zip(&reference) {
-                for i in 0..dim {
-                    worst = worst.max((y[i] - r[i]).abs() / scale[i]);
-                }
-            }
-            Ok((evals, worst))
-        })
-        .map_err(|e| format!("two-mass with {setting}: {e}"))?;
-        rows.push(ParetoRow {
-            scene: "two-mass",
-            setting,
-            rhs_evals: evals,
-            wall_ms,
-            error,
-            pareto: false,
-        });
-    }
-    mark_pareto(&mut rows);
-    Ok(rows)
+        }
+        Ok((evals, worst))
+    })
 }
 
 /// One point of a scaling series.
