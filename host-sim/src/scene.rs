@@ -523,27 +523,6 @@ impl Scene {
         }
         Ok(())
     }
-
-    /// Names of the effects this scene calls for, in assembly order.
-    pub fn effects(&self) -> Vec<&'static str> {
-        let mut v = Vec::new();
-        if self.motor.is_some() {
-            v.push("motor");
-        }
-        if self.load.is_some() {
-            v.push("load");
-        }
-        if !self.platform.is_empty() {
-            v.push("vibration");
-        }
-        if self.rotor.is_some() {
-            v.push("rotor-loads");
-        }
-        if self.encoder.is_some() {
-            v.push("encoder");
-        }
-        v
-    }
 }
 
 /// The scenes bundled with the simulator: (file name, text).
