@@ -39,6 +39,17 @@ pub enum SceneError {
     },
 }
 
+impl SceneError {
+    /// An impossible value at `key` of `file`.
+    pub fn value(file: &Path, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Value {
+            file: file.to_path_buf(),
+            key: key.to_string(),
+            message: message.into(),
+        }
+    }
+}
+
 /// A whole scene.
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -451,11 +462,7 @@ impl Scene {
     }
 
     fn check(&self, path: &Path) -> Result<(), SceneError> {
-        let bad = |key: &str, message: &str| SceneError::Value {
-            file: path.to_path_buf(),
-            key: key.to_string(),
-            message: message.to_string(),
-        };
+        let bad = |key: &str, message: &str| SceneError::value(path, key, message);
         let s = &self.simulation;
         let positive = |key: &str, x: f64| {
             if !x.is_finite() {
