@@ -69,7 +69,8 @@ fn default_counter_bits() -> u32 {
     32
 }
 
-/// Encoder, timer and fault parameters (a scene's `encoder` table).
+/// Encoder, timer and fault parameters. Deserializable from TOML, but scene files describe the
+/// encoder with [`crate::scene::EncoderSpec`], which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EncoderConfig {

@@ -49,7 +49,9 @@ pub trait OdeSystem {
     }
 }
 
-/// Which integrator to use, with its parameters (a scene's `integrator` table).
+/// Which integrator to use, with its parameters. Deserializable from TOML, but scene files choose
+/// it with `[simulation] integrator`, `rtol`, `atol` and `step` ([`crate::scene::SimulationSpec`]),
+/// which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Integrator {
