@@ -18,23 +18,16 @@ use drive_monitor::speed::Direction;
 use drive_monitor::supports::{
     Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, DEFAULT_WARNING_FRACTION,
 };
+use host_sim::accuracy::pulse_train;
 
 const LINES: u16 = 1024;
 const TIMER_HZ: f64 = 84e6;
-const REVS: usize = 8 * 5 + 2;
+const REVS: u32 = 8 * 5 + 2;
 
 /// Capture timestamps of the kneader-like ripple ω = 134·(1 + 0.015·sin(φ/8)) rad/s on a
 /// 1024-line disc and an 84 MHz timer (as the firmware's monitor section).
 fn stream() -> Vec<u32> {
-    let pitch = std::f64::consts::TAU / f64::from(LINES);
-    let mut t = 0.0f64;
-    (0..usize::from(LINES) * REVS)
-        .map(|i| {
-            let mid = (i as f64 + 0.5) * pitch;
-            t += pitch / (134.0 * (1.0 + 0.015 * (mid / 8.0).sin()));
-            (t * TIMER_HZ) as u64 as u32
-        })
-        .collect()
+    pulse_train(134.0, 0.015, LINES, TIMER_HZ, REVS)
 }
 
 fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {

@@ -70,6 +70,33 @@ fn settings(fine_step: f64) -> Vec<(String, Integrator)> {
     v
 }
 
+/// Runs every setting of [`settings`]`(fine_step)` on `scene` through `run` (best of three,
+/// which returns the right-hand-side evaluations and the error) and marks the Pareto front.
+fn pareto_sweep<F>(
+    scene: &'static str,
+    fine_step: f64,
+    mut run: F,
+) -> Result<Vec<ParetoRow>, String>
+where
+    F: FnMut(Integrator) -> Result<(u64, f64), String>,
+{
+    let mut rows = Vec::new();
+    for (setting, integ) in settings(fine_step) {
+        let (wall_ms, (rhs_evals, error)) = best_of_three(|| run(integ.clone()))
+            .map_err(|e| format!("{scene} with {setting}: {e}"))?;
+        rows.push(ParetoRow {
+            scene,
+            setting,
+            rhs_evals,
+            wall_ms,
+            error,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
 fn mark_pareto(rows: &mut [ParetoRow]) {
     let copy: Vec<(f64, f64)> = rows.iter().map(|r| (r.wall_ms, r.error)).collect();
     for r in rows.iter_mut() {
@@ -96,6 +123,12 @@ fn kneader_model() -> Result<DriveModel, String> {
         .ok_or_else(|| "the kneader scene has no drive model".to_string())
 }
 
+/// |ω²/u(φ) − 1|: the deviation from the kneader's exact steady state (seed 000 eq. 11), the
+/// error of every kneader table here.
+fn steady_error(model: &DriveModel, phi: f64, omega: f64) -> f64 {
+    (omega * omega / model.omega_squared(phi) - 1.0).abs()
+}
+
 struct KneaderError<'a> {
     model: &'a DriveModel,
     from: f64,
@@ -110,8 +143,7 @@ impl Observer for KneaderError<'_> {
         }
         for t in [0.5 * (step.t0() + step.t1()), step.t1()] {
             let s = step.shaft(t);
-            let u = self.model.omega_squared(s.phi);
-            self.worst = self.worst.max((s.omega * s.omega / u - 1.0).abs());
+            self.worst = self.worst.max(steady_error(self.model, s.phi, s.omega));
         }
     }
 }
@@ -139,32 +171,18 @@ fn kneader_simulation(
 /// Error against wall time on the kneader scene (30 s, 1024 lines, edges generated).
 pub fn kneader_pareto() -> Result<Vec<ParetoRow>, String> {
     let model = kneader_model()?;
-    let mut rows = Vec::new();
-    for (setting, integ) in settings(1.25e-4) {
-        let (wall_ms, (evals, error)) = best_of_three(|| {
-            let mut obs = KneaderError {
-                model: &model,
-                from: 10.0,
-                worst: 0.0,
-            };
-            let mut sim = kneader_simulation(&model, integ.clone(), 1024)?;
-            let stats = sim
-                .run_observed(30.0, &mut obs)
-                .map_err(|e| e.to_string())?;
-            Ok((stats.solver.rhs_evals, obs.worst))
-        })
-        .map_err(|e| format!("kneader with {setting}: {e}"))?;
-        rows.push(ParetoRow {
-            scene: "kneader",
-            setting,
-            rhs_evals: evals,
-            wall_ms,
-            error,
-            pareto: false,
-        });
-    }
-    mark_pareto(&mut rows);
-    Ok(rows)
+    pareto_sweep("kneader", 1.25e-4, |integ| {
+        let mut obs = KneaderError {
+            model: &model,
+            from: 10.0,
+            worst: 0.0,
+        };
+        let mut sim = kneader_simulation(&model, integ, 1024)?;
+        let stats = sim
+            .run_observed(30.0, &mut obs)
+            .map_err(|e| e.to_string())?;
+        Ok((stats.solver.rhs_evals, obs.worst))
+    })
 }
 
 struct Sampler {
@@ -238,33 +256,19 @@ pub fn balancer_pareto() -> Result<Vec<ParetoRow>, String> {
                 .max(1e-300)
         })
         .collect();
-    let mut rows = Vec::new();
-    for (setting, integ) in settings(2.5e-5) {
-        let (wall_ms, (evals, error)) = best_of_three(|| {
-            let (evals, states) = balancer_states(&scene, integ.clone(), duration)?;
-            if states.len() != reference.len() {
-                return Ok((evals, f64::INFINITY));
+    pareto_sweep("two-mass", 2.5e-5, |integ| {
+        let (evals, states) = balancer_states(&scene, integ, duration)?;
+        if states.len() != reference.len() {
+            return Ok((evals, f64::INFINITY));
+        }
+        let mut worst: f64 = 0.0;
+        for (y, r) in states.iter().zip(&reference) {
+            for i in 0..dim {
+                worst = worst.max((y[i] - r[i]).abs() / scale[i]);
             }
-            let mut worst: f64 = 0.0;
-            for (y, r) in states.iter().zip(&reference) {
-                for i in 0..dim {
-                    worst = worst.max((y[i] - r[i]).abs() / scale[i]);
-                }
-            }
-            Ok((evals, worst))
-        })
-        .map_err(|e| format!("two-mass with {setting}: {e}"))?;
-        rows.push(ParetoRow {
-            scene: "two-mass",
-            setting,
-            rhs_evals: evals,
-            wall_ms,
-            error,
-            pareto: false,
-        });
-    }
-    mark_pareto(&mut rows);
-    Ok(rows)
+        }
+        Ok((evals, worst))
+    })
 }
 
 /// One point of a scaling series.
@@ -377,8 +381,7 @@ impl Observer for Every {
         while self.next <= step.t1() {
             if self.next >= self.from {
                 let s = step.shaft(self.next);
-                let u = self.model.omega_squared(s.phi);
-                self.worst = self.worst.max((s.omega * s.omega / u - 1.0).abs());
+                self.worst = self.worst.max(steady_error(&self.model, s.phi, s.omega));
             }
             self.next += self.dt;
         }
@@ -409,8 +412,7 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
             let mut worst: f64 = 0.0;
             for (t, y) in solver.x_out().iter().zip(solver.y_out()) {
                 if *t >= 10.0 {
-                    let u = model.omega_squared(y[0]);
-                    worst = worst.max((y[1] * y[1] / u - 1.0).abs());
+                    worst = worst.max(steady_error(&model, y[0], y[1]));
                 }
             }
             Ok(worst)

@@ -21,9 +21,10 @@
 //! dropped with probability `drop_probability`; before each line edge a glitch edge is inserted
 //! with probability `glitch_probability`, at a uniformly random time since the previous line
 //! edge (glitches are quantised without jitter). Edges are delivered in true-time order; keep the
-//! jitter well below the edge spacing, or the captured ticks can run backwards. All randomness comes from `seed` through independent ChaCha8 streams (jitter, drops,
-//! glitches, pitch errors), so enabling one fault does not change the others' draws: the same
-//! seed gives identical ticks.
+//! jitter well below the edge spacing, or the captured ticks can run backwards. All randomness
+//! comes from `seed` through independent ChaCha8 streams (jitter, drops, glitches, pitch
+//! errors), so enabling one fault does not change the others' draws: the same seed gives
+//! identical ticks.
 
 use core::f64::consts::TAU;
 
@@ -68,7 +69,8 @@ fn default_counter_bits() -> u32 {
     32
 }
 
-/// Encoder, timer and fault parameters (a scene's `encoder` table).
+/// Encoder, timer and fault parameters. Deserializable from TOML, but scene files describe the
+/// encoder with [`crate::scene::EncoderSpec`], which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EncoderConfig {
@@ -224,6 +226,13 @@ fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
 }
 
+/// Stream `k` of `seed`: 0 jitter, 1 drops, 2 glitches, 3 pitch errors.
+fn stream(seed: u64, k: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(k);
+    rng
+}
+
 fn probability(name: &'static str, p: f64) -> Result<f64, ConfigError> {
     let p = non_negative(name, p)?;
     if p >= 1.0 {
@@ -278,8 +287,7 @@ impl Encoder {
             Some(r) => r.eccentricity / r.radius * (theta + r.phase).sin(),
             None => 0.0,
         };
-        let mut rng_pitch = ChaCha8Rng::seed_from_u64(config.seed);
-        rng_pitch.set_stream(3);
+        let mut rng_pitch = stream(config.seed, 3);
         let mut marks = Vec::with_capacity(lines as usize + 1);
         if config.reference == Reference::Index {
             let nominal = -0.5 * pitch;
@@ -313,24 +321,16 @@ impl Encoder {
             // Errors so large that marks swap places or reach into the next revolution.
             return Err(ConfigError::Inconsistent("encoder.pitch_errors"));
         }
-        let mut rng_jitter = ChaCha8Rng::seed_from_u64(config.seed);
-        rng_jitter.set_stream(0);
-        let mut rng_drop = ChaCha8Rng::seed_from_u64(config.seed);
-        rng_drop.set_stream(1);
-        let mut rng_glitch = ChaCha8Rng::seed_from_u64(config.seed);
-        rng_glitch.set_stream(2);
-        let mask = if config.counter_bits == 64 {
-            u64::MAX
-        } else {
-            (1u64 << config.counter_bits) - 1
-        };
+        // counter_bits ≤ 32 (checked above): the shift cannot overflow.
+        let mask = (1u64 << config.counter_bits) - 1;
+        let seed = config.seed;
         Ok(Encoder {
             config,
             marks,
             mask,
-            rng_jitter,
-            rng_drop,
-            rng_glitch,
+            rng_jitter: stream(seed, 0),
+            rng_drop: stream(seed, 1),
+            rng_glitch: stream(seed, 2),
             pos: 0,
             started: false,
             last_line_time: None,

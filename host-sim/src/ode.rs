@@ -49,7 +49,9 @@ pub trait OdeSystem {
     }
 }
 
-/// Which integrator to use, with its parameters (a scene's `integrator` table).
+/// Which integrator to use, with its parameters. Deserializable from TOML, but scene files choose
+/// it with `[simulation] integrator`, `rtol`, `atol` and `step` ([`crate::scene::SimulationSpec`]),
+/// which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Integrator {
@@ -271,18 +273,18 @@ impl DenseOutput {
     }
 
     /// Fills the power-form coefficients from the nested form used by the DOPRI codes:
-    /// y = y₀ + θ(F₀ + (1−θ)(F₁ + θ(F₂ + (1−θ)(F₃ + …)))), `f[j]` holding Fⱼ (length n each).
-    fn set_from_nested(&mut self, t0: f64, h: f64, y0: &[f64], f: &[&[f64]]) {
-        let m = f.len();
+    /// y = y₀ + θ(F₀ + (1−θ)(F₁ + θ(F₂ + (1−θ)(F₃ + …)))), the `m` blocks Fⱼ (length n each)
+    /// stored one after the other in `f` (Fⱼ at `j·n`).
+    fn set_from_nested(&mut self, t0: f64, h: f64, y0: &[f64], f: &[f64], m: usize) {
         self.t0 = t0;
         self.h = h;
         self.degree = m;
         self.y0.copy_from_slice(y0);
         let n = self.n;
-        for (i, &last) in f[m - 1].iter().enumerate().take(n) {
+        for i in 0..n {
             // q holds polynomial coefficients q[0..=m] in θ.
             let mut q = [0.0f64; MAX_DENSE_DEGREE + 1];
-            q[0] = last;
+            q[0] = f[(m - 1) * n + i];
             for j in (0..m - 1).rev() {
                 // Degree of q before this multiplication.
                 let deg = m - 2 - j;
@@ -296,7 +298,7 @@ impl DenseOutput {
                         q[k] -= q[k - 1];
                     }
                 }
-                q[0] += f[j][i];
+                q[0] += f[j * n + i];
             }
             // Final factor θ: coefficient of θ^(k+1) is q[k].
             for (k, &qk) in q.iter().enumerate().take(m) {
@@ -309,8 +311,7 @@ impl DenseOutput {
 #[derive(Debug, Clone, Copy)]
 enum Method {
     Rk4 { step: f64 },
-    Dopri5 { rtol: f64, atol: f64, max_step: f64 },
-    Dop853 { rtol: f64, atol: f64, max_step: f64 },
+    Adaptive { tol: Tol, tableau: Tableau },
 }
 
 /// A one-step-at-a-time integrator holding its state, work buffers and the dense output of the
@@ -344,26 +345,26 @@ const SAFETY: f64 = 0.9;
 impl Solver {
     /// A solver for an `n`-dimensional system. `integrator` must have been validated.
     pub fn new(integrator: &Integrator, n: usize) -> Self {
+        let adaptive = |rtol, atol, max_step: Option<f64>, tableau| Method::Adaptive {
+            tol: Tol {
+                rtol,
+                atol,
+                max_step: max_step.unwrap_or(f64::INFINITY),
+            },
+            tableau,
+        };
         let method = match *integrator {
             Integrator::Rk4 { step } => Method::Rk4 { step },
             Integrator::Dopri5 {
                 rtol,
                 atol,
                 max_step,
-            } => Method::Dopri5 {
-                rtol,
-                atol,
-                max_step: max_step.unwrap_or(f64::INFINITY),
-            },
+            } => adaptive(rtol, atol, max_step, Tableau::Dp5),
             Integrator::Dop853 {
                 rtol,
                 atol,
                 max_step,
-            } => Method::Dop853 {
-                rtol,
-                atol,
-                max_step: max_step.unwrap_or(f64::INFINITY),
-            },
+            } => adaptive(rtol, atol, max_step, Tableau::Dp853),
         };
         Solver {
             method,
@@ -439,34 +440,7 @@ impl Solver {
         }
         match self.method {
             Method::Rk4 { step } => self.step_rk4(sys, t_end, step),
-            Method::Dopri5 {
-                rtol,
-                atol,
-                max_step,
-            } => self.step_adaptive(
-                sys,
-                t_end,
-                Tol {
-                    rtol,
-                    atol,
-                    max_step,
-                },
-                Tableau::Dp5,
-            ),
-            Method::Dop853 {
-                rtol,
-                atol,
-                max_step,
-            } => self.step_adaptive(
-                sys,
-                t_end,
-                Tol {
-                    rtol,
-                    atol,
-                    max_step,
-                },
-                Tableau::Dp853,
-            ),
+            Method::Adaptive { tol, tableau } => self.step_adaptive(sys, t_end, tol, tableau),
         }
     }
 
@@ -478,12 +452,7 @@ impl Solver {
     ) -> Result<(), OdeError> {
         let n = self.n;
         let t = self.t;
-        // Avoid a sliver of a last step: stretch by up to 1 % instead.
-        let h = if t + 1.01 * step >= t_end {
-            t_end - t
-        } else {
-            step
-        };
+        let h = last_step(t, step, t_end);
         // k0 = f (already), k1..k3 in stage blocks 1..3.
         for i in 0..n {
             self.ytmp[i] = self.y[i] + 0.5 * h * self.f[i];
@@ -506,26 +475,29 @@ impl Solver {
             return Err(OdeError::NonFinite { t });
         }
         self.eval(sys, t + h, Buf::FNew, 0);
-        self.hermite_dense(t, h);
+        self.hermite_blocks(h);
+        self.set_dense(t, h, 3);
         self.accept(t + h);
         Ok(())
     }
 
-    /// Cubic Hermite on (y, f) at both ends, in the nested form
-    /// y₀ + θ(Δ + (1−θ)(h f₀ − Δ + θ(2Δ − h(f₀ + f₁)))).
-    fn hermite_dense(&mut self, t: f64, h: f64) {
+    /// Nested blocks 0–2: the cubic Hermite interpolant on (y, f) at both ends of the step,
+    /// y₀ + θ(Δ + (1−θ)(h f₀ − Δ + θ(2Δ − h(f₀ + f₁)))) — RK4's whole dense output and the
+    /// start of DOP853's.
+    fn hermite_blocks(&mut self, h: f64) {
         let n = self.n;
-        let (b0, rest) = self.nested.split_at_mut(n);
-        let (b1, rest) = rest.split_at_mut(n);
-        let b2 = &mut rest[..n];
         for i in 0..n {
             let d = self.ynew[i] - self.y[i];
-            b0[i] = d;
-            b1[i] = h * self.f[i] - d;
-            b2[i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
+            self.nested[i] = d;
+            self.nested[n + i] = h * self.f[i] - d;
+            self.nested[2 * n + i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
         }
+    }
+
+    /// The dense output of the step [t, t + h] from the first `blocks` nested blocks.
+    fn set_dense(&mut self, t: f64, h: f64, blocks: usize) {
         self.dense
-            .set_from_nested(t, h, &self.y, &[&b0[..], &b1[..], &b2[..]]);
+            .set_from_nested(t, h, &self.y, &self.nested[..blocks * self.n], blocks);
     }
 
     fn accept(&mut self, t_new: f64) {
@@ -611,10 +583,7 @@ impl Solver {
         loop {
             let t = self.t;
             let proposed = self.h.min(tol.max_step);
-            let mut h = proposed;
-            if t + 1.01 * h >= t_end {
-                h = t_end - t;
-            }
+            let h = last_step(t, proposed, t_end);
             let clipped = h < proposed;
             if h <= 16.0 * f64::EPSILON * t.abs().max(1e-300) {
                 return Err(OdeError::StepSizeUnderflow { t });
@@ -706,26 +675,23 @@ impl Solver {
         (sum / n as f64).sqrt()
     }
 
+    /// Shampine's continuous extension in Hairer's DOPRI5 form (its block 2 is the Hermite
+    /// term written as Δ − h f₁ − (h f₀ − Δ), rounded as there).
     fn dense_dp5(&mut self, t: f64, h: f64) {
         let n = self.n;
-        let (b0, rest) = self.nested.split_at_mut(n);
-        let (b1, rest) = rest.split_at_mut(n);
-        let (b2, rest) = rest.split_at_mut(n);
-        let b3 = &mut rest[..n];
         for i in 0..n {
             let d = self.ynew[i] - self.y[i];
             let bspl = h * self.f[i] - d;
-            b0[i] = d;
-            b1[i] = bspl;
-            b2[i] = d - h * self.fnew[i] - bspl;
+            self.nested[i] = d;
+            self.nested[n + i] = bspl;
+            self.nested[2 * n + i] = d - h * self.fnew[i] - bspl;
             let mut acc = DP5_D[6] * self.fnew[i];
             for (j, dj) in DP5_D.iter().enumerate().take(6) {
                 acc += dj * self.k[j * n + i];
             }
-            b3[i] = h * acc;
+            self.nested[3 * n + i] = h * acc;
         }
-        self.dense
-            .set_from_nested(t, h, &self.y, &[&b0[..], &b1[..], &b2[..], &b3[..]]);
+        self.set_dense(t, h, 4);
     }
 
     fn attempt_dp853<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, h: f64, tol: Tol) -> f64 {
@@ -783,11 +749,8 @@ impl Solver {
             self.stage_input(&DP8_A[s][..s], h);
             self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
         }
+        self.hermite_blocks(h);
         for i in 0..n {
-            let d = self.ynew[i] - self.y[i];
-            self.nested[i] = d;
-            self.nested[n + i] = h * self.f[i] - d;
-            self.nested[2 * n + i] = 2.0 * d - h * (self.f[i] + self.fnew[i]);
             for (r, drow) in DP8_D.iter().enumerate() {
                 let mut acc = 0.0;
                 for (j, dj) in drow.iter().enumerate() {
@@ -798,16 +761,17 @@ impl Solver {
                 self.nested[(3 + r) * n + i] = h * acc;
             }
         }
-        let blocks: [&[f64]; 7] = [
-            &self.nested[..n],
-            &self.nested[n..2 * n],
-            &self.nested[2 * n..3 * n],
-            &self.nested[3 * n..4 * n],
-            &self.nested[4 * n..5 * n],
-            &self.nested[5 * n..6 * n],
-            &self.nested[6 * n..7 * n],
-        ];
-        self.dense.set_from_nested(t, h, &self.y, &blocks);
+        self.set_dense(t, h, 7);
+    }
+}
+
+/// The step to take from `t` towards `t_end` when `h` is proposed: `h`, or exactly what is left
+/// when that is at most 1 % more than `h` (no sliver of a last step).
+fn last_step(t: f64, h: f64, t_end: f64) -> f64 {
+    if t + 1.01 * h >= t_end {
+        t_end - t
+    } else {
+        h
     }
 }
 
@@ -1118,6 +1082,22 @@ mod tests {
         (s, err, max_dense_err)
     }
 
+    fn dopri5(rtol: f64) -> Integrator {
+        Integrator::Dopri5 {
+            rtol,
+            atol: rtol,
+            max_step: None,
+        }
+    }
+
+    fn dop853(rtol: f64) -> Integrator {
+        Integrator::Dop853 {
+            rtol,
+            atol: rtol,
+            max_step: None,
+        }
+    }
+
     #[test]
     fn rk4_is_fourth_order() {
         let (_, e1, d1) = run(Integrator::Rk4 { step: 0.02 }, 10.0);
@@ -1133,14 +1113,7 @@ mod tests {
     #[test]
     fn dopri5_meets_tolerance_with_dense_output() {
         for rtol in [1e-6, 1e-9, 1e-11] {
-            let (s, e, d) = run(
-                Integrator::Dopri5 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s, e, d) = run(dopri5(rtol), 10.0);
             assert!(e < 50.0 * rtol, "rtol {rtol}: end error {e}");
             assert!(d < 50.0 * rtol, "rtol {rtol}: dense error {d}");
             let st = s.stats();
@@ -1155,24 +1128,10 @@ mod tests {
     #[test]
     fn dop853_meets_tolerance_with_fewer_steps() {
         for rtol in [1e-8, 1e-11, 1e-13] {
-            let (s8, e, d) = run(
-                Integrator::Dop853 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s8, e, d) = run(dop853(rtol), 10.0);
             assert!(e < 50.0 * rtol, "rtol {rtol}: end error {e}");
             assert!(d < 50.0 * rtol, "rtol {rtol}: dense error {d}");
-            let (s5, _, _) = run(
-                Integrator::Dopri5 {
-                    rtol,
-                    atol: rtol,
-                    max_step: None,
-                },
-                10.0,
-            );
+            let (s5, _, _) = run(dopri5(rtol), 10.0);
             assert!(s8.stats().accepted_steps * 2 < s5.stats().accepted_steps);
         }
     }

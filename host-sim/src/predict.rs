@@ -16,11 +16,7 @@ pub const MAX_UNBALANCES: usize = 32;
 
 /// Turns a core configuration error into a scene error naming `section.parameter`.
 pub fn value_error(file: &Path, section: &str, e: ConfigError) -> SceneError {
-    SceneError::Value {
-        file: file.to_path_buf(),
-        key: format!("{section}.{}", e.parameter()),
-        message: e.to_string(),
-    }
+    SceneError::value(file, &format!("{section}.{}", e.parameter()), e.to_string())
 }
 
 /// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
@@ -59,11 +55,11 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
     }
     let load = Load::new(load.mean, &harmonics).map_err(|e| value_error(file, "load", e))?;
     let Some(shaft) = &scene.shaft else {
-        return Err(SceneError::Value {
-            file: file.to_path_buf(),
-            key: "shaft".into(),
-            message: "missing: a motor-driven scene needs [shaft] inertia".into(),
-        });
+        return Err(SceneError::value(
+            file,
+            "shaft",
+            "missing: a motor-driven scene needs [shaft] inertia",
+        ));
     };
     DriveModel::new(motor, load, shaft.inertia, shaft.flywheel)
         .map(Some)
@@ -84,11 +80,11 @@ pub fn rotor(
         .map(|u| Unbalance::new(u.z, u.amount, u.angle.to_radians()))
         .collect();
     if unbalances.len() > MAX_UNBALANCES {
-        return Err(SceneError::Value {
-            file: file.to_path_buf(),
-            key: "unbalance".into(),
-            message: format!("at most {MAX_UNBALANCES} unbalances"),
-        });
+        return Err(SceneError::value(
+            file,
+            "unbalance",
+            format!("at most {MAX_UNBALANCES} unbalances"),
+        ));
     }
     let process = scene.process_load.map(|p| ProcessLoad {
         per_length: p.per_length,
@@ -142,10 +138,12 @@ pub fn machine(scene: &Scene, file: &Path) -> Result<Option<Machine>, SceneError
         BalancerKindSpec::Ball => BalancerKind::Ball,
         BalancerKindSpec::Roller => BalancerKind::Roller,
         BalancerKindSpec::Pendulum => BalancerKind::Pendulum {
-            inertia: ab.pendulum_inertia.ok_or_else(|| SceneError::Value {
-                file: file.to_path_buf(),
-                key: "autobalancer.pendulum_inertia".into(),
-                message: "missing: a pendulum auto-balancer needs its pendulum inertia".into(),
+            inertia: ab.pendulum_inertia.ok_or_else(|| {
+                SceneError::value(
+                    file,
+                    "autobalancer.pendulum_inertia",
+                    "missing: a pendulum auto-balancer needs its pendulum inertia",
+                )
             })?,
         },
     };

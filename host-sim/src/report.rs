@@ -186,23 +186,21 @@ pub fn run_plots(
         )?;
         out.push(path);
     }
-    if let (Some(c), Some(machine)) = (
-        &r.capture,
-        predict::machine(scene, file).map_err(|e| e.to_string())?,
-    ) {
+    let machine = predict::machine(scene, file).map_err(|e| e.to_string())?;
+    if let (Some(c), Some(machine)) = (&r.capture, &machine) {
         let path = dir.join(format!("{stem}-capture.svg"));
         crate::capture::write_capture_svg(
             &path,
             "Loads' speed against the rotor's (Sommerfeld capture)",
             &[("simulated".into(), c)],
-            &machine,
+            machine,
         )?;
         out.push(path);
         let path = dir.join(format!("{stem}-capture-time.svg"));
         crate::capture::write_time_svg(&path, "Rotor and loads' speeds", c)?;
         out.push(path);
     }
-    if let Some(machine) = predict::machine(scene, file).map_err(|e| e.to_string())? {
+    if let Some(machine) = &machine {
         let path = dir.join(format!("{stem}-regimes.svg"));
         let top = machine
             .resonant_speeds()

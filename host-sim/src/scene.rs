@@ -39,6 +39,17 @@ pub enum SceneError {
     },
 }
 
+impl SceneError {
+    /// An impossible value at `key` of `file`.
+    pub fn value(file: &Path, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Value {
+            file: file.to_path_buf(),
+            key: key.to_string(),
+            message: message.into(),
+        }
+    }
+}
+
 /// A whole scene.
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -451,11 +462,7 @@ impl Scene {
     }
 
     fn check(&self, path: &Path) -> Result<(), SceneError> {
-        let bad = |key: &str, message: &str| SceneError::Value {
-            file: path.to_path_buf(),
-            key: key.to_string(),
-            message: message.to_string(),
-        };
+        let bad = |key: &str, message: &str| SceneError::value(path, key, message);
         let s = &self.simulation;
         let positive = |key: &str, x: f64| {
             if !x.is_finite() {
@@ -522,27 +529,6 @@ impl Scene {
             }
         }
         Ok(())
-    }
-
-    /// Names of the effects this scene calls for, in assembly order.
-    pub fn effects(&self) -> Vec<&'static str> {
-        let mut v = Vec::new();
-        if self.motor.is_some() {
-            v.push("motor");
-        }
-        if self.load.is_some() {
-            v.push("load");
-        }
-        if !self.platform.is_empty() {
-            v.push("vibration");
-        }
-        if self.rotor.is_some() {
-            v.push("rotor-loads");
-        }
-        if self.encoder.is_some() {
-            v.push("encoder");
-        }
-        v
     }
 }
 

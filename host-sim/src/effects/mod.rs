@@ -4,8 +4,8 @@
 //! The motor and the load are the core's [`drive_monitor::drive::Motor`] and
 //! [`drive_monitor::drive::Load`] (validated by their constructors): the model lives in one
 //! place, and the simulator integrates the same torques the prediction uses. The effects
-//! without a core counterpart here have plain fields (deserializable from a scene table);
-//! call `validate` once before use.
+//! without a core counterpart here have plain fields (deserializable from TOML, though no
+//! scene-file table maps onto them); call `validate` once before use.
 
 pub mod load;
 pub mod motor;
