@@ -314,19 +314,19 @@ pub struct RampRun {
 /// Errors unless the scene's motor is a ramp and `factor` is positive and finite.
 pub fn with_ramp_stretched(scene: &Scene, file: &Path, factor: f64) -> Result<Scene, SceneError> {
     if !(factor.is_finite() && factor > 0.0) {
-        return Err(SceneError::Value {
-            file: file.to_path_buf(),
-            key: "motor.duration".into(),
-            message: format!("ramp time factor must be positive and finite, got {factor}"),
-        });
+        return Err(SceneError::value(
+            file,
+            "motor.duration",
+            format!("ramp time factor must be positive and finite, got {factor}"),
+        ));
     }
     let mut s = scene.clone();
     let Some(MotorSpec::Ramp { duration, .. }) = &mut s.motor else {
-        return Err(SceneError::Value {
-            file: file.to_path_buf(),
-            key: "motor".into(),
-            message: "the capture study needs a prescribed ramp (`model = \"ramp\"`)".into(),
-        });
+        return Err(SceneError::value(
+            file,
+            "motor",
+            "the capture study needs a prescribed ramp (`model = \"ramp\"`)",
+        ));
     };
     let hold = (s.simulation.duration - *duration).max(0.0);
     *duration *= factor;

@@ -14,7 +14,7 @@
 //! `max_step` for scenes that oscillate back and forth), then each crossing of the next mark
 //! angle is solved by Newton's method safeguarded by bisection, to |Δθ| ≤ 1e-13 of the step
 //! (in practice to rounding of t). A shaft moving backwards produces edges too, with
-//! [`Direction::Backward`].
+//! [`Direction::Reverse`].
 //!
 //! Then, like a capture unit: optional Gaussian jitter (std `jitter` s), quantisation
 //! ticks = ⌊t·timer_hz⌋ + counter_start masked to `counter_bits`. Faults: each real edge is
@@ -131,24 +131,8 @@ impl EncoderConfig {
     }
 }
 
-/// Direction of the shaft at an edge.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Direction {
-    /// φ increasing.
-    Forward,
-    /// φ decreasing.
-    Backward,
-}
-
-impl Direction {
-    /// +1 or −1.
-    pub fn sign(self) -> i8 {
-        match self {
-            Direction::Forward => 1,
-            Direction::Backward => -1,
-        }
-    }
-}
+/// Direction of the shaft at an edge: the core's, as the capture unit reports it.
+pub use drive_monitor::speed::Direction;
 
 /// One captured edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -440,7 +424,7 @@ impl Encoder {
                 let theta = solve(seg, target, lo, theta_b, -1.0);
                 let j = self.pos;
                 self.pos -= 1;
-                self.crossing(seg.t0 + theta * seg.h, Direction::Backward, j, emit);
+                self.crossing(seg.t0 + theta * seg.h, Direction::Reverse, j, emit);
                 lo = theta;
             }
         }
@@ -626,7 +610,16 @@ mod tests {
         };
         let mut edges = Vec::new();
         e.process(&seg, &mut |ed| edges.push(*ed));
-        let dirs: Vec<i8> = edges.iter().map(|e| e.direction.sign()).collect();
+        let dirs: Vec<i8> = edges
+            .iter()
+            .map(|e| {
+                if e.direction == Direction::Forward {
+                    1
+                } else {
+                    -1
+                }
+            })
+            .collect();
         let teeth: Vec<u32> = edges.iter().map(|e| e.tooth).collect();
         // Up across mark 1 (θ s.t. φ = pitch), then back down across 1 and 0.
         assert_eq!(dirs, vec![1, -1, -1]);

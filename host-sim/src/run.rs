@@ -25,7 +25,6 @@ use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
-use drive_monitor::speed::Direction;
 use drive_monitor::supports::{Level, SupportAnalysis};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -163,14 +162,6 @@ pub struct Overrides {
     /// Start the loads together at rest (for the Sommerfeld capture) instead of near the
     /// balancing position.
     pub loads_together: bool,
-}
-
-fn bad(file: &Path, key: &str, message: String) -> SceneError {
-    SceneError::Value {
-        file: file.to_path_buf(),
-        key: key.into(),
-        message,
-    }
 }
 
 fn integrator(scene: &Scene) -> Integrator {
@@ -332,17 +323,6 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
         length: revs,
         steady_tolerance: m.steady_tolerance.unwrap_or(0.02) as f32,
     };
-    // The same floor as the design-time check (`predict`): a limit finer than f64 resolves
-    // the speed cannot be met or monitored.
-    if let Some(l) = m.delta_limit {
-        if l < drive_monitor::drive::MIN_DELTA_TARGET {
-            return Err(value_error(
-                file,
-                "monitor",
-                drive_monitor::ConfigError::OutOfRange("delta_limit"),
-            ));
-        }
-    }
     let alarm = m.delta_limit.map(|l| AlarmConfig::new(l as f32));
     DeltaMonitor::new(enc, window, alarm)
         .map(Some)
@@ -425,11 +405,7 @@ impl Observer for Collector<'_> {
             return;
         }
         self.edges += 1;
-        let dir = match edge.direction {
-            crate::encoder::Direction::Forward => Direction::Forward,
-            crate::encoder::Direction::Backward => Direction::Reverse,
-        };
-        if let Some(o) = m.on_edge(edge.ticks, Some(dir)) {
+        if let Some(o) = m.on_edge(edge.ticks, Some(edge.direction)) {
             let r = o.report;
             self.windows.push(WindowOut {
                 time: edge.true_time,
@@ -544,18 +520,14 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         }
         (None, Some(_)) => {
             let Some(model) = &model else {
-                return Err(bad(
+                return Err(SceneError::value(
                     file,
                     "load",
-                    "missing: a motor-driven scene needs [load]".into(),
+                    "missing: a motor-driven scene needs [load]",
                 ));
             };
             let shaft = scene.shaft.as_ref().ok_or_else(|| {
-                bad(
-                    file,
-                    "shaft",
-                    "missing: a motor-driven scene needs [shaft]".into(),
-                )
+                SceneError::value(file, "shaft", "missing: a motor-driven scene needs [shaft]")
             })?;
             effects.push(Box::new(*model.motor()));
             names.push("motor");
@@ -580,11 +552,10 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
             })
         }
         (None, None) => {
-            return Err(bad(
+            return Err(SceneError::value(
                 file,
                 "motor",
-                "missing: a scene to run needs [motor] (a torque model or a prescribed speed)"
-                    .into(),
+                "missing: a scene to run needs [motor] (a torque model or a prescribed speed)",
             ))
         }
     };
@@ -623,7 +594,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         .validate()
         .map_err(|e| value_error(file, "simulation", e))?;
     let mut sim = Simulation::new(system, integ.clone(), sim_encoder(scene, file)?)
-        .map_err(|e| bad(file, "simulation", e.to_string()))?;
+        .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let duration = scene.simulation.duration;
     let lines = scene.encoder.as_ref().map_or(1, |e| e.lines as u64);
     let expected_edges = model
@@ -653,7 +624,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     };
     let stats = sim
         .run_observed(duration, &mut col)
-        .map_err(|e| bad(file, "simulation", e.to_string()))?;
+        .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
     let mut report = RunReport {
         scene: file.display().to_string(),

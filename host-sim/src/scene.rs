@@ -485,6 +485,19 @@ impl Scene {
                 ));
             }
         }
+        if let Some(l) = self.monitor.as_ref().and_then(|m| m.delta_limit) {
+            // A limit finer than f64 resolves the speed can be neither designed for
+            // (`DriveModel::flywheel_for`) nor monitored: one check for every command.
+            if l.is_nan() || l < drive_monitor::drive::MIN_DELTA_TARGET {
+                return Err(bad(
+                    "monitor.delta_limit",
+                    &format!(
+                        "must be at least {:e} (finer than f64 resolves the speed), got {l}",
+                        drive_monitor::drive::MIN_DELTA_TARGET
+                    ),
+                ));
+            }
+        }
         if self.platform.len() > 3 {
             return Err(bad("platform", "at most 3 platforms"));
         }

@@ -1,7 +1,8 @@
 //! `drive-sim criterion`: the auto-balancing criterion (seed 001) against direct simulation on
 //! randomised machines.
 //!
-//! Seed 001's criterion (`Re H(ω) < 0`: balancing, the core's [`Machine::zones`]) is
+//! Seed 001's criterion (`Re H(ω) < 0`: balancing, the core's
+//! [`Machine::zones`](drive_monitor::balancer::Machine::zones)) is
 //! approximate; its authors ask for the limits to be checked by computational experiment. This
 //! module draws machines at random in a documented range of the seed's dimensionless groups
 //! ([`RANGE`]), simulates each at a grid of prescribed rotor speeds, and reports
@@ -235,11 +236,11 @@ pub fn outcome(scene: &Scene, file: &Path, speed: f64) -> Result<Outcome, SceneE
             },
         )?;
         let Some(d) = r.regime_detail else {
-            return Err(SceneError::Value {
-                file: file.to_path_buf(),
-                key: "autobalancer".into(),
-                message: "the run produced no regime samples".into(),
-            });
+            return Err(SceneError::value(
+                file,
+                "autobalancer",
+                "the run produced no regime samples",
+            ));
         };
         // Balancing: the run's own classification (residual below 1 % of the reference).
         let balanced = d.regime == Simulated::Balancing;
@@ -338,11 +339,7 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
     let file = PathBuf::from(format!("random-machine-{}.toml", sample.id));
     let scene = Scene::parse(&sample.scene, &file)?;
     let Some(machine) = predict::machine(&scene, &file)? else {
-        return Err(SceneError::Value {
-            file,
-            key: "autobalancer".into(),
-            message: "missing".into(),
-        });
+        return Err(SceneError::value(&file, "autobalancer", "missing"));
     };
     let classifier = Classifier::new(&machine, BAND as f32, 0.5 * BAND as f32)
         .map_err(|e| predict::value_error(&file, "monitor", e))?;

@@ -195,11 +195,7 @@ pub fn sweep(
         steps,
         together,
     } = *request;
-    let bad = |key: &str, message: String| SceneError::Value {
-        file: file.to_path_buf(),
-        key: key.into(),
-        message,
-    };
+    let bad = |key: &str, message: String| SceneError::value(file, key, message);
     let Some(machine) = predict::machine(scene, file)? else {
         return Err(bad(
             "platform",

@@ -144,7 +144,7 @@ fn prescribed_reversal_gives_mirrored_backward_edges() {
         .collect();
     let bwd: Vec<&Edge> = edges
         .iter()
-        .filter(|e| e.direction == Direction::Backward)
+        .filter(|e| e.direction == Direction::Reverse)
         .collect();
     // Peak φ = 10 rad; marks 1 … ⌊10·256/2π⌋ forward, the same back down (mark 0 at t = 2 is
     // beyond the run).
