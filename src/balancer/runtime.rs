@@ -60,9 +60,8 @@ pub struct Classifier {
     seg_from: [f32; MAX_SEGMENTS],
     seg_regime: [Regime; MAX_SEGMENTS],
     n_seg: u8,
-    zone_from: [f32; MAX_ZONES],
+    /// Kind of each zone; zone `i > 0` starts at `bounds[i − 1]`, zone 0 at 0.
     zone_kind: [ZoneKind; MAX_ZONES],
-    n_zones: u8,
     bounds: [f32; MAX_BOUNDS],
     n_bounds: u8,
     margin: f32,
@@ -100,9 +99,7 @@ impl Classifier {
             seg_from: [0.0; MAX_SEGMENTS],
             seg_regime: [Regime::Gathering; MAX_SEGMENTS],
             n_seg: 0,
-            zone_from: [0.0; MAX_ZONES],
             zone_kind: [ZoneKind::Gathering; MAX_ZONES],
-            n_zones: 0,
             bounds: [0.0; MAX_BOUNDS],
             n_bounds: 0,
             margin,
@@ -119,8 +116,7 @@ impl Classifier {
             Ok(())
         };
         for (i, z) in machine.zones().iter().enumerate() {
-            if let (Some(f), Some(k)) = (c.zone_from.get_mut(i), c.zone_kind.get_mut(i)) {
-                *f = z.from as f32;
+            if let Some(k) = c.zone_kind.get_mut(i) {
                 *k = z.kind;
             }
             if i > 0 {
@@ -150,8 +146,7 @@ impl Classifier {
             }
         }
         c.n_seg = ns as u8;
-        c.n_zones = machine.zones().len().min(MAX_ZONES) as u8;
-        c.n_bounds = c.n_zones.saturating_sub(1);
+        c.n_bounds = machine.zones().len().clamp(1, MAX_ZONES) as u8 - 1;
         Ok(c)
     }
 
@@ -219,14 +214,17 @@ impl Classifier {
             return none;
         }
         let s = speed.abs();
-        let zones = self
-            .zone_from
-            .get(..usize::from(self.n_zones))
-            .unwrap_or(&[]);
-        let zi = zones.partition_point(|&f| f <= s).saturating_sub(1);
+        let bounds = self.bounds();
+        // Zone `i` is `[from(i), bounds[i])`; `s ≥ 0` lies in the zone after every boundary
+        // at or below it.
+        let from = |i: usize| match i.checked_sub(1) {
+            None => Some(0.0),
+            Some(b) => bounds.get(b).copied(),
+        };
+        let zi = bounds.partition_point(|&f| f <= s);
         let kind = self.zone_kind.get(zi).copied();
         let drop_below = match kind {
-            Some(ZoneKind::Balancing) => zones.get(zi).map(|&f| f * (1.0 - self.margin)),
+            Some(ZoneKind::Balancing) => from(zi).map(|f| f * (1.0 - self.margin)),
             _ => None,
         };
         // The highest gathering zone starting at or below s.
@@ -236,8 +234,8 @@ impl Classifier {
             zi.checked_sub(1)
         };
         let exciter_band = gi.and_then(|g| {
-            let from = zones.get(g).copied()?;
-            let to = zones.get(g + 1).copied()?;
+            let from = from(g)?;
+            let to = bounds.get(g).copied()?;
             let band = SpeedBand {
                 from: from * (1.0 + self.margin),
                 to: to * (1.0 - self.margin),
