@@ -129,9 +129,8 @@ impl WindowReport {
     }
 }
 
-/// An extreme sample: angle and interval. The interval is an integer tick count; it is stored
-/// already converted to f32 (the form every comparison and the report use), so the per-sample
-/// comparisons do not convert it again.
+/// An extreme sample: angle and interval, the interval as its exact integer tick count (equal
+/// angles compare the counts exactly; other comparisons convert them to f32).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Extreme {
     angle: f32,
@@ -271,12 +270,13 @@ impl WindowState {
         // neither count can reach its type's limit: plain wrapping adds are exact.
         self.samples = self.samples.wrapping_add(1);
         self.sample_ticks = self.sample_ticks.wrapping_add(s.ticks as u64);
+        let e = Extreme {
+            angle: s.angle,
+            ticks: s.ticks,
+        };
         if self.samples == 1 {
-            self.max = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
-            self.min = self.max;
+            self.max = e;
+            self.min = e;
             return;
         }
         // Compare angle/ticks by cross-multiplying: no division per edge. Equal angles (a
@@ -288,10 +288,7 @@ impl WindowState {
             s.angle * self.max.ticks as f32 > self.max.angle * t
         };
         if faster {
-            self.max = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
+            self.max = e;
         }
         let slower = if s.angle == self.min.angle {
             s.ticks > self.min.ticks
@@ -299,10 +296,7 @@ impl WindowState {
             s.angle * (self.min.ticks as f32) < self.min.angle * t
         };
         if slower {
-            self.min = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
+            self.min = e;
         }
     }
 
