@@ -36,8 +36,8 @@ use proptest::prelude::*;
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
 use testutil::{
-    coupling, drive, h, platform, seed_motor, BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE,
-    J, M1, MM, W0, WM,
+    coupling, drive, h, platform, reference_speeds, seed_motor, BAD, BAD_F32, BAD_F32_NON_NEGATIVE,
+    BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
 };
 
 /// Unit roundoff of f32 (half an ulp of 1).
@@ -764,88 +764,6 @@ fn assert_all_close(got: &[f64], want: &[f64], tol: f64, what: &str) {
             "{what}: {got:?} vs {want:?} (tol {tol:e})"
         );
     }
-}
-
-/// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
-fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
-    let n = cfg.platforms().len();
-    let mut k = [[0.0; 3]; 3];
-    let mut m = [0.0; 3];
-    for (i, p) in cfg.platforms().iter().enumerate() {
-        k[i][i] += p.stiffness;
-        m[i] = cfg.moving_mass(i);
-    }
-    for c in cfg.couplings() {
-        let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
-        k[a][a] += c.stiffness;
-        k[b][b] += c.stiffness;
-        k[a][b] -= c.stiffness;
-        k[b][a] -= c.stiffness;
-    }
-    (k, m, n)
-}
-
-/// Eigenvalues of (K, M) restricted to the indices `idx`, by bisection on Sylvester's inertia:
-/// the number of negative pivots of the LDLᵀ factorisation of K − λM is the number of
-/// eigenvalues below λ. A second method, independent of the closed forms and Jacobi rotations
-/// the core uses; each eigenvalue is bracketed down to adjacent doubles.
-fn inertia_eigenvalues(k: &[[f64; 3]; 3], m: &[f64; 3], idx: &[usize]) -> Vec<f64> {
-    let n = idx.len();
-    let below = |lambda: f64| {
-        let mut a = [[0.0; 3]; 3];
-        for i in 0..n {
-            for j in 0..n {
-                a[i][j] = k[idx[i]][idx[j]] - if i == j { lambda * m[idx[i]] } else { 0.0 };
-            }
-        }
-        let mut neg = 0;
-        for p in 0..n {
-            let d = a[p][p];
-            if d < 0.0 {
-                neg += 1;
-            }
-            let d = if d == 0.0 { f64::MIN_POSITIVE } else { d };
-            for i in p + 1..n {
-                let l = a[i][p] / d;
-                for j in p + 1..n {
-                    a[i][j] -= l * a[p][j];
-                }
-            }
-        }
-        neg
-    };
-    let hi0 = (0..n)
-        .map(|i| (0..n).map(|j| k[idx[i]][idx[j]].abs()).sum::<f64>() / m[idx[i]])
-        .fold(0.0, f64::max)
-        * 2.0;
-    (0..n)
-        .map(|i| {
-            let (mut lo, mut hi) = (0.0, hi0);
-            loop {
-                let mid = 0.5 * (lo + hi);
-                if mid <= lo || mid >= hi {
-                    break hi;
-                }
-                if below(mid) > i {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-        })
-        .map(f64::sqrt)
-        .collect()
-}
-
-/// Resonant and additional speeds of a machine by the inertia method.
-fn reference_speeds(cfg: &MachineConfig) -> (Vec<f64>, Vec<f64>) {
-    let (k, m, n) = km(cfg);
-    let all: Vec<usize> = (0..n).collect();
-    let others: Vec<usize> = (0..n).filter(|&i| i != cfg.exciter_index()).collect();
-    (
-        inertia_eigenvalues(&k, &m, &all),
-        inertia_eigenvalues(&k, &m, &others),
-    )
 }
 
 /// Case: zero coupling. Platform 3 is attached to nothing (a coupling of zero stiffness and
