@@ -26,7 +26,7 @@ pub(crate) const BAD_F32_NON_NEGATIVE: [f32; 5] =
     [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 1e-40];
 
 use drive_monitor::balancer::{Coupling, MachineConfig, Platform};
-use drive_monitor::drive::{DriveModel, Harmonic, Load, Motor, Parabola};
+use drive_monitor::drive::{DriveModel, Harmonic, Load, Motor, Parabola, SteadyState};
 
 /// The seed 000 kneader: ω0 = 145 rad/s, ω_m = 36 rad/s, M_m = 158 N·m, J = 0.323 kg·m²,
 /// mean load M1 = 24 N·m.
@@ -59,6 +59,23 @@ pub(crate) fn drive(harmonics: &[Harmonic], inertia: f64) -> DriveModel {
         0.0,
     )
     .unwrap()
+}
+
+/// The steady state of a drive that has one.
+pub(crate) fn steady(m: &DriveModel) -> SteadyState {
+    *m.predict().steady().expect("steady state")
+}
+
+/// The reference for one harmonic of amplitude `m2` and order `n` on the seed's drive at
+/// inertia `j`, in the paper's own coefficients (eq. 10–12, B's sign corrected), written
+/// independently of the model's `hypot` form: `(ū, R)` with ū = D2/D1 the mean and
+/// R = 2·D3/√(4·D1² + n²) the amplitude of ω².
+pub(crate) fn paper_terms(m2: f64, n: f64, j: f64) -> (f64, f64) {
+    let k = W0 * W0 - WM * WM;
+    let d1 = MM / (j * k);
+    let d2 = (MM * W0 * W0 - M1 * k) / (j * k);
+    let d3 = m2 / j;
+    (d2 / d1, 2.0 * d3 / (4.0 * d1 * d1 + n * n).sqrt())
 }
 
 /// A platform of a vibration machine.

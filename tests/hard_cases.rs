@@ -21,9 +21,7 @@ use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, Classifier, Coupling, Machine, MachineConfig, Platform, Regime,
     RegimeTracker, SearchOptions, ZoneKind,
 };
-use drive_monitor::drive::{
-    DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction, SteadyState,
-};
+use drive_monitor::drive::{DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::DeltaMonitor;
@@ -36,8 +34,8 @@ use proptest::prelude::*;
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
 use testutil::{
-    coupling, drive, h, platform, reference_speeds, seed_motor, BAD, BAD_F32, BAD_F32_NON_NEGATIVE,
-    BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
+    coupling, drive, h, paper_terms, platform, reference_speeds, seed_motor, steady, BAD, BAD_F32,
+    BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
 };
 
 /// Unit roundoff of f32 (half an ulp of 1).
@@ -56,21 +54,6 @@ fn rel(a: f64, b: f64) -> f64 {
 // =============================================================================================
 // Predicted δ (drive model, seed 000 eq. 11–13)
 // =============================================================================================
-
-fn steady(m: &DriveModel) -> SteadyState {
-    *m.predict().steady().expect("steady state")
-}
-
-/// The reference for one harmonic, in the paper's own coefficients (eq. 10–12, B's sign
-/// corrected), written independently of the model's `hypot` form: `(ū, R)` with ū = D2/D1 and
-/// R = 2·D3/√(4·D1² + n²) the amplitude of ω².
-fn paper_terms(m2: f64, n: f64, j: f64) -> (f64, f64) {
-    let k = W0 * W0 - WM * WM;
-    let d1 = MM / (j * k);
-    let d2 = (MM * W0 * W0 - M1 * k) / (j * k);
-    let d3 = m2 / j;
-    (d2 / d1, 2.0 * d3 / (4.0 * d1 * d1 + n * n).sqrt())
-}
 
 /// δ from r = R/ū without cancellation: ωmax,min = √ū·√(1 ± r), so
 /// δ = 2(√(1+r) − √(1−r))/(√(1+r) + √(1−r)) = 2r/(1 + √(1 − r²)).
