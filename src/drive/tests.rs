@@ -71,12 +71,25 @@ fn integrate(m: &DriveModel, settle: f64, period: f64, dt: f64) -> (f64, f64) {
         (phi, w) = step(phi, w);
     }
     let end = phi + period;
-    let mut y1 = w;
-    (phi, w) = step(phi, w);
-    let (mut wmax, mut wmin) = (f64::MIN, f64::MAX);
-    while phi < end + 0.01 {
-        let (p2, y2) = step(phi, w);
-        let y0 = core::mem::replace(&mut y1, w);
+    let first = w;
+    let rest = core::iter::from_fn(move || {
+        (phi < end + 0.01).then(|| {
+            (phi, w) = step(phi, w);
+            w
+        })
+    });
+    vertex_extrema(core::iter::once(first).chain(rest))
+}
+
+/// Largest and smallest value of a sampled curve, each local extremum refined by the vertex
+/// of the parabola through it and its two neighbours (`(f64::MIN, f64::MAX)` if none).
+fn vertex_extrema(samples: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let (mut max, mut min) = (f64::MIN, f64::MAX);
+    let mut samples = samples.into_iter();
+    let (Some(mut y0), Some(mut y1)) = (samples.next(), samples.next()) else {
+        return (max, min);
+    };
+    for y2 in samples {
         let curv = y0 - 2.0 * y1 + y2;
         let vertex = if curv != 0.0 {
             y1 - (y0 - y2) * (y0 - y2) / (8.0 * curv)
@@ -84,14 +97,14 @@ fn integrate(m: &DriveModel, settle: f64, period: f64, dt: f64) -> (f64, f64) {
             y1
         };
         if y1 >= y0 && y1 >= y2 {
-            wmax = wmax.max(vertex);
+            max = max.max(vertex);
         }
         if y1 <= y0 && y1 <= y2 {
-            wmin = wmin.min(vertex);
+            min = min.min(vertex);
         }
-        (phi, w) = (p2, y2);
+        (y0, y1) = (y1, y2);
     }
-    (wmax, wmin)
+    (max, min)
 }
 
 fn delta_of(wmax: f64, wmin: f64) -> f64 {
@@ -319,24 +332,11 @@ fn reference_delta(harmonics: &[(f64, f64, f64)], j: f64, period: f64, samples: 
             .sum()
     };
     let step = period / samples as f64;
-    let (mut smax, mut smin) = (f64::MIN, f64::MAX);
-    let (mut y0, mut y1) = (s(-step), s(0.0));
-    for i in 0..samples {
-        let y2 = s((i + 1) as f64 * step);
-        let den = y0 - 2.0 * y1 + y2;
-        let vertex = if den != 0.0 {
-            y1 - (y2 - y0) * (y2 - y0) / (8.0 * den)
-        } else {
-            y1
-        };
-        if y1 >= y0 && y1 >= y2 {
-            smax = smax.max(vertex);
-        }
-        if y1 <= y0 && y1 <= y2 {
-            smin = smin.min(vertex);
-        }
-        (y0, y1) = (y1, y2);
-    }
+    let (smax, smin) = vertex_extrema(
+        core::iter::once(-step)
+            .chain((0..=samples).map(|i| i as f64 * step))
+            .map(s),
+    );
     let w = (ubar + smax).sqrt() + (ubar + smin).sqrt();
     2.0 * (smax - smin) / (w * w)
 }
