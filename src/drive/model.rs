@@ -570,22 +570,17 @@ impl DriveModel {
             j
         };
         let mut lo = 0.0;
-        let mut confirmed = false;
-        for _ in 0..=MAX_CONFIRM_DOUBLINGS {
+        let mut doublings = 0;
+        loop {
             match at(hi) {
-                Some(m) if meets(&m) => {
-                    confirmed = true;
-                    break;
-                }
-                Some(_) => {
+                Some(m) if meets(&m) => break,
+                Some(_) if doublings < MAX_CONFIRM_DOUBLINGS => {
                     lo = hi;
                     hi *= 2.0;
+                    doublings += 1;
                 }
-                None => return Err(DesignError::Unreachable),
+                _ => return Err(DesignError::Unreachable),
             }
-        }
-        if !confirmed {
-            return Err(DesignError::Unreachable);
         }
         for _ in 0..MAX_BISECTIONS {
             let mid = lo + (hi - lo) / 2.0;
