@@ -105,8 +105,8 @@ fn timed_edge(m: &mut DeltaMonitor<1024>, t: u32) -> (u64, bool) {
 /// Instructions that finishing a window adds to the edge that ends it, and the number of
 /// windows measured. The stream goes through two monitors that differ only in window length:
 /// one revolution (every frame edge once the first window has started ends one) and
-/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in both; the cost is the
-/// mean difference over the edges that ended a window.
+/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in
+/// both; the cost is the mean difference over the edges that ended a window.
 ///
 /// Differencing whole streams with short and long windows instead would also count per-sample
 /// work that the window length changes: the running extremes move far more often in short

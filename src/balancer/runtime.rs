@@ -75,9 +75,9 @@ pub struct Classifier {
 /// speed's boundary (balancing below, gathering above) needs for the classifier to match the
 /// simulation on both sides was 0.3 % at the median and 2.0 % at the 90th percentile; 5 %
 /// covers 69 of the 71 boundaries (in the other two the gathering zone above the additional
-/// speed shrinks or vanishes in simulation). The needed band did not change measurably with `ε` (medians and maxima flat
-/// across the range; a power-law fit gives `ε^−0.01`), so it is one constant, not a function
-/// of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
+/// speed shrinks or vanishes in simulation). The needed band did not change measurably with
+/// `ε` (medians and maxima flat across the range; a power-law fit gives `ε^−0.01`), so it is
+/// one constant, not a function of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
 /// capture band ([`Regime::Bistable`]), not by this margin.
 pub const DEFAULT_MARGIN: f32 = 0.05;
 
