@@ -151,6 +151,10 @@ pub fn run() {
         2.0 * EPS
     );
     let empty = feed_empty(ticks);
+    hprintln!(
+        "memory: DeltaMonitor<1024> {} bytes",
+        core::mem::size_of::<DeltaMonitor<1024>>()
+    );
 
     // The report, with 16-edge speed samples and 8-revolution windows (printed in a pass of
     // its own, so formatting stays out of the measured passes).
