@@ -105,16 +105,6 @@ impl Classifier {
             margin,
             hysteresis,
         };
-        let mut ns = 0usize;
-        let mut push = |c: &mut Classifier, from: f64, r: Regime| -> Result<(), ConfigError> {
-            let (Some(f), Some(g)) = (c.seg_from.get_mut(ns), c.seg_regime.get_mut(ns)) else {
-                return Err(ConfigError::Capacity("segments"));
-            };
-            *f = from as f32;
-            *g = r;
-            ns += 1;
-            Ok(())
-        };
         for (i, z) in machine.zones().iter().enumerate() {
             if let Some(k) = c.zone_kind.get_mut(i) {
                 *k = z.kind;
@@ -125,7 +115,7 @@ impl Classifier {
                 }
             }
             match z.kind {
-                ZoneKind::Gathering => push(&mut c, z.from, Regime::Gathering)?,
+                ZoneKind::Gathering => c.push_segment(z.from, Regime::Gathering)?,
                 ZoneKind::Balancing => {
                     // Capture is possible up to the largest `until` of the windows below.
                     let until = machine
@@ -135,19 +125,30 @@ impl Classifier {
                         .fold(0.0f64, |u, w| u.max(w.until));
                     let to = z.to.unwrap_or(f64::INFINITY);
                     if until > z.from {
-                        push(&mut c, z.from, Regime::Bistable)?;
+                        c.push_segment(z.from, Regime::Bistable)?;
                         if until < to {
-                            push(&mut c, until, Regime::Balancing)?;
+                            c.push_segment(until, Regime::Balancing)?;
                         }
                     } else {
-                        push(&mut c, z.from, Regime::Balancing)?;
+                        c.push_segment(z.from, Regime::Balancing)?;
                     }
                 }
             }
         }
-        c.n_seg = ns as u8;
         c.n_bounds = machine.zones().len().clamp(1, MAX_ZONES) as u8 - 1;
         Ok(c)
+    }
+
+    /// Appends a segment starting at `from` rad/s.
+    fn push_segment(&mut self, from: f64, regime: Regime) -> Result<(), ConfigError> {
+        let i = usize::from(self.n_seg);
+        let (Some(f), Some(r)) = (self.seg_from.get_mut(i), self.seg_regime.get_mut(i)) else {
+            return Err(ConfigError::Capacity("segments"));
+        };
+        *f = from as f32;
+        *r = regime;
+        self.n_seg += 1;
+        Ok(())
     }
 
     fn segs(&self) -> &[f32] {
