@@ -96,6 +96,26 @@ pub(crate) fn coupling(a: u8, b: u8, stiffness: f64, damping: f64) -> Coupling {
     }
 }
 
+/// `cfg` with every mass ×`ms` (the auto-balancer's loads and housing too), stiffness ×`ks`
+/// and damping and load viscosity ×`cs`.
+pub(crate) fn scaled_config(cfg: &MachineConfig, ms: f64, ks: f64, cs: f64) -> MachineConfig {
+    let p: Vec<Platform> = cfg
+        .platforms()
+        .iter()
+        .map(|p| platform(p.mass * ms, p.stiffness * ks, p.damping * cs))
+        .collect();
+    let c: Vec<Coupling> = cfg
+        .couplings()
+        .iter()
+        .map(|c| coupling(c.between[0], c.between[1], c.stiffness * ks, c.damping * cs))
+        .collect();
+    let mut b = *cfg.balancer();
+    b.load_mass *= ms;
+    b.housing_mass *= ms;
+    b.viscosity *= cs;
+    MachineConfig::new(&p, &c, b).unwrap()
+}
+
 /// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
 fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
     let n = cfg.platforms().len();

@@ -34,8 +34,8 @@ use proptest::prelude::*;
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
 use testutil::{
-    coupling, drive, h, paper_terms, platform, reference_speeds, seed_motor, steady, BAD, BAD_F32,
-    BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
+    coupling, drive, h, paper_terms, platform, reference_speeds, scaled_config, seed_motor, steady,
+    BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
 };
 
 /// Unit roundoff of f32 (half an ulp of 1).
@@ -1064,21 +1064,7 @@ fn damping_to_zero_and_damping_that_erases_a_zone() {
 
 /// A machine with every mass ×`ms`, stiffness ×`ks` and damping (and load viscosity) ×`cs`.
 fn scaled_machine(cfg: &MachineConfig, ms: f64, ks: f64, cs: f64) -> Machine {
-    let p: Vec<Platform> = cfg
-        .platforms()
-        .iter()
-        .map(|p| platform(p.mass * ms, p.stiffness * ks, p.damping * cs))
-        .collect();
-    let c: Vec<Coupling> = cfg
-        .couplings()
-        .iter()
-        .map(|c| coupling(c.between[0], c.between[1], c.stiffness * ks, c.damping * cs))
-        .collect();
-    let mut b = *cfg.balancer();
-    b.load_mass *= ms;
-    b.housing_mass *= ms;
-    b.viscosity *= cs;
-    machine(&p, &c, b)
+    Machine::new(scaled_config(cfg, ms, ks, cs), fine()).unwrap()
 }
 
 /// Case: parameters scaled by 10^±6 and by 2^±20. (i) masses, stiffness, damping and load

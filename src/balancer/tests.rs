@@ -13,7 +13,7 @@ extern crate std;
 use super::complex::C64;
 use super::modal::System;
 use super::*;
-use crate::testutil::{coupling, platform, reference_speeds};
+use crate::testutil::{coupling, platform, reference_speeds, scaled_config};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------------------
@@ -424,22 +424,8 @@ fn scaling_laws() {
         // Stiffness ×s², damping ×s: all speeds ×s.
         for (km, speed) in [(s, 1.0), (s * s, s)] {
             let mass = if speed == 1.0 { s } else { 1.0 };
-            let ps: Vec<Platform> = cfg
-                .platforms()
-                .iter()
-                .map(|p| platform(p.mass * mass, p.stiffness * km, p.damping * s))
-                .collect();
-            let cs: Vec<Coupling> = cfg
-                .couplings()
-                .iter()
-                .map(|c| coupling(c.between[0], c.between[1], c.stiffness * km, c.damping * s))
-                .collect();
-            let mut b = *cfg.balancer();
-            b.load_mass *= mass;
-            b.housing_mass *= mass;
-            // Keep β·(scaling) consistent: b_w scales with mass·speed.
-            b.viscosity *= mass * speed;
-            let m2 = analyse(MachineConfig::new(&ps, &cs, b).unwrap());
+            // Load viscosity ×s too: b_w scales with mass·speed, which is s in both cases.
+            let m2 = analyse(scaled_config(&cfg, mass, km, s));
             for (a, b) in m.resonant_speeds().iter().zip(m2.resonant_speeds()) {
                 assert!(rel(a * speed, *b) < 1e-12, "{a} {b}");
             }
