@@ -116,21 +116,37 @@ pub(crate) fn scaled_config(cfg: &MachineConfig, ms: f64, ks: f64, cs: f64) -> M
     MachineConfig::new(&p, &c, b).unwrap()
 }
 
-/// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
-fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
-    let n = cfg.platforms().len();
-    let mut k = [[0.0; 3]; 3];
-    let mut m = [0.0; 3];
+/// The symmetric matrix (0-based, zero beyond the platforms) that the supports and couplings of
+/// a validated machine make of one of their properties, assembled from the public
+/// configuration: `support(p)` to the ground on the diagonal, `link(c)` between the coupled
+/// platforms. Stiffness gives K, damping gives C.
+pub(crate) fn assemble(
+    cfg: &MachineConfig,
+    support: impl Fn(&Platform) -> f64,
+    link: impl Fn(&Coupling) -> f64,
+) -> [[f64; 3]; 3] {
+    let mut x = [[0.0; 3]; 3];
     for (i, p) in cfg.platforms().iter().enumerate() {
-        k[i][i] += p.stiffness;
-        m[i] = cfg.moving_mass(i);
+        x[i][i] += support(p);
     }
     for c in cfg.couplings() {
         let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
-        k[a][a] += c.stiffness;
-        k[b][b] += c.stiffness;
-        k[a][b] -= c.stiffness;
-        k[b][a] -= c.stiffness;
+        let v = link(c);
+        x[a][a] += v;
+        x[b][b] += v;
+        x[a][b] -= v;
+        x[b][a] -= v;
+    }
+    x
+}
+
+/// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
+fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
+    let n = cfg.platforms().len();
+    let k = assemble(cfg, |p| p.stiffness, |c| c.stiffness);
+    let mut m = [0.0; 3];
+    for (i, mi) in m.iter_mut().enumerate().take(n) {
+        *mi = cfg.moving_mass(i);
     }
     (k, m, n)
 }

@@ -13,7 +13,7 @@ extern crate std;
 use super::complex::C64;
 use super::modal::System;
 use super::*;
-use crate::testutil::{coupling, platform, reference_speeds, scaled_config};
+use crate::testutil::{assemble, coupling, platform, reference_speeds, scaled_config};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------------------
@@ -785,18 +785,8 @@ fn capture_lag_equals_power_dissipated_in_dampers() {
             let mut rhs = vec![C64::new(0.0, 0.0); n];
             rhs[s.e] = C64::new(sm * w * w, 0.0);
             let y = csolve(z, rhs);
-            // Build C from the configuration directly.
-            let mut cm = vec![vec![0.0; n]; n];
-            for (i, p) in cfg.platforms().iter().enumerate() {
-                cm[i][i] += p.damping;
-            }
-            for c in cfg.couplings() {
-                let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
-                cm[a][a] += c.damping;
-                cm[b][b] += c.damping;
-                cm[a][b] -= c.damping;
-                cm[b][a] -= c.damping;
-            }
+            // C from the configuration directly (zero beyond the n platforms).
+            let cm = assemble(&cfg, |p| p.damping, |c| c.damping);
             let mut quad = 0.0;
             for i in 0..n {
                 for j in 0..n {
