@@ -60,7 +60,6 @@ impl AlarmConfig {
             config: self,
             over: 0,
             under: 0,
-            seen: 0,
             active: false,
         })
     }
@@ -99,7 +98,6 @@ pub struct DeltaAlarm {
     config: AlarmConfig,
     over: u32,
     under: u32,
-    seen: u8,
     active: bool,
 }
 
@@ -141,7 +139,6 @@ impl DeltaAlarm {
         let below = r.delta < self.config.limit * (1.0 - self.config.hysteresis);
         self.over = ((self.over << 1) | (v == Verdict::Over) as u32) & mask;
         self.under = ((self.under << 1) | below as u32) & mask;
-        self.seen = self.seen.saturating_add(1);
         let n = self.config.raise_after as u32;
         let event = if !self.active && self.over.count_ones() >= n {
             self.active = true;

@@ -129,9 +129,8 @@ impl WindowReport {
     }
 }
 
-/// An extreme sample: angle and interval. The interval is an integer tick count; it is stored
-/// already converted to f32 (the form every comparison and the report use), so the per-sample
-/// comparisons do not convert it again.
+/// An extreme sample: angle and interval, the interval as its exact integer tick count (equal
+/// angles compare the counts exactly; other comparisons convert them to f32).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Extreme {
     angle: f32,
@@ -207,8 +206,8 @@ fn split_ticks(t: u32) -> (f32, f32) {
 /// two software `libm::fmaf` calls (no fused multiply-add is reachable from stable `core`).
 ///
 /// Counts below 2²⁴ are exact in f32 and take this path alone; larger ones round in f32 and go
-/// to [`cross_wide`], out of line. Splitting every count instead (remainders then 0) made the
-/// window finish 241 instructions instead of 232 (`monitor::window_finish`, firmware/run.sh).
+/// to [`cross_wide`], out of line. Splitting every count instead (remainders then 0) cost the
+/// window finish 9 more instructions when measured (`monitor::window_finish`, firmware/run.sh).
 #[inline]
 fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
     if (t1 | t2) < 1 << 24 {
@@ -271,12 +270,13 @@ impl WindowState {
         // neither count can reach its type's limit: plain wrapping adds are exact.
         self.samples = self.samples.wrapping_add(1);
         self.sample_ticks = self.sample_ticks.wrapping_add(s.ticks as u64);
+        let e = Extreme {
+            angle: s.angle,
+            ticks: s.ticks,
+        };
         if self.samples == 1 {
-            self.max = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
-            self.min = self.max;
+            self.max = e;
+            self.min = e;
             return;
         }
         // Compare angle/ticks by cross-multiplying: no division per edge. Equal angles (a
@@ -288,10 +288,7 @@ impl WindowState {
             s.angle * self.max.ticks as f32 > self.max.angle * t
         };
         if faster {
-            self.max = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
+            self.max = e;
         }
         let slower = if s.angle == self.min.angle {
             s.ticks > self.min.ticks
@@ -299,10 +296,7 @@ impl WindowState {
             s.angle * (self.min.ticks as f32) < self.min.angle * t
         };
         if slower {
-            self.min = Extreme {
-                angle: s.angle,
-                ticks: s.ticks,
-            };
+            self.min = e;
         }
     }
 

@@ -137,9 +137,9 @@ fn full_ring_ticks(sum: u32, k: u16) -> u32 {
 /// panicking, and every path is O(1).
 #[derive(Debug, Clone)]
 pub struct SpeedTracker {
+    /// `Running` or `Reversed` exactly when `last` holds the previous edge's time.
     state: ShaftState,
     last: u32,
-    have_last: bool,
     /// Previous accepted interval and the pitch it spanned (0 when none).
     prev_dt: u32,
     prev_pitch: f32,
@@ -167,7 +167,6 @@ impl SpeedTracker {
         SpeedTracker {
             state: ShaftState::NoSignal,
             last: 0,
-            have_last: false,
             prev_dt: 0,
             prev_pitch: 0.0,
             synced: false,
@@ -241,7 +240,7 @@ impl SpeedTracker {
     /// Checks for a timeout at time `now` (ticks). Call it at least once per counter period:
     /// elapsed time is measured modulo the counter.
     pub fn poll<const N: usize>(&mut self, enc: &Encoder<N>, now: u32) -> Option<Fault> {
-        if !self.have_last {
+        if !self.has_last() {
             return None;
         }
         let elapsed = now.wrapping_sub(self.last) & enc.mask();
@@ -252,10 +251,14 @@ impl SpeedTracker {
         None
     }
 
+    /// Whether `last` holds the time of the previous edge (running forward or reversed).
+    fn has_last(&self) -> bool {
+        matches!(self.state, ShaftState::Running | ShaftState::Reversed)
+    }
+
     #[cold]
     fn enter_standstill(&mut self) {
         self.state = ShaftState::Standstill;
-        self.have_last = false;
         self.prev_dt = 0;
         self.count(Fault::Timeout);
         self.lose_sync();
@@ -269,10 +272,9 @@ impl SpeedTracker {
         direction: Option<Direction>,
     ) -> EdgeEvent {
         let ticks = ticks & enc.mask();
-        if direction == Some(Direction::Reverse)
-            || !self.have_last
-            || self.state == ShaftState::Reversed
-        {
+        // Only a shaft running forward gives an interval: after start, standstill or reversal
+        // the edge is a new time reference.
+        if direction == Some(Direction::Reverse) || self.state != ShaftState::Running {
             return self.restart(enc, ticks, direction);
         }
         let dt = ticks.wrapping_sub(self.last) & enc.mask();
@@ -300,7 +302,6 @@ impl SpeedTracker {
             }
             self.lose_sync();
             self.last = ticks;
-            self.have_last = true;
             self.prev_dt = 0;
             return ev;
         }
@@ -308,7 +309,6 @@ impl SpeedTracker {
         // index pulse before it still frames it as tooth 0.
         self.state = ShaftState::Running;
         self.last = ticks;
-        self.have_last = true;
         self.prev_dt = 0;
         if self.index_pending && enc.config().framing == Framing::Index {
             self.index_pending = false;
@@ -326,14 +326,14 @@ impl SpeedTracker {
         self.enter_standstill();
         self.state = ShaftState::Running;
         self.last = ticks;
-        self.have_last = true;
         EdgeEvent {
             fault: Some(Fault::Timeout),
             ..EdgeEvent::default()
         }
     }
 
-    /// An edge `dt` ticks after the previous accepted one, at `ticks`.
+    /// An edge `dt` ticks after the previous accepted one, at `ticks`; the shaft is running
+    /// forward (and stays so: a glitch or a fault does not change the state).
     #[inline(always)]
     fn on_interval<const N: usize>(&mut self, enc: &Encoder<N>, dt: u32, ticks: u32) -> EdgeEvent {
         let mut ev = EdgeEvent::default();
@@ -389,7 +389,6 @@ impl SpeedTracker {
         }
         self.last = ticks;
         self.counters.accepted = self.counters.accepted.wrapping_add(1);
-        self.state = ShaftState::Running;
 
         let mut tooth = next;
         // Apparent pitch of this interval in uniform pitches, `num / uniform_den`: ≈1 for a

@@ -21,9 +21,7 @@ use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, Classifier, Coupling, Machine, MachineConfig, Platform, Regime,
     RegimeTracker, SearchOptions, ZoneKind,
 };
-use drive_monitor::drive::{
-    DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction, SteadyState,
-};
+use drive_monitor::drive::{DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::DeltaMonitor;
@@ -36,8 +34,8 @@ use proptest::prelude::*;
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
 use testutil::{
-    coupling, drive, h, platform, seed_motor, BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE,
-    J, M1, MM, W0, WM,
+    coupling, drive, h, paper_terms, platform, reference_speeds, scaled_config, seed_motor, steady,
+    BAD, BAD_F32, BAD_F32_NON_NEGATIVE, BAD_NON_NEGATIVE, J, M1, MM, W0, WM,
 };
 
 /// Unit roundoff of f32 (half an ulp of 1).
@@ -56,21 +54,6 @@ fn rel(a: f64, b: f64) -> f64 {
 // =============================================================================================
 // Predicted δ (drive model, seed 000 eq. 11–13)
 // =============================================================================================
-
-fn steady(m: &DriveModel) -> SteadyState {
-    *m.predict().steady().expect("steady state")
-}
-
-/// The reference for one harmonic, in the paper's own coefficients (eq. 10–12, B's sign
-/// corrected), written independently of the model's `hypot` form: `(ū, R)` with ū = D2/D1 and
-/// R = 2·D3/√(4·D1² + n²) the amplitude of ω².
-fn paper_terms(m2: f64, n: f64, j: f64) -> (f64, f64) {
-    let k = W0 * W0 - WM * WM;
-    let d1 = MM / (j * k);
-    let d2 = (MM * W0 * W0 - M1 * k) / (j * k);
-    let d3 = m2 / j;
-    (d2 / d1, 2.0 * d3 / (4.0 * d1 * d1 + n * n).sqrt())
-}
 
 /// δ from r = R/ū without cancellation: ωmax,min = √ū·√(1 ± r), so
 /// δ = 2(√(1+r) − √(1−r))/(√(1+r) + √(1−r)) = 2r/(1 + √(1 − r²)).
@@ -766,88 +749,6 @@ fn assert_all_close(got: &[f64], want: &[f64], tol: f64, what: &str) {
     }
 }
 
-/// Stiffness and mass matrices of a validated machine (moving masses include the balancer).
-fn km(cfg: &MachineConfig) -> ([[f64; 3]; 3], [f64; 3], usize) {
-    let n = cfg.platforms().len();
-    let mut k = [[0.0; 3]; 3];
-    let mut m = [0.0; 3];
-    for (i, p) in cfg.platforms().iter().enumerate() {
-        k[i][i] += p.stiffness;
-        m[i] = cfg.moving_mass(i);
-    }
-    for c in cfg.couplings() {
-        let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
-        k[a][a] += c.stiffness;
-        k[b][b] += c.stiffness;
-        k[a][b] -= c.stiffness;
-        k[b][a] -= c.stiffness;
-    }
-    (k, m, n)
-}
-
-/// Eigenvalues of (K, M) restricted to the indices `idx`, by bisection on Sylvester's inertia:
-/// the number of negative pivots of the LDLᵀ factorisation of K − λM is the number of
-/// eigenvalues below λ. A second method, independent of the closed forms and Jacobi rotations
-/// the core uses; each eigenvalue is bracketed down to adjacent doubles.
-fn inertia_eigenvalues(k: &[[f64; 3]; 3], m: &[f64; 3], idx: &[usize]) -> Vec<f64> {
-    let n = idx.len();
-    let below = |lambda: f64| {
-        let mut a = [[0.0; 3]; 3];
-        for i in 0..n {
-            for j in 0..n {
-                a[i][j] = k[idx[i]][idx[j]] - if i == j { lambda * m[idx[i]] } else { 0.0 };
-            }
-        }
-        let mut neg = 0;
-        for p in 0..n {
-            let d = a[p][p];
-            if d < 0.0 {
-                neg += 1;
-            }
-            let d = if d == 0.0 { f64::MIN_POSITIVE } else { d };
-            for i in p + 1..n {
-                let l = a[i][p] / d;
-                for j in p + 1..n {
-                    a[i][j] -= l * a[p][j];
-                }
-            }
-        }
-        neg
-    };
-    let hi0 = (0..n)
-        .map(|i| (0..n).map(|j| k[idx[i]][idx[j]].abs()).sum::<f64>() / m[idx[i]])
-        .fold(0.0, f64::max)
-        * 2.0;
-    (0..n)
-        .map(|i| {
-            let (mut lo, mut hi) = (0.0, hi0);
-            loop {
-                let mid = 0.5 * (lo + hi);
-                if mid <= lo || mid >= hi {
-                    break hi;
-                }
-                if below(mid) > i {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-        })
-        .map(f64::sqrt)
-        .collect()
-}
-
-/// Resonant and additional speeds of a machine by the inertia method.
-fn reference_speeds(cfg: &MachineConfig) -> (Vec<f64>, Vec<f64>) {
-    let (k, m, n) = km(cfg);
-    let all: Vec<usize> = (0..n).collect();
-    let others: Vec<usize> = (0..n).filter(|&i| i != cfg.exciter_index()).collect();
-    (
-        inertia_eigenvalues(&k, &m, &all),
-        inertia_eigenvalues(&k, &m, &others),
-    )
-}
-
 /// Case: zero coupling. Platform 3 is attached to nothing (a coupling of zero stiffness and
 /// damping), so it must not change what the exciter platform sees.
 /// Reference: the two-platform machine without it, plus √(k3/M3) as an extra resonance and an
@@ -1163,21 +1064,7 @@ fn damping_to_zero_and_damping_that_erases_a_zone() {
 
 /// A machine with every mass ×`ms`, stiffness ×`ks` and damping (and load viscosity) ×`cs`.
 fn scaled_machine(cfg: &MachineConfig, ms: f64, ks: f64, cs: f64) -> Machine {
-    let p: Vec<Platform> = cfg
-        .platforms()
-        .iter()
-        .map(|p| platform(p.mass * ms, p.stiffness * ks, p.damping * cs))
-        .collect();
-    let c: Vec<Coupling> = cfg
-        .couplings()
-        .iter()
-        .map(|c| coupling(c.between[0], c.between[1], c.stiffness * ks, c.damping * cs))
-        .collect();
-    let mut b = *cfg.balancer();
-    b.load_mass *= ms;
-    b.housing_mass *= ms;
-    b.viscosity *= cs;
-    machine(&p, &c, b)
+    Machine::new(scaled_config(cfg, ms, ks, cs), fine()).unwrap()
 }
 
 /// Case: parameters scaled by 10^±6 and by 2^±20. (i) masses, stiffness, damping and load

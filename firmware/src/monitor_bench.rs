@@ -89,8 +89,8 @@ fn feed_empty(ticks: &[u32; EDGES]) -> u64 {
 }
 
 /// Passes over the stream in [`window_finish`]: each timed call is read to the counter's
-/// 40-instruction resolution, and the 160 windows of four passes average that out (1, 2, 4 and
-/// 8 passes gave 229, 232, 232 and 231).
+/// 40-instruction resolution, and the 160 windows of four passes average that out (when this
+/// was chosen, 1, 2, 4 and 8 passes agreed within 3 instructions).
 const FINISH_PASSES: u32 = 4;
 
 /// One edge, timed: (instructions, whether it ended a window). Both monitors of
@@ -105,8 +105,8 @@ fn timed_edge(m: &mut DeltaMonitor<1024>, t: u32) -> (u64, bool) {
 /// Instructions that finishing a window adds to the edge that ends it, and the number of
 /// windows measured. The stream goes through two monitors that differ only in window length:
 /// one revolution (every frame edge once the first window has started ends one) and
-/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in both; the cost is the
-/// mean difference over the edges that ended a window.
+/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in
+/// both; the cost is the mean difference over the edges that ended a window.
 ///
 /// Differencing whole streams with short and long windows instead would also count per-sample
 /// work that the window length changes: the running extremes move far more often in short
@@ -151,6 +151,10 @@ pub fn run() {
         2.0 * EPS
     );
     let empty = feed_empty(ticks);
+    hprintln!(
+        "memory: DeltaMonitor<1024> {} bytes",
+        core::mem::size_of::<DeltaMonitor<1024>>()
+    );
 
     // The report, with 16-edge speed samples and 8-revolution windows (printed in a pass of
     // its own, so formatting stays out of the measured passes).

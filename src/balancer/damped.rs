@@ -5,10 +5,10 @@
 //! The sign of `g(ω) = Re H_ee(ω)` ([`System::criterion`]: a pivoted solve of `Z·y = e_e`, not
 //! the determinant form, whose roots degrade at double poles) is evaluated on the system
 //! scaled to unit largest mass and stiffness (no overflow for any units). `g(0) > 0`
-//! (static compliance); undamped, `g` also changes sign at its poles. The scan nodes are `0`, then, in each interval between consecutive
-//! undamped characteristic speeds (from `10⁻³·` the lowest to `max_factor·` the highest),
-//! `nodes_per_interval` log-spaced nodes, so every undamped zone is sampled inside however
-//! narrow it is. Each sign change is bisected to a relative bracket width `rel_tol`. Above the
+//! (static compliance); undamped, `g` also changes sign at its poles. The scan nodes are `0`,
+//! then, in each interval between consecutive undamped characteristic speeds (from `10⁻³·` the
+//! lowest to `max_factor·` the highest), `nodes_per_interval` log-spaced nodes, so every
+//! undamped zone is sampled inside however narrow it is. Each sign change is bisected to a relative bracket width `rel_tol`. Above the
 //! scan `g < 0` is required (at high speed `H_ee → −1/(M_eΣ·ω²)`); if not, the scan is
 //! extended by doubling. Pairs of boundaries closer than `1e3·rel_tol` (relative) are
 //! dropped: such a zone is below the resolution of the search (a pole and a zero that

@@ -94,6 +94,14 @@ pub struct Coupling {
     pub damping: f64,
 }
 
+impl Coupling {
+    /// The two platforms as indices from 0 (kept in range for any `between`).
+    pub(crate) fn indices(&self) -> [usize; 2] {
+        self.between
+            .map(|p| usize::from(p).saturating_sub(1) % MAX_PLATFORMS)
+    }
+}
+
 /// Type of auto-balancer; fixes the inertia factor `κ` of the loads (seed eq. 9).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -331,8 +339,7 @@ impl MachineConfig {
             d.rho[i] = me / mi;
         }
         for c in self.couplings() {
-            let a = usize::from(c.between[0]).saturating_sub(1) % MAX_PLATFORMS;
-            let b = usize::from(c.between[1]).saturating_sub(1) % MAX_PLATFORMS;
+            let [a, b] = c.indices();
             let n2 = c.stiffness / (me * w * w);
             let h = c.damping / (2.0 * me * w);
             d.n_sq_coupling[a][b] = n2;

@@ -52,8 +52,7 @@ impl System {
             s.cs[i] = p.damping;
         }
         for c in cfg.couplings() {
-            let a = usize::from(c.between[0]).saturating_sub(1) % MAX_PLATFORMS;
-            let b = usize::from(c.between[1]).saturating_sub(1) % MAX_PLATFORMS;
+            let [a, b] = c.indices();
             s.kc[a][b] = c.stiffness;
             s.kc[b][a] = c.stiffness;
             s.cc[a][b] = c.damping;

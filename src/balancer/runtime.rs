@@ -74,9 +74,8 @@ pub struct Classifier {
     seg_from: [f32; MAX_SEGMENTS],
     seg_regime: [Regime; MAX_SEGMENTS],
     n_seg: u8,
-    zone_from: [f32; MAX_ZONES],
+    /// Kind of each zone; zone `i > 0` starts at `bounds[i − 1]`, zone 0 at 0.
     zone_kind: [ZoneKind; MAX_ZONES],
-    n_zones: u8,
     bounds: [f32; MAX_BOUNDS],
     n_bounds: u8,
     margin: f32,
@@ -90,9 +89,9 @@ pub struct Classifier {
 /// speed's boundary (balancing below, gathering above) needs for the classifier to match the
 /// simulation on both sides was 0.3 % at the median and 2.0 % at the 90th percentile; 5 %
 /// covers 69 of the 71 boundaries (in the other two the gathering zone above the additional
-/// speed shrinks or vanishes in simulation). The needed band did not change measurably with `ε` (medians and maxima flat
-/// across the range; a power-law fit gives `ε^−0.01`), so it is one constant, not a function
-/// of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
+/// speed shrinks or vanishes in simulation). The needed band did not change measurably with
+/// `ε` (medians and maxima flat across the range; a power-law fit gives `ε^−0.01`), so it is
+/// one constant, not a function of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
 /// capture band ([`Regime::Bistable`]), not by this margin.
 pub const DEFAULT_MARGIN: f32 = 0.05;
 
@@ -114,27 +113,14 @@ impl Classifier {
             seg_from: [0.0; MAX_SEGMENTS],
             seg_regime: [Regime::Gathering; MAX_SEGMENTS],
             n_seg: 0,
-            zone_from: [0.0; MAX_ZONES],
             zone_kind: [ZoneKind::Gathering; MAX_ZONES],
-            n_zones: 0,
             bounds: [0.0; MAX_BOUNDS],
             n_bounds: 0,
             margin,
             hysteresis,
         };
-        let mut ns = 0usize;
-        let mut push = |c: &mut Classifier, from: f64, r: Regime| -> Result<(), ConfigError> {
-            let (Some(f), Some(g)) = (c.seg_from.get_mut(ns), c.seg_regime.get_mut(ns)) else {
-                return Err(ConfigError::Capacity("segments"));
-            };
-            *f = from as f32;
-            *g = r;
-            ns += 1;
-            Ok(())
-        };
         for (i, z) in machine.zones().iter().enumerate() {
-            if let (Some(f), Some(k)) = (c.zone_from.get_mut(i), c.zone_kind.get_mut(i)) {
-                *f = z.from as f32;
+            if let Some(k) = c.zone_kind.get_mut(i) {
                 *k = z.kind;
             }
             if i > 0 {
@@ -143,7 +129,7 @@ impl Classifier {
                 }
             }
             match z.kind {
-                ZoneKind::Gathering => push(&mut c, z.from, Regime::Gathering)?,
+                ZoneKind::Gathering => c.push_segment(z.from, Regime::Gathering)?,
                 ZoneKind::Balancing => {
                     // Capture is possible up to the largest `until` of the windows below.
                     let until = machine
@@ -153,20 +139,30 @@ impl Classifier {
                         .fold(0.0f64, |u, w| u.max(w.until));
                     let to = z.to.unwrap_or(f64::INFINITY);
                     if until > z.from {
-                        push(&mut c, z.from, Regime::Bistable)?;
+                        c.push_segment(z.from, Regime::Bistable)?;
                         if until < to {
-                            push(&mut c, until, Regime::Balancing)?;
+                            c.push_segment(until, Regime::Balancing)?;
                         }
                     } else {
-                        push(&mut c, z.from, Regime::Balancing)?;
+                        c.push_segment(z.from, Regime::Balancing)?;
                     }
                 }
             }
         }
-        c.n_seg = ns as u8;
-        c.n_zones = machine.zones().len().min(MAX_ZONES) as u8;
-        c.n_bounds = c.n_zones.saturating_sub(1);
+        c.n_bounds = machine.zones().len().clamp(1, MAX_ZONES) as u8 - 1;
         Ok(c)
+    }
+
+    /// Appends a segment starting at `from` rad/s.
+    fn push_segment(&mut self, from: f64, regime: Regime) -> Result<(), ConfigError> {
+        let i = usize::from(self.n_seg);
+        let (Some(f), Some(r)) = (self.seg_from.get_mut(i), self.seg_regime.get_mut(i)) else {
+            return Err(ConfigError::Capacity("segments"));
+        };
+        *f = from as f32;
+        *r = regime;
+        self.n_seg += 1;
+        Ok(())
     }
 
     fn segs(&self) -> &[f32] {
@@ -233,14 +229,17 @@ impl Classifier {
             return none;
         }
         let s = speed.abs();
-        let zones = self
-            .zone_from
-            .get(..usize::from(self.n_zones))
-            .unwrap_or(&[]);
-        let zi = zones.partition_point(|&f| f <= s).saturating_sub(1);
+        let bounds = self.bounds();
+        // Zone `i` is `[from(i), bounds[i])`; `s ≥ 0` lies in the zone after every boundary
+        // at or below it.
+        let from = |i: usize| match i.checked_sub(1) {
+            None => Some(0.0),
+            Some(b) => bounds.get(b).copied(),
+        };
+        let zi = bounds.partition_point(|&f| f <= s);
         let kind = self.zone_kind.get(zi).copied();
         let drop_below = match kind {
-            Some(ZoneKind::Balancing) => zones.get(zi).map(|&f| f * (1.0 - self.margin)),
+            Some(ZoneKind::Balancing) => from(zi).map(|f| f * (1.0 - self.margin)),
             _ => None,
         };
         // The highest gathering zone starting at or below s.
@@ -250,8 +249,8 @@ impl Classifier {
             zi.checked_sub(1)
         };
         let exciter_band = gi.and_then(|g| {
-            let from = zones.get(g).copied()?;
-            let to = zones.get(g + 1).copied()?;
+            let from = from(g)?;
+            let to = bounds.get(g).copied()?;
             let band = SpeedBand {
                 from: from * (1.0 + self.margin),
                 to: to * (1.0 - self.margin),

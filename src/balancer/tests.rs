@@ -13,7 +13,7 @@ extern crate std;
 use super::complex::C64;
 use super::modal::System;
 use super::*;
-use crate::testutil::{coupling, platform};
+use crate::testutil::{assemble, coupling, platform, reference_speeds, scaled_config};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------------------
@@ -101,92 +101,6 @@ fn random_machine(rng: &mut Rng, n: usize, exciter_any: bool) -> MachineConfig {
     b.load_mass *= scale;
     b.housing_mass *= scale;
     MachineConfig::new(&ps, &cs, b).unwrap()
-}
-
-fn k_matrix(s: &System) -> [[f64; 3]; 3] {
-    let mut k = [[0.0; 3]; 3];
-    for (i, row) in k.iter_mut().enumerate().take(s.n) {
-        for (j, x) in row.iter_mut().enumerate().take(s.n) {
-            *x = s.k(i, j);
-        }
-    }
-    k
-}
-
-/// Number of eigenvalues of `(K, diag m)` below `lambda`: negative pivots of the LDLᵀ
-/// factorisation of `K − λ·M` (Sylvester's law of inertia).
-fn count_below(k: &[Vec<f64>], m: &[f64], lambda: f64) -> usize {
-    let n = m.len();
-    let mut a: Vec<Vec<f64>> = k.to_vec();
-    for i in 0..n {
-        a[i][i] -= lambda * m[i];
-    }
-    let mut count = 0;
-    for p in 0..n {
-        let mut d = a[p][p];
-        if d == 0.0 {
-            d = -f64::MIN_POSITIVE;
-        }
-        if d < 0.0 {
-            count += 1;
-        }
-        for i in p + 1..n {
-            let l = a[i][p] / d;
-            for j in p + 1..n {
-                a[i][j] -= l * a[p][j];
-            }
-        }
-    }
-    count
-}
-
-/// Generalised eigenvalues of `(K, diag m)` by bisection on the inertia count.
-fn eig_by_inertia(k: &[Vec<f64>], m: &[f64]) -> Vec<f64> {
-    let n = m.len();
-    let upper = (0..n)
-        .map(|i| k[i].iter().map(|x| x.abs()).sum::<f64>() / m[i])
-        .fold(0.0, f64::max)
-        * 1.01;
-    (0..n)
-        .map(|idx| {
-            let (mut lo, mut hi) = (0.0, upper);
-            for _ in 0..2000 {
-                let mid = 0.5 * (lo + hi);
-                if mid <= lo || mid >= hi || hi - lo <= 1e-16 * hi {
-                    break;
-                }
-                if count_below(k, m, mid) > idx {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            0.5 * (lo + hi)
-        })
-        .collect()
-}
-
-/// Reference resonant and additional speeds (rad/s) for a machine.
-fn reference_speeds(cfg: &MachineConfig) -> (Vec<f64>, Vec<f64>) {
-    let s = System::new(cfg);
-    let k = k_matrix(&s);
-    let full: Vec<Vec<f64>> = (0..s.n).map(|i| k[i][..s.n].to_vec()).collect();
-    let m: Vec<f64> = s.m[..s.n].to_vec();
-    let res = eig_by_inertia(&full, &m)
-        .into_iter()
-        .map(f64::sqrt)
-        .collect();
-    let keep: Vec<usize> = (0..s.n).filter(|&i| i != s.e).collect();
-    let red: Vec<Vec<f64>> = keep
-        .iter()
-        .map(|&i| keep.iter().map(|&j| k[i][j]).collect())
-        .collect();
-    let mr: Vec<f64> = keep.iter().map(|&i| s.m[i]).collect();
-    let add = eig_by_inertia(&red, &mr)
-        .into_iter()
-        .map(f64::sqrt)
-        .collect();
-    (res, add)
 }
 
 /// Determinant by Gaussian elimination with partial pivoting (test-only, any size).
@@ -510,22 +424,8 @@ fn scaling_laws() {
         // Stiffness ×s², damping ×s: all speeds ×s.
         for (km, speed) in [(s, 1.0), (s * s, s)] {
             let mass = if speed == 1.0 { s } else { 1.0 };
-            let ps: Vec<Platform> = cfg
-                .platforms()
-                .iter()
-                .map(|p| platform(p.mass * mass, p.stiffness * km, p.damping * s))
-                .collect();
-            let cs: Vec<Coupling> = cfg
-                .couplings()
-                .iter()
-                .map(|c| coupling(c.between[0], c.between[1], c.stiffness * km, c.damping * s))
-                .collect();
-            let mut b = *cfg.balancer();
-            b.load_mass *= mass;
-            b.housing_mass *= mass;
-            // Keep β·(scaling) consistent: b_w scales with mass·speed.
-            b.viscosity *= mass * speed;
-            let m2 = analyse(MachineConfig::new(&ps, &cs, b).unwrap());
+            // Load viscosity ×s too: b_w scales with mass·speed, which is s in both cases.
+            let m2 = analyse(scaled_config(&cfg, mass, km, s));
             for (a, b) in m.resonant_speeds().iter().zip(m2.resonant_speeds()) {
                 assert!(rel(a * speed, *b) < 1e-12, "{a} {b}");
             }
@@ -885,18 +785,8 @@ fn capture_lag_equals_power_dissipated_in_dampers() {
             let mut rhs = vec![C64::new(0.0, 0.0); n];
             rhs[s.e] = C64::new(sm * w * w, 0.0);
             let y = csolve(z, rhs);
-            // Build C from the configuration directly.
-            let mut cm = vec![vec![0.0; n]; n];
-            for (i, p) in cfg.platforms().iter().enumerate() {
-                cm[i][i] += p.damping;
-            }
-            for c in cfg.couplings() {
-                let (a, b) = (c.between[0] as usize - 1, c.between[1] as usize - 1);
-                cm[a][a] += c.damping;
-                cm[b][b] += c.damping;
-                cm[a][b] -= c.damping;
-                cm[b][a] -= c.damping;
-            }
+            // C from the configuration directly (zero beyond the n platforms).
+            let cm = assemble(&cfg, |p| p.damping, |c| c.damping);
             let mut quad = 0.0;
             for i in 0..n {
                 for j in 0..n {

@@ -220,8 +220,13 @@ impl Component {
         libm::hypot(self.c, self.d)
     }
     fn value(&self, phi: f64) -> f64 {
-        let x = self.order * phi;
-        self.c * libm::cos(x) + self.d * libm::sin(x)
+        self.wave(self.c, self.d, phi)
+    }
+    /// `x·cos(nφ) + y·sin(nφ)` at this order: the term itself for `(c, d)`, a derivative of it
+    /// for a pair of derivatives.
+    fn wave(&self, x: f64, y: f64, phi: f64) -> f64 {
+        let t = self.order * phi;
+        x * libm::cos(t) + y * libm::sin(t)
     }
 }
 
@@ -406,25 +411,24 @@ impl DriveModel {
         let d_umean = -(2.0 * dd / (w * w * w)) * (1.0 / x + 1.0 / y);
         let (smax_j, smax_a, smin_j, smin_a) = match (ex.phi_max, ex.phi_min) {
             (Some(pmax), Some(pmin)) => {
-                let dj = |phi: f64| {
+                // ∂s/∂J or ∂s/∂a at φ, from each component's pair of derivatives.
+                let slope = |phi: f64, pair: fn(&Component) -> (f64, f64)| {
                     self.components
                         .iter()
                         .map(|c| {
-                            let t = c.order * phi;
-                            c.dc_dj * libm::cos(t) + c.dd_dj * libm::sin(t)
+                            let (x, y) = pair(c);
+                            c.wave(x, y, phi)
                         })
                         .sum::<f64>()
                 };
-                let da = |phi: f64| {
-                    self.components
-                        .iter()
-                        .map(|c| {
-                            let t = c.order * phi;
-                            c.dc_da * libm::cos(t) + c.dd_da * libm::sin(t)
-                        })
-                        .sum::<f64>()
-                };
-                (dj(pmax), da(pmax), dj(pmin), da(pmin))
+                let dj = |c: &Component| (c.dc_dj, c.dd_dj);
+                let da = |c: &Component| (c.dc_da, c.dd_da);
+                (
+                    slope(pmax, dj),
+                    slope(pmax, da),
+                    slope(pmin, dj),
+                    slope(pmin, da),
+                )
             }
             _ => {
                 // smax = Σ R_k, smin = −Σ R_k (or both 0): derivative of each |(c, d)|.
@@ -566,22 +570,17 @@ impl DriveModel {
             j
         };
         let mut lo = 0.0;
-        let mut confirmed = false;
-        for _ in 0..=MAX_CONFIRM_DOUBLINGS {
+        let mut doublings = 0;
+        loop {
             match at(hi) {
-                Some(m) if meets(&m) => {
-                    confirmed = true;
-                    break;
-                }
-                Some(_) => {
+                Some(m) if meets(&m) => break,
+                Some(_) if doublings < MAX_CONFIRM_DOUBLINGS => {
                     lo = hi;
                     hi *= 2.0;
+                    doublings += 1;
                 }
-                None => return Err(DesignError::Unreachable),
+                _ => return Err(DesignError::Unreachable),
             }
-        }
-        if !confirmed {
-            return Err(DesignError::Unreachable);
         }
         for _ in 0..MAX_BISECTIONS {
             let mid = lo + (hi - lo) / 2.0;

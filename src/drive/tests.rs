@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::error::ConfigError;
-use crate::testutil::{drive, h, seed_motor, J, M1, MM, W0, WM};
+use crate::testutil::{drive, h, paper_terms, seed_motor, steady, J, M1, MM, W0, WM};
 use core::f64::consts::PI;
 use proptest::prelude::*;
 
@@ -11,23 +11,8 @@ fn seed() -> DriveModel {
     drive(&[h(0.125, 12.0, 0.0)], J)
 }
 
-fn steady(m: &DriveModel) -> SteadyState {
-    *m.predict().steady().expect("steady state")
-}
-
 fn rel(a: f64, b: f64) -> f64 {
     ((a - b) / b).abs()
-}
-
-/// The paper's D-coefficients (eq. 10 legend) with B's sign corrected; independent of the
-/// `hypot` form the model uses.
-/// Returns `(D2/D1, 2·D3/√(4·D1² + n²))`: mean and amplitude of ω² (eq. 12).
-fn paper_terms(m1: f64, m2: f64, n: f64, j: f64) -> (f64, f64) {
-    let k = W0 * W0 - WM * WM;
-    let d1 = MM / (j * k);
-    let d2 = (MM * W0 * W0 - m1 * k) / (j * k);
-    let d3 = m2 / j;
-    (d2 / d1, 2.0 * d3 / (4.0 * d1 * d1 + n * n).sqrt())
 }
 
 #[test]
@@ -39,7 +24,7 @@ fn seed_case_reproduced() {
     assert_eq!(s.horizon, Horizon::ClosedForm);
     assert!(s.within_working_branch);
     // Eq. 12 in the paper's own coefficients agrees to rounding.
-    let (ubar, amp) = paper_terms(24.0, 12.0, 0.125, J);
+    let (ubar, amp) = paper_terms(12.0, 0.125, J);
     assert!(rel(s.omega_max, (ubar + amp).sqrt()) < 1e-14);
     assert!(rel(s.omega_min, (ubar - amp).sqrt()) < 1e-14);
     // The extremal angles are where the periodic solution peaks.
@@ -86,12 +71,25 @@ fn integrate(m: &DriveModel, settle: f64, period: f64, dt: f64) -> (f64, f64) {
         (phi, w) = step(phi, w);
     }
     let end = phi + period;
-    let mut y1 = w;
-    (phi, w) = step(phi, w);
-    let (mut wmax, mut wmin) = (f64::MIN, f64::MAX);
-    while phi < end + 0.01 {
-        let (p2, y2) = step(phi, w);
-        let y0 = core::mem::replace(&mut y1, w);
+    let first = w;
+    let rest = core::iter::from_fn(move || {
+        (phi < end + 0.01).then(|| {
+            (phi, w) = step(phi, w);
+            w
+        })
+    });
+    vertex_extrema(core::iter::once(first).chain(rest))
+}
+
+/// Largest and smallest value of a sampled curve, each local extremum refined by the vertex
+/// of the parabola through it and its two neighbours (`(f64::MIN, f64::MAX)` if none).
+fn vertex_extrema(samples: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let (mut max, mut min) = (f64::MIN, f64::MAX);
+    let mut samples = samples.into_iter();
+    let (Some(mut y0), Some(mut y1)) = (samples.next(), samples.next()) else {
+        return (max, min);
+    };
+    for y2 in samples {
         let curv = y0 - 2.0 * y1 + y2;
         let vertex = if curv != 0.0 {
             y1 - (y0 - y2) * (y0 - y2) / (8.0 * curv)
@@ -99,14 +97,14 @@ fn integrate(m: &DriveModel, settle: f64, period: f64, dt: f64) -> (f64, f64) {
             y1
         };
         if y1 >= y0 && y1 >= y2 {
-            wmax = wmax.max(vertex);
+            max = max.max(vertex);
         }
         if y1 <= y0 && y1 <= y2 {
-            wmin = wmin.min(vertex);
+            min = min.min(vertex);
         }
-        (phi, w) = (p2, y2);
+        (y0, y1) = (y1, y2);
     }
-    (wmax, wmin)
+    (max, min)
 }
 
 fn delta_of(wmax: f64, wmin: f64) -> f64 {
@@ -179,7 +177,7 @@ fn several_harmonics_match_brute_force_search() {
 fn tiny_delta_keeps_full_precision() {
     for (j, expect) in [(1.065e5, 1e-7), (1.065e11, 1e-13)] {
         let s = steady(&drive(&[h(0.125, 12.0, 0.0)], j));
-        let (ubar, r_amp) = paper_terms(24.0, 12.0, 0.125, j);
+        let (ubar, r_amp) = paper_terms(12.0, 0.125, j);
         // Exact, cancellation-free reference: r = R/ū, δ = 2r/(1 + √(1 − r²)).
         let r = r_amp / ubar;
         let reference = 2.0 * r / (1.0 + (1.0 - r * r).sqrt());
@@ -334,24 +332,11 @@ fn reference_delta(harmonics: &[(f64, f64, f64)], j: f64, period: f64, samples: 
             .sum()
     };
     let step = period / samples as f64;
-    let (mut smax, mut smin) = (f64::MIN, f64::MAX);
-    let (mut y0, mut y1) = (s(-step), s(0.0));
-    for i in 0..samples {
-        let y2 = s((i + 1) as f64 * step);
-        let den = y0 - 2.0 * y1 + y2;
-        let vertex = if den != 0.0 {
-            y1 - (y2 - y0) * (y2 - y0) / (8.0 * den)
-        } else {
-            y1
-        };
-        if y1 >= y0 && y1 >= y2 {
-            smax = smax.max(vertex);
-        }
-        if y1 <= y0 && y1 <= y2 {
-            smin = smin.min(vertex);
-        }
-        (y0, y1) = (y1, y2);
-    }
+    let (smax, smin) = vertex_extrema(
+        core::iter::once(-step)
+            .chain((0..=samples).map(|i| i as f64 * step))
+            .map(s),
+    );
     let w = (ubar + smax).sqrt() + (ubar + smin).sqrt();
     2.0 * (smax - smin) / (w * w)
 }

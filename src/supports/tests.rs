@@ -265,32 +265,45 @@ fn transfer_between_plane_pairs_eq_34_to_38() {
 
 #[test]
 fn table_1_scheme_i_inboard_and_scheme_ii_overhung() {
-    let (l, l1, l2) = (4.0, 1.0, 3.0); // scheme I: both correction planes inside the span
+    let l = 4.0;
     let (v1, v2) = (Vec2::new(0.3, -0.1), Vec2::new(-0.2, 0.25));
-    let [a, b] = equivalent_planes(&[(l1, v1), (l2, v2)], [0.0, l]).unwrap();
-    // Static column (signed vectors).
-    assert_vec_close(
-        a,
-        (v1 * (l - l1) + v2 * (l - l2)) * (1.0 / l),
-        1e-15,
-        "I: D_A",
-    );
-    assert_vec_close(b, (v1 * l1 + v2 * l2) * (1.0 / l), 1e-15, "I: D_B");
-    let [c1, c2] = equivalent_planes(&[(0.0, a), (l, b)], [l1, l2]).unwrap();
-    // D_1 corrected (the table repeats D_2's formula), D_2 as printed.
-    assert_vec_close(
-        c1,
-        (a * l2 + b * (l2 - l)) * (1.0 / (l2 - l1)),
-        1e-15,
-        "I: D_1",
-    );
-    assert_vec_close(
-        c2,
-        (-a * l1 + b * (l - l1)) * (1.0 / (l2 - l1)),
-        1e-15,
-        "I: D_2",
-    );
-    assert_vec_close(c1, v1, 1e-15, "I: back to plane 1");
+    // Static column (signed vectors), the same balance for both schemes: unbalances v1, v2 in
+    // planes l1, l2 to the supports (D_A, D_B) and back; `tol` for the way back.
+    let static_column = |scheme: &str, l1: f64, l2: f64, tol: f64| {
+        let [a, b] = equivalent_planes(&[(l1, v1), (l2, v2)], [0.0, l]).unwrap();
+        assert_vec_close(
+            a,
+            (v1 * (l - l1) + v2 * (l - l2)) * (1.0 / l),
+            1e-15,
+            &format!("{scheme}: D_A"),
+        );
+        assert_vec_close(
+            b,
+            (v1 * l1 + v2 * l2) * (1.0 / l),
+            1e-15,
+            &format!("{scheme}: D_B"),
+        );
+        let [c1, c2] = equivalent_planes(&[(0.0, a), (l, b)], [l1, l2]).unwrap();
+        // D_1 corrected (scheme I's table repeats D_2's formula), D_2 as printed.
+        assert_vec_close(
+            c1,
+            (a * l2 + b * (l2 - l)) * (1.0 / (l2 - l1)),
+            tol,
+            &format!("{scheme}: D_1"),
+        );
+        assert_vec_close(
+            c2,
+            (-a * l1 + b * (l - l1)) * (1.0 / (l2 - l1)),
+            tol,
+            &format!("{scheme}: D_2"),
+        );
+        assert_vec_close(c1, v1, tol, &format!("{scheme}: back to plane 1"));
+        assert_vec_close(c2, v2, tol, &format!("{scheme}: back to plane 2"));
+        [a, b]
+    };
+    // Scheme I: both correction planes inside the span.
+    let (l1, l2) = (1.0, 3.0);
+    static_column("I", l1, l2, 1e-15);
     // Moment column: magnitudes d1 at 0°, d2 at 180°; D_A along 0°, D_B along 180°.
     let (d1, d2) = (0.4, 0.3);
     let [ma, mb] = equivalent_planes(
@@ -319,30 +332,7 @@ fn table_1_scheme_i_inboard_and_scheme_ii_overhung() {
     );
 
     // Scheme II: correction planes overhung beyond B (signed l > L). Same balance.
-    let (l1, l2) = (5.0, 6.5);
-    let [a, b] = equivalent_planes(&[(l1, v1), (l2, v2)], [0.0, l]).unwrap();
-    assert_vec_close(
-        a,
-        (v1 * (l - l1) + v2 * (l - l2)) * (1.0 / l),
-        1e-15,
-        "II: D_A",
-    );
-    assert_vec_close(b, (v1 * l1 + v2 * l2) * (1.0 / l), 1e-15, "II: D_B");
-    let [c1, c2] = equivalent_planes(&[(0.0, a), (l, b)], [l1, l2]).unwrap();
-    assert_vec_close(
-        c1,
-        (a * l2 + b * (l2 - l)) * (1.0 / (l2 - l1)),
-        1e-14,
-        "II: D_1",
-    );
-    assert_vec_close(
-        c2,
-        (-a * l1 + b * (l - l1)) * (1.0 / (l2 - l1)),
-        1e-14,
-        "II: D_2",
-    );
-    assert_vec_close(c1, v1, 1e-14, "II: back to plane 1");
-    assert_vec_close(c2, v2, 1e-14, "II: back to plane 2");
+    let [a, b] = static_column("II", 5.0, 6.5, 1e-14);
     // And the supports themselves overhung by the correction planes on both sides.
     let [c1, c2] = equivalent_planes(&[(0.0, a), (l, b)], [-2.0, 7.0]).unwrap();
     let [ra, rb] = equivalent_planes(&[(-2.0, c1), (7.0, c2)], [0.0, l]).unwrap();

@@ -169,7 +169,9 @@ pub(crate) fn split<I: IntoIterator<Item = (f64, Vec2)>>(items: I, z1: f64, z2: 
     let mut e1 = VecDot2::default();
     let mut e2 = VecDot2::default();
     for (z, v) in items {
-        // Stability: lever arms are exact differences of coordinates (rounded difference plus its error) and the sums are compensated, never 1 − share or products of absolute coordinates.
+        // Stability: lever arms are exact differences of coordinates (rounded difference plus
+        // its error) and the sums are compensated, never 1 − share or products of absolute
+        // coordinates.
         e1.add_lever(v, z2, z);
         e2.add_lever(v, z, z1);
     }
