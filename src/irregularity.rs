@@ -207,7 +207,7 @@ fn split_ticks(t: u32) -> (f32, f32) {
 ///
 /// Counts below 2²⁴ are exact in f32 and take this path alone; larger ones round in f32 and go
 /// to [`cross_wide`], out of line. Splitting every count instead (remainders then 0) cost the
-/// window finish 9 more instructions when measured (`monitor::window_finish`, firmware/run.sh).
+/// window finish 9 more instructions when measured (`monitor::window_finish`, examples/qemu/run.sh).
 #[inline]
 fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
     if (t1 | t2) < 1 << 24 {

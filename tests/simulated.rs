@@ -1,8 +1,8 @@
 //! The core driven by the simulator: encoder edges of simulated machines through the same
 //! monitor that runs on the target, compared with the design-time prediction.
 
-use host_sim::run::{run, Overrides};
-use host_sim::scene::{resolve, Scene};
+use host_sim::app::run::{run, Overrides};
+use host_sim::app::scene::{resolve, Scene};
 use std::path::Path;
 
 fn scene(text: &str) -> Scene {
@@ -109,7 +109,7 @@ fn vibration_scenes_agree_with_the_criterion_at_their_speed() {
         // Prescribed speed: the core measures exactly it.
         let w = r.speed_measured.unwrap();
         let set = match &s.motor {
-            Some(host_sim::scene::MotorSpec::Speed { speed }) => *speed,
+            Some(host_sim::app::scene::MotorSpec::Speed { speed }) => *speed,
             _ => unreachable!(),
         };
         assert!((w / set - 1.0).abs() < 1e-5, "{name}: {w} vs {set}");

@@ -18,7 +18,7 @@ use drive_monitor::speed::Direction;
 use drive_monitor::supports::{
     Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, DEFAULT_WARNING_FRACTION,
 };
-use host_sim::accuracy::pulse_train;
+use host_sim::studies::accuracy::pulse_train;
 
 const LINES: u16 = 1024;
 const TIMER_HZ: f64 = 84e6;

@@ -10,15 +10,16 @@
 //! turns, is within 0.2 % of `capture_speed(ω)` at 1 rad/s² and slower (0.52 % at 4 rad/s²).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use host_sim::capture::{self, CaptureReport, RampRun};
-use host_sim::run::{run, vibration_params, Overrides};
-use host_sim::scene::{resolve, LoadStart, Scene};
-use host_sim::vibration::LoadPlacement;
+use host_sim::app::capture::CaptureReport;
+use host_sim::app::run::{run, vibration_params, Overrides};
+use host_sim::app::scene::{resolve, LoadStart, Scene};
+use host_sim::engine::vibration::LoadPlacement;
+use host_sim::studies::runup::{self, RampRun};
 use std::path::Path;
 
-fn runup(factor: f64) -> (RampRun, host_sim::run::RunReport) {
+fn runup(factor: f64) -> (RampRun, host_sim::app::run::RunReport) {
     let (scene, path) = resolve("one-mass-runup").unwrap();
-    let mut s = capture::with_ramp_stretched(&scene, &path, factor).unwrap();
+    let mut s = runup::with_ramp_stretched(&scene, &path, factor).unwrap();
     s.encoder = None;
     let r = run(&s, &path, Overrides::default()).unwrap();
     let rate = 130.0 / (130.0 * factor);
@@ -68,7 +69,7 @@ fn start_key_is_validated_and_names_the_bad_value() {
         LoadPlacement::Together { .. }
     ));
     assert_eq!(forced.initial.load_speed, 0.0);
-    let text = host_sim::scene::BUNDLED
+    let text = host_sim::app::scene::BUNDLED
         .iter()
         .find(|(n, _)| *n == "one-mass-runup.toml")
         .unwrap()
@@ -150,7 +151,7 @@ fn release_converges_on_until_and_captured_speed_matches_the_core() {
     assert!(excess[0] > excess[1] && excess[1] > excess[2], "{excess:?}");
     let slow = excess[2];
     assert!((-0.003..0.010).contains(&slow), "{slow}");
-    let (a, b) = capture::release_fit(&runs).unwrap();
+    let (a, b) = runup::release_fit(&runs).unwrap();
     assert!((a / until - 1.0).abs() < 0.005 && b > 0.0, "{a} {b}");
     for r in &runs[1..] {
         let c = r.capture.as_ref().unwrap();
@@ -162,9 +163,11 @@ fn release_converges_on_until_and_captured_speed_matches_the_core() {
     }
     // The page built from these runs carries the table and the fit.
     let (scene, path) = resolve("one-mass-runup").unwrap();
-    let machine = host_sim::predict::machine(&scene, &path).unwrap().unwrap();
+    let machine = host_sim::app::predict::machine(&scene, &path)
+        .unwrap()
+        .unwrap();
     let (_, main) = runup(1.0);
-    let page = capture::markdown("t", "cmd", ["a.svg", "b.svg"], &main, &runs, &machine, None);
+    let page = runup::markdown("t", "cmd", ["a.svg", "b.svg"], &main, &runs, &machine, None);
     assert!(
         page.contains("| 0.25 |") && page.contains("| 4 |"),
         "{page}"

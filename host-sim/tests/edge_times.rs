@@ -3,16 +3,16 @@
 
 use core::f64::consts::TAU;
 
-use host_sim::effects::{ConstantTorque, ViscousFriction};
-use host_sim::encoder::{Direction, Edge, EncoderConfig};
-use host_sim::ode::Integrator;
-use host_sim::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
+use host_sim::engine::effects::{ConstantTorque, ViscousFriction};
+use host_sim::engine::encoder::{Direction, Edge, EncoderConfig};
+use host_sim::engine::ode::Integrator;
+use host_sim::engine::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
 
 const LINES: u32 = 256;
 
 fn edges_of(
     shaft: ShaftModel,
-    effects: Vec<Box<dyn host_sim::model::Effect>>,
+    effects: Vec<Box<dyn host_sim::engine::model::Effect>>,
     integrator: Integrator,
     duration: f64,
 ) -> Vec<Edge> {

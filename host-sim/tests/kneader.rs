@@ -6,9 +6,9 @@
 use std::time::Instant;
 
 use drive_monitor::drive::{Harmonic, Load, Motor, Parabola};
-use host_sim::encoder::{EncoderConfig, Reference};
-use host_sim::ode::Integrator;
-use host_sim::system::{DynamicShaft, Observer, ShaftModel, Simulation, StepView, System};
+use host_sim::engine::encoder::{EncoderConfig, Reference};
+use host_sim::engine::ode::Integrator;
+use host_sim::engine::system::{DynamicShaft, Observer, ShaftModel, Simulation, StepView, System};
 
 const J: f64 = 0.323;
 const OMEGA0: f64 = 145.0;
@@ -71,7 +71,7 @@ struct SteadyCheck {
 }
 
 impl Observer for SteadyCheck {
-    fn edge(&mut self, _edge: &host_sim::encoder::Edge) {}
+    fn edge(&mut self, _edge: &host_sim::engine::encoder::Edge) {}
     fn step(&mut self, step: &StepView<'_>) {
         if step.t0() < self.from {
             return;

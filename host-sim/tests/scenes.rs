@@ -6,11 +6,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use drive_monitor::drive::{Load, Motor, Parabola};
-use host_sim::effects::{ConstantTorque, ViscousFriction};
-use host_sim::encoder::{Edge, EncoderConfig, Reference};
-use host_sim::model::{Effect, Shaft};
-use host_sim::ode::Integrator;
-use host_sim::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
+use host_sim::engine::effects::{ConstantTorque, ViscousFriction};
+use host_sim::engine::encoder::{Edge, EncoderConfig, Reference};
+use host_sim::engine::model::{Effect, Shaft};
+use host_sim::engine::ode::Integrator;
+use host_sim::engine::system::{DynamicShaft, ShaftModel, Simulation, SpeedLaw, System};
 
 /// An effect with one state (a first-order lag of the speed) that counts its own calls.
 struct Probe {
@@ -140,7 +140,7 @@ fn faulty(seed: u64, drop: f64, glitch: f64, jitter: f64) -> EncoderConfig {
 fn run_prescribed(
     encoder: EncoderConfig,
     duration: f64,
-) -> (Vec<Edge>, host_sim::system::RunStats) {
+) -> (Vec<Edge>, host_sim::engine::system::RunStats) {
     let system = System::new(
         ShaftModel::Prescribed(SpeedLaw::Ramp {
             omega0: 50.0,
@@ -175,7 +175,7 @@ fn faults_are_reproducible_per_seed_and_independent() {
     );
     // Same crossings (the motion does not depend on the seed), different faults.
     assert_eq!(sa.encoder.crossings, sc.encoder.crossings);
-    let dropped = |v: &[Edge], s: &host_sim::system::RunStats| {
+    let dropped = |v: &[Edge], s: &host_sim::engine::system::RunStats| {
         (
             s.encoder.crossings - (v.len() as u64 - s.encoder.glitches),
             s.encoder.dropped,
@@ -340,7 +340,7 @@ fn variable_inertia_conserves_kinetic_energy() {
     let shaft = DynamicShaft {
         inertia: 1.0,
         flywheel: 0.2,
-        harmonics: vec![host_sim::system::InertiaHarmonic {
+        harmonics: vec![host_sim::engine::system::InertiaHarmonic {
             amplitude: 0.3,
             order: 2.0,
             phase: 0.4,
@@ -363,9 +363,9 @@ fn variable_inertia_conserves_kinetic_energy() {
     .unwrap();
     let mut speeds = (f64::MAX, f64::MIN);
     struct Obs<'a>(&'a mut (f64, f64), f64, &'a dyn Fn(f64, f64) -> f64);
-    impl host_sim::system::Observer for Obs<'_> {
+    impl host_sim::engine::system::Observer for Obs<'_> {
         fn edge(&mut self, _e: &Edge) {}
-        fn step(&mut self, s: &host_sim::system::StepView<'_>) {
+        fn step(&mut self, s: &host_sim::engine::system::StepView<'_>) {
             let sh = s.shaft(0.5 * (s.t0() + s.t1()));
             self.0 .0 = self.0 .0.min(sh.omega);
             self.0 .1 = self.0 .1.max(sh.omega);

@@ -1,7 +1,7 @@
 //! The vibration machine against seed 001's dimensionless equations, energy balance, analytic
 //! forced response, and the regimes the seed (and SEED-NOTES) report.
 //!
-//! Parameter mapping used throughout (module docs of `host_sim::vibration`): the seed's
+//! Parameter mapping used throughout (module docs of `host_sim::engine::vibration`): the seed's
 //! single-mass observation machine (N = 2 balls, h = 0.1, ε = 0.05, β = 2) is built with
 //! ω̃ = 30 rad/s, m = 0.5 kg, R = 0.1 m, M_c = 3 kg, hence M_Σ = N·m/(κ·ε) = 14.286 kg,
 //! k = M_Σ·ω̃² = 12 857 N/m, b = 2h·M_Σ·ω̃ = 85.71 N·s/m, b_w = β·N·m²·ω̃/M_Σ = 2.1 N·s/m, and a
@@ -11,8 +11,8 @@
 
 mod vibration_common;
 
-use host_sim::model::{Effect, Shaft};
-use host_sim::vibration::{
+use host_sim::engine::model::{Effect, Shaft};
+use host_sim::engine::vibration::{
     balancing_angles_two, classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind,
     LoadPlacement, PlatformParams, Regime, RegimeCriteria, VibrationMachine,
     VibrationMachineParams,
@@ -924,8 +924,8 @@ fn criterion_study_boundaries_match_floquet() {
         (1.4..1.45).contains(&high) && (0.99..1.01).contains(&low),
         "{low} {high}"
     );
-    let sample = host_sim::study::machine(0, eps, h, beta, 0.0, &[], &[]);
-    let r = host_sim::study::study_machine(sample).unwrap();
+    let sample = host_sim::studies::criterion::machine(0, eps, h, beta, 0.0, &[], &[]);
+    let r = host_sim::studies::criterion::study_machine(sample).unwrap();
     let b = &r.boundaries[0];
     let scale = b.predicted / b.q;
     assert!((b.q - 1.0).abs() < 1e-9, "{b:?}");

@@ -1,8 +1,8 @@
 //! `drive-sim`: run, predict and sweep scenes.
 
 use clap::{Parser, Subcommand};
-use host_sim::predict::predict;
-use host_sim::scene::{resolve, BUNDLED, DEFAULT_SCENE};
+use host_sim::app::predict::predict;
+use host_sim::app::scene::{resolve, BUNDLED, DEFAULT_SCENE};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -122,7 +122,7 @@ fn main() -> ExitCode {
             out,
         }) => criterion_cmd(machines, seed, json, out.as_deref()),
         Some(Command::Accuracy { out, target }) => {
-            host_sim::publish::accuracy(&out, target).map(|files| list(&files, "wrote"))
+            host_sim::studies::publish::accuracy(&out, target).map(|files| list(&files, "wrote"))
         }
         Some(Command::Scenes) => {
             for (name, text) in BUNDLED {
@@ -153,15 +153,15 @@ fn run_cmd(
 ) -> Result<(), String> {
     let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
     let report =
-        host_sim::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
+        host_sim::app::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
     if let Some(dir) = out {
-        let files = host_sim::capture::publish(name, &scene, &path, &report, dir)?;
+        let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
         if !json {
             list(&files, "wrote");
         }
     }
     if let Some(dir) = plot {
-        let files = host_sim::report::run_plots(&scene, &path, &report, dir)?;
+        let files = host_sim::app::report::run_plots(&scene, &path, &report, dir)?;
         if !json {
             list(&files, "plot:");
         }
@@ -170,8 +170,8 @@ fn run_cmd(
         print_json(&report)?;
     } else {
         let p = predict(&scene, &path).map_err(|e| e.to_string())?;
-        print!("{}", host_sim::report::run_text(&scene, &report));
-        print!("{}", host_sim::report::prediction_text(&p));
+        print!("{}", host_sim::app::report::run_text(&scene, &report));
+        print!("{}", host_sim::app::report::prediction_text(&p));
     }
     Ok(())
 }
@@ -186,13 +186,14 @@ fn sweep_cmd(
     out: Option<&std::path::Path>,
 ) -> Result<(), String> {
     let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
-    let request = host_sim::sweep::SweepRequest {
+    let request = host_sim::studies::sweep::SweepRequest {
         from,
         to,
         steps,
         together,
     };
-    let s = host_sim::sweep::sweep(&scene, &path, &request, true).map_err(|e| e.to_string())?;
+    let s = host_sim::studies::sweep::sweep(&scene, &path, &request, true)
+        .map_err(|e| e.to_string())?;
     if let Some(dir) = out {
         let files = s.publish(name, &path, dir)?;
         if !json {
@@ -242,9 +243,9 @@ fn criterion_cmd(
     json: bool,
     out: Option<&std::path::Path>,
 ) -> Result<(), String> {
-    let s = host_sim::study::study(seed, machines, true).map_err(|e| e.to_string())?;
+    let s = host_sim::studies::criterion::study(seed, machines, true).map_err(|e| e.to_string())?;
     if let Some(dir) = out {
-        let files = host_sim::study::publish(&s, dir)?;
+        let files = host_sim::studies::criterion::publish(&s, dir)?;
         if !json {
             list(&files, "wrote");
         }
@@ -252,7 +253,7 @@ fn criterion_cmd(
     if json {
         print_json(&s)?;
     } else {
-        print!("{}", host_sim::study::summary_text(&s));
+        print!("{}", host_sim::studies::criterion::summary_text(&s));
     }
     Ok(())
 }
@@ -263,7 +264,7 @@ fn predict_cmd(name: &str, json: bool) -> Result<(), String> {
     if json {
         print_json(&p)?;
     } else {
-        println!("{}", host_sim::report::prediction_text(&p));
+        println!("{}", host_sim::app::report::prediction_text(&p));
     }
     Ok(())
 }

@@ -2,8 +2,8 @@
 //! calling `Effect::eval` directly, and the seed-001 single-mass machine in physical units.
 #![allow(dead_code, clippy::unwrap_used)]
 
-use host_sim::model::{Effect, Shaft};
-use host_sim::vibration::{
+use host_sim::engine::model::{Effect, Shaft};
+use host_sim::engine::vibration::{
     InitialParams, LoadKind, RegimeSample, SeedSingleMass, VibrationMachine, VibrationMachineParams,
 };
 

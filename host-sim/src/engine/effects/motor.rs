@@ -10,7 +10,7 @@
 
 use drive_monitor::drive::Motor;
 
-use crate::model::{Effect, Shaft};
+use crate::engine::model::{Effect, Shaft};
 
 impl Effect for Motor {
     fn name(&self) -> &'static str {

@@ -34,7 +34,7 @@
 //! of the unbalance neglected); the simulator's output stage calls [`RotorLoads::reactions`] at
 //! sampled times.
 
-use crate::model::{Effect, Shaft};
+use crate::engine::model::{Effect, Shaft};
 use drive_monitor::error::{finite, non_negative, ConfigError};
 use serde::Deserialize;
 

@@ -14,9 +14,9 @@
 //!
 //! ```
 //! use drive_monitor::drive::{Harmonic, Load, Motor, Parabola};
-//! use host_sim::encoder::EncoderConfig;
-//! use host_sim::ode::Integrator;
-//! use host_sim::system::{DynamicShaft, ShaftModel, Simulation, System};
+//! use host_sim::engine::encoder::EncoderConfig;
+//! use host_sim::engine::ode::Integrator;
+//! use host_sim::engine::system::{DynamicShaft, ShaftModel, Simulation, System};
 //!
 //! let shaft = ShaftModel::Dynamic(DynamicShaft::constant(0.323));
 //! let motor = Motor::parabola(Parabola::new(145.0, 36.0, 158.0)?);
@@ -28,7 +28,7 @@
 //! let stats = sim.run(1.0, |_edge| edges += 1)?;
 //! assert_eq!(stats.encoder.edges, edges);
 //! assert_eq!(stats.evaluations_of("load"), stats.solver.rhs_evals);
-//! # Ok::<(), host_sim::system::SimError>(())
+//! # Ok::<(), host_sim::engine::system::SimError>(())
 //! ```
 
 use core::f64::consts::TAU;
@@ -37,9 +37,9 @@ use serde::Deserialize;
 
 use drive_monitor::error::{finite, non_negative, positive, ConfigError};
 
-use crate::encoder::{Edge, Encoder, EncoderConfig, EncoderStats};
-use crate::model::{Effect, Shaft};
-use crate::ode::{
+use crate::engine::encoder::{Edge, Encoder, EncoderConfig, EncoderStats};
+use crate::engine::model::{Effect, Shaft};
+use crate::engine::ode::{
     ComponentPoly, DenseOutput, Integrator, OdeError, OdeSystem, Solver, SolverStats,
 };
 
@@ -162,7 +162,7 @@ impl SpeedLaw {
         let (ts, phi, omega, alpha) = self.piece(mid);
         let s = t0 - ts;
         let h = t1 - t0;
-        let mut coeffs = [0.0; crate::ode::MAX_DENSE_DEGREE];
+        let mut coeffs = [0.0; crate::engine::ode::MAX_DENSE_DEGREE];
         coeffs[0] = (omega + alpha * s) * h;
         coeffs[1] = 0.5 * alpha * h * h;
         ComponentPoly {

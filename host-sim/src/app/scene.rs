@@ -547,19 +547,22 @@ impl Scene {
 
 /// The scenes bundled with the simulator: (file name, text).
 pub const BUNDLED: &[(&str, &str)] = &[
-    ("kneader.toml", include_str!("../scenes/kneader.toml")),
-    ("auger.toml", include_str!("../scenes/auger.toml")),
+    ("kneader.toml", include_str!("../../scenes/kneader.toml")),
+    ("auger.toml", include_str!("../../scenes/auger.toml")),
     (
         "auger-overhung.toml",
-        include_str!("../scenes/auger-overhung.toml"),
+        include_str!("../../scenes/auger-overhung.toml"),
     ),
-    ("one-mass.toml", include_str!("../scenes/one-mass.toml")),
+    ("one-mass.toml", include_str!("../../scenes/one-mass.toml")),
     (
         "one-mass-runup.toml",
-        include_str!("../scenes/one-mass-runup.toml"),
+        include_str!("../../scenes/one-mass-runup.toml"),
     ),
-    ("two-mass.toml", include_str!("../scenes/two-mass.toml")),
-    ("three-mass.toml", include_str!("../scenes/three-mass.toml")),
+    ("two-mass.toml", include_str!("../../scenes/two-mass.toml")),
+    (
+        "three-mass.toml",
+        include_str!("../../scenes/three-mass.toml"),
+    ),
 ];
 
 /// The default scene of `drive-sim` without arguments.

@@ -97,7 +97,7 @@
 
 pub mod regime;
 
-use crate::model::{Effect, Shaft};
+use crate::engine::model::{Effect, Shaft};
 use drive_monitor::error::{finite, non_negative, positive, ConfigError};
 use serde::Deserialize;
 

@@ -1,10 +1,10 @@
 //! `drive-sim accuracy`: regenerates the published cost/accuracy tables and plots.
 
-use crate::accuracy::{accuracy_table, markdown, measure_case, AccuracySweep};
-use crate::cost::{
+use crate::app::plot::{write_svg, Chart, Series};
+use crate::studies::accuracy::{accuracy_table, markdown, measure_case, AccuracySweep};
+use crate::studies::cost::{
     balancer_pareto, crate_comparison, kneader_pareto, scaling, ParetoRow, ScalingRow,
 };
-use crate::plot::{write_svg, Chart, Series};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -107,13 +107,13 @@ fn bench_line(line: &str) -> Option<(String, String)> {
 fn target_benches() -> Result<TargetReport, String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let out = Command::new("bash")
-        .arg(root.join("firmware/run.sh"))
+        .arg(root.join("examples/qemu/run.sh"))
         .output()
-        .map_err(|e| format!("firmware/run.sh: {e}"))?;
+        .map_err(|e| format!("examples/qemu/run.sh: {e}"))?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     if !out.status.success() {
         return Err(format!(
-            "firmware/run.sh failed:\n{text}{}",
+            "examples/qemu/run.sh failed:\n{text}{}",
             String::from_utf8_lossy(&out.stderr)
         ));
     }

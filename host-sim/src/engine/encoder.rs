@@ -34,7 +34,7 @@ use serde::Deserialize;
 
 use drive_monitor::error::{finite, non_negative, positive, ConfigError};
 
-use crate::ode::ComponentPoly;
+use crate::engine::ode::ComponentPoly;
 
 /// Reference mark framing each revolution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
@@ -70,7 +70,7 @@ fn default_counter_bits() -> u32 {
 }
 
 /// Encoder, timer and fault parameters. Deserializable from TOML, but scene files describe the
-/// encoder with [`crate::scene::EncoderSpec`], which `drive-sim run` maps onto this.
+/// encoder with [`crate::app::scene::EncoderSpec`], which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EncoderConfig {
@@ -549,7 +549,7 @@ mod tests {
     use super::*;
 
     fn line(t0: f64, h: f64, base: f64, rate: f64) -> ComponentPoly {
-        let mut coeffs = [0.0; crate::ode::MAX_DENSE_DEGREE];
+        let mut coeffs = [0.0; crate::engine::ode::MAX_DENSE_DEGREE];
         coeffs[0] = rate * h;
         ComponentPoly {
             t0,
@@ -598,7 +598,7 @@ mod tests {
         let mut e = Encoder::new(EncoderConfig::ideal(8, 1e9)).unwrap();
         let pitch = TAU / 8.0;
         // φ = pitch/2 + 3·pitch·θ − 4·pitch·θ²: peak 1.0625 pitch at θ = 3/8, end −pitch/2.
-        let mut coeffs = [0.0; crate::ode::MAX_DENSE_DEGREE];
+        let mut coeffs = [0.0; crate::engine::ode::MAX_DENSE_DEGREE];
         coeffs[0] = 3.0 * pitch;
         coeffs[1] = -4.0 * pitch;
         let seg = ComponentPoly {

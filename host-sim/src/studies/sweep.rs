@@ -1,10 +1,10 @@
 //! `drive-sim sweep`: a vibration-machine scene at a series of prescribed rotor speeds, in
 //! parallel, comparing the criterion's zone with what the loads did in the simulation.
 
-use crate::predict;
-use crate::run::{run, Overrides};
-use crate::scene::{Scene, SceneError};
-use indicatif::{ProgressBar, ProgressStyle};
+use crate::app::predict;
+use crate::app::progress::progress_bar;
+use crate::app::run::{run, Overrides};
+use crate::app::scene::{Scene, SceneError};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -67,7 +67,7 @@ impl Sweep {
     /// it.
     pub fn publish(&self, name: &str, path: &Path, dir: &Path) -> Result<Vec<PathBuf>, String> {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let stem = crate::run::scene_stem(path);
+        let stem = crate::app::run::scene_stem(path);
         let SweepRequest {
             from,
             to,
@@ -127,7 +127,7 @@ impl Sweep {
     /// The regime map as an SVG: zones along the speed axis, simulated outcomes as points
     /// (1 = balancing, 0 = gathering) with the final residual unbalance.
     pub fn write_svg(&self, path: &Path, title: &str) -> Result<(), String> {
-        use crate::plot::{write_svg, Chart, Mark, Series};
+        use crate::app::plot::{write_svg, Chart, Mark, Series};
         let top = self.points.last().map_or(1.0, |p| p.speed);
         let mut marks: Vec<Mark> = self
             .zones
@@ -166,22 +166,6 @@ impl Sweep {
     }
 }
 
-/// A progress bar over `len` items named `unit` on stderr, or a hidden one.
-pub fn progress_bar(len: usize, unit: &str, show: bool) -> ProgressBar {
-    let bar = if show {
-        ProgressBar::new(len as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{bar:40}} {{pos}}/{{len}} {unit}, {{elapsed}} elapsed, ETA {{eta}}"
-        ))
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar
-}
-
 /// Runs `scene` at the speeds of `request`, in parallel.
 pub fn sweep(
     scene: &Scene,
@@ -214,7 +198,7 @@ pub fn sweep(
             format!("need at least 2 steps, got {steps}"),
         ));
     }
-    let (classifier, margin) = crate::run::regime_classifier(scene, file, &machine)?;
+    let (classifier, margin) = crate::app::run::regime_classifier(scene, file, &machine)?;
     // The sweep judges the loads, not δ: no encoder, so no edges to generate.
     let mut quiet = scene.clone();
     quiet.encoder = None;

@@ -50,7 +50,7 @@ pub trait OdeSystem {
 }
 
 /// Which integrator to use, with its parameters. Deserializable from TOML, but scene files choose
-/// it with `[simulation] integrator`, `rtol`, `atol` and `step` ([`crate::scene::SimulationSpec`]),
+/// it with `[simulation] integrator`, `rtol`, `atol` and `step` ([`crate::app::scene::SimulationSpec`]),
 /// which `drive-sim run` maps onto this.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]

@@ -1,7 +1,7 @@
 //! Design-time results of a scene, computed by the core (no simulation): predicted δ and the
 //! flywheel for the limit, the support unbalances and limits, the auto-balancer's zones.
 
-use crate::scene::{BalancerKindSpec, MotorSpec, Scene, SceneError};
+use crate::app::scene::{BalancerKindSpec, MotorSpec, Scene, SceneError};
 use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, Coupling, Machine, MachineConfig, Platform, SearchOptions,
 };

@@ -16,7 +16,7 @@ use serde::Deserialize;
 
 use drive_monitor::error::{finite, ConfigError};
 
-use crate::model::{Effect, Shaft};
+use crate::engine::model::{Effect, Shaft};
 
 /// A constant torque on the shaft (a test drive, or a constant external moment).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]

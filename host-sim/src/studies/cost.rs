@@ -11,13 +11,15 @@
 //!
 //! Wall times are the minimum of three runs on the machine at hand (stated in the output).
 
-use crate::encoder::{EncoderConfig, Reference};
-use crate::model::Effect;
-use crate::ode::Integrator;
-use crate::run::{run, Overrides};
-use crate::scene::{resolve, Scene};
-use crate::system::{DynamicShaft, Observer, ShaftModel, Simulation, SpeedLaw, StepView, System};
-use crate::vibration::VibrationMachine;
+use crate::app::run::{run, Overrides};
+use crate::app::scene::{resolve, Scene};
+use crate::engine::encoder::{EncoderConfig, Reference};
+use crate::engine::model::Effect;
+use crate::engine::ode::Integrator;
+use crate::engine::system::{
+    DynamicShaft, Observer, ShaftModel, Simulation, SpeedLaw, StepView, System,
+};
+use crate::engine::vibration::VibrationMachine;
 use drive_monitor::drive::DriveModel;
 use serde::Serialize;
 use std::path::Path;
@@ -118,7 +120,7 @@ fn best_of_three<T, F: FnMut() -> Result<T, String>>(mut f: F) -> Result<(f64, T
 
 fn kneader_model() -> Result<DriveModel, String> {
     let (scene, path) = resolve("kneader").map_err(|e| e.to_string())?;
-    crate::predict::drive_model(&scene, &path)
+    crate::app::predict::drive_model(&scene, &path)
         .map_err(|e| e.to_string())?
         .ok_or_else(|| "the kneader scene has no drive model".to_string())
 }
@@ -136,7 +138,7 @@ struct KneaderError<'a> {
 }
 
 impl Observer for KneaderError<'_> {
-    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn edge(&mut self, _edge: &crate::engine::encoder::Edge) {}
     fn step(&mut self, step: &StepView<'_>) {
         if step.t1() < self.from {
             return;
@@ -193,7 +195,7 @@ struct Sampler {
 }
 
 impl Observer for Sampler {
-    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn edge(&mut self, _edge: &crate::engine::encoder::Edge) {}
     fn step(&mut self, step: &StepView<'_>) {
         while self.next < self.times.len() && self.times[self.next] <= step.t1() {
             step.state_into(self.times[self.next], &mut self.buf);
@@ -208,7 +210,7 @@ fn balancer_states(
     integ: Integrator,
     duration: f64,
 ) -> Result<(u64, Vec<Vec<f64>>), String> {
-    let params = crate::run::vibration_params(scene, false, 100.0)
+    let params = crate::app::run::vibration_params(scene, false, 100.0)
         .ok_or_else(|| "the scene has no vibration machine".to_string())?;
     let vm = VibrationMachine::new(&params).map_err(|e| e.to_string())?;
     let system = System::new(
@@ -308,7 +310,7 @@ fn scaled_run(series: &'static str, value: String, text: &str) -> Result<Scaling
 
 /// Cost of the kneader run against simulated duration, encoder lines and added effects.
 pub fn scaling() -> Result<Vec<ScalingRow>, String> {
-    let base = crate::scene::BUNDLED
+    let base = crate::app::scene::BUNDLED
         .iter()
         .find(|(n, _)| *n == "kneader.toml")
         .map(|(_, t)| *t)
@@ -376,7 +378,7 @@ struct Every {
 }
 
 impl Observer for Every {
-    fn edge(&mut self, _edge: &crate::encoder::Edge) {}
+    fn edge(&mut self, _edge: &crate::engine::encoder::Edge) {}
     fn step(&mut self, step: &StepView<'_>) {
         while self.next <= step.t1() {
             if self.next >= self.from {

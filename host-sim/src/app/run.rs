@@ -6,16 +6,18 @@
 //! core's classifiers judge the measured speed. The report puts the core's measurements next
 //! to the design-time prediction and to what the simulation itself did.
 
-use crate::encoder::{EncoderConfig as SimEncoder, Reference, Runout};
-use crate::model::Effect;
-use crate::ode::Integrator;
-use crate::predict::{self, value_error};
-use crate::rotor_loads::{RotorLoads, RotorLoadsParams, StaticLoadParams, UnbalanceParams};
-use crate::scene::{BalancerKindSpec, FramingSpec, IntegratorKind, MotorSpec, Scene, SceneError};
-use crate::system::{
+use crate::app::predict::{self, value_error};
+use crate::app::scene::{
+    BalancerKindSpec, FramingSpec, IntegratorKind, MotorSpec, Scene, SceneError,
+};
+use crate::engine::encoder::{EncoderConfig as SimEncoder, Reference, Runout};
+use crate::engine::model::Effect;
+use crate::engine::ode::Integrator;
+use crate::engine::rotor_loads::{RotorLoads, RotorLoadsParams, StaticLoadParams, UnbalanceParams};
+use crate::engine::system::{
     DynamicShaft, InertiaHarmonic, Observer, ShaftModel, Simulation, SpeedLaw, StepView, System,
 };
-use crate::vibration::{
+use crate::engine::vibration::{
     classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind, LoadPlacement,
     PlatformParams, RegimeCriteria, RegimeReport, RegimeSample, VibrationMachine,
     VibrationMachineParams,
@@ -136,10 +138,10 @@ pub struct RunReport {
     /// Support results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsRunOut>,
-    /// Sommerfeld capture of loads started together ([`crate::capture`]): where they were
+    /// Sommerfeld capture of loads started together ([`crate::app::capture`]): where they were
     /// captured and released, against the core's capture window.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub capture: Option<crate::capture::CaptureReport>,
+    pub capture: Option<crate::app::capture::CaptureReport>,
     /// Every window (for plots).
     #[serde(skip)]
     pub window_list: Vec<WindowOut>,
@@ -192,7 +194,7 @@ pub fn vibration_params(
     rotor_speed: f64,
 ) -> Option<VibrationMachineParams> {
     let ab = scene.autobalancer.as_ref()?;
-    let together = together || ab.start == crate::scene::LoadStart::Together;
+    let together = together || ab.start == crate::app::scene::LoadStart::Together;
     let kind = match ab.kind {
         BalancerKindSpec::Ball => LoadKind::Ball,
         BalancerKindSpec::Roller => LoadKind::Roller,
@@ -356,7 +358,8 @@ fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
     c.drop_probability = e.drop_probability;
     c.glitch_probability = e.glitch_probability;
     c.seed = scene.simulation.seed;
-    crate::encoder::Encoder::new(c.clone()).map_err(|er| value_error(file, "encoder", er))?;
+    crate::engine::encoder::Encoder::new(c.clone())
+        .map_err(|er| value_error(file, "encoder", er))?;
     Ok(c)
 }
 
@@ -396,7 +399,7 @@ struct Collector<'a> {
 }
 
 impl Observer for Collector<'_> {
-    fn edge(&mut self, edge: &crate::encoder::Edge) {
+    fn edge(&mut self, edge: &crate::engine::encoder::Edge) {
         let Some(m) = self.monitor.as_mut() else {
             return;
         };
@@ -463,13 +466,13 @@ fn capture_analysis(
     file: &Path,
     params: Option<&VibrationMachineParams>,
     samples: &[RegimeSample],
-) -> Result<Option<crate::capture::CaptureReport>, SceneError> {
+) -> Result<Option<crate::app::capture::CaptureReport>, SceneError> {
     let together =
         params.is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
     if !together {
         return Ok(None);
     }
-    Ok(predict::machine(scene, file)?.and_then(|m| crate::capture::analyse(samples, &m)))
+    Ok(predict::machine(scene, file)?.and_then(|m| crate::app::capture::analyse(samples, &m)))
 }
 
 /// The scene's file name without its extension ("scene" if it has none): the stem of the

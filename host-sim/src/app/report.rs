@@ -1,9 +1,9 @@
 //! Readable text reports.
 
-use crate::plot::{write_svg, Chart, Mark, Series};
-use crate::predict::{self, Prediction};
-use crate::run::RunReport;
-use crate::scene::Scene;
+use crate::app::plot::{write_svg, Chart, Mark, Series};
+use crate::app::predict::{self, Prediction};
+use crate::app::run::RunReport;
+use crate::app::scene::Scene;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -90,7 +90,7 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         );
     }
     if let Some(c) = &r.capture {
-        s.push_str(&crate::capture::summary(c));
+        s.push_str(&crate::app::capture::summary(c));
     }
     if let Some(u) = &r.supports {
         let _ = writeln!(
@@ -189,7 +189,7 @@ pub fn run_plots(
     let machine = predict::machine(scene, file).map_err(|e| e.to_string())?;
     if let (Some(c), Some(machine)) = (&r.capture, &machine) {
         let path = dir.join(format!("{stem}-capture.svg"));
-        crate::capture::write_capture_svg(
+        crate::app::capture::write_capture_svg(
             &path,
             "Loads' speed against the rotor's (Sommerfeld capture)",
             &[("simulated".into(), c)],
@@ -197,7 +197,7 @@ pub fn run_plots(
         )?;
         out.push(path);
         let path = dir.join(format!("{stem}-capture-time.svg"));
-        crate::capture::write_time_svg(&path, "Rotor and loads' speeds", c)?;
+        crate::app::capture::write_time_svg(&path, "Rotor and loads' speeds", c)?;
         out.push(path);
     }
     if let Some(machine) = &machine {

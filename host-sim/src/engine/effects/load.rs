@@ -9,7 +9,7 @@ use serde::Deserialize;
 use drive_monitor::drive::Load;
 use drive_monitor::error::{non_negative, ConfigError};
 
-use crate::model::{Effect, Shaft};
+use crate::engine::model::{Effect, Shaft};
 
 /// The load opposes the drive: the effect's torque is −M_c(φ).
 impl Effect for Load {

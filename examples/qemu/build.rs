@@ -1,4 +1,4 @@
-//! Puts the repository's one memory map (`../memory.x`) on the linker's search path, where
+//! Puts the repository's one memory map (`../../memory.x`) on the linker's search path, where
 //! cortex-m-rt's `link.x` includes it.
 
 use std::{env, fs, path::PathBuf};
@@ -6,7 +6,7 @@ use std::{env, fs, path::PathBuf};
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
-    let memory_x = manifest.join("..").join("memory.x");
+    let memory_x = manifest.join("../..").join("memory.x");
     fs::copy(&memory_x, out.join("memory.x"))
         .unwrap_or_else(|e| panic!("cannot copy {}: {e}", memory_x.display()));
     println!("cargo:rustc-link-search={}", out.display());
