@@ -115,9 +115,10 @@ impl DeltaAlarm {
     /// Judges a window without changing state.
     pub fn judge(&self, r: &WindowReport) -> Verdict {
         let c = &self.config;
-        if !r.valid() {
-            Verdict::Invalid
-        } else if !r.steady {
+        let Some(r) = r.measurement() else {
+            return Verdict::Invalid;
+        };
+        if !r.steady {
             Verdict::Unsteady
         } else if r.noise_floor.is_nan() || r.noise_floor > c.floor_fraction * c.limit {
             Verdict::FloorNearLimit
@@ -131,9 +132,12 @@ impl DeltaAlarm {
     /// Takes a window; returns its verdict and the transition it caused, if any.
     pub fn update(&mut self, r: &WindowReport) -> (Verdict, Option<AlarmEvent>) {
         let v = self.judge(r);
-        if !matches!(v, Verdict::Over | Verdict::Within) {
+        let Some(r) = r
+            .measurement()
+            .filter(|_| matches!(v, Verdict::Over | Verdict::Within))
+        else {
             return (v, None);
-        }
+        };
         let m = self.config.of_last as u32;
         let mask = if m >= 32 { u32::MAX } else { (1u32 << m) - 1 };
         let below = r.delta < self.config.limit * (1.0 - self.config.hysteresis);
@@ -188,16 +192,21 @@ mod tests {
 
     fn window(delta: f32, steady: bool, floor: f32) -> WindowReport {
         WindowReport {
-            omega_max: 0.0,
-            omega_min: 0.0,
-            omega_mean: 100.0,
-            delta,
-            spread: delta,
-            noise_floor: floor,
+            start_edge: 0,
+            end_edge: 8192,
+            start_ticks: 0,
+            end_ticks: 1_000_000,
             revolutions: 8,
-            samples: 8192,
-            fault: None,
-            steady,
+            result: Ok(crate::irregularity::Measurement {
+                omega_max: 0.0,
+                omega_min: 0.0,
+                omega_mean: 100.0,
+                delta,
+                spread: delta,
+                noise_floor: floor,
+                samples: 8192,
+                steady,
+            }),
         }
     }
 
@@ -236,7 +245,7 @@ mod tests {
                 Verdict::FloorNearLimit
             );
             let mut bad = window(0.1, true, 1e-4);
-            bad.fault = Some(crate::speed::Fault::Glitch);
+            bad.result = Err(crate::speed::Fault::Glitch);
             assert_eq!(a.update(&bad).0, Verdict::Invalid);
         }
         assert!(!a.active());

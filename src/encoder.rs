@@ -1,36 +1,164 @@
 //! Encoder geometry and capture-timer setup, validated once.
 //!
-//! An [`EncoderConfig`] describes the disc (tooth positions, how revolutions are framed),
-//! the capture timer (clock, counter width) and the speed estimator. [`Encoder::new`]
-//! validates it and precomputes the tables the per-edge path reads: the angle from each
-//! edge to the next (uniform by default, or a learned/imported table) and the angle spanned
-//! by the last `K` edges ending at each tooth, so the per-edge work is a table lookup.
+//! An [`EncoderConfig`] names the wheel and how its revolutions are framed ([`Wheel`]: a
+//! uniform disc with an index pulse, a uniform disc without one, or a toothed wheel whose
+//! [`Pattern`] of missing or extra teeth frames the revolution), the capture timer (clock,
+//! counter width, input prescaler), the speed estimator and the tolerances of the edge checks
+//! ([`Tolerances`]). [`Encoder::new`] validates it once and derives everything the per-edge
+//! path needs as integers: the timeout and the acceptance band as tick arithmetic, the pitch of
+//! every tooth in angle units.
 //!
-//! Edges are numbered within a revolution: tooth 0 is the first edge after the frame marker
-//! (the index pulse, or the edge that ends the missing-tooth gap). `pitch(k)` is the angle
-//! travelled from edge k−1 to edge k; for a missing-tooth disc `pitch(0)` spans the gap.
+//! # Angle units
+//!
+//! Angles are integers: one unit is `2π / (positions · 2^16)`, so a nominal pitch (one grid
+//! position) is exactly [`PITCH_UNITS`] = 65 536 units and a turn at most 2^30 (positions are at
+//! most [`MAX_LINES`]). A speed sample is a span of units over a count of ticks, both exact,
+//! and speeds are compared by 64-bit cross products: no float and no rounding on the per-edge
+//! path. A learned per-tooth correction fits in 16 bits ([`crate::pitch::Corrected`]).
+//!
+//! # Teeth and frames
+//!
+//! Edges are numbered within a revolution: tooth 0 is the frame tooth — the first edge after
+//! the index pulse, or on a pattern wheel the edge that ends its most distinctive pitch (the
+//! gap of a missing-tooth wheel, the extra tooth of a `12+1` wheel). `pitch(k)` is the angle
+//! from edge k−1 to edge k; on a 60-2 wheel `pitch(0)` spans the gap (three positions).
 
 use crate::error::{positive, ConfigError};
 
-/// Full turn in f64, for configuration-time sums.
-const TAU64: f64 = core::f64::consts::TAU;
+/// Largest number of lines (grid positions) per revolution: a turn is at most 2^30 units.
+pub const MAX_LINES: u16 = 16_384;
+/// Largest grid of a [`Pattern`] (its teeth are a `u128` bit mask).
+pub const MAX_PATTERN_POSITIONS: u8 = 128;
+/// Most teeth a [`Pattern`] may have (its alignment search is a `u64` bit mask).
+pub const MAX_PATTERN_TEETH: usize = 64;
+/// Largest `K` of the `K`-edge speed estimator (the length of the timestamp ring).
+pub const MAX_SPAN: usize = 64;
+/// Angle units per grid position (one nominal pitch).
+pub const PITCH_UNITS: u32 = 1 << 16;
 
-/// How revolutions are framed.
+/// A toothed wheel: teeth at some of `positions` equally spaced grid positions.
+///
+/// The pattern frames the revolution, so it must not look the same after any rotation short of
+/// a full turn (a wheel with three equal gaps 120° apart cannot tell its revolutions apart) and
+/// must have at least one pitch that differs from the most common one. Examples:
+///
+/// - `Pattern::missing_teeth(60, 2)`: 60-2 (58 teeth, one gap of three pitches);
+/// - `Pattern::with_gaps(36, &[(0, 2), (12, 2), (27, 2)])`: a 36-2-2-2 wheel;
+/// - `Pattern::from_teeth(24, &[0, 1, 2, 4, ..., 22])`: a 12+1 wheel on a half-pitch grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Framing {
-    /// No once-per-revolution marker: teeth cannot be told apart, so only a uniform disc can be
-    /// used, revolutions are counted in edges, and a missing edge is detected by its long
-    /// interval only.
-    None,
-    /// A separate index pulse once per revolution, reported with [`crate::speed::SpeedTracker::on_index`].
-    Index,
-    /// `missing` consecutive tooth positions are absent (e.g. 60-2 has `missing = 2`); the long
-    /// interval across the gap frames the revolution.
-    MissingTooth {
-        /// Number of absent positions, 1 to 3.
-        missing: u8,
+pub struct Pattern {
+    positions: u8,
+    present: u128,
+}
+
+impl Pattern {
+    /// The wheel whose teeth are the set bits of `present` (bit `i` = a tooth at grid position
+    /// `i` of `positions`). Checked by [`Encoder::new`].
+    pub const fn from_mask(positions: u8, present: u128) -> Self {
+        Pattern { positions, present }
+    }
+
+    /// A wheel of `positions` positions with the last `missing` of them absent: one gap.
+    /// `missing_teeth(36, 2)` is the common 36-2 crank wheel.
+    pub const fn missing_teeth(positions: u8, missing: u8) -> Self {
+        let teeth = positions.saturating_sub(missing) as u32;
+        let present = if teeth >= 128 {
+            u128::MAX
+        } else {
+            (1u128 << teeth) - 1
+        };
+        Pattern { positions, present }
+    }
+
+    /// A wheel of `positions` positions with gaps `(first missing position, count)`.
+    pub fn with_gaps(positions: u8, gaps: &[(u8, u8)]) -> Result<Self, ConfigError> {
+        if positions == 0 || positions > MAX_PATTERN_POSITIONS {
+            return Err(ConfigError::OutOfRange("pattern.positions"));
+        }
+        let all = mask_of(positions);
+        let mut present = all;
+        for &(start, count) in gaps {
+            if start >= positions || count == 0 || u16::from(start) + u16::from(count) > 255 {
+                return Err(ConfigError::OutOfRange("pattern.gaps"));
+            }
+            for p in start..start + count {
+                present &= !(1u128 << (p % positions));
+            }
+        }
+        Ok(Pattern { positions, present })
+    }
+
+    /// A wheel of `positions` positions with teeth at the listed positions.
+    pub fn from_teeth(positions: u8, teeth: &[u8]) -> Result<Self, ConfigError> {
+        if positions == 0 || positions > MAX_PATTERN_POSITIONS {
+            return Err(ConfigError::OutOfRange("pattern.positions"));
+        }
+        let mut present = 0u128;
+        for &p in teeth {
+            if p >= positions {
+                return Err(ConfigError::OutOfRange("pattern.teeth"));
+            }
+            present |= 1u128 << p;
+        }
+        Ok(Pattern { positions, present })
+    }
+
+    /// Grid positions per revolution.
+    pub fn positions(&self) -> u8 {
+        self.positions
+    }
+
+    /// The present teeth as a bit mask over the grid positions.
+    pub fn present(&self) -> u128 {
+        self.present
+    }
+
+    /// Number of teeth.
+    pub fn teeth(&self) -> u32 {
+        (self.present & mask_of(self.positions)).count_ones()
+    }
+}
+
+/// Bits `0..n` set.
+const fn mask_of(n: u8) -> u128 {
+    if n >= 128 {
+        u128::MAX
+    } else {
+        (1u128 << n) - 1
+    }
+}
+
+/// The wheel, and with it how revolutions are framed. There is no default: a configuration
+/// names its framing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Wheel {
+    /// A uniform disc of `lines` lines and a separate index pulse once per revolution,
+    /// reported with its timestamp through `on_index`.
+    Indexed {
+        /// Lines per revolution (2 to [`MAX_LINES`]).
+        lines: u16,
     },
+    /// A uniform disc without a once-per-revolution marker: teeth cannot be told apart,
+    /// "revolutions" are counted in edges from the first, and a fault is found from the
+    /// intervals alone.
+    Unframed {
+        /// Lines per revolution (2 to [`MAX_LINES`]).
+        lines: u16,
+    },
+    /// A toothed wheel whose missing or extra teeth frame the revolution.
+    Pattern(Pattern),
+}
+
+impl Wheel {
+    /// Grid positions per revolution (lines of a uniform disc).
+    pub fn positions(&self) -> u16 {
+        match *self {
+            Wheel::Indexed { lines } | Wheel::Unframed { lines } => lines,
+            Wheel::Pattern(p) => u16::from(p.positions),
+        }
+    }
 }
 
 /// How the speed sample at each edge is estimated.
@@ -43,90 +171,227 @@ pub enum Estimator {
     Edges(u16),
 }
 
-/// Encoder and capture-timer description, in SI units.
+/// Tolerances of the edge checks. The defaults suit index discs and the common crank wheels
+/// (36-1, 36-2, 60-2, 8-1, 36-2-2-2, 12+1) from cranking to full speed; see each field.
+///
+/// Terms: the *per-pitch interval* of an edge is its interval divided by the nominal pitch it
+/// spans (a gap of two missing teeth spans three); the *swing* is the ratio of consecutive
+/// per-pitch intervals. Real cranking swings between about 0.5 and 2 from tooth to tooth
+/// (compression strokes on an 8-1 wheel reach 1.6; a clean signal stays within 0.45–2.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tolerances {
+    /// Edges whose swing lies within `[1/accept, accept]` are taken at once (the fast path);
+    /// others are judged with the two edges that follow them. Default 1.45: steady running
+    /// and ordinary ripple stay inside, so the careful judgement costs nothing on average.
+    /// 1.05 to 2.
+    pub accept: f32,
+    /// An edge arriving before this fraction of the expected interval is a glitch outright,
+    /// whatever follows: no real tooth swings that far (1/2.2 = 0.45 is the fastest real
+    /// swing, less a margin). Default 0.35. 0.05 to 0.6.
+    pub glitch_fraction: f32,
+    /// How much better (in squared log swings summed over the judged intervals) a fault must
+    /// explain the intervals than a clean tooth before it is called. Default 0.3: a steady
+    /// shaft with one tooth missing scores 0.96 in favour of the fault and a noise pulse
+    /// between 30 and 70 % of a tooth at least 0.96; a compression swing of 1.6 for one tooth
+    /// scores 0.34 in favour of a missing tooth that is not there, so the margin keeps it a
+    /// tooth. 0.05 to 2.
+    pub fault_margin: f32,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            accept: 1.45,
+            glitch_fraction: 0.35,
+            fault_margin: 0.3,
+        }
+    }
+}
+
+/// Encoder and capture-timer description, in SI units. Built by a constructor that names the
+/// wheel ([`EncoderConfig::indexed`], [`EncoderConfig::unframed`], [`EncoderConfig::pattern`],
+/// [`EncoderConfig::missing_teeth`]), then adjusted field by field.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EncoderConfig {
-    /// Tooth positions per revolution on the disc, including missing ones (e.g. 1024 lines, or
-    /// 60 for a 60-2 wheel).
-    pub positions: u16,
-    /// Revolution framing.
-    pub framing: Framing,
+    /// The wheel and its framing.
+    pub wheel: Wheel,
     /// Capture timer clock, Hz.
     pub timer_hz: f64,
     /// Width of the capture counter in bits (16 to 32); timestamps wrap modulo 2^bits.
     pub counter_bits: u8,
+    /// Input prescaler of the capture: one capture every `prescaler` edges (1, 2, 4 or 8;
+    /// uniform discs only, and `lines` must be a multiple of it).
+    pub prescaler: u8,
     /// Slowest speed still considered running, rad/s: an edge later than the longest pitch at
     /// this speed means the shaft stood still (timeout).
     pub min_speed: f64,
     /// Speed estimator.
     pub estimator: Estimator,
-    /// An edge whose interval is shorter than this fraction of the interval expected from the
-    /// previous one is rejected as a glitch (0.05 to 0.95; 0.5 is usual).
-    pub glitch_fraction: f32,
+    /// Tolerances of the edge checks.
+    pub tolerances: Tolerances,
 }
 
 impl EncoderConfig {
-    /// A uniform disc with `positions` lines framed by an index pulse, a 32-bit timer, per-edge
-    /// speed, glitch fraction 0.5 and a minimum speed of 1 rad/s.
-    pub fn new(positions: u16, timer_hz: f64) -> Self {
+    fn with_wheel(wheel: Wheel, timer_hz: f64) -> Self {
         EncoderConfig {
-            positions,
-            framing: Framing::Index,
+            wheel,
             timer_hz,
             counter_bits: 32,
+            prescaler: 1,
             min_speed: 1.0,
             estimator: Estimator::Edges(1),
-            glitch_fraction: 0.5,
+            tolerances: Tolerances::default(),
         }
+    }
+
+    /// A uniform disc of `lines` lines framed by an index pulse; a 32-bit timer at `timer_hz`,
+    /// per-edge speed, a minimum speed of 1 rad/s, default tolerances.
+    pub fn indexed(lines: u16, timer_hz: f64) -> Self {
+        Self::with_wheel(Wheel::Indexed { lines }, timer_hz)
+    }
+
+    /// A uniform disc of `lines` lines without a frame marker (otherwise as
+    /// [`EncoderConfig::indexed`]).
+    pub fn unframed(lines: u16, timer_hz: f64) -> Self {
+        Self::with_wheel(Wheel::Unframed { lines }, timer_hz)
+    }
+
+    /// A toothed wheel framed by its pattern (otherwise as [`EncoderConfig::indexed`]).
+    pub fn pattern(pattern: Pattern, timer_hz: f64) -> Self {
+        Self::with_wheel(Wheel::Pattern(pattern), timer_hz)
+    }
+
+    /// A missing-tooth wheel such as 60-2: `positions` positions, the last `missing` absent.
+    pub fn missing_teeth(positions: u8, missing: u8, timer_hz: f64) -> Self {
+        Self::pattern(Pattern::missing_teeth(positions, missing), timer_hz)
     }
 }
 
-/// A validated encoder with its per-tooth tables. `N` is the capacity: the largest number of
-/// edges per revolution this instance can hold (memory: 8·N bytes).
+/// How the frame is found, derived from the [`Wheel`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Framing {
+    /// An index pulse.
+    Index,
+    /// The wheel's pattern.
+    Pattern,
+    /// None.
+    None,
+}
+
+/// A validated encoder: the configuration and the integers the per-edge path works with.
+/// Memory: about 130 bytes whatever the wheel (a pattern's pitches are one byte per tooth).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Encoder<const N: usize> {
+pub struct Encoder {
     config: EncoderConfig,
+    framing: Framing,
     edges: u16,
     k: u16,
     mask: u32,
-    timeout_ticks: u32,
+    timeout: u32,
+    /// `accept` and its inverse as 0.32 fixed-point fractions: the band of the next interval
+    /// is `[prev·lo/2^32, prev + prev·hi/2^32]` for a tooth of the previous one's pitch.
+    band_lo: u32,
+    band_hi: u32,
     timer_hz: f32,
-    inv_timer_hz: f32,
-    gap_ratio: f32,
-    uniform: f32,
-    /// Angle from edge k−1 to edge k, rad.
-    pitch: [f32; N],
-    /// Angle spanned by the `k` edges ending at edge k (sum of `k` pitches), rad.
-    span: [f32; N],
+    /// Radians per angle unit.
+    unit_rad: f32,
+    /// Nominal pitch of every tooth in grid positions (pattern wheels only).
+    pattern: [u8; MAX_PATTERN_TEETH],
+    /// Grid positions of the most common pitch.
+    base: u8,
+    /// Teeth whose pitch is longer / shorter than the base (pattern wheels), bit k = tooth k.
+    long: u64,
+    short: u64,
+    /// Span of `k` nominal pitches on a uniform disc, units.
+    uniform_span: u32,
+    /// Whether every tooth has the same nominal pitch.
+    uniform: bool,
 }
 
-impl<const N: usize> Encoder<N> {
-    /// Validates `config` and builds the uniform tables.
+impl Encoder {
+    /// A placeholder with no edges: a monitor holding it ignores everything until configured.
+    pub const UNCONFIGURED: Encoder = Encoder {
+        config: EncoderConfig {
+            wheel: Wheel::Unframed { lines: 0 },
+            timer_hz: 0.0,
+            counter_bits: 32,
+            prescaler: 1,
+            min_speed: 0.0,
+            estimator: Estimator::Edges(1),
+            tolerances: Tolerances {
+                accept: 1.45,
+                glitch_fraction: 0.35,
+                fault_margin: 0.3,
+            },
+        },
+        framing: Framing::None,
+        edges: 0,
+        k: 1,
+        mask: u32::MAX,
+        timeout: 0,
+        band_lo: 0,
+        band_hi: 0,
+        timer_hz: 0.0,
+        unit_rad: 0.0,
+        pattern: [0; MAX_PATTERN_TEETH],
+        base: 1,
+        long: 0,
+        short: 0,
+        uniform_span: 0,
+        uniform: true,
+    };
+
+    /// Validates `config` and derives the per-edge constants.
     ///
     /// Besides each field's range, the timer must fit the speed range: the longest pitch at
     /// `min_speed` must last fewer ticks than the counter holds (`Inconsistent("min_speed")`)
-    /// and at least 2 ticks (`Inconsistent("timer_hz")`).
+    /// and at least 2 ticks (`Inconsistent("timer_hz")`), and `K` of them must fit in 32 bits
+    /// (`Inconsistent("estimator.edges")`).
     pub fn new(config: EncoderConfig) -> Result<Self, ConfigError> {
-        let missing = match config.framing {
-            Framing::MissingTooth { missing } => {
-                if !(1..=3).contains(&missing) {
-                    return Err(ConfigError::OutOfRange("framing.missing"));
+        let mut pattern = [0u8; MAX_PATTERN_TEETH];
+        let prescaler = config.prescaler;
+        if !matches!(prescaler, 1 | 2 | 4 | 8) {
+            return Err(ConfigError::OutOfRange("prescaler"));
+        }
+        let (framing, positions, edges, base, long, short) = match config.wheel {
+            Wheel::Indexed { lines } | Wheel::Unframed { lines } => {
+                if !(2..=MAX_LINES).contains(&lines) {
+                    return Err(ConfigError::OutOfRange("lines"));
                 }
-                missing as u16
+                if lines % u16::from(prescaler) != 0 || lines / u16::from(prescaler) < 2 {
+                    return Err(ConfigError::Inconsistent("prescaler"));
+                }
+                let framing = match config.wheel {
+                    Wheel::Indexed { .. } => Framing::Index,
+                    _ => Framing::None,
+                };
+                (
+                    framing,
+                    lines,
+                    lines / u16::from(prescaler),
+                    prescaler,
+                    0,
+                    0,
+                )
             }
-            _ => 0,
+            Wheel::Pattern(p) => {
+                if prescaler != 1 {
+                    return Err(ConfigError::Inconsistent("prescaler"));
+                }
+                let (edges, base, long, short) = pattern_table(p, &mut pattern)?;
+                (
+                    Framing::Pattern,
+                    u16::from(p.positions),
+                    edges,
+                    base,
+                    long,
+                    short,
+                )
+            }
         };
-        if config.positions < 2 {
-            return Err(ConfigError::OutOfRange("positions"));
-        }
-        let edges = config.positions.saturating_sub(missing);
-        if edges < 2 || missing > 0 && edges < 2 * missing + 2 {
-            return Err(ConfigError::OutOfRange("positions"));
-        }
-        if edges as usize > N {
-            return Err(ConfigError::Capacity("positions"));
-        }
         let timer_hz = positive("timer_hz", config.timer_hz)?;
         if !(1.0..=1.0e10).contains(&timer_hz) {
             return Err(ConfigError::OutOfRange("timer_hz"));
@@ -141,114 +406,67 @@ impl<const N: usize> Encoder<N> {
         };
         let min_speed = positive("min_speed", config.min_speed)?;
         let Estimator::Edges(k) = config.estimator;
-        if k == 0 || k > edges || k as usize > crate::speed::MAX_SPAN {
+        if k == 0 || k > edges || usize::from(k) > MAX_SPAN {
             return Err(ConfigError::OutOfRange("estimator.edges"));
         }
-        let g = config.glitch_fraction;
-        if !g.is_finite() {
-            return Err(ConfigError::NonFinite("glitch_fraction"));
-        }
-        if !(0.05..=0.95).contains(&g) {
-            return Err(ConfigError::OutOfRange("glitch_fraction"));
-        }
-        let pitch = TAU64 / config.positions as f64;
-        let longest = pitch * (missing as f64 + 1.0);
-        let timeout = longest / min_speed * timer_hz;
+        let t = config.tolerances;
+        check_range("tolerances.accept", t.accept, 1.05, 2.0)?;
+        check_range("tolerances.glitch_fraction", t.glitch_fraction, 0.05, 0.6)?;
+        check_range("tolerances.fault_margin", t.fault_margin, 0.05, 2.0)?;
+        let longest = if framing == Framing::Pattern {
+            pattern
+                .iter()
+                .take(usize::from(edges))
+                .copied()
+                .max()
+                .unwrap_or(1)
+        } else {
+            base
+        };
+        let grid = core::f64::consts::TAU / f64::from(positions);
+        let timeout = grid * f64::from(longest) / min_speed * timer_hz;
         // Intervals are measured modulo the counter: a timeout beyond its range cannot be seen.
-        if !timeout.is_finite() || timeout >= mask as f64 {
+        if !timeout.is_finite() || timeout >= f64::from(mask) {
             return Err(ConfigError::Inconsistent("min_speed"));
         }
-        // A pitch at the minimum speed shorter than 2 ticks carries no speed information: every
-        // interval the tracker accepts would be a single tick.
+        // A pitch at the minimum speed shorter than 2 ticks carries no speed information.
         if timeout < 2.0 {
             return Err(ConfigError::Inconsistent("timer_hz"));
         }
-        // A K-edge sample must fit in u32 ticks even at the slowest speed.
-        if timeout * k as f64 >= u32::MAX as f64 {
+        // A K-edge sample (a sum of K intervals) must fit in 32 bits even at the slowest speed.
+        if timeout * f64::from(k) >= f64::from(u32::MAX) {
             return Err(ConfigError::Inconsistent("estimator.edges"));
         }
-        let mut enc = Encoder {
+        let uniform = long == 0 && short == 0;
+        Ok(Encoder {
             config,
+            framing,
             edges,
             k,
             mask,
-            timeout_ticks: libm::ceil(timeout) as u32,
+            timeout: libm::ceil(timeout) as u32,
+            band_lo: fraction_q32(1.0 / f64::from(t.accept)),
+            band_hi: fraction_q32(f64::from(t.accept) - 1.0),
             timer_hz: timer_hz as f32,
-            inv_timer_hz: (1.0 / timer_hz) as f32,
-            // Midway between a normal pitch (1) and the gap (missing + 1).
-            gap_ratio: 1.0 + 0.5 * missing as f32,
-            uniform: pitch as f32,
-            pitch: [0.0; N],
-            span: [0.0; N],
-        };
-        let mut table = [0.0f64; N];
-        for (i, p) in table.iter_mut().enumerate().take(edges as usize) {
-            *p = if i == 0 { longest } else { pitch };
-        }
-        enc.load(&table);
-        Ok(enc)
-    }
-
-    /// Replaces the per-tooth pitch table (rad, edge k−1 to edge k, `edges()` entries), e.g. a
-    /// learned correction restored after a reboot. Each pitch must be positive and within 50 %
-    /// of its nominal value, and the table must close the turn (sum 2π within 1e-4 rad).
-    pub fn with_pitches(mut self, pitches: &[f32]) -> Result<Self, ConfigError> {
-        if self.config.framing == Framing::None {
-            return Err(ConfigError::Inconsistent("pitches (teeth unframed)"));
-        }
-        if pitches.len() != self.edges as usize {
-            return Err(ConfigError::OutOfRange("pitches.len"));
-        }
-        let mut table = [0.0f64; N];
-        let mut sum = 0.0f64;
-        for (i, (&p, t)) in pitches.iter().zip(table.iter_mut()).enumerate() {
-            let p = positive("pitches", p as f64)?;
-            let nominal = self.nominal_pitch(i);
-            if (p / nominal - 1.0).abs() > 0.5 {
-                return Err(ConfigError::OutOfRange("pitches"));
-            }
-            *t = p;
-            sum += p;
-        }
-        if (sum - TAU64).abs() > 1e-4 {
-            return Err(ConfigError::Inconsistent("pitches (sum)"));
-        }
-        // Rescale so the stored table closes the turn to f64 rounding.
-        for t in table.iter_mut() {
-            *t *= TAU64 / sum;
-        }
-        self.load(&table);
-        Ok(self)
-    }
-
-    fn nominal_pitch(&self, tooth: usize) -> f64 {
-        let p = TAU64 / self.config.positions as f64;
-        match self.config.framing {
-            Framing::MissingTooth { missing } if tooth == 0 => p * (missing as f64 + 1.0),
-            _ => p,
-        }
-    }
-
-    fn load(&mut self, table: &[f64; N]) {
-        let n = self.edges as usize;
-        let k = self.k as usize;
-        for i in 0..n {
-            self.pitch[i] = table[i] as f32;
-            // Each span summed in f64 from the pitches, not as a difference of cumulative angles
-            // (which would cancel): exact to one f32 rounding.
-            let mut s = 0.0f64;
-            for j in 0..k {
-                s += table[(i + n - j) % n];
-            }
-            self.span[i] = s as f32;
-        }
+            unit_rad: (grid / f64::from(PITCH_UNITS)) as f32,
+            pattern,
+            base,
+            long,
+            short,
+            uniform_span: u32::from(k) * u32::from(base) * PITCH_UNITS,
+            uniform,
+        })
     }
 
     /// The configuration this encoder was built from.
     pub fn config(&self) -> &EncoderConfig {
         &self.config
     }
-    /// Edges per revolution (positions less missing ones).
+    /// How revolutions are framed.
+    pub fn framing(&self) -> Framing {
+        self.framing
+    }
+    /// Captured edges per revolution (teeth, or lines over the prescaler).
     pub fn edges(&self) -> u16 {
         self.edges
     }
@@ -262,36 +480,185 @@ impl<const N: usize> Encoder<N> {
     }
     /// Ticks without an edge after which the shaft is at standstill.
     pub fn timeout_ticks(&self) -> u32 {
-        self.timeout_ticks
+        self.timeout
     }
     /// Timer clock, Hz.
     pub fn timer_hz(&self) -> f32 {
         self.timer_hz
     }
-    /// Timer period, s.
-    pub fn tick_seconds(&self) -> f32 {
-        self.inv_timer_hz
+    /// Radians per angle unit.
+    pub fn unit_rad(&self) -> f32 {
+        self.unit_rad
     }
-    /// Interval ratio above which an interval is taken as the missing-tooth gap.
-    pub(crate) fn gap_ratio(&self) -> f32 {
-        self.gap_ratio
-    }
-    /// Nominal pitch of one tooth position, 2π/positions.
-    pub fn uniform_pitch(&self) -> f32 {
+    /// Whether every tooth has the same nominal pitch (a uniform disc).
+    pub fn is_uniform(&self) -> bool {
         self.uniform
     }
-    /// Angle from edge `tooth − 1` to edge `tooth` (0 for an index beyond the table).
-    pub fn pitch(&self, tooth: u16) -> f32 {
-        self.pitch.get(tooth as usize).copied().unwrap_or(0.0)
+    /// Nominal pitch of `tooth` (the angle from the edge before it) in units; 0 beyond the
+    /// wheel.
+    pub fn nominal_pitch(&self, tooth: u16) -> u32 {
+        self.grid_pitch(tooth) * PITCH_UNITS
     }
-    /// Angle of the `samples_span()` edges ending at `tooth`.
-    pub fn span(&self, tooth: u16) -> f32 {
-        self.span.get(tooth as usize).copied().unwrap_or(0.0)
+    /// Nominal pitch of `tooth` in grid positions (0 beyond the wheel).
+    #[inline]
+    pub(crate) fn grid_pitch(&self, tooth: u16) -> u32 {
+        if tooth >= self.edges {
+            0
+        } else if self.framing != Framing::Pattern {
+            u32::from(self.base)
+        } else {
+            self.pattern
+                .get(usize::from(tooth))
+                .map_or(0, |&p| u32::from(p))
+        }
     }
-    /// The pitch table in use (`edges()` entries).
-    pub fn pitches(&self) -> &[f32] {
-        self.pitch.get(..self.edges as usize).unwrap_or(&[])
+    /// Grid positions of the most common pitch.
+    pub(crate) fn base_pitch(&self) -> u32 {
+        u32::from(self.base)
     }
+    /// Teeth whose pitch is longer than the base (bit k = tooth k; pattern wheels).
+    pub(crate) fn long_teeth(&self) -> u64 {
+        self.long
+    }
+    /// Teeth whose pitch is shorter than the base (bit k = tooth k; pattern wheels).
+    pub(crate) fn short_teeth(&self) -> u64 {
+        self.short
+    }
+    /// Span of `samples_span()` teeth on a uniform disc, units.
+    pub fn uniform_span(&self) -> u32 {
+        self.uniform_span
+    }
+    /// Lower and upper fast-path band factors (0.32 fixed point; the upper one is the excess
+    /// over 1).
+    pub(crate) fn band(&self) -> (u32, u32) {
+        (self.band_lo, self.band_hi)
+    }
+}
+
+/// `x` (in `[0, 1)`) as a 0.32 fixed-point fraction.
+fn fraction_q32(x: f64) -> u32 {
+    let q = libm::round(x * 4_294_967_296.0);
+    if q >= 4_294_967_295.0 {
+        u32::MAX
+    } else if q <= 0.0 {
+        0
+    } else {
+        q as u32
+    }
+}
+
+fn check_range(name: &'static str, x: f32, lo: f32, hi: f32) -> Result<(), ConfigError> {
+    if !x.is_finite() {
+        return Err(ConfigError::NonFinite(name));
+    }
+    if !(lo..=hi).contains(&x) {
+        return Err(ConfigError::OutOfRange(name));
+    }
+    Ok(())
+}
+
+/// Validates a pattern and writes the grid pitch of every tooth, tooth 0 first, into `table`.
+/// Returns (teeth, base pitch, long-teeth mask, short-teeth mask).
+fn pattern_table(
+    p: Pattern,
+    table: &mut [u8; MAX_PATTERN_TEETH],
+) -> Result<(u16, u8, u64, u64), ConfigError> {
+    let n = p.positions;
+    if !(3..=MAX_PATTERN_POSITIONS).contains(&n) {
+        return Err(ConfigError::OutOfRange("pattern.positions"));
+    }
+    let present = p.present;
+    if present & !mask_of(n) != 0 {
+        return Err(ConfigError::OutOfRange("pattern.teeth"));
+    }
+    let teeth = present.count_ones() as usize;
+    if teeth < 3 {
+        return Err(ConfigError::OutOfRange("pattern.teeth"));
+    }
+    if teeth > MAX_PATTERN_TEETH {
+        return Err(ConfigError::Capacity("pattern.teeth"));
+    }
+    // Pitches in grid order: tooth i ends the pitch from the tooth before it.
+    let mut pitch = [0u8; MAX_PATTERN_TEETH];
+    let mut pos = [0u8; MAX_PATTERN_TEETH];
+    let mut j = 0usize;
+    for q in 0..n {
+        if present & (1u128 << q) != 0 {
+            if let Some(slot) = pos.get_mut(j) {
+                *slot = q;
+            }
+            j += 1;
+        }
+    }
+    for i in 0..teeth {
+        let here = pos.get(i).copied().unwrap_or(0);
+        let before = pos.get((i + teeth - 1) % teeth).copied().unwrap_or(0);
+        let d = (u16::from(here) + u16::from(n) - u16::from(before)) % u16::from(n);
+        if let Some(slot) = pitch.get_mut(i) {
+            *slot = if d == 0 { n } else { d as u8 };
+        }
+    }
+    // The base pitch is the most common one; special teeth differ from it.
+    let mut base = 0u8;
+    let mut best = 0usize;
+    for &c in pitch.iter().take(teeth) {
+        let count = pitch.iter().take(teeth).filter(|&&x| x == c).count();
+        if count > best || (count == best && c < base) {
+            best = count;
+            base = c;
+        }
+    }
+    if best == teeth {
+        return Err(ConfigError::Inconsistent(
+            "pattern (uniform: use an indexed or unframed disc)",
+        ));
+    }
+    // Special pitches must be told from the base at a glance: at least 1.5× or at most 0.75×.
+    for &c in pitch.iter().take(teeth) {
+        let (c, b) = (u16::from(c), u16::from(base));
+        if c != b && 4 * c > 3 * b && 2 * c < 3 * b {
+            return Err(ConfigError::Inconsistent(
+                "pattern (a pitch too close to the base)",
+            ));
+        }
+    }
+    // The frame tooth: the one whose pitch differs most from the base (ratio in either
+    // direction), the first in grid order among equals.
+    let distinct = |c: u8| -> u32 {
+        let (c, b) = (u32::from(c), u32::from(base));
+        // Compare max(c/b, b/c) without division: scale both ways by b·c.
+        if c >= b { c * c } else { b * b }.saturating_mul(1000) / (b * c).max(1)
+    };
+    let mut frame = 0usize;
+    for i in 0..teeth {
+        if distinct(pitch.get(i).copied().unwrap_or(base))
+            > distinct(pitch.get(frame).copied().unwrap_or(base))
+        {
+            frame = i;
+        }
+    }
+    // A pattern that repeats after a fraction of a turn cannot frame a revolution.
+    for shift in 1..teeth {
+        if teeth % shift == 0 && (0..teeth).all(|i| pitch.get(i) == pitch.get((i + shift) % teeth))
+        {
+            return Err(ConfigError::Inconsistent(
+                "pattern (rotationally symmetric)",
+            ));
+        }
+    }
+    let (mut long, mut short) = (0u64, 0u64);
+    for i in 0..teeth {
+        let c = pitch.get((frame + i) % teeth).copied().unwrap_or(base);
+        if let Some(slot) = table.get_mut(i) {
+            *slot = c;
+        }
+        if c > base {
+            long |= 1 << i;
+        } else if c < base {
+            short |= 1 << i;
+        }
+    }
+    Ok((teeth as u16, base, long, short))
 }
 
 #[cfg(test)]
@@ -299,49 +666,140 @@ mod tests {
     use super::*;
 
     #[test]
-    fn uniform_tables_close_the_turn() {
-        let mut c = EncoderConfig::new(1000, 84e6);
+    fn uniform_discs_have_exact_integer_pitches() {
+        let mut c = EncoderConfig::indexed(1000, 84e6);
         c.estimator = Estimator::Edges(8);
-        let e = Encoder::<1024>::new(c).unwrap();
-        let sum: f64 = e.pitches().iter().map(|&p| p as f64).sum();
-        assert!((sum - TAU64).abs() < 1e-5);
-        assert!((e.span(3) as f64 - 8.0 * TAU64 / 1000.0).abs() < 1e-8);
+        let e = Encoder::new(c).unwrap();
+        assert_eq!(e.edges(), 1000);
+        assert_eq!(e.nominal_pitch(3), PITCH_UNITS);
+        assert_eq!(e.uniform_span(), 8 * PITCH_UNITS);
+        assert!(e.is_uniform());
+        let turn = f64::from(e.unit_rad()) * 1000.0 * f64::from(PITCH_UNITS);
+        assert!((turn - core::f64::consts::TAU).abs() < 1e-6);
         assert_eq!(e.mask(), u32::MAX);
+        assert_eq!(e.framing(), Framing::Index);
     }
 
     #[test]
-    fn missing_tooth_gap_spans_the_absent_positions() {
-        let mut c = EncoderConfig::new(60, 1e6);
-        c.framing = Framing::MissingTooth { missing: 2 };
+    fn a_prescaler_makes_each_capture_span_several_lines() {
+        let mut c = EncoderConfig::indexed(1024, 84e6);
+        c.prescaler = 4;
+        c.estimator = Estimator::Edges(4);
+        let e = Encoder::new(c).unwrap();
+        assert_eq!(e.edges(), 256);
+        assert_eq!(e.nominal_pitch(0), 4 * PITCH_UNITS);
+        assert_eq!(e.uniform_span(), 16 * PITCH_UNITS);
+        c.prescaler = 3;
+        assert_eq!(
+            Encoder::new(c).err(),
+            Some(ConfigError::OutOfRange("prescaler"))
+        );
+        let mut c = EncoderConfig::indexed(1022, 84e6);
+        c.prescaler = 4;
+        assert_eq!(
+            Encoder::new(c).err(),
+            Some(ConfigError::Inconsistent("prescaler"))
+        );
+        let mut c = EncoderConfig::missing_teeth(36, 2, 1e6);
+        c.prescaler = 2;
+        assert_eq!(
+            Encoder::new(c).err(),
+            Some(ConfigError::Inconsistent("prescaler"))
+        );
+    }
+
+    #[test]
+    fn missing_tooth_gap_is_tooth_zero() {
+        let mut c = EncoderConfig::missing_teeth(60, 2, 1e6);
         c.estimator = Estimator::Edges(2);
-        let e = Encoder::<64>::new(c).unwrap();
+        let e = Encoder::new(c).unwrap();
         assert_eq!(e.edges(), 58);
-        let p = TAU64 / 60.0;
-        assert!((e.pitch(0) as f64 - 3.0 * p).abs() < 1e-7);
-        assert!((e.pitch(1) as f64 - p).abs() < 1e-7);
-        // The span ending at tooth 0 covers tooth 57 and the gap.
-        assert!((e.span(0) as f64 - 4.0 * p).abs() < 1e-7);
-        assert!((e.gap_ratio() - 2.0).abs() < 1e-6);
+        assert_eq!(e.framing(), Framing::Pattern);
+        assert_eq!(e.nominal_pitch(0), 3 * PITCH_UNITS);
+        assert_eq!(e.nominal_pitch(1), PITCH_UNITS);
+        assert_eq!(e.nominal_pitch(57), PITCH_UNITS);
+        assert_eq!(e.nominal_pitch(58), 0);
+        assert_eq!(e.long_teeth(), 1);
+        assert_eq!(e.short_teeth(), 0);
+        assert!(!e.is_uniform());
+        // The timeout covers the gap at the minimum speed.
+        let gap = 3.0 * core::f64::consts::TAU / 60.0;
+        assert_eq!(e.timeout_ticks(), libm::ceil(gap / 1.0 * 1e6) as u32);
+    }
+
+    #[test]
+    fn general_patterns_are_numbered_from_their_most_distinctive_tooth() {
+        // 36-2-1: a gap of two and a gap of one; tooth 0 ends the larger.
+        let p = Pattern::with_gaps(36, &[(10, 1), (30, 2)]).unwrap();
+        let e = Encoder::new(EncoderConfig::pattern(p, 1e6)).unwrap();
+        assert_eq!(e.edges(), 33);
+        assert_eq!(e.nominal_pitch(0), 3 * PITCH_UNITS);
+        // Teeth 32..=35 → 0..3 after the big gap; the small gap (position 10) ends at the tooth
+        // at position 11: after 0..9 (10 teeth) → tooth 4 + 10 = 14.
+        assert_eq!(e.long_teeth(), 1 | 1 << 14);
+        // 12+1 on a half-pitch grid: the extra tooth at position 7 splits a pitch in two.
+        let mut teeth = [0u8; 13];
+        for (i, t) in teeth.iter_mut().take(12).enumerate() {
+            *t = 2 * i as u8;
+        }
+        teeth[12] = 7;
+        let p = Pattern::from_teeth(24, &teeth).unwrap();
+        let e = Encoder::new(EncoderConfig::pattern(p, 1e6)).unwrap();
+        assert_eq!(e.edges(), 13);
+        assert_eq!(e.base_pitch(), 2);
+        assert_eq!(e.nominal_pitch(0), PITCH_UNITS);
+        assert_eq!(e.nominal_pitch(1), PITCH_UNITS);
+        assert_eq!(e.short_teeth(), 0b11);
+        assert_eq!(e.long_teeth(), 0);
+    }
+
+    #[test]
+    fn patterns_that_cannot_frame_are_rejected() {
+        let bad = |p: Pattern| Encoder::new(EncoderConfig::pattern(p, 1e6)).err();
+        // Three equal gaps 120° apart look the same after a third of a turn.
+        let sym = Pattern::with_gaps(36, &[(0, 2), (12, 2), (24, 2)]).unwrap();
+        assert_eq!(
+            bad(sym),
+            Some(ConfigError::Inconsistent(
+                "pattern (rotationally symmetric)"
+            ))
+        );
+        // Uneven gaps frame.
+        let asym = Pattern::with_gaps(36, &[(0, 2), (12, 2), (27, 2)]).unwrap();
+        assert_eq!(bad(asym), None);
+        assert!(matches!(
+            bad(Pattern::from_mask(36, (1u128 << 36) - 1)),
+            Some(ConfigError::Inconsistent(_))
+        ));
+        assert_eq!(
+            bad(Pattern::from_mask(36, 1 << 40)),
+            Some(ConfigError::OutOfRange("pattern.teeth"))
+        );
+        assert_eq!(
+            bad(Pattern::missing_teeth(100, 2)),
+            Some(ConfigError::Capacity("pattern.teeth"))
+        );
+        assert_eq!(
+            Pattern::with_gaps(36, &[(40, 2)]).err(),
+            Some(ConfigError::OutOfRange("pattern.gaps"))
+        );
     }
 
     #[test]
     fn bad_configs_name_the_parameter() {
-        let ok = EncoderConfig::new(100, 1e6);
+        let ok = EncoderConfig::indexed(100, 1e6);
         let with = |f: &dyn Fn(&mut EncoderConfig)| {
             let mut c = ok;
             f(&mut c);
-            Encoder::<128>::new(c).err()
+            Encoder::new(c).err()
         };
+        assert_eq!(with(&|_| ()), None);
         assert_eq!(
             with(&|c| c.timer_hz = f64::NAN),
             Some(ConfigError::NonFinite("timer_hz"))
         );
         assert_eq!(
             with(&|c| c.timer_hz = 0.0),
-            Some(ConfigError::NotPositive("timer_hz"))
-        );
-        assert_eq!(
-            with(&|c| c.timer_hz = -1.0),
             Some(ConfigError::NotPositive("timer_hz"))
         );
         assert_eq!(
@@ -353,12 +811,12 @@ mod tests {
             Some(ConfigError::NonFinite("min_speed"))
         );
         assert_eq!(
-            with(&|c| c.positions = 1),
-            Some(ConfigError::OutOfRange("positions"))
+            with(&|c| c.wheel = Wheel::Indexed { lines: 1 }),
+            Some(ConfigError::OutOfRange("lines"))
         );
         assert_eq!(
-            with(&|c| c.positions = 200),
-            Some(ConfigError::Capacity("positions"))
+            with(&|c| c.wheel = Wheel::Unframed { lines: 20_000 }),
+            Some(ConfigError::OutOfRange("lines"))
         );
         assert_eq!(
             with(&|c| c.counter_bits = 8),
@@ -369,12 +827,20 @@ mod tests {
             Some(ConfigError::OutOfRange("estimator.edges"))
         );
         assert_eq!(
-            with(&|c| c.glitch_fraction = f32::NAN),
-            Some(ConfigError::NonFinite("glitch_fraction"))
+            with(&|c| c.estimator = Estimator::Edges(65)),
+            Some(ConfigError::OutOfRange("estimator.edges"))
         );
         assert_eq!(
-            with(&|c| c.framing = Framing::MissingTooth { missing: 4 }),
-            Some(ConfigError::OutOfRange("framing.missing"))
+            with(&|c| c.tolerances.accept = f32::NAN),
+            Some(ConfigError::NonFinite("tolerances.accept"))
+        );
+        assert_eq!(
+            with(&|c| c.tolerances.glitch_fraction = 0.9),
+            Some(ConfigError::OutOfRange("tolerances.glitch_fraction"))
+        );
+        assert_eq!(
+            with(&|c| c.tolerances.fault_margin = -1.0),
+            Some(ConfigError::OutOfRange("tolerances.fault_margin"))
         );
         // A 16-bit counter at 84 MHz wraps every 780 µs: 1 rad/s on 100 lines is 63 ms per edge.
         assert_eq!(
@@ -383,31 +849,6 @@ mod tests {
                 c.timer_hz = 84e6
             }),
             Some(ConfigError::Inconsistent("min_speed"))
-        );
-    }
-
-    #[test]
-    fn imported_pitches_are_checked() {
-        let e = Encoder::<8>::new(EncoderConfig::new(8, 1e6)).unwrap();
-        let p = (TAU64 / 8.0) as f32;
-        let mut t = [p; 8];
-        t[0] *= 1.01;
-        t[1] *= 0.99;
-        let e2 = e.clone().with_pitches(&t).unwrap();
-        assert!((e2.pitch(0) - t[0]).abs() < 1e-6);
-        assert_eq!(
-            e.clone().with_pitches(&t[..7]).err(),
-            Some(ConfigError::OutOfRange("pitches.len"))
-        );
-        t[2] = f32::NAN;
-        assert_eq!(
-            e.clone().with_pitches(&t).err(),
-            Some(ConfigError::NonFinite("pitches"))
-        );
-        let t = [p * 1.01; 8];
-        assert_eq!(
-            e.with_pitches(&t).err(),
-            Some(ConfigError::Inconsistent("pitches (sum)"))
         );
     }
 }

@@ -6,13 +6,18 @@
 //! mean speed is exact: ω_mean = W·2π / (sum of the window's intervals), the intervals summed
 //! as integers (no drift over any run length).
 //!
-//! Reported per window: ωmax, ωmin, ω_mean, δ = 2(ωmax − ωmin)/(ωmax + ωmin) (seed 000,
-//! eq. 13), the spread (ωmax − ωmin)/ω_mean, the quantization noise floor, validity with its
-//! reason, and whether the speed was steady. No filtering happens before δ: a low-pass would
-//! remove exactly the ripple δ measures.
+//! Reported per window: where it starts and ends (accepted-edge numbers and capture ticks), and
+//! either its [`Measurement`] — ωmax, ωmin, ω_mean, δ = 2(ωmax − ωmin)/(ωmax + ωmin) (seed 000,
+//! eq. 13), the spread (ωmax − ωmin)/ω_mean, the quantization noise floor and whether the
+//! speed was steady — or the fault that cut it short (an invalid window carries no numbers).
+//! No filtering happens before δ: a low-pass would remove exactly the ripple δ measures.
+//!
+//! The extremes are kept as exact samples (angle units over ticks, see [`crate::encoder`])
+//! and compared by 64-bit cross products, so the per-edge work is integer compares; δ is formed
+//! once per window from the exact products.
 
 use crate::error::{positive, positive_f32, ConfigError};
-use crate::speed::{EdgeEvent, Fault, SpeedSample};
+use crate::speed::{Fault, Sample, Tooth};
 
 /// Largest window, in revolutions.
 pub const MAX_WINDOW_REVS: u16 = 1024;
@@ -90,19 +95,25 @@ impl WindowConfig {
 }
 
 impl Window {
+    /// A placeholder (one revolution) for an unconfigured monitor.
+    pub(crate) const UNCONFIGURED: Window = Window {
+        revolutions: 1,
+        steady_tolerance: 0.02,
+    };
+
     /// Revolutions per window.
     pub fn revolutions(&self) -> u16 {
         self.revolutions
     }
 }
 
-/// The result of one window.
+/// What a valid window measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct WindowReport {
+pub struct Measurement {
     /// Largest speed sample, rad/s.
     pub omega_max: f32,
-    /// Smallest speed sample, rad/s.
+    /// Smallest speed sample, rad/s (never above `omega_max`).
     pub omega_min: f32,
     /// Mean speed, angle over time, rad/s.
     pub omega_mean: f32,
@@ -112,29 +123,43 @@ pub struct WindowReport {
     pub spread: f32,
     /// Bound on the error of δ from timer quantization: 2 / (mean ticks per speed sample).
     pub noise_floor: f32,
-    /// Revolutions covered (the configured count for a valid window).
-    pub revolutions: u16,
     /// Speed samples taken.
     pub samples: u32,
-    /// `None` for a valid window, else the first fault seen in it.
-    pub fault: Option<Fault>,
     /// The mean speed was within the steady tolerance of the previous valid window's.
     pub steady: bool,
+}
+
+/// One window: where it lies and what it measured, or why it is invalid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindowReport {
+    /// Number of the accepted edge the window starts at (the tracker's running count).
+    pub start_edge: u32,
+    /// Number of the last accepted edge in the window.
+    pub end_edge: u32,
+    /// Capture time of the start edge, ticks.
+    pub start_ticks: u32,
+    /// Capture time of the end (the last edge, or where the fault was found), ticks.
+    pub end_ticks: u32,
+    /// Whole revolutions covered (the configured count for a valid window).
+    pub revolutions: u16,
+    /// The measurement, or the fault that cut the window short.
+    pub result: Result<Measurement, Fault>,
 }
 
 impl WindowReport {
     /// A complete window with no fault.
     pub fn valid(&self) -> bool {
-        self.fault.is_none()
+        self.result.is_ok()
     }
-}
-
-/// An extreme sample: angle and interval, the interval as its exact integer tick count (equal
-/// angles compare the counts exactly; other comparisons convert them to f32).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Extreme {
-    angle: f32,
-    ticks: u32,
+    /// The measurement of a valid window.
+    pub fn measurement(&self) -> Option<&Measurement> {
+        self.result.as_ref().ok()
+    }
+    /// The fault of an invalid window.
+    pub fn fault(&self) -> Option<Fault> {
+        self.result.err()
+    }
 }
 
 /// Per-window accumulation state.
@@ -142,11 +167,15 @@ struct Extreme {
 pub struct WindowState {
     started: bool,
     revs: u16,
+    /// Sum of the window's intervals, ticks.
     ticks: u64,
     samples: u32,
-    sample_ticks: u64,
-    max: Extreme,
-    min: Extreme,
+    start_edge: u32,
+    start_ticks: u32,
+    last_edge: u32,
+    last_ticks: u32,
+    max: Sample,
+    min: Sample,
     /// Mean speed of the previous valid window (0 when none).
     prev_mean: f32,
 }
@@ -172,66 +201,7 @@ fn u64_to_f32(x: u64) -> f32 {
     }
 }
 
-/// Veltkamp's split: `x = hi + lo` exactly, each half with at most 12 significant bits, so
-/// products of halves are exact in f32.
-#[inline]
-fn split(x: f32) -> (f32, f32) {
-    // 2^12 + 1: splits the 24-bit significand in two.
-    let c = 4097.0 * x;
-    let hi = c - (c - x);
-    (hi, x - hi)
-}
-
-/// Dekker's product: `p + e = x·y` exactly (no overflow or underflow here: angles and tick
-/// counts are far inside the f32 range).
-#[inline]
-fn two_product(x: f32, y: f32) -> (f32, f32) {
-    let p = x * y;
-    let (xh, xl) = split(x);
-    let (yh, yl) = split(y);
-    let e = ((xh * yh - p) + xh * yl + xl * yh) + xl * yl;
-    (p, e)
-}
-
-/// A tick count as an f32 head (its rounding) plus the exact remainder (|rem| ≤ 128).
-#[inline]
-fn split_ticks(t: u32) -> (f32, f32) {
-    let head = t as f32;
-    (head, (i64::from(t) - head as i64) as f32)
-}
-
-/// a1·t2 − a2·t1 for integer tick counts, to within about one rounding of the result: both
-/// products are split exactly (Dekker) and differenced term by term, so equal speeds cancel to
-/// exactly 0. Plain f32 arithmetic: on a Cortex-M4F ~40 FPU instructions, against ~400 for
-/// two software `libm::fmaf` calls (no fused multiply-add is reachable from stable `core`).
-///
-/// Counts below 2²⁴ are exact in f32 and take this path alone; larger ones round in f32 and go
-/// to [`cross_wide`], out of line. Splitting every count instead (remainders then 0) cost the
-/// window finish 9 more instructions when measured (`monitor::window_finish`, examples/qemu/run.sh).
-#[inline]
-fn cross(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
-    if (t1 | t2) < 1 << 24 {
-        let (p1, e1) = two_product(a1, t2 as f32);
-        let (p2, e2) = two_product(a2, t1 as f32);
-        (p1 - p2) + (e1 - e2)
-    } else {
-        cross_wide(a1, t2, a2, t1)
-    }
-}
-
-/// [`cross`] for counts of 2²⁴ and above, which round in f32: each count is split exactly into
-/// its f32 head and the remainder; the head products go through Dekker as in [`cross`], and the
-/// small remainder products (|remainder| ≤ 128) are added after, so equal speeds still cancel
-/// to exactly 0.
-#[cold]
-#[inline(never)]
-fn cross_wide(a1: f32, t2: u32, a2: f32, t1: u32) -> f32 {
-    let (h2, l2) = split_ticks(t2);
-    let (h1, l1) = split_ticks(t1);
-    let (p1, e1) = two_product(a1, h2);
-    let (p2, e2) = two_product(a2, h1);
-    ((p1 - p2) + (e1 - e2)) + (a1 * l2 - a2 * l1)
-}
+const NO_SAMPLE: Sample = Sample { span: 0, ticks: 0 };
 
 impl WindowState {
     /// No window in progress.
@@ -241,76 +211,102 @@ impl WindowState {
             revs: 0,
             ticks: 0,
             samples: 0,
-            sample_ticks: 0,
-            max: Extreme {
-                angle: 0.0,
-                ticks: 0,
-            },
-            min: Extreme {
-                angle: 0.0,
-                ticks: 0,
-            },
+            start_edge: 0,
+            start_ticks: 0,
+            last_edge: 0,
+            last_ticks: 0,
+            max: NO_SAMPLE,
+            min: NO_SAMPLE,
             prev_mean: 0.0,
         }
     }
 
-    fn restart(&mut self) {
+    /// Whether a window is in progress.
+    pub fn started(&self) -> bool {
+        self.started
+    }
+
+    fn restart(&mut self, edge: u32, ticks: u32) {
         self.started = true;
         self.revs = 0;
         self.ticks = 0;
         self.samples = 0;
-        self.sample_ticks = 0;
+        self.start_edge = edge;
+        self.start_ticks = ticks;
+        self.last_edge = edge;
+        self.last_ticks = ticks;
     }
 
-    fn take(&mut self, s: &SpeedSample) {
-        if s.ticks == 0 {
-            return;
-        }
-        // A window holds at most MAX_WINDOW_REVS·65535 < 2^26 edges of < 2^32 ticks each, so
-        // neither count can reach its type's limit: plain wrapping adds are exact.
+    /// Takes one speed sample: integer compares, no division (the extremes are exact).
+    #[inline(always)]
+    pub(crate) fn take(&mut self, s: Sample) {
+        // A window holds at most MAX_WINDOW_REVS·65535 < 2^26 edges: the count cannot wrap.
         self.samples = self.samples.wrapping_add(1);
-        self.sample_ticks = self.sample_ticks.wrapping_add(s.ticks as u64);
-        let e = Extreme {
-            angle: s.angle,
-            ticks: s.ticks,
-        };
         if self.samples == 1 {
-            self.max = e;
-            self.min = e;
+            self.max = s;
+            self.min = s;
             return;
         }
-        // Compare angle/ticks by cross-multiplying: no division per edge. Equal angles (a
-        // uniform disc) compare the exact integer counts, which round in f32 above 2²⁴.
-        let t = s.ticks as f32;
-        let faster = if s.angle == self.max.angle {
-            s.ticks < self.max.ticks
-        } else {
-            s.angle * self.max.ticks as f32 > self.max.angle * t
-        };
-        if faster {
-            self.max = e;
+        // Equal spans (a uniform disc) compare the tick counts; others the cross products,
+        // exact in 64 bits (spans ≤ 2^30, ticks < 2^32).
+        if s.span == self.max.span {
+            if s.ticks < self.max.ticks {
+                self.max = s;
+            }
+        } else if u64::from(s.span) * u64::from(self.max.ticks)
+            > u64::from(self.max.span) * u64::from(s.ticks)
+        {
+            self.max = s;
         }
-        let slower = if s.angle == self.min.angle {
-            s.ticks > self.min.ticks
-        } else {
-            s.angle * (self.min.ticks as f32) < self.min.angle * t
-        };
-        if slower {
-            self.min = e;
+        if s.span == self.min.span {
+            if s.ticks > self.min.ticks {
+                self.min = s;
+            }
+        } else if u64::from(s.span) * u64::from(self.min.ticks)
+            < u64::from(self.min.span) * u64::from(s.ticks)
+        {
+            self.min = s;
         }
     }
 
-    fn report(&self, window: &Window, timer_hz: f32, fault: Option<Fault>) -> WindowReport {
-        let (a1, t1) = (self.max.angle, self.max.ticks as f32);
-        let (a2, t2) = (self.min.angle, self.min.ticks as f32);
-        let omega_max = if t1 > 0.0 { a1 * timer_hz / t1 } else { 0.0 };
-        let omega_min = if t2 > 0.0 { a2 * timer_hz / t2 } else { 0.0 };
-        // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1): the numerator
-        // from exact integer ticks and an error-free product difference, never by subtracting
-        // two speeds.
-        let num = cross(a1, self.min.ticks, a2, self.max.ticks);
-        let den = a1 * t2 + a2 * t1;
-        let delta = if den > 0.0 { 2.0 * num / den } else { 0.0 };
+    /// Adds an ordinary tooth (not a frame) to the window in progress.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, index: u32, time: u32, dt: u32, sample: Option<Sample>) {
+        // Bounded like the sample count: the wrapping add is exact.
+        self.ticks = self.ticks.wrapping_add(u64::from(dt));
+        self.last_edge = index;
+        self.last_ticks = time;
+        if let Some(s) = sample {
+            self.take(s);
+        }
+    }
+
+    fn measurement(&self, window: &Window, unit_rad: f32, timer_hz: f32, k: u16) -> Measurement {
+        let (a1, t1) = (u64::from(self.max.span), u64::from(self.max.ticks));
+        let (a2, t2) = (u64::from(self.min.span), u64::from(self.min.ticks));
+        // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1), from the
+        // exact integer products: never a difference of two rounded speeds.
+        let p1 = a1 * t2;
+        let p2 = a2 * t1;
+        let num = p1.saturating_sub(p2);
+        let den = p1 + p2;
+        let delta = if den > 0 {
+            2.0 * (u64_to_f32(num) / u64_to_f32(den))
+        } else {
+            0.0
+        };
+        let omega_max = if t1 > 0 {
+            a1 as f32 * unit_rad * timer_hz / t1 as f32
+        } else {
+            0.0
+        };
+        // ωmin = ωmax·(a2·t1)/(a1·t2): the ratio of the exact products is at most 1 and stays
+        // so through monotone rounding, so ωmin never exceeds ωmax (no negative spread).
+        let omega_min = if p1 > 0 {
+            omega_max * (u64_to_f32(p2) / u64_to_f32(p1))
+        } else {
+            0.0
+        };
         let omega_mean = if self.ticks > 0 {
             self.revs as f32 * core::f32::consts::TAU * timer_hz / u64_to_f32(self.ticks)
         } else {
@@ -321,71 +317,79 @@ impl WindowState {
         } else {
             0.0
         };
-        let noise_floor = if self.sample_ticks > 0 {
-            2.0 * self.samples as f32 / u64_to_f32(self.sample_ticks)
+        // Mean ticks per K-edge sample: K times the mean interval of the window's edges.
+        let edges = self.last_edge.wrapping_sub(self.start_edge);
+        let noise_floor = if self.ticks > 0 && edges > 0 {
+            2.0 * edges as f32 / (f32::from(k.max(1)) * u64_to_f32(self.ticks))
         } else {
             1.0
         };
-        let steady = fault.is_none()
-            && self.prev_mean > 0.0
+        let steady = self.prev_mean > 0.0
             && (omega_mean - self.prev_mean).abs() < window.steady_tolerance * omega_mean;
-        WindowReport {
+        Measurement {
             omega_max,
             omega_min,
             omega_mean,
             delta,
             spread,
             noise_floor,
-            revolutions: self.revs,
             samples: self.samples,
-            fault,
             steady,
         }
     }
 
-    /// Feeds one edge's event; returns a report when a window ends (complete, or cut short by
-    /// a fault: then invalid with that fault as its reason).
-    pub fn on_event(
+    fn report(&self, result: Result<Measurement, Fault>) -> WindowReport {
+        WindowReport {
+            start_edge: self.start_edge,
+            end_edge: self.last_edge,
+            start_ticks: self.start_ticks,
+            end_ticks: self.last_ticks,
+            revolutions: self.revs,
+            result,
+        }
+    }
+
+    /// Feeds one accepted edge; returns a report when a window ends. `unit_rad`, `timer_hz` and `k` are the encoder's (see
+    /// [`crate::encoder::Encoder`]).
+    pub fn on_tooth(
         &mut self,
         window: &Window,
+        tooth: &Tooth,
+        unit_rad: f32,
         timer_hz: f32,
-        ev: &EdgeEvent,
+        k: u16,
     ) -> Option<WindowReport> {
-        if let Some(fault) = ev.fault {
-            return self.abort(window, timer_hz, fault);
+        if !tooth.synced {
+            return None;
         }
         if !self.started {
-            if ev.frame {
-                self.restart();
+            if tooth.frame {
+                self.restart(tooth.index, tooth.time);
             }
             return None;
         }
-        if let Some((dt, _)) = ev.interval {
-            // Bounded like the sample counts (see `take`): the wrapping add is exact.
-            self.ticks = self.ticks.wrapping_add(dt as u64);
-        }
-        if let Some(s) = &ev.sample {
-            self.take(s);
-        }
-        if ev.frame {
+        self.add(tooth.index, tooth.time, tooth.dt, tooth.sample);
+        if tooth.frame {
             self.revs = self.revs.saturating_add(1);
             if self.revs >= window.revolutions {
-                let r = self.report(window, timer_hz, None);
-                self.prev_mean = r.omega_mean;
-                self.restart();
+                let m = self.measurement(window, unit_rad, timer_hz, k);
+                let r = self.report(Ok(m));
+                self.prev_mean = m.omega_mean;
+                self.restart(tooth.index, tooth.time);
                 return Some(r);
             }
         }
         None
     }
 
-    /// Ends the window in progress as invalid with `fault` (e.g. a timeout found by polling).
-    pub fn abort(&mut self, window: &Window, timer_hz: f32, fault: Fault) -> Option<WindowReport> {
+    /// Ends the window in progress as invalid with `fault`, found at `time`.
+    pub fn abort(&mut self, fault: Fault, time: u32) -> Option<WindowReport> {
         let was = self.started;
         self.started = false;
         self.prev_mean = 0.0;
         if was {
-            Some(self.report(window, timer_hz, Some(fault)))
+            self.last_ticks = time;
+            Some(self.report(Err(fault)))
         } else {
             None
         }
@@ -418,40 +422,6 @@ mod tests {
     }
 
     #[test]
-    fn cross_product_difference_matches_exact_f64() {
-        // Products of f32 values are exact in f64; their difference is exact to 2^-53 of the
-        // larger product. The split products must agree with it to one f32 rounding of the
-        // result plus 2^-46 of the products, and cancel exactly for equal products.
-        let mut seed = 0x2545_f491_u32;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed
-        };
-        for _ in 0..20_000 {
-            let a1 = 1e-3 + (next() % 1_000_000) as f32 * 1e-7;
-            let a2 = a1 * (1.0 + ((next() % 2001) as f32 - 1000.0) * 1e-5);
-            // Counts on both sides of 2^24, where f32 stops holding them exactly.
-            let t1 = 1_000 + next() % 50_000_000;
-            let t2 = (t1 + next() % 20_001).saturating_sub(10_000).max(1);
-            let exact = a1 as f64 * t2 as f64 - a2 as f64 * t1 as f64;
-            let scale = (a1 as f64 * t2 as f64)
-                .abs()
-                .max((a2 as f64 * t1 as f64).abs());
-            let got = cross(a1, t2, a2, t1) as f64;
-            let bound = exact.abs() * f32::EPSILON as f64 + scale * 2f64.powi(-46);
-            assert!(
-                (got - exact).abs() <= bound,
-                "{a1} {t2} {a2} {t1}: {got} vs {exact}"
-            );
-            assert_eq!(cross(a1, t1, a1, t1), 0.0);
-        }
-        // Equal products from different factors cancel too.
-        assert_eq!(cross(0.5, 6, 1.5, 2), 0.0);
-    }
-
-    #[test]
     fn u64_conversion_matches_the_cast() {
         for x in [
             0u64,
@@ -465,21 +435,143 @@ mod tests {
         }
     }
 
+    fn window(revs: u16) -> Window {
+        WindowConfig {
+            length: WindowLength::Revolutions(revs),
+            steady_tolerance: 0.02,
+        }
+        .validate()
+        .unwrap()
+    }
+
+    fn tooth(index: u32, time: u32, dt: u32, frame: bool, sample: Option<Sample>) -> Tooth {
+        Tooth {
+            index,
+            time,
+            dt,
+            tooth: 0,
+            synced: true,
+            frame,
+            sample,
+        }
+    }
+
     #[test]
-    fn cross_product_difference_is_exact_for_close_speeds() {
-        // Two samples differing by one tick in 1e7: δ = 2e-7 must not be lost in rounding;
-        // nor one tick in 3e9, where each count rounds to a multiple of 256 in f32.
-        let a = 0.006_135_923_f32;
+    fn delta_is_exact_for_close_speeds() {
+        // Two samples one tick apart in 1e7 (δ = 2e-7) and in 3e9 (each count rounds to a
+        // multiple of 256 in f32): δ comes from the exact products, not from rounded speeds.
+        let w = window(1);
         for (t1, t2) in [
             (10_000_000u32, 10_000_001u32),
             (3_000_000_001, 3_000_000_002),
         ] {
-            let num = cross(a, t2, a, t1);
-            let exact = a as f64 * 1.0;
-            assert!(
-                (num as f64 - exact).abs() <= 1e-7 * exact,
-                "{num} vs {exact}"
+            let mut st = WindowState::new();
+            let span = 1 << 20;
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1e-6, 1e6, 16);
+            st.on_tooth(
+                &w,
+                &tooth(1, 1, 1, false, Some(Sample { span, ticks: t1 })),
+                1e-6,
+                1e6,
+                16,
             );
+            let r = st
+                .on_tooth(
+                    &w,
+                    &tooth(2, 2, 1, true, Some(Sample { span, ticks: t2 })),
+                    1e-6,
+                    1e6,
+                    16,
+                )
+                .unwrap();
+            let m = r.measurement().unwrap();
+            let exact = 2.0 * (f64::from(t2) - f64::from(t1)) / (f64::from(t2) + f64::from(t1));
+            assert!(
+                (f64::from(m.delta) / exact - 1.0).abs() < 1e-6,
+                "{m:?} {exact}"
+            );
+            assert!(m.omega_min <= m.omega_max);
+            assert_eq!((r.start_edge, r.end_edge, r.revolutions), (0, 2, 1));
         }
+    }
+
+    #[test]
+    fn equal_speeds_from_different_spans_give_no_negative_spread() {
+        // 3 units in 7 ticks and 6 in 14: the same speed, compared exactly; the minimum is
+        // never reported above the maximum however the f32 conversions round.
+        let w = window(1);
+        let mut seed = 0x9e37_79b9_u32;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed
+        };
+        for _ in 0..2000 {
+            let a = 1 + next() % (1 << 20);
+            let t = 1 + next() % (1 << 20);
+            let m = 1 + next() % 1000;
+            let mut st = WindowState::new();
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1.0e-5, 84e6, 1);
+            st.on_tooth(
+                &w,
+                &tooth(1, 1, t, false, Some(Sample { span: a, ticks: t })),
+                1.0e-5,
+                84e6,
+                1,
+            );
+            let r = st
+                .on_tooth(
+                    &w,
+                    &tooth(
+                        2,
+                        2,
+                        t,
+                        true,
+                        Some(Sample {
+                            span: a * m,
+                            ticks: t * m,
+                        }),
+                    ),
+                    1.0e-5,
+                    84e6,
+                    1,
+                )
+                .unwrap();
+            let m = r.measurement().unwrap();
+            assert_eq!(m.delta, 0.0);
+            assert!(m.omega_min <= m.omega_max && m.spread >= 0.0, "{m:?}");
+        }
+    }
+
+    #[test]
+    fn an_aborted_window_carries_its_span_and_no_numbers() {
+        let w = window(4);
+        let mut st = WindowState::new();
+        st.on_tooth(&w, &tooth(7, 100, 0, true, None), 1e-6, 1e6, 1);
+        st.on_tooth(
+            &w,
+            &tooth(
+                8,
+                200,
+                100,
+                false,
+                Some(Sample {
+                    span: 1,
+                    ticks: 100,
+                }),
+            ),
+            1e-6,
+            1e6,
+            1,
+        );
+        let r = st.abort(Fault::Glitch, 250).unwrap();
+        assert_eq!(r.result, Err(Fault::Glitch));
+        assert_eq!(
+            (r.start_edge, r.end_edge, r.start_ticks, r.end_ticks),
+            (7, 8, 100, 250)
+        );
+        assert!(r.measurement().is_none());
+        assert!(st.abort(Fault::Glitch, 260).is_none());
     }
 }

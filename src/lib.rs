@@ -16,6 +16,7 @@ pub mod irregularity;
 pub mod learn;
 pub mod math;
 pub mod monitor;
+pub mod pitch;
 pub mod speed;
 pub mod supports;
 // Lets `testutil` name the crate the same way from unit tests and from `tests/hard_cases.rs`.

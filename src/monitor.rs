@@ -1,18 +1,29 @@
 //! The irregularity monitor: encoder edges in, δ windows, shaft state, alarm and diagnostics out.
 //!
 //! [`DeltaMonitor`] ties together the validated configuration ([`Encoder`], [`Window`],
-//! [`DeltaAlarm`]) and the per-edge state ([`SpeedTracker`], [`WindowState`],
-//! [`ToothLearner`]). Call [`DeltaMonitor::on_edge`] from the capture interrupt with the raw
-//! timestamp, [`DeltaMonitor::on_index`] for an index pulse, and [`DeltaMonitor::poll`]
-//! periodically (at least once per counter period) so a stopped shaft is seen as standstill.
-//! Every call is O(1), allocation-free and panic-free for any input.
+//! [`DeltaAlarm`]), the pitch table ([`PitchTable`]: none for a wheel at its nominal pitches, or
+//! a learned correction) and the per-edge state ([`SpeedTracker`], [`WindowState`]). Feed it
+//!
+//! - [`DeltaMonitor::on_edge`] from a capture interrupt with each raw timestamp, or
+//!   [`DeltaMonitor::on_captures`] with a slice of timestamps (a DMA buffer), which gives the
+//!   same results edge for edge;
+//! - [`DeltaMonitor::on_index`] with the timestamp of an index pulse, before the captures after
+//!   it;
+//! - [`DeltaMonitor::poll`] periodically (at least once per counter period), so a stopped shaft
+//!   is seen as standstill.
+//!
+//! Every call is O(1) per edge, allocation-free and panic-free for any input. A monitor can be
+//! built in place: [`DeltaMonitor::unconfigured`] is a `const` value for a `static`, and
+//! [`DeltaMonitor::configure`] fills it without large temporaries.
 
 use crate::alarm::{AlarmConfig, AlarmEvent, DeltaAlarm, Verdict};
-use crate::encoder::Encoder;
+use crate::encoder::{Encoder, EncoderConfig};
 use crate::error::ConfigError;
 use crate::irregularity::{Window, WindowConfig, WindowReport, WindowState};
-use crate::learn::ToothLearner;
-use crate::speed::{Direction, EdgeCounters, Fault, ShaftState, SpeedSample, SpeedTracker};
+use crate::pitch::{deviations, Nominal, PitchTable};
+use crate::speed::{
+    Direction, EdgeCounters, EdgeSink, Fault, ShaftState, SpeedTracker, SyncState, Tooth,
+};
 
 /// Everything the monitor counted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -40,49 +51,197 @@ pub struct WindowOutcome {
     pub event: Option<AlarmEvent>,
 }
 
-/// Monitor of running irregularity for a disc of up to `N` edges per revolution.
-#[derive(Debug, Clone)]
-pub struct DeltaMonitor<const N: usize> {
-    encoder: Encoder<N>,
-    window: Window,
-    tracker: SpeedTracker,
-    state: WindowState,
-    alarm: Option<DeltaAlarm>,
-    learner: Option<ToothLearner<N>>,
-    /// The latest speed sample as angle (rad) over ticks (0 ticks: none); converted to rad/s
-    /// only when asked for, so the per-edge path does not divide.
-    last_angle: f32,
-    last_ticks: u32,
-    diag: Diagnostics,
+/// An observer that wants nothing.
+impl EdgeSink for () {
+    #[inline(always)]
+    fn tooth(&mut self, _tooth: &Tooth) {}
+    #[inline(always)]
+    fn fault(&mut self, _fault: Fault, _time: u32) {}
 }
 
-impl<const N: usize> DeltaMonitor<N> {
+/// Monitor of running irregularity for a wheel of up to `N` edges per revolution, with pitch
+/// storage `P` ([`Nominal`] by default: no per-tooth table; [`crate::pitch::Corrected<N>`] for
+/// a learned or measured correction).
+///
+/// Memory: a few hundred bytes plus `P` (see the firmware's `memory:` lines).
+#[derive(Debug, Clone)]
+pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
+    encoder: Encoder,
+    window: Window,
+    alarm: Option<DeltaAlarm>,
+    table: P,
+    tracker: SpeedTracker,
+    state: WindowState,
+    diag: Diagnostics,
+    /// A second window finished by the same call, returned by the next one.
+    spill: Option<WindowOutcome>,
+}
+
+/// Where the tracker's findings go during one call: the window, the alarm, the observer, and
+/// the caller's window callback.
+struct Feed<'a, O: EdgeSink, F: FnMut(WindowOutcome)> {
+    encoder: &'a Encoder,
+    window: &'a Window,
+    state: &'a mut WindowState,
+    alarm: &'a mut Option<DeltaAlarm>,
+    diag: &'a mut Diagnostics,
+    observer: &'a mut O,
+    out: F,
+}
+
+impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
+    #[inline(always)]
+    fn tooth(&mut self, tooth: &Tooth) {
+        self.observer.tooth(tooth);
+        let e = self.encoder;
+        if let Some(r) = self.state.on_tooth(
+            self.window,
+            tooth,
+            e.unit_rad(),
+            e.timer_hz(),
+            e.samples_span(),
+        ) {
+            let o = finish(self.alarm, self.diag, r);
+            (self.out)(o);
+        }
+    }
+
+    #[inline]
+    fn fault(&mut self, fault: Fault, time: u32) {
+        self.observer.fault(fault, time);
+        if let Some(r) = self.state.abort(fault, time) {
+            let o = finish(self.alarm, self.diag, r);
+            (self.out)(o);
+        }
+    }
+}
+
+/// Counts a finished window and runs the alarm on it: once per window, kept out of line so
+/// the per-edge path stays small.
+#[cold]
+#[inline(never)]
+fn finish(
+    alarm: &mut Option<DeltaAlarm>,
+    diag: &mut Diagnostics,
+    report: WindowReport,
+) -> WindowOutcome {
+    if report.valid() {
+        diag.valid_windows = diag.valid_windows.wrapping_add(1);
+    } else {
+        diag.invalid_windows = diag.invalid_windows.wrapping_add(1);
+    }
+    let (verdict, event) = match alarm.as_mut() {
+        Some(a) => {
+            let (v, e) = a.update(&report);
+            (Some(v), e)
+        }
+        None => (None, None),
+    };
+    if event == Some(AlarmEvent::Raised) {
+        diag.alarms_raised = diag.alarms_raised.wrapping_add(1);
+    }
+    WindowOutcome {
+        report,
+        verdict,
+        event,
+    }
+}
+
+/// Keeps the first outcome of a call and spills a second one to the next call.
+#[inline(always)]
+fn keep(first: &mut Option<WindowOutcome>, spill: &mut Option<WindowOutcome>, o: WindowOutcome) {
+    if first.is_none() {
+        *first = Some(o);
+    } else {
+        *spill = Some(o);
+    }
+}
+
+impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     /// Builds a monitor from validated pieces.
     pub fn new(
-        encoder: Encoder<N>,
+        encoder: Encoder,
         window: WindowConfig,
         alarm: Option<AlarmConfig>,
     ) -> Result<Self, ConfigError> {
+        let mut m = Self::unconfigured();
+        m.configure(encoder, window, alarm)?;
+        Ok(m)
+    }
+
+    /// A monitor that does nothing until [`DeltaMonitor::configure`] (edges, index pulses and
+    /// polls are ignored): a `const` value to initialise a `static` with.
+    pub const fn unconfigured() -> Self {
+        DeltaMonitor {
+            encoder: Encoder::UNCONFIGURED,
+            window: Window::UNCONFIGURED,
+            alarm: None,
+            table: P::EMPTY,
+            tracker: SpeedTracker::new(),
+            state: WindowState::new(),
+            diag: Diagnostics {
+                edges: EdgeCounters {
+                    accepted: 0,
+                    glitches: 0,
+                    missing: 0,
+                    extra: 0,
+                    missing_frames: 0,
+                    reversals: 0,
+                    timeouts: 0,
+                    revolutions: 0,
+                    syncs: 0,
+                    sync_losses: 0,
+                },
+                valid_windows: 0,
+                invalid_windows: 0,
+                alarms_raised: 0,
+            },
+            spill: None,
+        }
+    }
+
+    /// (Re)configures the monitor in place: validates, then resets all per-edge state and the
+    /// pitch table to nominal. On error the monitor is left as it was.
+    pub fn configure(
+        &mut self,
+        encoder: Encoder,
+        window: WindowConfig,
+        alarm: Option<AlarmConfig>,
+    ) -> Result<(), ConfigError> {
+        if usize::from(encoder.edges()) > N {
+            return Err(ConfigError::Capacity("edges per revolution"));
+        }
+        if !P::NOMINAL && usize::from(encoder.edges()) > P::CAPACITY {
+            return Err(ConfigError::Capacity("pitch table"));
+        }
         let window = window.validate()?;
         let alarm = match alarm {
             Some(a) => Some(a.validate()?),
             None => None,
         };
-        Ok(DeltaMonitor {
-            encoder,
-            window,
-            tracker: SpeedTracker::new(),
-            state: WindowState::new(),
-            alarm,
-            learner: None,
-            last_angle: 0.0,
-            last_ticks: 0,
-            diag: Diagnostics::default(),
-        })
+        self.encoder = encoder;
+        self.window = window;
+        self.alarm = alarm;
+        self.table.store(&[]);
+        self.tracker = SpeedTracker::new();
+        self.state = WindowState::new();
+        self.diag = Diagnostics::default();
+        self.spill = None;
+        Ok(())
+    }
+
+    /// Validates `config` into an [`Encoder`] and configures the monitor with it.
+    pub fn configure_from(
+        &mut self,
+        config: EncoderConfig,
+        window: WindowConfig,
+        alarm: Option<AlarmConfig>,
+    ) -> Result<(), ConfigError> {
+        self.configure(Encoder::new(config)?, window, alarm)
     }
 
     /// The encoder in use.
-    pub fn encoder(&self) -> &Encoder<N> {
+    pub fn encoder(&self) -> &Encoder {
         &self.encoder
     }
 
@@ -91,39 +250,20 @@ impl<const N: usize> DeltaMonitor<N> {
         self.window.revolutions()
     }
 
-    /// Replaces the pitch table (a learned or stored correction); restarts framing.
+    /// Replaces the pitch table (rad, edge k−1 to edge k, one per edge; a learned or stored
+    /// correction, see [`crate::pitch::deviations`] for the checks); restarts framing.
+    /// A monitor without a table ([`Nominal`]) rejects it: `Capacity("pitch table")`.
     pub fn set_pitches(&mut self, pitches: &[f32]) -> Result<(), ConfigError> {
-        self.encoder = self.encoder.clone().with_pitches(pitches)?;
+        if P::NOMINAL {
+            return Err(ConfigError::Capacity("pitch table"));
+        }
+        let mut dev = [0i16; N];
+        deviations(&self.encoder, pitches, &mut dev)?;
+        self.table
+            .store(dev.get(..usize::from(self.encoder.edges())).unwrap_or(&[]));
         self.tracker = SpeedTracker::new();
         self.state = WindowState::new();
         Ok(())
-    }
-
-    /// Starts learning per-tooth corrections on revolutions whose period is within
-    /// `steady_tolerance` of the previous one's.
-    pub fn start_learning(&mut self, steady_tolerance: f32) {
-        self.learner = Some(ToothLearner::new(steady_tolerance));
-    }
-
-    /// The learner, while learning.
-    pub fn learner(&self) -> Option<&ToothLearner<N>> {
-        self.learner.as_ref()
-    }
-
-    /// Stops learning and, with at least `min_revolutions` per tooth, applies what was learned
-    /// (also written into `out`, to store it).
-    pub fn finish_learning<'a>(
-        &mut self,
-        min_revolutions: u16,
-        out: &'a mut [f32; N],
-    ) -> Result<&'a [f32], ConfigError> {
-        let learner = self
-            .learner
-            .take()
-            .ok_or(ConfigError::Inconsistent("learned revolutions"))?;
-        let table = learner.pitches(&self.encoder, min_revolutions, out)?;
-        self.set_pitches(table)?;
-        Ok(table)
     }
 
     /// The shaft state.
@@ -131,17 +271,23 @@ impl<const N: usize> DeltaMonitor<N> {
         self.tracker.state()
     }
 
-    /// The latest speed sample, rad/s (0 unless running).
+    /// How far the revolution is framed.
+    pub fn sync_state(&self) -> SyncState {
+        self.tracker.sync_state()
+    }
+
+    /// The tooth of the last accepted edge, when teeth are identified.
+    pub fn tooth(&self) -> Option<u16> {
+        self.tracker.tooth()
+    }
+
+    /// A recent speed, rad/s (0 unless running; see [`SpeedTracker::recent_sample`]).
     pub fn speed(&self) -> f32 {
-        if self.tracker.state() == ShaftState::Running && self.last_ticks > 0 {
-            SpeedSample {
-                angle: self.last_angle,
-                ticks: self.last_ticks,
-                tooth: 0,
+        match self.tracker.recent_sample(&self.encoder) {
+            Some(s) => {
+                s.span as f32 * self.encoder.unit_rad() * self.encoder.timer_hz() / s.ticks as f32
             }
-            .omega(self.encoder.timer_hz())
-        } else {
-            0.0
+            None => 0.0,
         }
     }
 
@@ -158,178 +304,204 @@ impl<const N: usize> DeltaMonitor<N> {
         }
     }
 
-    /// An index pulse was captured; call before the edge that follows it.
-    pub fn on_index(&mut self) {
-        self.tracker.on_index();
+    /// An index pulse captured at `ticks` (raw counter value); report it before the captures
+    /// that follow it.
+    pub fn on_index(&mut self, ticks: u32) {
+        self.tracker.on_index(&self.encoder, ticks);
     }
 
     /// One encoder edge captured at `ticks` (raw counter value), with the direction if known.
-    /// Returns a window when one ends.
+    /// Returns a window when one ends (a second window ended by the same edge, which a late
+    /// judgement can cause, is returned by the next call).
+    #[inline]
     pub fn on_edge(&mut self, ticks: u32, direction: Option<Direction>) -> Option<WindowOutcome> {
-        let ev = self.tracker.on_edge(&self.encoder, ticks, direction);
-        if let Some(s) = &ev.sample {
-            self.last_angle = s.angle;
-            self.last_ticks = s.ticks;
+        self.on_edge_observed(ticks, direction, &mut ())
+    }
+
+    /// [`DeltaMonitor::on_edge`], also telling `observer` every accepted tooth and fault (e.g.
+    /// a [`crate::learn::ToothLearner`], or a recorder of per-edge decisions).
+    #[inline]
+    pub fn on_edge_observed<O: EdgeSink>(
+        &mut self,
+        ticks: u32,
+        direction: Option<Direction>,
+        observer: &mut O,
+    ) -> Option<WindowOutcome> {
+        let mut first = self.spill.take();
+        let spill = &mut self.spill;
+        let mut feed = Feed {
+            encoder: &self.encoder,
+            window: &self.window,
+            state: &mut self.state,
+            alarm: &mut self.alarm,
+            diag: &mut self.diag,
+            observer,
+            out: |o| keep(&mut first, spill, o),
+        };
+        self.tracker
+            .on_edge(&self.encoder, &self.table, ticks, direction, &mut feed);
+        first
+    }
+
+    /// A batch of captures (forward running), e.g. the half of a DMA ring that just filled;
+    /// `on_window` gets every window that ends, in order. Same results as calling
+    /// [`DeltaMonitor::on_edge`] for each.
+    pub fn on_captures<F: FnMut(WindowOutcome)>(&mut self, captures: &[u32], on_window: F) {
+        self.on_captures_observed(captures, &mut (), on_window);
+    }
+
+    /// [`DeltaMonitor::on_captures`] with an observer (see
+    /// [`DeltaMonitor::on_edge_observed`]).
+    pub fn on_captures_observed<O: EdgeSink, F: FnMut(WindowOutcome)>(
+        &mut self,
+        captures: &[u32],
+        observer: &mut O,
+        mut on_window: F,
+    ) {
+        if let Some(o) = self.spill.take() {
+            on_window(o);
         }
-        if let Some(l) = self.learner.as_mut() {
-            l.on_event(self.encoder.edges(), &ev);
+        let mut feed = Feed {
+            encoder: &self.encoder,
+            window: &self.window,
+            state: &mut self.state,
+            alarm: &mut self.alarm,
+            diag: &mut self.diag,
+            observer,
+            out: on_window,
+        };
+        for &t in captures {
+            self.tracker.on_edge(
+                &self.encoder,
+                &self.table,
+                t,
+                Some(Direction::Forward),
+                &mut feed,
+            );
         }
-        let report = self
-            .state
-            .on_event(&self.window, self.encoder.timer_hz(), &ev)?;
-        Some(self.finish(report))
     }
 
     /// Checks for standstill at time `now` (ticks); returns the window cut short, if any.
     pub fn poll(&mut self, now: u32) -> Option<WindowOutcome> {
-        let fault = self.tracker.poll(&self.encoder, now)?;
-        self.last_ticks = 0;
-        if let Some(l) = self.learner.as_mut() {
-            l.on_event(
-                self.encoder.edges(),
-                &crate::speed::EdgeEvent {
-                    fault: Some(fault),
-                    ..Default::default()
-                },
-            );
-        }
-        let report = self
-            .state
-            .abort(&self.window, self.encoder.timer_hz(), fault)?;
-        Some(self.finish(report))
-    }
-
-    /// Counts a finished window and runs the alarm on it: once per window, kept out of line so
-    /// the per-edge path stays small.
-    #[cold]
-    #[inline(never)]
-    fn finish(&mut self, report: WindowReport) -> WindowOutcome {
-        if report.valid() {
-            self.diag.valid_windows = self.diag.valid_windows.wrapping_add(1);
-        } else {
-            self.diag.invalid_windows = self.diag.invalid_windows.wrapping_add(1);
-        }
-        let (verdict, event) = match self.alarm.as_mut() {
-            Some(a) => {
-                let (v, e) = a.update(&report);
-                (Some(v), e)
-            }
-            None => (None, None),
+        let mut first = self.spill.take();
+        let spill = &mut self.spill;
+        let mut feed = Feed {
+            encoder: &self.encoder,
+            window: &self.window,
+            state: &mut self.state,
+            alarm: &mut self.alarm,
+            diag: &mut self.diag,
+            observer: &mut (),
+            out: |o| keep(&mut first, spill, o),
         };
-        if event == Some(AlarmEvent::Raised) {
-            self.diag.alarms_raised = self.diag.alarms_raised.wrapping_add(1);
-        }
-        WindowOutcome {
-            report,
-            verdict,
-            event,
-        }
+        self.tracker
+            .poll(&self.encoder, &self.table, now, &mut feed);
+        first
     }
 }
 
 /// Why a window was invalid, as a short name for logs and reports.
 pub fn fault_name(f: Fault) -> &'static str {
-    match f {
-        Fault::Glitch => "glitch",
-        Fault::MissingEdge => "missing-edge",
-        Fault::ExtraEdge => "extra-edge",
-        Fault::MissingFrame => "missing-frame",
-        Fault::Reversal => "reversal",
-        Fault::Timeout => "timeout",
-    }
+    f.name()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::encoder::{EncoderConfig, Estimator, Framing};
+    use crate::encoder::{Estimator, Pattern};
     use crate::irregularity::WindowLength;
+    use crate::learn::ToothLearner;
+    use crate::pitch::Corrected;
+    use core::f64::consts::TAU;
     use std::vec::Vec;
 
-    /// Capture timestamps of a disc whose edge k sits at `angle(k)`, for a shaft whose speed is
-    /// `omega(φ)`: t(θ) = ∫dφ/ω by Simpson's rule per pitch (error far below one tick).
-    struct Gen {
-        t: f64,
-        phi: f64,
-    }
-
-    impl Gen {
-        fn advance(&mut self, to: f64, omega: &dyn Fn(f64) -> f64) -> f64 {
-            let n = 8;
-            let h = (to - self.phi) / n as f64;
-            let mut s = 1.0 / omega(self.phi) + 1.0 / omega(to);
-            for i in 1..n {
-                let w = if i % 2 == 1 { 4.0 } else { 2.0 };
-                s += w / omega(self.phi + i as f64 * h);
-            }
-            self.t += s * h / 3.0;
-            self.phi = to;
-            self.t
-        }
-    }
-
+    /// A capture event: an edge or an index pulse at its tick count.
     #[derive(Clone, Copy, PartialEq, Debug)]
     enum Ev {
         Edge(u32),
-        Index,
+        Index(u32),
     }
 
-    /// Edge stream for `revs` revolutions of a disc with `positions` lines, `missing` positions
-    /// absent at the start of each turn, index pulse before tooth 0 if `index`, per-position
-    /// angle error `err(k)`.
-    #[allow(clippy::too_many_arguments)]
+    /// Capture timestamps of a wheel with teeth at `teeth` (angles in [0, 2π)), an index mark
+    /// at `index` if any, for a shaft whose speed is `omega(φ)`: t(θ) = ∫dφ/ω by Simpson's rule
+    /// per segment (error far below one tick).
     fn stream(
-        positions: u32,
-        missing: u32,
-        index: bool,
+        teeth: &[f64],
+        index: Option<f64>,
         revs: u32,
         timer_hz: f64,
         mask: u32,
         omega: &dyn Fn(f64) -> f64,
-        err: &dyn Fn(u32) -> f64,
     ) -> Vec<Ev> {
-        let mut g = Gen { t: 0.0, phi: 0.0 };
+        let mut marks: Vec<(f64, bool)> = teeth.iter().map(|&a| (a, false)).collect();
+        if let Some(i) = index {
+            marks.push((i, true));
+        }
+        marks.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (mut t, mut phi) = (0.0f64, 0.0f64);
         let mut out = Vec::new();
-        let p = core::f64::consts::TAU / positions as f64;
         for r in 0..revs {
-            for k in missing..positions {
-                let to = core::f64::consts::TAU * r as f64 + p * k as f64 + err(k) + p * 0.5;
-                let t = g.advance(to, omega);
-                if index && k == missing {
-                    out.push(Ev::Index);
+            for &(a, is_index) in &marks {
+                let to = TAU * f64::from(r) + a;
+                let n = 8;
+                let h = (to - phi) / n as f64;
+                let mut s = 1.0 / omega(phi) + 1.0 / omega(to);
+                for i in 1..n {
+                    s += if i % 2 == 1 { 4.0 } else { 2.0 } / omega(phi + i as f64 * h);
                 }
-                out.push(Ev::Edge(((t * timer_hz) as u64 as u32) & mask));
+                t += s * h / 3.0;
+                phi = to;
+                let ticks = ((t * timer_hz) as u64 as u32) & mask;
+                out.push(if is_index {
+                    Ev::Index(ticks)
+                } else {
+                    Ev::Edge(ticks)
+                });
             }
         }
         out
     }
 
-    fn monitor(
-        positions: u16,
-        framing: Framing,
-        k: u16,
-        bits: u8,
-        timer_hz: f64,
-        revs: u16,
-    ) -> DeltaMonitor<1024> {
-        let mut c = EncoderConfig::new(positions, timer_hz);
-        c.framing = framing;
-        c.estimator = Estimator::Edges(k);
-        c.counter_bits = bits;
-        c.min_speed = 20.0;
-        let enc = Encoder::new(c).unwrap();
-        let w = WindowConfig {
-            length: WindowLength::Revolutions(revs),
-            steady_tolerance: 0.02,
-        };
-        DeltaMonitor::new(enc, w, Some(AlarmConfig::new(0.06))).unwrap()
+    /// Tooth angles of a uniform disc (edges half a pitch after the index).
+    fn uniform(lines: u32) -> Vec<f64> {
+        (0..lines)
+            .map(|k| TAU * (f64::from(k) + 0.5) / f64::from(lines))
+            .collect()
     }
 
-    fn run(m: &mut DeltaMonitor<1024>, evs: &[Ev]) -> Vec<WindowOutcome> {
+    /// Tooth angles of a pattern: present grid positions, half a position after the mark.
+    fn pattern_angles(p: Pattern) -> Vec<f64> {
+        let n = u32::from(p.positions());
+        (0..n)
+            .filter(|&k| p.present() >> k & 1 == 1)
+            .map(|k| TAU * (f64::from(k) + 0.5) / f64::from(n))
+            .collect()
+    }
+
+    fn window(revs: u16) -> WindowConfig {
+        WindowConfig {
+            length: WindowLength::Revolutions(revs),
+            steady_tolerance: 0.02,
+        }
+    }
+
+    fn monitor(c: EncoderConfig, revs: u16) -> DeltaMonitor<1024> {
+        DeltaMonitor::new(
+            Encoder::new(c).unwrap(),
+            window(revs),
+            Some(AlarmConfig::new(0.06)),
+        )
+        .unwrap()
+    }
+
+    fn run<const N: usize, P: PitchTable>(
+        m: &mut DeltaMonitor<N, P>,
+        evs: &[Ev],
+    ) -> Vec<WindowOutcome> {
         let mut out = Vec::new();
         for e in evs {
             match *e {
-                Ev::Index => m.on_index(),
+                Ev::Index(t) => m.on_index(t),
                 Ev::Edge(t) => out.extend(m.on_edge(t, Some(Direction::Forward))),
             }
         }
@@ -341,134 +513,363 @@ mod tests {
         move |phi: f64| 134.0 * (1.0 + eps * (phi / 8.0).sin())
     }
 
+    fn indexed(lines: u16, k: u16, bits: u8, timer_hz: f64) -> EncoderConfig {
+        let mut c = EncoderConfig::indexed(lines, timer_hz);
+        c.estimator = Estimator::Edges(k);
+        c.counter_bits = bits;
+        c.min_speed = 20.0;
+        c
+    }
+
     #[test]
     fn measures_delta_of_a_known_speed_ripple() {
         let w = kneader(0.015);
         for (bits, k) in [(32u8, 16u16), (16, 16), (32, 1)] {
-            let mut m = monitor(1024, Framing::Index, k, bits, 84e6, 8);
+            let mut m = monitor(indexed(1024, k, bits, 84e6), 8);
             let mask = if bits == 32 {
                 u32::MAX
             } else {
                 (1 << bits) - 1
             };
-            let evs = stream(1024, 0, true, 8 * 5 + 2, 84e6, mask, &w, &|_| 0.0);
+            let evs = stream(&uniform(1024), Some(0.0), 8 * 5 + 2, 84e6, mask, &w);
             let out = run(&mut m, &evs);
-            let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
+            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
             assert_eq!(valid.len(), 5, "bits {bits} k {k}: {out:?}");
-            for o in &valid {
-                let r = o.report;
+            for r in &valid {
                 // Quantization bounds the error by the reported floor.
                 assert!(
-                    (r.delta as f64 - 0.03).abs() <= r.noise_floor as f64 + 1e-5,
+                    (f64::from(r.delta) - 0.03).abs() <= f64::from(r.noise_floor) + 1e-5,
                     "{r:?}"
                 );
                 // Angle over time of ω̄(1 + ε sin): ω̄·√(1 − ε²).
-                assert!(
-                    (r.omega_mean as f64 / (134.0 * (1.0 - 0.015f64.powi(2)).sqrt()) - 1.0).abs()
-                        < 2e-6
-                );
+                let mean = 134.0 * (1.0 - 0.015f64.powi(2)).sqrt();
+                assert!((f64::from(r.omega_mean) / mean - 1.0).abs() < 2e-6, "{r:?}");
+                assert!(r.omega_min <= r.omega_max);
             }
             if k == 16 {
                 // Averaging 16 edges puts the floor at 2/(16·3800) ≈ 3e-5: δ within 0.3 %.
-                let r = valid[4].report;
+                let r = valid[4];
                 assert!(r.noise_floor < 4e-5, "{r:?}");
-                assert!((r.delta as f64 / 0.03 - 1.0).abs() < 3e-3, "{r:?}");
+                assert!((r.delta / 0.03 - 1.0).abs() < 3e-3, "{r:?}");
                 assert!(r.steady);
             }
-            assert_eq!(m.diagnostics().edges.glitches, 0);
-            assert_eq!(m.diagnostics().invalid_windows, 0);
+            let d = m.diagnostics();
+            assert_eq!(
+                d.edges.glitches + d.edges.missing + d.edges.extra,
+                0,
+                "{d:?}"
+            );
+            assert_eq!(d.invalid_windows, 0);
             assert_eq!(m.shaft_state(), ShaftState::Running);
+            assert_eq!(m.sync_state(), SyncState::Synced);
+            // Synced at the second index: every later revolution counted.
+            assert_eq!(d.edges.revolutions, 40, "{d:?}");
         }
     }
 
     #[test]
-    fn missing_tooth_disc_frames_revolutions() {
-        let w = kneader(0.01);
-        let mut m = monitor(60, Framing::MissingTooth { missing: 2 }, 4, 32, 10e6, 8);
-        let evs = stream(60, 2, false, 8 * 4 + 2, 10e6, u32::MAX, &w, &|_| 0.0);
+    fn windows_say_where_they_lie() {
+        let mut m = monitor(indexed(64, 4, 32, 1e6), 2);
+        let evs = stream(&uniform(64), Some(0.0), 8, 1e6, u32::MAX, &kneader(0.01));
         let out = run(&mut m, &evs);
-        let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
-        assert!(valid.len() >= 3, "{out:?}");
-        for o in valid {
-            assert!((o.report.delta - 0.02).abs() < 2e-3, "{:?}", o.report);
+        let edges: Vec<u32> = evs
+            .iter()
+            .filter_map(|e| if let Ev::Edge(t) = e { Some(*t) } else { None })
+            .collect();
+        assert!(out.len() >= 3, "{out:?}");
+        for o in &out {
+            let r = o.report;
+            // Each window spans two revolutions of edges, from one frame to the next-but-one.
+            assert_eq!(r.end_edge - r.start_edge, 128, "{r:?}");
+            // Edge numbers count accepted edges; the first edge is only a time reference.
+            assert_eq!(r.start_ticks, edges[r.start_edge as usize]);
+            assert_eq!(r.end_ticks, edges[r.end_edge as usize]);
         }
-        assert_eq!(m.diagnostics().edges.missing, 0);
+    }
+
+    #[test]
+    fn missing_tooth_wheels_frame_revolutions() {
+        let w = kneader(0.01);
+        for (positions, missing) in [(60u8, 2u8), (36, 1), (36, 2), (8, 1)] {
+            let p = Pattern::missing_teeth(positions, missing);
+            let mut c = EncoderConfig::pattern(p, 10e6);
+            c.estimator = Estimator::Edges(if positions > 10 { 4 } else { 2 });
+            c.min_speed = 20.0;
+            let mut m = monitor(c, 8);
+            let evs = stream(&pattern_angles(p), None, 8 * 4 + 3, 10e6, u32::MAX, &w);
+            let out = run(&mut m, &evs);
+            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+            assert!(valid.len() >= 3, "{positions}-{missing}: {out:?}");
+            for r in valid {
+                assert!(
+                    (r.delta - 0.02).abs() < 2e-3,
+                    "{positions}-{missing}: {r:?}"
+                );
+            }
+            let d = m.diagnostics().edges;
+            assert_eq!(
+                d.missing + d.glitches + d.extra + d.missing_frames,
+                0,
+                "{positions}-{missing}: {d:?}"
+            );
+            assert_eq!(d.syncs, 1);
+        }
+    }
+
+    #[test]
+    fn a_slowdown_mid_revolution_is_not_a_gap() {
+        // The re-frame cascade: 36-2 at 5000 ticks per tooth, the speed dropping once to 1/1.6
+        // in the middle of a revolution (no edge missing). Nothing is a fault, and every
+        // revolution after sync is counted at its gap.
+        let p = Pattern::missing_teeth(36, 2);
+        let mut c = EncoderConfig::pattern(p, 1e6);
+        c.estimator = Estimator::Edges(1);
+        c.min_speed = 1.0;
+        let tooth_s = 5000.0 / 1e6;
+        let w0 = TAU / 36.0 / tooth_s;
+        let drop_at = TAU * 5.5;
+        let omega = move |phi: f64| if phi < drop_at { w0 } else { w0 / 1.6 };
+        let mut m = monitor(c, 1);
+        let evs = stream(&pattern_angles(p), None, 12, 1e6, u32::MAX, &omega);
+        run(&mut m, &evs);
+        let d = m.diagnostics();
+        assert_eq!(
+            d.edges.missing + d.edges.glitches + d.edges.extra,
+            0,
+            "{d:?}"
+        );
+        assert_eq!(d.invalid_windows, 0, "{d:?}");
+        assert_eq!(m.sync_state(), SyncState::Synced);
+        // Synced within the first two revolutions, then every revolution counted.
+        assert!(d.edges.revolutions >= 9, "{d:?}");
+    }
+
+    /// Cranking: ω = ω̄(1 + a·sin(2φ)) (two compression strokes per turn).
+    fn cranking(mean: f64, a: f64) -> impl Fn(f64) -> f64 {
+        move |phi: f64| mean * (1.0 + a * (2.0 * phi + 0.3).sin())
+    }
+
+    #[test]
+    fn cranking_ripple_on_an_8_1_wheel_syncs_without_faults() {
+        let p = Pattern::missing_teeth(8, 1);
+        let mut c = EncoderConfig::pattern(p, 1e6);
+        c.estimator = Estimator::Edges(1);
+        c.min_speed = 5.0;
+        for a in [0.2, 0.3, 0.4] {
+            let mut m = monitor(c, 1);
+            let evs = stream(
+                &pattern_angles(p),
+                None,
+                30,
+                1e6,
+                u32::MAX,
+                &cranking(25.0, a),
+            );
+            run(&mut m, &evs);
+            let d = m.diagnostics();
+            assert_eq!(
+                d.edges.missing + d.edges.glitches + d.edges.extra,
+                0,
+                "±{a}: {d:?}"
+            );
+            assert_eq!(m.sync_state(), SyncState::Synced, "±{a}: {d:?}");
+            assert!(d.edges.revolutions >= 20, "±{a}: {d:?}");
+        }
+    }
+
+    #[test]
+    fn a_noise_pulse_is_a_glitch_and_the_real_edge_is_kept() {
+        for frac in [0.3, 0.45, 0.55, 0.7] {
+            let mut evs = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));
+            // Between teeth 10 and 11 of revolution 20.
+            let at = (0..evs.len())
+                .filter(|&i| matches!(evs[i], Ev::Edge(_)))
+                .nth(256 * 20 + 10)
+                .unwrap();
+            let (Ev::Edge(a), Ev::Edge(b)) = (evs[at], evs[at + 1]) else {
+                panic!("edges expected");
+            };
+            evs.insert(at + 1, Ev::Edge(a + ((b - a) as f64 * frac) as u32));
+            let mut m = monitor(indexed(256, 4, 32, 84e6), 8);
+            let out = run(&mut m, &evs);
+            let d = m.diagnostics().edges;
+            assert_eq!((d.glitches, d.missing, d.extra), (1, 0, 0), "{frac}: {d:?}");
+            assert!(out.iter().any(|o| o.report.fault() == Some(Fault::Glitch)));
+            // The windows after it are valid again.
+            assert!(out.last().unwrap().report.valid());
+        }
     }
 
     #[test]
     fn faults_invalidate_windows_with_their_reason() {
-        let w = kneader(0.01);
-        let base = stream(256, 0, true, 40, 84e6, u32::MAX, &w, &|_| 0.0);
+        let base = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));
         let edges: Vec<usize> = (0..base.len())
             .filter(|&i| matches!(base[i], Ev::Edge(_)))
             .collect();
-        // A glitch between two edges in the third window.
-        let mut g = base.clone();
-        let i = edges[256 * 20 + 10];
-        if let (Ev::Edge(a), Ev::Edge(b)) = (g[i], g[i + 1]) {
-            g.insert(i + 1, Ev::Edge(a + (b - a) / 5));
-        }
-        let mut m = monitor(256, Framing::Index, 4, 32, 84e6, 8);
-        let out = run(&mut m, &g);
-        assert!(out.iter().any(|o| o.report.fault == Some(Fault::Glitch)));
-        assert_eq!(m.diagnostics().edges.glitches, 1);
         // A dropped edge.
         let mut d = base.clone();
         d.remove(edges[256 * 20 + 10]);
-        let mut m = monitor(256, Framing::Index, 4, 32, 84e6, 8);
+        let mut m = monitor(indexed(256, 4, 32, 84e6), 8);
         let out = run(&mut m, &d);
         assert!(
             out.iter()
-                .any(|o| o.report.fault == Some(Fault::MissingEdge)),
+                .any(|o| o.report.fault() == Some(Fault::MissingEdge)),
             "{out:?}"
         );
-        assert!(m.diagnostics().invalid_windows >= 1);
+        assert_eq!(m.diagnostics().edges.missing, 1);
+        assert_eq!(m.diagnostics().invalid_windows, 1);
         // A lost index pulse.
         let mut x = base.clone();
-        let idx: Vec<usize> = (0..x.len()).filter(|&i| x[i] == Ev::Index).collect();
+        let idx: Vec<usize> = (0..x.len())
+            .filter(|&i| matches!(x[i], Ev::Index(_)))
+            .collect();
         x.remove(idx[20]);
-        let mut m = monitor(256, Framing::Index, 4, 32, 84e6, 8);
+        let mut m = monitor(indexed(256, 4, 32, 84e6), 8);
         let out = run(&mut m, &x);
         assert!(
             out.iter()
-                .any(|o| o.report.fault == Some(Fault::MissingFrame)),
+                .any(|o| o.report.fault() == Some(Fault::MissingFrame)),
             "{out:?}"
         );
+        assert_eq!(m.diagnostics().edges.missing_frames, 1);
         // Valid windows resume after each fault.
         assert!(out.last().unwrap().report.valid());
     }
 
     #[test]
     fn reversal_and_standstill_are_states() {
-        let w = kneader(0.0);
-        let evs = stream(256, 0, true, 20, 84e6, u32::MAX, &w, &|_| 0.0);
-        let mut m = monitor(256, Framing::Index, 1, 32, 84e6, 1);
+        let evs = stream(&uniform(256), Some(0.0), 20, 84e6, u32::MAX, &kneader(0.0));
+        let mut m = monitor(indexed(256, 1, 32, 84e6), 1);
         assert_eq!(m.shaft_state(), ShaftState::NoSignal);
-        run(&mut m, &evs[..evs.len() / 2]);
+        let half = (evs.len() / 2..)
+            .find(|&i| matches!(evs[i], Ev::Edge(_)))
+            .unwrap();
+        run(&mut m, &evs[..half]);
         assert_eq!(m.shaft_state(), ShaftState::Running);
-        assert!((m.speed() - 134.0).abs() < 0.1);
-        let half = evs.len() / 2 + usize::from(evs[evs.len() / 2] == Ev::Index);
+        assert!((m.speed() - 134.0).abs() < 0.1, "{}", m.speed());
         let Ev::Edge(t) = evs[half] else {
             unreachable!()
         };
         let o = m.on_edge(t, Some(Direction::Reverse)).unwrap();
-        assert_eq!(o.report.fault, Some(Fault::Reversal));
+        assert_eq!(o.report.fault(), Some(Fault::Reversal));
         assert_eq!(m.shaft_state(), ShaftState::Reversed);
         assert_eq!(m.speed(), 0.0);
         // Forward again, then stop: the poll after the timeout reports standstill.
-        let rest: Vec<Ev> = evs[half + 1..].to_vec();
-        run(&mut m, &rest);
+        let rest = &evs[half + 1..];
+        run(&mut m, rest);
         assert_eq!(m.shaft_state(), ShaftState::Running);
-        let Some(Ev::Edge(last)) = rest.last().copied() else {
-            unreachable!()
-        };
+        let last = rest
+            .iter()
+            .rev()
+            .find_map(|e| if let Ev::Edge(t) = e { Some(*t) } else { None })
+            .unwrap();
         assert!(m.poll(last + 1000).is_none());
         let o = m.poll(last + m.encoder().timeout_ticks() + 1).unwrap();
-        assert_eq!(o.report.fault, Some(Fault::Timeout));
+        assert_eq!(o.report.fault(), Some(Fault::Timeout));
         assert_eq!(m.shaft_state(), ShaftState::Standstill);
         assert_eq!(m.speed(), 0.0);
         assert_eq!(m.diagnostics().edges.timeouts, 1);
         assert_eq!(m.diagnostics().edges.reversals, 1);
+    }
+
+    #[test]
+    fn a_shaft_creeping_below_min_speed_does_not_flip_state() {
+        // Edges every 1.5 timeouts, polled in between, with the direction flickering: no
+        // timeouts or reversals are counted, and the state stays at standstill.
+        let mut m = monitor(indexed(64, 1, 32, 1e6), 1);
+        let step = m.encoder().timeout_ticks() * 3 / 2;
+        let mut t = 0u32;
+        for i in 0..300 {
+            t = t.wrapping_add(step);
+            let dir = if i % 7 == 3 {
+                Direction::Reverse
+            } else {
+                Direction::Forward
+            };
+            assert!(m.on_edge(t, Some(dir)).is_none());
+            assert!(m.poll(t + step / 2).is_none());
+            assert!(m.poll(t + step - 1).is_none());
+        }
+        let d = m.diagnostics().edges;
+        assert_eq!((d.timeouts, d.reversals), (0, 0), "{d:?}");
+        assert_ne!(m.shaft_state(), ShaftState::Running);
+    }
+
+    #[test]
+    fn a_batch_gives_the_same_results_as_edge_by_edge() {
+        let base = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));
+        let mut a = monitor(indexed(256, 4, 32, 84e6), 4);
+        let mut b = a.clone();
+        let one = run(&mut a, &base);
+        let mut batch = Vec::new();
+        let mut chunk = Vec::new();
+        for e in &base {
+            match *e {
+                Ev::Index(t) => b.on_index(t),
+                Ev::Edge(t) => {
+                    chunk.push(t);
+                    if chunk.len() == 64 {
+                        b.on_captures(&chunk, |o| batch.push(o));
+                        chunk.clear();
+                    }
+                }
+            }
+        }
+        b.on_captures(&chunk, |o| batch.push(o));
+        assert_eq!(one, batch);
+        assert_eq!(a.diagnostics(), b.diagnostics());
+    }
+
+    #[test]
+    fn a_prescaled_capture_measures_the_same_delta() {
+        let w = kneader(0.015);
+        let all = stream(&uniform(1024), Some(0.0), 8 * 3 + 2, 84e6, u32::MAX, &w);
+        let mut c = indexed(1024, 4, 32, 84e6);
+        c.prescaler = 4;
+        let mut m = monitor(c, 8);
+        // Every fourth line edge, as a capture prescaler of 4 delivers them.
+        let mut n = 0;
+        let mut out = Vec::new();
+        for e in &all {
+            match *e {
+                Ev::Index(t) => m.on_index(t),
+                Ev::Edge(t) => {
+                    if n % 4 == 0 {
+                        out.extend(m.on_edge(t, None));
+                    }
+                    n += 1;
+                }
+            }
+        }
+        let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+        // Framed at the first index, confirmed at the second: windows end at revolutions 9,
+        // 17 and 25.
+        assert_eq!(valid.len(), 3, "{out:?}");
+        for r in valid {
+            assert!(
+                (f64::from(r.delta) - 0.03).abs() <= f64::from(r.noise_floor) + 1e-5,
+                "{r:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_unconfigured_monitor_ignores_everything() {
+        let mut m = DeltaMonitor::<64>::unconfigured();
+        for t in [0u32, 10, 20, 30, 40] {
+            assert!(m.on_edge(t, None).is_none());
+            m.on_index(t);
+            assert!(m.poll(t + 1_000_000).is_none());
+        }
+        assert_eq!(m.diagnostics(), Diagnostics::default());
+        assert_eq!(m.shaft_state(), ShaftState::NoSignal);
+        m.configure(
+            Encoder::new(EncoderConfig::indexed(64, 1e6)).unwrap(),
+            window(1),
+            None,
+        )
+        .unwrap();
+        assert_eq!(m.encoder().edges(), 64);
     }
 
     #[test]
@@ -477,33 +878,49 @@ mod tests {
         // error of up to ±1e-4 rad per line (0.8 % of a 0.0123 rad pitch).
         let err = |k: u32| {
             let hash = ((k.wrapping_mul(2_654_435_761) >> 16) % 2001) as f64 / 1000.0 - 1.0;
-            2e-3 * (core::f64::consts::TAU * k as f64 / 512.0).sin() + 1e-4 * hash
+            2e-3 * (TAU * f64::from(k) / 512.0).sin() + 1e-4 * hash
         };
-        let steady = kneader(0.0);
-        let ripple = kneader(0.005);
-        let mut m = monitor(512, Framing::Index, 8, 32, 84e6, 8);
-        let out = run(
-            &mut m,
-            &stream(512, 0, true, 41, 84e6, u32::MAX, &ripple, &err),
-        );
-        let before = out.last().unwrap().report;
+        let teeth: Vec<f64> = (0..512)
+            .map(|k| TAU * (f64::from(k) + 0.5) / 512.0 + err(k))
+            .collect();
+        let c = indexed(512, 8, 32, 84e6);
+        let mut m: DeltaMonitor<512, Corrected<512>> = DeltaMonitor::new(
+            Encoder::new(c).unwrap(),
+            window(8),
+            Some(AlarmConfig::new(0.06)),
+        )
+        .unwrap();
+        let ripple = stream(&teeth, Some(0.0), 41, 84e6, u32::MAX, &kneader(0.005));
+        let out = run(&mut m, &ripple);
+        let before = *out.last().unwrap().report.measurement().unwrap();
         // Uncorrected, the disc's error dominates: δ far from 0.01.
         assert!(before.delta > 0.013, "{before:?}");
-        m.start_learning(0.01);
-        run(
-            &mut m,
-            &stream(512, 0, true, 30, 84e6, u32::MAX, &steady, &err),
-        );
-        let mut table = [0.0f32; 1024];
-        let learned = m.finish_learning(20, &mut table).unwrap();
+        let mut learner = ToothLearner::<512>::new(m.encoder(), 0.01).unwrap();
+        for e in stream(&teeth, Some(0.0), 30, 84e6, u32::MAX, &kneader(0.0)) {
+            match e {
+                Ev::Index(t) => m.on_index(t),
+                Ev::Edge(t) => {
+                    m.on_edge_observed(t, None, &mut learner);
+                }
+            }
+        }
+        let mut table = [0.0f32; 512];
+        let learned = learner.pitches(20, &mut table).unwrap();
         assert_eq!(learned.len(), 512);
+        m.set_pitches(learned).unwrap();
         // Re-run the ripple: now δ is the shaft's.
-        let out = run(
-            &mut m,
-            &stream(512, 0, true, 41, 84e6, u32::MAX, &ripple, &err),
-        );
-        let after = out.last().unwrap().report;
-        assert!(after.valid());
+        let out = run(&mut m, &ripple);
+        let after = *out.last().unwrap().report.measurement().unwrap();
         assert!((after.delta - 0.01).abs() < 5e-4, "{after:?}");
+        // A monitor without a table cannot take one.
+        let mut plain = monitor(indexed(512, 8, 32, 84e6), 8);
+        assert_eq!(
+            plain.set_pitches(learned),
+            Err(ConfigError::Capacity("pitch table"))
+        );
+        assert_eq!(
+            ToothLearner::<512>::new(plain.encoder(), f32::NAN).err(),
+            Some(ConfigError::NonFinite("steady_tolerance"))
+        );
     }
 }

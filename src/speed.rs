@@ -1,22 +1,50 @@
-//! Edge timing: from raw capture timestamps to framed, checked speed samples.
+//! Edge timing: from raw capture timestamps to framed, checked teeth and speed samples.
 //!
 //! [`SpeedTracker`] takes each capture timestamp as a raw counter value (ticks; the counter
-//! wraps modulo 2^bits). Intervals are taken with wrapping integer subtraction and masked to
-//! the counter width; floats appear only after the subtraction. Every edge is classified:
-//! accepted, or rejected as a glitch (impossibly early). Revolutions are framed by the index
-//! pulse or the missing-tooth gap, and the tooth count of every revolution is checked: a
-//! missing or extra edge is a [`Fault`], never interpolated. The shaft state is explicit
-//! ([`ShaftState`]): no signal, standstill (no edge within the timeout derived from the minimum
-//! speed), running, reversed.
+//! wraps modulo 2^bits). Intervals are wrapping integer differences masked to the counter
+//! width, and every per-edge decision is integer arithmetic against bounds derived from the
+//! previous interval. An edge is *accepted* as a tooth, or *rejected* as a glitch; the tooth of
+//! every accepted edge is known once the revolution is framed ([`SyncState::Synced`]).
 //!
-//! A speed sample is the angle of the last `K` teeth over their interval in ticks; both are
-//! kept as exact numbers (the interval as an integer sum), so a sample carries no drift however
-//! long the shaft runs.
+//! # Judging an edge
+//!
+//! The per-pitch interval (interval over the nominal pitch it spans) changes from tooth to
+//! tooth by the *swing*. An edge whose swing lies within the accept band
+//! ([`crate::encoder::Tolerances::accept`]) and which is not a special tooth (the frame, a gap,
+//! an extra tooth) is taken at once: this is the path nearly every edge takes. Any other edge
+//! is judged with the two edges that follow it, by how smoothly each explanation continues the
+//! per-pitch intervals (the sum of squared log swings): the expected tooth; a glitch (the edge
+//! is dropped and the next one is the tooth); one or two missing teeth; and, on a pattern
+//! wheel, a count one ahead or behind (an earlier extra or missing edge). A fault must explain
+//! the intervals better than the plain tooth by [`crate::encoder::Tolerances::fault_margin`].
+//! A real compression swing is therefore taken as a tooth, a noise pulse between two teeth is
+//! rejected as a glitch and the real edge behind it kept, and a tooth lost mid-revolution moves
+//! the count on by one instead of re-framing the revolution there (no cascade).
+//!
+//! # Framing
+//!
+//! - Index pulse ([`crate::encoder::Wheel::Indexed`]): the first edge after an index
+//!   timestamp is tooth 0. The first index is a candidate; the revolution is framed once the
+//!   next index comes exactly one revolution of edges later. In sync an index that does not
+//!   fall where the count says is a fault (extra or missing edge) and the count is realigned
+//!   to it; a revolution without its index is a [`Fault::MissingFrame`] and the count goes on.
+//! - Pattern ([`crate::encoder::Wheel::Pattern`]): each interval is compared with both of its
+//!   neighbours; an interval clearly longer than both is a long pitch (a gap), one clearly
+//!   shorter a short pitch (an extra tooth), and each such observation rules out the
+//!   alignments of the pattern it contradicts (a bit mask of the teeth the last edge could
+//!   be). Once one alignment is left and the pattern's special teeth have been seen where due
+//!   for a full revolution, the revolution is framed.
+//! - None ([`crate::encoder::Wheel::Unframed`]): revolutions are counted in edges.
+//!
+//! # Shaft state
+//!
+//! [`ShaftState`] is explicit. An edge after standstill (or the first one) is only a time
+//! reference: the shaft is running once an interval within the timeout is seen, so a shaft
+//! creeping below the minimum speed stays at standstill instead of flipping state on every edge.
+//! Timeouts and reversals are counted on leaving [`ShaftState::Running`] only.
 
-use crate::encoder::{Encoder, Framing};
-
-/// Largest `K` of the `K`-edge estimator (size of the interval ring).
-pub const MAX_SPAN: usize = 64;
+use crate::encoder::{Encoder, Framing, MAX_PATTERN_TEETH, MAX_SPAN, PITCH_UNITS};
+use crate::pitch::PitchTable;
 
 /// Direction of rotation reported with an edge (e.g. from the quadrature B channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,25 +62,39 @@ pub enum Direction {
 pub enum ShaftState {
     /// No edge seen since start or reset.
     NoSignal,
-    /// Edges stopped: none within the timeout.
+    /// Edges stopped (none within the timeout), or too slow to be running.
     Standstill,
-    /// Edges arriving in the forward direction.
+    /// Edges arriving in the forward direction within the timeout.
     Running,
-    /// Edges arriving with the reverse direction flag.
+    /// Edges arriving with the reverse direction flag (until two forward edges within the
+    /// timeout).
     Reversed,
+}
+
+/// How far the revolution is framed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SyncState {
+    /// Looking for the frame (index pulse or pattern).
+    Searching,
+    /// A frame candidate is being confirmed over one revolution.
+    Confirming,
+    /// Teeth are identified.
+    Synced,
 }
 
 /// Why an edge or a window could not be trusted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Fault {
-    /// An edge arrived impossibly early (or with a zero interval) and was rejected.
+    /// A spurious edge (a noise pulse between teeth), rejected.
     Glitch,
-    /// An interval spans more than one tooth, or a revolution had too few edges.
+    /// A tooth edge was lost.
     MissingEdge,
-    /// A revolution had more edges than the disc has.
+    /// More edges than teeth were counted (an unidentified spurious edge).
     ExtraEdge,
-    /// The frame marker (index pulse or gap) was not seen where it was due.
+    /// The frame marker (index pulse or pattern) was not seen where it was due, or was not
+    /// found at all.
     MissingFrame,
     /// The direction input reported reverse rotation.
     Reversal,
@@ -60,98 +102,145 @@ pub enum Fault {
     Timeout,
 }
 
-/// A speed sample: `angle` radians travelled in `ticks` timer ticks, ending at `tooth`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct SpeedSample {
-    /// Angle of the averaged teeth, rad.
-    pub angle: f32,
-    /// Their interval, timer ticks (exact).
-    pub ticks: u32,
-    /// The tooth the sample ends at.
-    pub tooth: u16,
-}
-
-impl SpeedSample {
-    /// Speed in rad/s for a timer of `timer_hz`.
-    #[inline]
-    pub fn omega(&self, timer_hz: f32) -> f32 {
-        self.angle * timer_hz / self.ticks as f32
+impl Fault {
+    /// A short name for logs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fault::Glitch => "glitch",
+            Fault::MissingEdge => "missing-edge",
+            Fault::ExtraEdge => "extra-edge",
+            Fault::MissingFrame => "missing-frame",
+            Fault::Reversal => "reversal",
+            Fault::Timeout => "timeout",
+        }
     }
 }
 
-/// What one edge produced.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// A speed sample: `span` angle units travelled in `ticks` timer ticks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct EdgeEvent {
-    /// The accepted edge's interval in ticks and its tooth, when teeth are framed.
-    pub interval: Option<(u32, u16)>,
-    /// A speed sample ending at this edge.
-    pub sample: Option<SpeedSample>,
-    /// This edge is tooth 0 of a correctly counted revolution.
+pub struct Sample {
+    /// Angle, units (see [`crate::encoder`]).
+    pub span: u32,
+    /// Interval, timer ticks (exact).
+    pub ticks: u32,
+}
+
+/// An accepted edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tooth {
+    /// Number of this accepted edge (the running count of accepted edges, wrapping).
+    pub index: u32,
+    /// Capture time (masked to the counter).
+    pub time: u32,
+    /// Ticks since the previous accepted edge (0 after a restart).
+    pub dt: u32,
+    /// Tooth number within the revolution (meaningful when `synced`).
+    pub tooth: u16,
+    /// Teeth are identified.
+    pub synced: bool,
+    /// This edge is tooth 0 of a revolution counted in sync.
     pub frame: bool,
-    /// A fault found at this edge.
-    pub fault: Option<Fault>,
+    /// The speed sample ending at this edge, once `K` edges are known.
+    pub sample: Option<Sample>,
+}
+
+/// Receives what the tracker finds, in order.
+pub trait EdgeSink {
+    /// An edge accepted as a tooth.
+    fn tooth(&mut self, tooth: &Tooth);
+    /// A fault found at `time` (a rejected glitch, a missing edge, a timeout...).
+    fn fault(&mut self, fault: Fault, time: u32);
 }
 
 /// Counters of everything the tracker accepted or rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EdgeCounters {
-    /// Edges accepted.
+    /// Edges accepted as teeth.
     pub accepted: u32,
     /// Edges rejected as glitches.
     pub glitches: u32,
-    /// Missing edges detected (long intervals or short revolutions).
+    /// Tooth edges lost.
     pub missing: u32,
-    /// Revolutions with too many edges.
+    /// Extra edges counted in a revolution.
     pub extra: u32,
-    /// Frame markers missed.
+    /// Frame markers missed (and every three revolutions' worth of edges searched without a
+    /// frame).
     pub missing_frames: u32,
     /// Changes to reverse rotation.
     pub reversals: u32,
     /// Timeouts (standstill or lost signal).
     pub timeouts: u32,
-    /// Correctly counted revolutions.
+    /// Revolutions counted in sync.
     pub revolutions: u32,
+    /// Times the frame was found and confirmed.
+    pub syncs: u32,
+    /// Times sync was lost (a timeout, a reversal, or faults the count could not absorb).
+    pub sync_losses: u32,
 }
 
-/// The exact interval sum of a full ring of `k` intervals, from the sum modulo 2^32, saturated
-/// at `u32::MAX`.
-///
-/// Each interval is 1 to `timeout` ticks (0 is a glitch, more is a timeout) and the encoder
-/// checks K·timeout < 2^32 before rounding `timeout` up to whole ticks, so the exact sum is at
-/// least `k` and below 2^32 + `k`. A sum modulo 2^32 below `k` therefore means it wrapped, and
-/// the exact sum is at least 2^32: saturate. Keeping the running sum in one 32-bit word instead
-/// of a u64 pair keeps it in registers on the per-edge path.
-#[inline]
-fn full_ring_ticks(sum: u32, k: u16) -> u32 {
-    if sum < u32::from(k) {
-        u32::MAX
-    } else {
-        sum
-    }
-}
+/// Pending raw edges awaiting judgement: the edge itself and two for lookahead.
+const PENDING: usize = 3;
+/// Index timestamps that may wait for their edge.
+const INDEXES: usize = 4;
+/// Faults within one revolution after which the count is no longer trusted.
+const FAULTS_TO_RESYNC: u8 = 3;
 
 /// Per-edge state of the timing front end. Total: every input sequence is handled without
-/// panicking, and every path is O(1).
+/// panicking, and every path is O(1). Memory: about 340 bytes (the 64-slot interval ring).
 #[derive(Debug, Clone)]
 pub struct SpeedTracker {
-    /// `Running` or `Reversed` exactly when `last` holds the previous edge's time.
+    /// Everything the fast path needs holds (running, synced, ring full, nothing pending).
+    fast: bool,
     state: ShaftState,
+    sync: SyncState,
+    /// `last` is a time reference (an accepted or starting edge).
+    has_ref: bool,
     last: u32,
-    /// Previous accepted interval and the pitch it spanned (0 when none).
-    prev_dt: u32,
-    prev_pitch: f32,
-    synced: bool,
-    /// Tooth of the last accepted edge (valid when `synced`).
+    /// Latest raw edge time (for timeouts while edges are pending).
+    latest: u32,
+    /// The previous accepted interval scaled to one base pitch (0: none).
+    prev: u32,
+    /// Acceptance band of the next interval, ticks (valid when `fast`).
+    lo: u32,
+    hi: u32,
+    /// Tooth of the last accepted edge.
     tooth: u16,
-    index_pending: bool,
+    /// The fast path stops after this tooth: the next one is special.
+    stop: u16,
+    /// Accepted edges since the last frame (or since the frame candidate).
+    count: u16,
+    /// Faults since the last frame.
+    faults: u8,
+    /// The last `K` accepted intervals, ticks; `pos` is the oldest, `fill` how many are held.
     ring: [u32; MAX_SPAN],
-    ring_pos: u16,
-    ring_fill: u16,
-    /// Sum of the ring's intervals modulo 2^32 (see [`full_ring_ticks`]).
-    ring_sum: u32,
+    pos: u8,
+    fill: u8,
+    /// Their sum (exact: `K` intervals within the timeout fit in 32 bits) and the angle they
+    /// span in units (kept only when pitches differ): the latest speed sample.
+    sum: u32,
+    span: u32,
+    /// Per-base interval of every tooth in the last revolution (wheels of up to
+    /// [`MAX_PATTERN_TEETH`] teeth): cranking ripple repeats every turn, so each tooth's swing
+    /// is judged against the same tooth's swing one revolution earlier. `history` once a
+    /// whole revolution is recorded.
+    hist: [u32; MAX_PATTERN_TEETH],
+    hist_teeth: u16,
+    history: bool,
+    pending: [u32; PENDING],
+    npend: u8,
+    index: [u32; INDEXES],
+    nidx: u8,
+    /// Pattern acquisition: alignments still possible for the last accepted edge (bit k:
+    /// it is tooth k), the two previous unsynced intervals, and the confirmation countdown.
+    viable: u64,
+    acq: [u32; 2],
+    confirm: u16,
+    seen_special: bool,
+    /// Edges accepted while searching (a missing frame is counted every two revolutions).
+    searched: u16,
     counters: EdgeCounters,
 }
 
@@ -161,21 +250,95 @@ impl Default for SpeedTracker {
     }
 }
 
+/// `(x·f) >> 32`: the high word of the 64-bit product, one instruction on a Cortex-M4.
+#[inline(always)]
+fn mul_hi(x: u32, f: u32) -> u32 {
+    ((u64::from(x) * u64::from(f)) >> 32) as u32
+}
+
+/// Squared natural log of `a/b` for tick counts known to ±1 tick: the ratio is taken at the
+/// end of its quantization range nearest 1, so rounding alone never looks like a swing.
+/// Careful path only (f32).
+fn log_sq(a: f32, b: f32) -> f32 {
+    let (a, b) = if a >= b {
+        ((a - 1.0).max(b + 1.0), b + 1.0)
+    } else {
+        ((a + 1.0).min(b - 1.0), b - 1.0)
+    };
+    if a <= 0.0 || b <= 0.0 {
+        return 0.0;
+    }
+    let l = ln(a / b);
+    l * l
+}
+
+/// Natural log, accurate to about 1e-4 (ample for judging swings): exponent from the bits, a
+/// short series on the mantissa. No `libm` call, so the careful path stays cheap.
+fn ln(x: f32) -> f32 {
+    if x.is_nan() || x <= 0.0 || x.is_infinite() {
+        return 0.0;
+    }
+    let bits = x.to_bits();
+    let exp = ((bits >> 23) & 0xff) as i32 - 127;
+    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000); // in [1, 2)
+                                                                // ln(m) = 2·atanh((m−1)/(m+1)), |s| ≤ 1/3: four terms give 1e-5.
+    let s = (m - 1.0) / (m + 1.0);
+    let s2 = s * s;
+    let atanh = s * (1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0))));
+    exp as f32 * core::f32::consts::LN_2 + 2.0 * atanh
+}
+
+/// What the judged edge is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Verdict {
+    /// The expected tooth.
+    Tooth,
+    /// A glitch: drop it.
+    Glitch,
+    /// `n` teeth were lost before it.
+    Missing(u16),
+    /// The count was one ahead: it is the tooth before the expected one.
+    Behind,
+    /// The count was one behind: it is the tooth after the expected one.
+    Ahead,
+    /// Not enough edges yet to judge.
+    Wait,
+}
+
 impl SpeedTracker {
     /// A tracker that has seen nothing yet.
     pub const fn new() -> Self {
         SpeedTracker {
+            fast: false,
             state: ShaftState::NoSignal,
+            sync: SyncState::Searching,
+            has_ref: false,
             last: 0,
-            prev_dt: 0,
-            prev_pitch: 0.0,
-            synced: false,
+            latest: 0,
+            prev: 0,
+            lo: 0,
+            hi: 0,
             tooth: 0,
-            index_pending: false,
+            stop: 0,
+            count: 0,
+            faults: 0,
             ring: [0; MAX_SPAN],
-            ring_pos: 0,
-            ring_fill: 0,
-            ring_sum: 0,
+            pos: 0,
+            fill: 0,
+            sum: 0,
+            span: 0,
+            hist: [0; MAX_PATTERN_TEETH],
+            hist_teeth: 0,
+            history: false,
+            pending: [0; PENDING],
+            npend: 0,
+            index: [0; INDEXES],
+            nidx: 0,
+            viable: 0,
+            acq: [0; 2],
+            confirm: 0,
+            seen_special: false,
+            searched: 0,
             counters: EdgeCounters {
                 accepted: 0,
                 glitches: 0,
@@ -185,6 +348,8 @@ impl SpeedTracker {
                 reversals: 0,
                 timeouts: 0,
                 revolutions: 0,
+                syncs: 0,
+                sync_losses: 0,
             },
         }
     }
@@ -194,9 +359,19 @@ impl SpeedTracker {
         self.state
     }
 
-    /// Whether teeth are identified (the revolution is framed).
+    /// How far the revolution is framed.
+    pub fn sync_state(&self) -> SyncState {
+        self.sync
+    }
+
+    /// Whether teeth are identified.
     pub fn synced(&self) -> bool {
-        self.synced
+        self.sync == SyncState::Synced
+    }
+
+    /// The tooth of the last accepted edge, when teeth are identified.
+    pub fn tooth(&self) -> Option<u16> {
+        self.synced().then_some(self.tooth)
     }
 
     /// The counters.
@@ -204,312 +379,1092 @@ impl SpeedTracker {
         self.counters
     }
 
-    #[cold]
-    fn lose_sync(&mut self) {
-        self.synced = false;
-        self.index_pending = false;
-        self.clear_ring();
-    }
-
-    #[cold]
-    fn count(&mut self, f: Fault) -> Fault {
-        let c = &mut self.counters;
-        let n = match f {
-            Fault::Glitch => &mut c.glitches,
-            Fault::MissingEdge => &mut c.missing,
-            Fault::ExtraEdge => &mut c.extra,
-            Fault::MissingFrame => &mut c.missing_frames,
-            Fault::Reversal => &mut c.reversals,
-            Fault::Timeout => &mut c.timeouts,
+    /// The latest speed sample (the last `K` accepted intervals) while running; `None` before
+    /// `K` intervals are known (and, on a pattern wheel, before the teeth are identified).
+    pub fn recent_sample(&self, enc: &Encoder) -> Option<Sample> {
+        if self.state != ShaftState::Running || self.fill < enc.samples_span() as u8 {
+            return None;
+        }
+        if enc.framing() == Framing::Pattern && self.sync != SyncState::Synced {
+            return None;
+        }
+        let span = if self.span == 0 {
+            enc.uniform_span()
+        } else {
+            self.span
         };
-        *n = n.wrapping_add(1);
-        f
+        (self.sum > 0).then_some(Sample {
+            span,
+            ticks: self.sum,
+        })
     }
 
-    fn clear_ring(&mut self) {
-        self.ring_fill = 0;
-        self.ring_pos = 0;
-        self.ring_sum = 0;
+    /// Whether the teeth are numbered: synced, or confirming a frame candidate.
+    #[inline(always)]
+    fn teeth_known(&self, enc: &Encoder) -> bool {
+        self.sync == SyncState::Synced
+            || (self.sync == SyncState::Confirming && enc.framing() != Framing::None)
     }
 
-    /// An index pulse was captured. Call it before the edge that follows the pulse.
-    pub fn on_index(&mut self) {
-        self.index_pending = true;
+    /// Pitch of `tooth` in units (nominal plus correction; a base pitch while the teeth are
+    /// not numbered).
+    #[inline(always)]
+    fn pitch<P: PitchTable>(&self, enc: &Encoder, table: &P, tooth: u16) -> u32 {
+        if !self.teeth_known(enc) {
+            return enc.base_pitch() * PITCH_UNITS;
+        }
+        let nominal = enc.nominal_pitch(tooth);
+        if P::NOMINAL {
+            nominal
+        } else {
+            nominal.wrapping_add_signed(table.deviation(tooth))
+        }
+    }
+
+    /// An index pulse captured at `ticks` (raw counter value). Report it before the captures
+    /// that follow it; up to four may wait for their edge.
+    pub fn on_index(&mut self, enc: &Encoder, ticks: u32) {
+        if enc.framing() != Framing::Index {
+            return;
+        }
+        let t = ticks & enc.mask();
+        if usize::from(self.nidx) >= INDEXES {
+            // The oldest waiting index lost its edge: drop it.
+            self.index.copy_within(1.., 0);
+            self.nidx -= 1;
+            self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
+        }
+        if let Some(slot) = self.index.get_mut(usize::from(self.nidx)) {
+            *slot = t;
+            self.nidx += 1;
+        }
+        self.fast = false;
     }
 
     /// Checks for a timeout at time `now` (ticks). Call it at least once per counter period:
-    /// elapsed time is measured modulo the counter.
-    pub fn poll<const N: usize>(&mut self, enc: &Encoder<N>, now: u32) -> Option<Fault> {
-        if !self.has_last() {
-            return None;
+    /// elapsed time is measured modulo the counter. Reports [`Fault::Timeout`] when a running
+    /// shaft stops (once per stop).
+    pub fn poll<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        now: u32,
+        sink: &mut S,
+    ) {
+        if self.state == ShaftState::NoSignal || enc.edges() == 0 {
+            return;
         }
-        let elapsed = now.wrapping_sub(self.last) & enc.mask();
+        let elapsed = (now & enc.mask()).wrapping_sub(self.latest) & enc.mask();
         if elapsed > enc.timeout_ticks() {
-            self.enter_standstill();
-            return Some(Fault::Timeout);
+            self.flush(enc, table, sink);
+            self.stop_running(now & enc.mask(), sink);
+            self.has_ref = false;
         }
-        None
-    }
-
-    /// Whether `last` holds the time of the previous edge (running forward or reversed).
-    fn has_last(&self) -> bool {
-        matches!(self.state, ShaftState::Running | ShaftState::Reversed)
-    }
-
-    #[cold]
-    fn enter_standstill(&mut self) {
-        self.state = ShaftState::Standstill;
-        self.prev_dt = 0;
-        self.count(Fault::Timeout);
-        self.lose_sync();
     }
 
     /// Processes one captured edge at `ticks` (raw counter value).
-    pub fn on_edge<const N: usize>(
-        &mut self,
-        enc: &Encoder<N>,
-        ticks: u32,
-        direction: Option<Direction>,
-    ) -> EdgeEvent {
-        let ticks = ticks & enc.mask();
-        // Only a shaft running forward gives an interval: after start, standstill or reversal
-        // the edge is a new time reference.
-        if direction == Some(Direction::Reverse) || self.state != ShaftState::Running {
-            return self.restart(enc, ticks, direction);
-        }
-        let dt = ticks.wrapping_sub(self.last) & enc.mask();
-        if dt > enc.timeout_ticks() {
-            return self.restart_after_timeout(ticks);
-        }
-        self.on_interval(enc, dt, ticks)
-    }
-
-    /// An edge that gives no interval: reverse rotation, or the first edge after start,
-    /// standstill or reversal. Off the per-edge path.
-    #[cold]
-    #[inline(never)]
-    fn restart<const N: usize>(
-        &mut self,
-        enc: &Encoder<N>,
-        ticks: u32,
-        direction: Option<Direction>,
-    ) -> EdgeEvent {
-        let mut ev = EdgeEvent::default();
-        if direction == Some(Direction::Reverse) {
-            if self.state != ShaftState::Reversed {
-                self.state = ShaftState::Reversed;
-                ev.fault = Some(self.count(Fault::Reversal));
-            }
-            self.lose_sync();
-            self.last = ticks;
-            self.prev_dt = 0;
-            return ev;
-        }
-        // First edge after start, standstill or reversal: only a time reference, but an
-        // index pulse before it still frames it as tooth 0.
-        self.state = ShaftState::Running;
-        self.last = ticks;
-        self.prev_dt = 0;
-        if self.index_pending && enc.config().framing == Framing::Index {
-            self.index_pending = false;
-            self.synced = true;
-            self.tooth = 0;
-            self.clear_ring();
-        }
-        ev
-    }
-
-    /// The shaft stopped and restarted between two polls.
-    #[cold]
-    #[inline(never)]
-    fn restart_after_timeout(&mut self, ticks: u32) -> EdgeEvent {
-        self.enter_standstill();
-        self.state = ShaftState::Running;
-        self.last = ticks;
-        EdgeEvent {
-            fault: Some(Fault::Timeout),
-            ..EdgeEvent::default()
-        }
-    }
-
-    /// An edge `dt` ticks after the previous accepted one, at `ticks`; the shaft is running
-    /// forward (and stays so: a glitch or a fault does not change the state).
     #[inline(always)]
-    fn on_interval<const N: usize>(&mut self, enc: &Encoder<N>, dt: u32, ticks: u32) -> EdgeEvent {
-        let mut ev = EdgeEvent::default();
-        let edges = enc.edges();
-        let next = if self.synced {
-            if self.tooth + 1 >= edges {
-                0
-            } else {
-                self.tooth + 1
-            }
-        } else {
-            1
-        };
-        let uniform = enc.uniform_pitch();
-        let was_synced = self.synced;
-        let next_pitch = if was_synced { enc.pitch(next) } else { uniform };
-        // This interval's ticks scaled by the previous pitch, `num`: against
-        // `prev_dt·uniform` it is the apparent pitch in uniform pitches (compared by
-        // cross-multiplying: no division on the per-edge path).
-        let num = if self.prev_dt > 0 {
-            dt as f32 * self.prev_pitch
-        } else {
-            1.0
-        };
-        let gap_framing = matches!(enc.config().framing, Framing::MissingTooth { .. });
-        let glitch_fraction = enc.config().glitch_fraction;
-        // Unsynced on a gapped disc the next interval may be a gap or follow one: only an
-        // interval short even against that (ratio below glitch_fraction / gap_ratio / 2) is a
-        // glitch.
-        // Both counts are quantized to ±1 tick: an interval is a glitch only if its ratio is
-        // below the limit even at its largest, (dt + 1)/(prev − 1), and "long" (a missing edge)
-        // only if above 1.5 even at its smallest, (dt − 1)/(prev + 1); a coarse timer's
-        // rounding is then neither.
-        let (num_hi, den_lo, num_lo, den_hi) = if self.prev_dt > 0 {
-            let (d, p) = (dt as f32, self.prev_dt as f32);
-            (
-                (d + 1.0) * self.prev_pitch,
-                (p - 1.0) * next_pitch,
-                (d - 1.0) * self.prev_pitch,
-                (p + 1.0) * next_pitch,
-            )
-        } else {
-            (1.0, 1.0, 1.0, 1.0)
-        };
-        let glitch = if !self.synced && gap_framing {
-            num_hi * (2.0 * enc.gap_ratio()) < glitch_fraction * den_lo
-        } else {
-            num_hi < glitch_fraction * den_lo
-        };
-        if dt == 0 || glitch {
-            ev.fault = Some(self.count(Fault::Glitch));
-            return ev;
+    pub fn on_edge<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        ticks: u32,
+        direction: Option<Direction>,
+        sink: &mut S,
+    ) {
+        let t = ticks & enc.mask();
+        let dt = t.wrapping_sub(self.last) & enc.mask();
+        if !self.fast
+            || direction == Some(Direction::Reverse)
+            || self.tooth == self.stop
+            || dt.wrapping_sub(self.lo) > self.hi.wrapping_sub(self.lo)
+        {
+            self.careful(enc, table, t, direction, sink);
+            return;
         }
-        self.last = ticks;
-        self.counters.accepted = self.counters.accepted.wrapping_add(1);
+        self.accept_fast(enc, table, t, dt, sink);
+    }
 
-        let mut tooth = next;
-        // Apparent pitch of this interval in uniform pitches, `num / uniform_den`: ≈1 for a
-        // tooth, ≈m+1 for a gap.
-        let uniform_den = self.prev_dt as f32 * uniform;
-        let long = self.prev_dt > 0 && num_lo > 1.5 * den_hi;
-        match enc.config().framing {
-            Framing::MissingTooth { .. } => {
-                let gap = self.prev_dt > 0 && num > enc.gap_ratio() * uniform_den;
-                if self.synced {
-                    if gap && next != 0 {
-                        // Too few edges before the gap; the gap itself still frames tooth 0.
-                        ev.fault = Some(self.count(Fault::MissingEdge));
-                        self.clear_ring();
-                        tooth = 0;
-                    } else if !gap && next == 0 {
-                        ev.fault = Some(self.count(Fault::ExtraEdge));
-                        self.lose_sync();
-                    } else if !gap && long {
-                        ev.fault = Some(self.count(Fault::MissingEdge));
-                        self.lose_sync();
-                    } else if next == 0 {
-                        ev.frame = true;
-                    }
-                } else if gap {
-                    self.synced = true;
-                    self.clear_ring();
-                    tooth = 0;
+    /// The fast path's acceptance: the next tooth, ordinary pitch, inside the band.
+    #[inline(always)]
+    fn accept_fast<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        t: u32,
+        dt: u32,
+        sink: &mut S,
+    ) {
+        let edges = enc.edges();
+        let tooth = if self.tooth + 1 >= edges {
+            0
+        } else {
+            self.tooth + 1
+        };
+        self.tooth = tooth;
+        self.last = t;
+        self.latest = t;
+        self.count = self.count.wrapping_add(1);
+        if self.history {
+            if let Some(h) = self.hist.get_mut(usize::from(tooth)) {
+                *h = dt;
+            }
+        }
+        self.set_band(enc, dt, tooth);
+        self.counters.accepted = self.counters.accepted.wrapping_add(1);
+        // The ring is full on the fast path: evict the oldest interval, add this one.
+        let k = usize::from(enc.samples_span());
+        let pos = usize::from(self.pos);
+        let oldest = match self.ring.get_mut(pos) {
+            Some(slot) => core::mem::replace(slot, dt),
+            None => dt,
+        };
+        self.pos = if pos + 1 >= k { 0 } else { (pos + 1) as u8 };
+        let ticks = self.sum.wrapping_add(dt).wrapping_sub(oldest);
+        self.sum = ticks;
+        let span = if enc.is_uniform() && P::NOMINAL {
+            enc.uniform_span()
+        } else {
+            let out = tooth_back(tooth, k as u16, edges);
+            self.span = self
+                .span
+                .wrapping_add(self.pitch(enc, table, tooth))
+                .wrapping_sub(self.pitch(enc, table, out));
+            self.span
+        };
+        sink.tooth(&Tooth {
+            index: self.counters.accepted,
+            time: t,
+            dt,
+            tooth,
+            synced: true,
+            frame: false,
+            sample: Some(Sample { span, ticks }),
+        });
+    }
+
+    /// Sets the acceptance band of the next interval from this one (`per_base`: scaled to a
+    /// base pitch), which ended at `tooth`: around this interval, or around the swing the next
+    /// tooth had one revolution earlier when that is known.
+    #[inline(always)]
+    fn set_band(&mut self, enc: &Encoder, per_base: u32, tooth: u16) {
+        let (lo, hi) = enc.band();
+        self.prev = per_base;
+        let expected = if self.history {
+            self.expected_after(enc, per_base, tooth)
+        } else {
+            per_base
+        };
+        // ±1 tick of quantization on both counts.
+        self.lo = mul_hi(expected, lo).saturating_sub(1);
+        self.hi = expected
+            .saturating_add(mul_hi(expected, hi))
+            .saturating_add(1)
+            .min(enc.timeout_ticks());
+    }
+
+    /// The per-base interval expected after one of `per_base` ending at `tooth`, from the
+    /// recorded revolution.
+    #[inline]
+    fn expected_after(&self, enc: &Encoder, per_base: u32, tooth: u16) -> u32 {
+        let next = tooth_after(tooth, 1, enc.edges());
+        let here = self.hist.get(usize::from(tooth)).copied().unwrap_or(0);
+        let there = self.hist.get(usize::from(next)).copied().unwrap_or(0);
+        if here == 0 {
+            return per_base;
+        }
+        let e = u64::from(per_base) * u64::from(there) / u64::from(here);
+        u32::try_from(e).unwrap_or(u32::MAX)
+    }
+
+    /// The swing tooth `to` had against tooth `from` one revolution earlier (1 without a
+    /// recorded revolution). Careful path only.
+    fn recorded_swing(&self, from: u16, to: u16) -> f32 {
+        if !self.history {
+            return 1.0;
+        }
+        let a = self.hist.get(usize::from(from)).copied().unwrap_or(0);
+        let b = self.hist.get(usize::from(to)).copied().unwrap_or(0);
+        if a == 0 || b == 0 {
+            1.0
+        } else {
+            b as f32 / a as f32
+        }
+    }
+
+    /// Records the per-base interval of `tooth` (teeth known, small wheels).
+    fn record(&mut self, enc: &Encoder, tooth: u16, per_base: u32) {
+        if usize::from(enc.edges()) > MAX_PATTERN_TEETH {
+            return;
+        }
+        if let Some(h) = self.hist.get_mut(usize::from(tooth)) {
+            *h = per_base;
+            self.hist_teeth = self.hist_teeth.saturating_add(1);
+            if self.hist_teeth >= enc.edges() {
+                self.history = true;
+            }
+        }
+    }
+
+    /// Every edge that is not the fast path's: start, restart, reversal, the frame and special
+    /// teeth, out-of-band intervals, unsynced edges. Out of line: it runs rarely.
+    #[cold]
+    #[inline(never)]
+    fn careful<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        t: u32,
+        direction: Option<Direction>,
+        sink: &mut S,
+    ) {
+        self.fast = false;
+        if enc.edges() == 0 {
+            // An unconfigured monitor ignores everything.
+            return;
+        }
+        if direction == Some(Direction::Reverse) {
+            self.flush(enc, table, sink);
+            if self.state == ShaftState::Running {
+                self.counters.reversals = self.counters.reversals.wrapping_add(1);
+                sink.fault(Fault::Reversal, t);
+                self.lose_sync(false);
+            }
+            // Reverse edges are no forward time reference: running forward again needs two
+            // forward edges within the timeout.
+            self.state = ShaftState::Reversed;
+            self.restart_at(t);
+            self.has_ref = false;
+            return;
+        }
+        if !self.has_ref {
+            self.restart_at(t);
+            if self.state == ShaftState::NoSignal {
+                self.state = ShaftState::Standstill;
+            }
+            self.index_at_reference(enc, t);
+            return;
+        }
+        let since_latest = t.wrapping_sub(self.latest) & enc.mask();
+        if since_latest > enc.timeout_ticks() {
+            // Too long since the last edge: whatever was pending is judged as it stands, and
+            // this edge is a new time reference.
+            self.flush(enc, table, sink);
+            self.stop_running(t, sink);
+            self.restart_at(t);
+            return;
+        }
+        if since_latest == 0 {
+            // A second capture at the same tick cannot be a tooth.
+            self.reject(t, sink);
+            return;
+        }
+        if self.state != ShaftState::Running {
+            // A forward interval within the timeout: the shaft runs. The edge before it was
+            // only a reference.
+            self.state = ShaftState::Running;
+            self.accept_unjudged(enc, table, t, sink);
+            return;
+        }
+        if let Some(slot) = self.pending.get_mut(usize::from(self.npend)) {
+            *slot = t;
+            self.npend += 1;
+        }
+        self.latest = t;
+        self.resolve(enc, table, false, sink);
+    }
+
+    /// Judges pending edges while there is enough lookahead (all of them if `flushing`).
+    fn resolve<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        flushing: bool,
+        sink: &mut S,
+    ) {
+        while self.npend > 0 {
+            let e1 = self.pending[0];
+            match self.judge(enc, flushing) {
+                Verdict::Wait => return,
+                Verdict::Glitch => {
+                    self.pop();
+                    self.reject(e1, sink);
+                }
+                Verdict::Tooth => {
+                    self.pop();
+                    self.accept(enc, table, e1, true, sink);
+                }
+                Verdict::Missing(n) => {
+                    self.pop();
+                    self.counters.missing = self.counters.missing.wrapping_add(u32::from(n));
+                    sink.fault(Fault::MissingEdge, e1);
+                    self.fault_in_revolution();
+                    self.advance_after_fault(enc, n);
+                    self.accept(enc, table, e1, false, sink);
+                }
+                Verdict::Behind => {
+                    self.pop();
+                    self.counters.extra = self.counters.extra.wrapping_add(1);
+                    sink.fault(Fault::ExtraEdge, e1);
+                    self.fault_in_revolution();
+                    self.tooth = tooth_back(self.tooth, 1, enc.edges());
+                    self.reset_ring();
+                    self.accept(enc, table, e1, false, sink);
+                }
+                Verdict::Ahead => {
+                    self.pop();
+                    self.counters.missing = self.counters.missing.wrapping_add(1);
+                    sink.fault(Fault::MissingEdge, e1);
+                    self.fault_in_revolution();
+                    self.advance_after_fault(enc, 1);
+                    self.accept(enc, table, e1, false, sink);
                 }
             }
-            Framing::Index => {
-                let index = self.index_pending;
-                self.index_pending = false;
-                if self.synced {
-                    if index && next != 0 {
-                        let f = if next > edges / 2 {
-                            Fault::MissingEdge
-                        } else {
-                            Fault::ExtraEdge
-                        };
-                        ev.fault = Some(self.count(f));
-                        self.clear_ring();
-                        tooth = 0;
-                    } else if !index && next == 0 {
-                        ev.fault = Some(self.count(Fault::MissingFrame));
-                        self.lose_sync();
-                    } else if long {
-                        ev.fault = Some(self.count(Fault::MissingEdge));
-                        self.lose_sync();
-                    } else if next == 0 {
-                        ev.frame = true;
+        }
+        self.update_fast(enc);
+    }
+
+    fn pop(&mut self) {
+        self.pending.copy_within(1.., 0);
+        self.npend = self.npend.saturating_sub(1);
+    }
+
+    /// Judges all pending edges with what is known (a timeout, a reversal, a poll).
+    fn flush<P: PitchTable, S: EdgeSink>(&mut self, enc: &Encoder, table: &P, sink: &mut S) {
+        if self.npend > 0 {
+            self.resolve(enc, table, true, sink);
+        }
+    }
+
+    /// The verdict on `pending[0]`.
+    fn judge(&self, enc: &Encoder, flushing: bool) -> Verdict {
+        let e1 = self.pending[0];
+        let d1 = e1.wrapping_sub(self.last) & enc.mask();
+        let r = self.prev;
+        if r == 0 {
+            return Verdict::Tooth;
+        }
+        let synced = self.sync == SyncState::Synced;
+        let edges = enc.edges();
+        let base = enc.base_pitch();
+        let next = tooth_after(self.tooth, 1, edges);
+        // Grid pitch of the expected tooth: unsynced, the shortest the wheel has (so only what
+        // is short even against that is a glitch outright).
+        // Unsynced on a pattern wheel, the previous interval may have been the longest pitch
+        // and this one the shortest: only what is short even against that is a glitch.
+        let expected = if synced || enc.framing() != Framing::Pattern {
+            r as f32 * enc.grid_pitch(if synced { next } else { 0 }) as f32 / base as f32
+                * if synced {
+                    self.recorded_swing(self.tooth, next)
+                } else {
+                    1.0
+                }
+        } else {
+            let (lo, hi) = (0..edges).fold((u32::MAX, 0), |(lo, hi), k| {
+                let p = enc.grid_pitch(k);
+                (lo.min(p), hi.max(p))
+            });
+            r as f32 * lo as f32 / hi.max(1) as f32
+        };
+        let x = d1 as f32;
+        let tol = enc.config().tolerances;
+        if x + 1.0 < tol.glitch_fraction * (expected - 1.0) {
+            return Verdict::Glitch;
+        }
+        if !synced && enc.framing() == Framing::Pattern {
+            // Unsynced on a pattern wheel the expected pitch is unknown: take every edge that
+            // is not a glitch outright; the acquisition judges the intervals.
+            return Verdict::Tooth;
+        }
+        let special = synced && self.is_special(enc, next);
+        let accept = tol.accept;
+        let in_band = x + 1.0 >= (expected - 1.0) / accept && x - 1.0 <= (expected + 1.0) * accept;
+        // In the band an ordinary tooth is taken at once, and so is the frame of an index disc
+        // when its index pulse is there (the count is checked on acceptance) or of an unframed
+        // one; a pattern's special teeth are always judged with what follows.
+        let plain = !special
+            || enc.framing() == Framing::None
+            || (enc.framing() == Framing::Index && self.index_covers(enc, e1));
+        if in_band && plain {
+            return Verdict::Tooth;
+        }
+        // Judge with the following two edges.
+        let n = usize::from(self.npend);
+        if n < PENDING && !flushing {
+            return Verdict::Wait;
+        }
+        let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
+        let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
+        let pitch = |k: u16| enc.grid_pitch(k) as f32 / base as f32;
+        // Per-base intervals of a hypothesis: e1 is tooth `first` (spanning `spans` pitches
+        // from the last accepted edge), the following edges the teeth after it.
+        // A hypothesis: e1 is tooth `first`, its interval spanning `spans` base pitches from the
+        // last accepted edge, which was tooth `before`; the following edges are the teeth
+        // after `first` (for a glitch, e1 and e2 merged are `first`). Its cost: the squared log
+        // swings of the per-pitch intervals against the swings the same teeth had one
+        // revolution earlier (against 1 without a recorded revolution).
+        let chain_cost = |before: u16, first: u16, spans: f32, skip_e1: bool| -> f32 {
+            let mut terms = [(0.0f32, 0u16); 3];
+            let mut len = 0usize;
+            let rest: [Option<u32>; 2] = if skip_e1 {
+                let Some(d2) = d2 else {
+                    return f32::INFINITY;
+                };
+                terms[0] = ((d1 + d2) as f32 / spans, first);
+                [d3, None]
+            } else {
+                terms[0] = (x / spans, first);
+                [d2, d3]
+            };
+            len += 1;
+            let mut tooth = first;
+            for d in rest.iter().flatten() {
+                tooth = tooth_after(tooth, 1, edges);
+                if let Some(slot) = terms.get_mut(len) {
+                    *slot = (*d as f32 / pitch(tooth), tooth);
+                }
+                len += 1;
+            }
+            let (mut prev, mut prev_tooth) = (r as f32, before);
+            let mut cost = 0.0;
+            for &(v, tooth) in terms.iter().take(len) {
+                cost += log_sq(v, prev * self.recorded_swing(prev_tooth, tooth));
+                prev = v;
+                prev_tooth = tooth;
+            }
+            cost
+        };
+        let margin = tol.fault_margin;
+        let p_next = pitch(next);
+        let here = self.tooth;
+        let mut best = (chain_cost(here, next, p_next, false), Verdict::Tooth);
+        let mut consider = |cost: f32, v: Verdict| {
+            if cost + margin < best.0 {
+                best = (cost, v);
+            }
+        };
+        consider(chain_cost(here, next, p_next, true), Verdict::Glitch);
+        if synced {
+            let mut spans = p_next;
+            let mut tooth = next;
+            for j in 1..=2u16 {
+                tooth = tooth_after(tooth, 1, edges);
+                spans += pitch(tooth);
+                // The frame tooth of an index disc is not skipped silently: the index decides.
+                consider(
+                    chain_cost(here, tooth, spans, false) + margin * f32::from(j - 1),
+                    Verdict::Missing(j),
+                );
+            }
+            if enc.framing() == Framing::Pattern {
+                let behind = tooth_back(next, 1, edges);
+                let before_behind = tooth_back(behind, 1, edges);
+                consider(
+                    chain_cost(before_behind, behind, pitch(behind), false),
+                    Verdict::Behind,
+                );
+                let ahead = tooth_after(next, 1, edges);
+                consider(chain_cost(next, ahead, pitch(ahead), false), Verdict::Ahead);
+            }
+        }
+        best.1
+    }
+
+    /// Whether `tooth` needs the careful judgement when it comes next.
+    fn is_special(&self, enc: &Encoder, tooth: u16) -> bool {
+        tooth == 0
+            || (enc.framing() == Framing::Pattern
+                && ((enc.long_teeth() | enc.short_teeth()) >> tooth) & 1 == 1)
+    }
+
+    /// Whether a waiting index timestamp lies between the last accepted edge and `t`.
+    fn index_covers(&self, enc: &Encoder, t: u32) -> bool {
+        let m = enc.mask();
+        let d = t.wrapping_sub(self.last) & m;
+        self.index
+            .iter()
+            .take(usize::from(self.nidx))
+            .any(|&i| (i.wrapping_sub(self.last) & m) <= d && (i.wrapping_sub(self.last) & m) > 0)
+    }
+
+    /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
+    /// ending at `t`. Timestamps older than the last accepted edge lost their edge: each is
+    /// counted as a missing frame.
+    fn take_index(&mut self, enc: &Encoder, t: u32) -> bool {
+        let m = enc.mask();
+        let d = t.wrapping_sub(self.last) & m;
+        let mut framed = false;
+        let mut keep = 0usize;
+        for i in 0..usize::from(self.nidx) {
+            let x = self.index.get(i).copied().unwrap_or(0);
+            let since = x.wrapping_sub(self.last) & m;
+            if since == 0 || since > d {
+                if since > d && since < m / 2 {
+                    // Still ahead of this edge: keep it.
+                    if let Some(slot) = self.index.get_mut(keep) {
+                        *slot = x;
                     }
-                } else if index {
-                    self.synced = true;
-                    self.clear_ring();
-                    tooth = 0;
+                    keep += 1;
+                } else if self.sync == SyncState::Synced {
+                    // An index that framed no edge: its edge was not seen.
+                    self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
+                }
+            } else {
+                framed = true;
+            }
+        }
+        self.nidx = keep as u8;
+        framed
+    }
+
+    /// An index waiting before a new time reference `t` (within a timeout of it) makes that
+    /// edge the frame candidate: the first index of a start is not lost to the reference edge.
+    fn index_at_reference(&mut self, enc: &Encoder, t: u32) {
+        if enc.framing() != Framing::Index || self.nidx == 0 {
+            return;
+        }
+        let m = enc.mask();
+        let mut framed = false;
+        let mut keep = 0usize;
+        for i in 0..usize::from(self.nidx) {
+            let x = self.index.get(i).copied().unwrap_or(0);
+            let before = t.wrapping_sub(x) & m;
+            if before <= enc.timeout_ticks() {
+                framed |= before > 0;
+                if before == 0 {
+                    // At the same tick: it belongs to the next edge.
+                    if let Some(slot) = self.index.get_mut(keep) {
+                        *slot = x;
+                    }
+                    keep += 1;
+                }
+            } else if before > m / 2 {
+                // Ahead of this edge: keep it.
+                if let Some(slot) = self.index.get_mut(keep) {
+                    *slot = x;
+                }
+                keep += 1;
+            }
+        }
+        self.nidx = keep as u8;
+        if framed {
+            self.sync = SyncState::Confirming;
+            self.tooth = 0;
+            self.count = 0;
+            self.searched = 0;
+        }
+    }
+
+    /// Rejects the raw edge at `t` as a glitch.
+    fn reject<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
+        self.counters.glitches = self.counters.glitches.wrapping_add(1);
+        sink.fault(Fault::Glitch, t);
+    }
+
+    /// A fault inside the current revolution: too many and the count is given up.
+    fn fault_in_revolution(&mut self) {
+        self.faults = self.faults.saturating_add(1);
+        if self.faults >= FAULTS_TO_RESYNC && self.sync == SyncState::Synced {
+            self.lose_sync(true);
+        }
+    }
+
+    /// Moves the count on past `n` lost teeth (the edge being accepted is `n` teeth further).
+    fn advance_after_fault(&mut self, enc: &Encoder, n: u16) {
+        if self.sync == SyncState::Synced {
+            self.tooth = tooth_after(self.tooth, n, enc.edges());
+        }
+        self.reset_ring();
+    }
+
+    /// Accepts the first edge of a running interval without judging it (no reference yet).
+    fn accept_unjudged<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        t: u32,
+        sink: &mut S,
+    ) {
+        self.accept(enc, table, t, true, sink);
+        self.update_fast(enc);
+    }
+
+    /// Accepts the edge at `t` as the tooth after the current one (or as framed by an index).
+    fn accept<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        t: u32,
+        clean: bool,
+        sink: &mut S,
+    ) {
+        let edges = enc.edges();
+        let dt = t.wrapping_sub(self.last) & enc.mask();
+        let mut tooth = tooth_after(self.tooth, 1, edges);
+        let mut frame = false;
+        let mut realigned = false;
+        let was_synced = self.sync == SyncState::Synced;
+        let was_known = self.teeth_known(enc);
+        let old_tooth = self.tooth;
+        match enc.framing() {
+            Framing::Index => {
+                let indexed = self.take_index(enc, t);
+                match self.sync {
+                    SyncState::Synced => {
+                        if indexed {
+                            if tooth != 0 {
+                                // The index is authoritative: count the discrepancy, realign.
+                                let ahead = tooth <= edges / 2;
+                                if ahead {
+                                    self.counters.extra = self.counters.extra.wrapping_add(1);
+                                    sink.fault(Fault::ExtraEdge, t);
+                                } else {
+                                    self.counters.missing = self.counters.missing.wrapping_add(1);
+                                    sink.fault(Fault::MissingEdge, t);
+                                }
+                                self.reset_ring();
+                                tooth = 0;
+                                realigned = true;
+                            }
+                            frame = true;
+                        } else if tooth == 0 {
+                            // The revolution's index did not come: keep counting, but this
+                            // revolution cannot be vouched for.
+                            self.counters.missing_frames =
+                                self.counters.missing_frames.wrapping_add(1);
+                            sink.fault(Fault::MissingFrame, t);
+                        }
+                    }
+                    SyncState::Confirming => {
+                        if indexed {
+                            if self.count == edges - 1 {
+                                self.sync = SyncState::Synced;
+                                self.counters.syncs = self.counters.syncs.wrapping_add(1);
+                                frame = true;
+                            }
+                            tooth = 0;
+                            self.count = 0;
+                        }
+                    }
+                    SyncState::Searching => {
+                        if indexed {
+                            self.sync = SyncState::Confirming;
+                            tooth = 0;
+                            self.count = 0;
+                            self.searched = 0;
+                        } else {
+                            self.count_search(enc);
+                        }
+                    }
                 }
             }
             Framing::None => {
-                if !self.synced {
-                    // Without a marker the first accepted interval starts the count.
-                    self.synced = true;
+                if self.sync != SyncState::Synced {
+                    self.sync = SyncState::Synced;
+                    self.counters.syncs = self.counters.syncs.wrapping_add(1);
                     tooth = 0;
-                } else if long {
-                    ev.fault = Some(self.count(Fault::MissingEdge));
-                    self.clear_ring();
-                } else if next == 0 {
-                    ev.frame = true;
+                } else if tooth == 0 {
+                    frame = true;
+                }
+            }
+            Framing::Pattern => {
+                if self.sync == SyncState::Synced {
+                    frame = tooth == 0;
+                } else {
+                    // Acquisition: the evidence on the interval before this one, now that both
+                    // its neighbours are known.
+                    tooth = self.acquire(enc, dt);
+                    frame = self.sync == SyncState::Synced && tooth == 0;
                 }
             }
         }
-        let pitch = if self.synced {
-            if was_synced && tooth == next {
-                next_pitch
-            } else {
-                enc.pitch(tooth)
-            }
-        } else {
-            // Unframed: the interval spanned a whole number of uniform pitches.
-            let apparent = if self.prev_dt > 0 {
-                num / uniform_den
-            } else {
-                1.0
-            };
-            uniform * libm::roundf(apparent).max(1.0)
-        };
-        self.prev_dt = dt;
-        self.prev_pitch = pitch;
-        if !self.synced {
-            return ev;
-        }
-        self.tooth = tooth;
-        if ev.frame {
+        if frame && !realigned && was_synced {
             self.counters.revolutions = self.counters.revolutions.wrapping_add(1);
         }
-        ev.interval = Some((dt, tooth));
-        // K-edge ring: exact integer running sum (add the new interval, drop the oldest).
-        let k = enc.samples_span().min(MAX_SPAN as u16);
-        let pos = usize::from(self.ring_pos) % MAX_SPAN;
-        let oldest = match self.ring.get_mut(pos) {
-            Some(slot) => core::mem::replace(slot, dt),
-            None => 0,
-        };
-        if self.ring_fill >= k {
-            self.ring_sum = self.ring_sum.wrapping_sub(oldest);
-        } else {
-            self.ring_fill += 1;
+        if frame {
+            self.faults = 0;
         }
-        self.ring_sum = self.ring_sum.wrapping_add(dt);
-        self.ring_pos = if self.ring_pos + 1 >= k {
+        // Edges counted since tooth 0 (the frame, or the candidate being confirmed).
+        self.count = if tooth == 0 {
             0
         } else {
-            self.ring_pos + 1
+            self.count.wrapping_add(1)
         };
-        if self.ring_fill >= k {
-            ev.sample = Some(SpeedSample {
-                angle: enc.span(tooth),
-                ticks: full_ring_ticks(self.ring_sum, k),
-                tooth,
-            });
+        self.tooth = tooth;
+        let synced = self.sync == SyncState::Synced;
+        let known = self.teeth_known(enc);
+        if known != was_known || (known && tooth != tooth_after(old_tooth, 1, edges)) {
+            // The numbering changed: spans summed under the old one must not mix with the new.
+            self.reset_ring();
         }
-        ev
+        // The ring: the sample ends here. An interval across a fault is no sample.
+        let sample = if clean {
+            self.push(enc, table, tooth, dt)
+        } else {
+            self.reset_ring();
+            None
+        };
+        let had_ref = self.prev != 0 || dt != 0;
+        let grid = if known {
+            enc.grid_pitch(tooth)
+        } else {
+            enc.base_pitch()
+        };
+        let per_base = if grid == enc.base_pitch() || grid == 0 {
+            dt
+        } else {
+            (u64::from(dt) * u64::from(enc.base_pitch()) / u64::from(grid)) as u32
+        };
+        if known && clean && had_ref {
+            self.record(enc, tooth, per_base);
+        }
+        if had_ref {
+            self.set_band(enc, per_base, tooth);
+        }
+        self.last = t;
+        self.counters.accepted = self.counters.accepted.wrapping_add(1);
+        sink.tooth(&Tooth {
+            index: self.counters.accepted,
+            time: t,
+            dt,
+            tooth,
+            synced,
+            frame,
+            sample,
+        });
+        if synced {
+            self.stop = self.stop_after(enc, tooth);
+        }
+    }
+
+    /// Counts a missing frame for every three revolutions' worth of edges searched without one
+    /// (finding and confirming a pattern takes up to two).
+    fn count_search(&mut self, enc: &Encoder) {
+        self.searched = self.searched.saturating_add(1);
+        if self.searched >= enc.edges().saturating_mul(3).max(6) {
+            self.searched = 0;
+            self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
+        }
+    }
+
+    /// Pattern acquisition on the edge at the end of interval `dt`: judges the interval before
+    /// it (both neighbours known), narrows the alignments, and returns this edge's tooth (the
+    /// alignment if unique, else a count).
+    fn acquire(&mut self, enc: &Encoder, dt: u32) -> u16 {
+        let edges = enc.edges();
+        let all = if edges >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << edges) - 1
+        };
+        let [before, middle] = self.acq;
+        self.acq = [middle, dt];
+        if self.viable == 0 {
+            self.viable = all;
+        }
+        if before > 0 && middle > 0 && dt > 0 {
+            let (lo, hi) = if before < dt {
+                (before, dt)
+            } else {
+                (dt, before)
+            };
+            let (long_thr, not_long_thr, short_thr) = acquisition_thresholds(enc);
+            let m = middle as f32;
+            let mut allowed = all;
+            if enc.long_teeth() != 0 {
+                if m >= long_thr * hi as f32 {
+                    allowed &= enc.long_teeth();
+                } else if m <= not_long_thr * lo as f32 {
+                    allowed &= !enc.long_teeth();
+                }
+            }
+            if enc.short_teeth() != 0 && m <= short_thr * hi as f32 {
+                allowed &= enc.short_teeth();
+            }
+            // `viable` refers to the edge ending `middle` (the previous edge).
+            let special = allowed != all;
+            let narrowed = self.viable & allowed;
+            if narrowed == 0 {
+                // Contradiction: start over from this evidence.
+                self.viable = allowed;
+                self.sync = SyncState::Searching;
+                self.confirm = 0;
+                self.seen_special = false;
+            } else {
+                self.viable = narrowed;
+                if self.sync == SyncState::Confirming && special {
+                    self.seen_special = true;
+                }
+            }
+        }
+        self.count_search(enc);
+        // Move on to this edge.
+        self.viable = rotate_left(self.viable, edges) & all;
+        if self.viable.count_ones() == 1 {
+            let tooth = self.viable.trailing_zeros() as u16;
+            match self.sync {
+                SyncState::Searching => {
+                    self.sync = SyncState::Confirming;
+                    self.confirm = edges;
+                    self.seen_special = false;
+                }
+                SyncState::Confirming => {
+                    self.confirm = self.confirm.saturating_sub(1);
+                    if self.confirm == 0 && self.seen_special {
+                        self.sync = SyncState::Synced;
+                        self.counters.syncs = self.counters.syncs.wrapping_add(1);
+                        self.searched = 0;
+                        self.faults = 0;
+                        self.reset_ring();
+                    }
+                }
+                SyncState::Synced => {}
+            }
+            tooth
+        } else {
+            if self.sync == SyncState::Confirming {
+                self.sync = SyncState::Searching;
+            }
+            tooth_after(self.tooth, 1, edges)
+        }
+    }
+
+    /// The tooth after which the fast path must stop (the next one is special).
+    fn stop_after(&self, enc: &Encoder, tooth: u16) -> u16 {
+        let edges = enc.edges();
+        match enc.framing() {
+            Framing::Index | Framing::None => edges - 1,
+            Framing::Pattern => {
+                let special = enc.long_teeth() | enc.short_teeth() | 1;
+                let mut k = tooth_after(tooth, 1, edges);
+                for _ in 0..edges {
+                    if (special >> k) & 1 == 1 {
+                        return tooth_back(k, 1, edges);
+                    }
+                    k = tooth_after(k, 1, edges);
+                }
+                edges - 1
+            }
+        }
+    }
+
+    /// Recomputes whether the next edge may take the fast path.
+    fn update_fast(&mut self, enc: &Encoder) {
+        self.fast = self.state == ShaftState::Running
+            && self.sync == SyncState::Synced
+            && self.has_ref
+            && self.prev != 0
+            && self.npend == 0
+            && self.nidx == 0
+            && usize::from(self.fill) >= usize::from(enc.samples_span());
+    }
+
+    /// The running shaft stopped (a timeout): count it once, lose sync.
+    fn stop_running<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
+        if self.state == ShaftState::Running {
+            self.counters.timeouts = self.counters.timeouts.wrapping_add(1);
+            sink.fault(Fault::Timeout, t);
+            self.lose_sync(false);
+        }
+        self.state = ShaftState::Standstill;
+        self.fast = false;
+    }
+
+    /// `t` is a new time reference: no interval, nothing pending.
+    fn restart_at(&mut self, t: u32) {
+        self.has_ref = true;
+        self.last = t;
+        self.latest = t;
+        self.prev = 0;
+        self.npend = 0;
+        self.fast = false;
+        self.acq = [0; 2];
+        self.forget_history();
+        self.reset_ring();
+    }
+
+    fn reset_ring(&mut self) {
+        self.fill = 0;
+        self.pos = 0;
+        self.sum = 0;
+        self.span = 0;
+    }
+
+    /// Pushes the interval `dt` ending at `tooth` into the ring; the sample of the last `K`
+    /// intervals once there are `K`.
+    fn push<P: PitchTable>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        tooth: u16,
+        dt: u32,
+    ) -> Option<Sample> {
+        let k = enc.samples_span();
+        let pos = usize::from(self.pos);
+        let oldest = match self.ring.get_mut(pos) {
+            Some(slot) => core::mem::replace(slot, dt),
+            None => dt,
+        };
+        self.pos = if pos + 1 >= usize::from(k) {
+            0
+        } else {
+            (pos + 1) as u8
+        };
+        let uniform = enc.is_uniform() && P::NOMINAL;
+        if self.fill >= k as u8 {
+            self.sum = self.sum.wrapping_add(dt).wrapping_sub(oldest);
+            if !uniform {
+                let out = tooth_back(tooth, k, enc.edges());
+                self.span = self
+                    .span
+                    .wrapping_add(self.pitch(enc, table, tooth))
+                    .wrapping_sub(self.pitch(enc, table, out));
+            }
+        } else {
+            self.fill += 1;
+            self.sum = self.sum.wrapping_add(dt);
+            if !uniform {
+                self.span = self.span.wrapping_add(self.pitch(enc, table, tooth));
+            }
+            if self.fill < k as u8 {
+                return None;
+            }
+        }
+        let span = if uniform {
+            enc.uniform_span()
+        } else {
+            self.span
+        };
+        (self.sum > 0).then_some(Sample {
+            span,
+            ticks: self.sum,
+        })
+    }
+
+    /// Teeth are no longer identified.
+    fn lose_sync(&mut self, counted: bool) {
+        if self.sync == SyncState::Synced || counted {
+            self.counters.sync_losses = self.counters.sync_losses.wrapping_add(1);
+        }
+        self.sync = SyncState::Searching;
+        self.viable = 0;
+        self.confirm = 0;
+        self.seen_special = false;
+        self.count = 0;
+        self.faults = 0;
+        self.searched = 0;
+        self.fast = false;
+        self.forget_history();
+        self.reset_ring();
+    }
+
+    fn forget_history(&mut self) {
+        self.hist_teeth = 0;
+        self.history = false;
+    }
+}
+
+/// Evidence thresholds of pattern acquisition, from the wheel's pitches: an interval at least
+/// `long`× both neighbours is a long pitch, at most `not_long`× both is not one, at most
+/// `short`× the larger neighbour is a short pitch. With `R` the smallest long pitch over the
+/// base: `long = R^0.75` (1.68 for one missing tooth, above the 1.6 compression swing of a
+/// cranking 8-1 wheel), `not_long = R^0.25` (a gap seen through a swing of R^0.75 still
+/// exceeds it); with `S` the largest short pitch over the base, `short = S^0.75` (0.59 for an
+/// extra tooth halving a pitch, below the 0.63 of a 1.6 swing).
+fn acquisition_thresholds(enc: &Encoder) -> (f32, f32, f32) {
+    let base = enc.base_pitch() as f32;
+    let (mut r_long, mut r_short) = (f32::INFINITY, 0.0f32);
+    for k in 0..enc.edges() {
+        let p = enc.grid_pitch(k) as f32 / base;
+        if p > 1.0 {
+            r_long = r_long.min(p);
+        } else if p < 1.0 {
+            r_short = r_short.max(p);
+        }
+    }
+    let pow = |x: f32, e: f32| {
+        if x > 0.0 && x.is_finite() {
+            exp(e * ln(x))
+        } else {
+            x
+        }
+    };
+    (pow(r_long, 0.75), pow(r_long, 0.25), pow(r_short, 0.75))
+}
+
+/// e^x for small |x| (a few units): range-reduced series. Configuration and acquisition only.
+fn exp(x: f32) -> f32 {
+    let n = (x / core::f32::consts::LN_2) as i32;
+    let r = x - n as f32 * core::f32::consts::LN_2;
+    let mut term = 1.0f32;
+    let mut sum = 1.0f32;
+    for i in 1..10 {
+        term *= r / i as f32;
+        sum += term;
+    }
+    let mut scale = 1.0f32;
+    if n >= 0 {
+        for _ in 0..n.min(60) {
+            scale *= 2.0;
+        }
+    } else {
+        for _ in 0..(-n).min(60) {
+            scale *= 0.5;
+        }
+    }
+    sum * scale
+}
+
+/// `bits` rotated left by one within `n` bits.
+fn rotate_left(bits: u64, n: u16) -> u64 {
+    if n >= 64 {
+        bits.rotate_left(1)
+    } else {
+        let top = (bits >> (n - 1)) & 1;
+        ((bits << 1) | top) & ((1u64 << n) - 1)
+    }
+}
+
+/// The tooth `n` after `tooth` on a wheel of `edges` teeth.
+#[inline(always)]
+fn tooth_after(tooth: u16, n: u16, edges: u16) -> u16 {
+    let s = u32::from(tooth) + u32::from(n);
+    (s % u32::from(edges.max(1))) as u16
+}
+
+/// The tooth `n` before `tooth` on a wheel of `edges` teeth.
+#[inline(always)]
+fn tooth_back(tooth: u16, n: u16, edges: u16) -> u16 {
+    let e = u32::from(edges.max(1));
+    ((u32::from(tooth) + e - u32::from(n) % e) % e) as u16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_is_accurate_enough_to_judge_swings() {
+        for &x in &[1e-3f32, 0.1, 0.45, 0.5, 1.0, 1.45, 2.0, 3.0, 1e4] {
+            assert!((ln(x) - x.ln()).abs() < 2e-4, "{x}");
+        }
+        assert!((exp(0.5) - 0.5f32.exp()).abs() < 1e-5);
+        assert!((exp(-2.3) - (-2.3f32).exp()).abs() < 1e-5);
+    }
+
+    #[test]
+    fn rotation_and_tooth_arithmetic_wrap() {
+        assert_eq!(rotate_left(0b100, 3), 0b001);
+        assert_eq!(rotate_left(1 << 63, 64), 1);
+        assert_eq!(tooth_after(57, 2, 58), 1);
+        assert_eq!(tooth_back(0, 1, 58), 57);
+        assert_eq!(tooth_back(3, 60, 58), 1);
+    }
+
+    #[test]
+    fn quantized_ratios_do_not_look_like_swings() {
+        // 2 against 3 ticks may both be 2.5: no swing at all.
+        assert_eq!(log_sq(3.0, 2.0), 0.0);
+        assert!(log_sq(30.0, 10.0) > 0.9);
     }
 }

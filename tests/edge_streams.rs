@@ -3,7 +3,7 @@
 //! every window it reports is either valid with finite numbers or carries its fault.
 
 use drive_monitor::alarm::AlarmConfig;
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength};
 use drive_monitor::monitor::DeltaMonitor;
 use drive_monitor::speed::Direction;
@@ -15,7 +15,7 @@ enum Op {
     Edge(u32, Option<bool>),
     /// A burst of `n` edges `dt` ticks apart.
     Burst(u8, u32),
-    Index,
+    Index(u32),
     Poll(u32),
 }
 
@@ -24,17 +24,14 @@ fn op() -> impl Strategy<Value = Op> {
         6 => (prop_oneof![0u32..3, 3000u32..5000, any::<u32>()], proptest::option::of(any::<bool>()))
             .prop_map(|(d, dir)| Op::Edge(d, dir)),
         1 => (1u8..40, 0u32..10_000).prop_map(|(n, d)| Op::Burst(n, d)),
-        1 => Just(Op::Index),
+        1 => any::<u32>().prop_map(Op::Index),
         1 => any::<u32>().prop_map(Op::Poll),
     ]
 }
 
-fn framing() -> impl Strategy<Value = Framing> {
-    prop_oneof![
-        Just(Framing::None),
-        Just(Framing::Index),
-        (1u8..=3).prop_map(|missing| Framing::MissingTooth { missing }),
-    ]
+/// The wheel: 0 unframed, 1 indexed, 2 a missing-tooth wheel with 1–3 missing.
+fn framing() -> impl Strategy<Value = (u8, u8)> {
+    (0u8..3, 1u8..=3)
 }
 
 proptest! {
@@ -49,14 +46,17 @@ proptest! {
         positions in 12u16..64,
         revs in 1u16..4,
     ) {
-        let mut c = EncoderConfig::new(positions, 1e6);
-        c.framing = framing;
+        let mut c = match framing.0 {
+            0 => EncoderConfig::unframed(positions, 1e6),
+            1 => EncoderConfig::indexed(positions, 1e6),
+            _ => EncoderConfig::missing_teeth(positions as u8, framing.1, 1e6),
+        };
         c.counter_bits = bits;
         c.estimator = Estimator::Edges(k);
         c.min_speed = 100.0;
-        let enc = Encoder::<64>::new(c).unwrap();
+        let enc = Encoder::new(c).unwrap();
         let w = WindowConfig { length: WindowLength::Revolutions(revs), steady_tolerance: 0.05 };
-        let mut m = DeltaMonitor::new(enc, w, Some(AlarmConfig::new(0.05))).unwrap();
+        let mut m = DeltaMonitor::<64>::new(enc, w, Some(AlarmConfig::new(0.05))).unwrap();
         let mut t = 0u32;
         let mut reports = Vec::new();
         for o in ops {
@@ -72,7 +72,7 @@ proptest! {
                         reports.extend(m.on_edge(t, None));
                     }
                 }
-                Op::Index => m.on_index(),
+                Op::Index(dt) => m.on_index(t.wrapping_add(dt % 10_000)),
                 Op::Poll(dt) => reports.extend(m.poll(t.wrapping_add(dt))),
             }
             prop_assert!(m.speed().is_finite() && m.speed() >= 0.0);
@@ -81,10 +81,10 @@ proptest! {
         prop_assert_eq!(d.valid_windows + d.invalid_windows, reports.len() as u32);
         for r in reports {
             let r = r.report;
-            if r.valid() {
-                prop_assert!(r.delta.is_finite() && r.delta >= 0.0 && r.delta < 2.0, "{:?}", r);
-                prop_assert!(r.omega_max >= r.omega_min);
-                prop_assert!(r.noise_floor.is_finite());
+            if let Some(m) = r.measurement() {
+                prop_assert!(m.delta.is_finite() && m.delta >= 0.0 && m.delta < 2.0, "{:?}", r);
+                prop_assert!(m.omega_max >= m.omega_min);
+                prop_assert!(m.noise_floor.is_finite());
                 prop_assert_eq!(r.revolutions, revs);
             }
         }

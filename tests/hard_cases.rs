@@ -22,9 +22,11 @@ use drive_monitor::balancer::{
     RegimeTracker, SearchOptions, ZoneKind,
 };
 use drive_monitor::drive::{DriveModel, Harmonic, Horizon, Kloss, Load, Parabola, Prediction};
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
-use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Wheel};
+use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
+use drive_monitor::learn::ToothLearner;
 use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::pitch::Corrected;
 use drive_monitor::speed::{Direction, Fault};
 use drive_monitor::supports::{
     equivalent_planes, Level, Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, Vec2,
@@ -261,12 +263,11 @@ impl ExactTrain {
         let n = self.positions * self.revs;
         let h = &self.hist;
         let last = h.len() - 1;
-        let (mut smax, mut smin, mut ssum) = (0u64, u64::MAX, 0u64);
+        let (mut smax, mut smin) = (0u64, u64::MAX);
         for j in last + 1 - n..=last {
             let s = h[j] - h[j - self.k];
             smax = smax.max(s);
             smin = smin.min(s);
-            ssum += s;
         }
         let span = self.k as f64 * TAU / self.positions as f64;
         let f = self.timer_hz;
@@ -275,7 +276,9 @@ impl ExactTrain {
             omega_max: span * f / smin as f64,
             omega_min: span * f / smax as f64,
             omega_mean: self.revs as f64 * TAU * f / (h[last] - h[last - n]) as f64,
-            noise_floor: 2.0 * n as f64 / ssum as f64,
+            // 2 / (mean ticks per K-edge sample), the mean taken as K times the window's mean
+            // interval (what the core computes without summing samples per edge).
+            noise_floor: 2.0 * n as f64 / (self.k as f64 * (h[last] - h[last - n]) as f64),
             samples: n,
         }
     }
@@ -287,7 +290,9 @@ impl ExactTrain {
 /// the difference of products error-free (FMA) — a few roundings relative to δ itself
 /// (tolerance 8 roundings, 4.8e-7), however small δ is.
 fn assert_matches_exact(r: &WindowReport, e: &Exact, what: &str) {
-    assert!(r.valid(), "{what}: {r:?}");
+    let Some(r) = r.measurement() else {
+        panic!("{what}: {r:?}");
+    };
     assert_eq!(r.samples as usize, e.samples, "{what}");
     let speed_tol = 5.0 * U32 * 1.0001;
     assert!(
@@ -328,7 +333,7 @@ fn encoder_config(
     k: u16,
     min_speed: f64,
 ) -> EncoderConfig {
-    let mut c = EncoderConfig::new(positions, timer_hz);
+    let mut c = EncoderConfig::indexed(positions, timer_hz);
     c.counter_bits = bits;
     c.estimator = Estimator::Edges(k);
     c.min_speed = min_speed;
@@ -355,7 +360,7 @@ fn run_exact<const N: usize>(
     mask: u64,
     mut t: impl FnMut(u64) -> u64,
     what: &str,
-) -> Vec<(WindowReport, Exact)> {
+) -> Vec<(Measurement, Exact)> {
     let positions = m.encoder().edges() as usize;
     let revs = m.window_revolutions() as usize;
     let timer_hz = m.encoder().config().timer_hz;
@@ -365,12 +370,12 @@ fn run_exact<const N: usize>(
         let tk = t(e) + start;
         exact.push(tk);
         if e % positions as u64 == 0 {
-            m.on_index();
+            m.on_index((tk.wrapping_sub(1) & mask) as u32);
         }
         if let Some(o) = m.on_edge((tk & mask) as u32, Some(Direction::Forward)) {
             let x = exact.window();
             assert_matches_exact(&o.report, &x, what);
-            out.push((o.report, x));
+            out.push((*o.report.measurement().unwrap(), x));
         }
     }
     out
@@ -559,14 +564,14 @@ fn one_tick_interval_is_a_counted_glitch() {
             let tk = t(e);
             exact.push(tk);
             if e % 32 == 0 {
-                m.on_index();
+                m.on_index((tk as u32).wrapping_sub(1));
             }
             for (ticks, real) in [(tk, true), (tk + extra, false)] {
                 if !real && e != 32 * 5 + 7 {
                     continue;
                 }
                 if let Some(o) = m.on_edge(ticks as u32, Some(Direction::Forward)) {
-                    match o.report.fault {
+                    match o.report.fault() {
                         None => {
                             assert_matches_exact(&o.report, &exact.window(), "after glitch");
                             valid += 1;
@@ -593,7 +598,7 @@ fn one_tick_interval_is_a_counted_glitch() {
 fn interval_of_nearly_the_whole_counter_range() {
     // 8 lines at 1 MHz on 16 bits: timeout = (2π/8)/12 rad/s·1e6 = 65 450 ticks < 65 535.
     let c16 = encoder_config(8, 1e6, 16, 1, 12.0);
-    assert_eq!(Encoder::<8>::new(c16).unwrap().timeout_ticks(), 65_450);
+    assert_eq!(Encoder::new(c16).unwrap().timeout_ticks(), 65_450);
     let intervals: Vec<u64> = (0..8).map(|i| 65_000 + 50 * (i % 3)).collect();
     let mut m = monitor::<8>(c16, 1);
     let out = run_exact(
@@ -609,7 +614,7 @@ fn interval_of_nearly_the_whole_counter_range() {
     let mut bad = c16;
     bad.min_speed = 11.9;
     assert_eq!(
-        Encoder::<8>::new(bad).unwrap_err(),
+        Encoder::new(bad).unwrap_err(),
         ConfigError::Inconsistent("min_speed")
     );
     // 4 lines at 1 GHz on 32 bits: min_speed 0.3658 rad/s gives a timeout of 4.2941e9 ticks.
@@ -630,14 +635,14 @@ fn interval_of_nearly_the_whole_counter_range() {
     let mut m = monitor::<8>(c16, 1);
     let mut t = 0u64;
     for e in 0..20 {
-        if e % 8 == 0 {
-            m.on_index();
-        }
         t += 65_000;
+        if e % 8 == 0 {
+            m.on_index(((t - 1) & 0xFFFF) as u32);
+        }
         m.on_edge((t & 0xFFFF) as u32, Some(Direction::Forward));
     }
     let o = m.on_edge(((t + 65_451) & 0xFFFF) as u32, Some(Direction::Forward));
-    assert_eq!(o.map(|o| o.report.fault), Some(Some(Fault::Timeout)));
+    assert_eq!(o.map(|o| o.report.fault()), Some(Some(Fault::Timeout)));
     assert_eq!(m.diagnostics().edges.timeouts, 1);
 }
 
@@ -661,7 +666,7 @@ fn one_rpm_and_thirty_thousand_rpm_from_1_khz_to_200_mhz() {
             for bits in [16u8, 32] {
                 let c = encoder_config(1024, timer_hz, bits, 16, speed / 2.0);
                 let case = format!("{:.0} rpm, {timer_hz:e} Hz, {bits} bit", speed * 60.0 / TAU);
-                let enc = Encoder::<1024>::new(c);
+                let enc = Encoder::new(c);
                 let slow_pitch_ticks = TAU / 1024.0 / (speed / 2.0) * timer_hz;
                 let expect = if slow_pitch_ticks < 2.0 {
                     Err(ConfigError::Inconsistent("timer_hz"))
@@ -1373,9 +1378,9 @@ fn f64_parameters() -> Vec<(&'static str, Domain, Check)> {
     use Domain::*;
     let enc = |f: fn(&mut EncoderConfig, f64)| -> Check {
         Box::new(move |x| {
-            let mut c = EncoderConfig::new(64, 1e6);
+            let mut c = EncoderConfig::indexed(64, 1e6);
             f(&mut c, x);
-            ok(Encoder::<64>::new(c))
+            ok(Encoder::new(c))
         })
     };
     let machine_cfg =
@@ -1689,12 +1694,38 @@ fn f32_parameters() -> Vec<(&'static str, Domain, Check32)> {
     };
     vec![
         (
-            "glitch_fraction",
+            "tolerances.glitch_fraction",
             Positive,
             Box::new(|x| {
-                let mut c = EncoderConfig::new(64, 1e6);
-                c.glitch_fraction = x;
-                ok(Encoder::<64>::new(c))
+                let mut c = EncoderConfig::indexed(64, 1e6);
+                c.tolerances.glitch_fraction = x;
+                ok(Encoder::new(c))
+            }),
+        ),
+        (
+            "tolerances.accept",
+            Positive,
+            Box::new(|x| {
+                let mut c = EncoderConfig::indexed(64, 1e6);
+                c.tolerances.accept = x;
+                ok(Encoder::new(c))
+            }),
+        ),
+        (
+            "tolerances.fault_margin",
+            Positive,
+            Box::new(|x| {
+                let mut c = EncoderConfig::indexed(64, 1e6);
+                c.tolerances.fault_margin = x;
+                ok(Encoder::new(c))
+            }),
+        ),
+        (
+            "steady_tolerance",
+            Positive,
+            Box::new(|x| {
+                let e = Encoder::new(EncoderConfig::indexed(64, 1e6)).unwrap();
+                ok(ToothLearner::<64>::new(&e, x))
             }),
         ),
         (
@@ -1729,10 +1760,10 @@ fn f32_parameters() -> Vec<(&'static str, Domain, Check32)> {
             "pitches",
             Positive,
             Box::new(|x| {
-                let e = Encoder::<8>::new(EncoderConfig::new(8, 1e6)).unwrap();
+                let e = Encoder::new(EncoderConfig::indexed(8, 1e6)).unwrap();
                 let mut t = [(TAU / 8.0) as f32; 8];
                 t[3] = x;
-                ok(e.with_pitches(&t))
+                ok(drive_monitor::pitch::deviations(&e, &t, &mut [0i16; 8]))
             }),
         ),
     ]
@@ -1848,34 +1879,38 @@ proptest! {
     #[test]
     fn delta_monitor_is_total(
         positions in prop_oneof![1 => 0u16..40, 8 => 4u16..32],
-        framing in prop_oneof![Just(Framing::None), Just(Framing::Index),
-                               (0u8..5).prop_map(|missing| Framing::MissingTooth { missing })],
+        wheel in 0u8..3,
+        missing in 0u8..5,
         timer_hz in prop_oneof![1 => nasty_f64(), 6 => magnitude(3.0, 9.5)],
         bits in prop_oneof![1 => 14u8..34, 3 => Just(32u8), 2 => Just(16u8), 1 => Just(24u8)],
         k in prop_oneof![1 => 0u16..70, 6 => 1u16..5],
         min_speed in proptest::option::weighted(0.15, nasty_f64()),
-        glitch in prop_oneof![1 => any::<f32>(), 6 => 0.05f32..0.95],
+        glitch in prop_oneof![1 => any::<f32>(), 6 => 0.05f32..0.6],
         steady in prop_oneof![1 => any::<f32>(), 6 => 0.001f32..0.5],
         limit in prop_oneof![1 => any::<f32>(), 6 => 0.001f32..0.5],
         revs in 0u16..4,
         nominal in 20u32..20_000,
         ops in proptest::collection::vec(op(), 0..40),
     ) {
-        let mut c = EncoderConfig::new(positions, timer_hz);
-        c.framing = framing;
+        let mut c = match wheel {
+            0 => EncoderConfig::unframed(positions, timer_hz),
+            1 => EncoderConfig::indexed(positions, timer_hz),
+            _ => EncoderConfig::missing_teeth(positions as u8, missing, timer_hz),
+        };
         c.counter_bits = bits;
         c.estimator = Estimator::Edges(k);
-        // By default the timeout is twice the longest nominal interval.
-        c.min_speed = min_speed.unwrap_or(TAU / f64::from(positions.max(1)) * timer_hz / (2.0 * f64::from(nominal)));
-        c.glitch_fraction = glitch;
-        let Ok(enc) = Encoder::<32>::new(c) else { return Ok(()); };
+        // By default the timeout is twice the longest nominal interval (a gap spans 4 at most).
+        c.min_speed = min_speed.unwrap_or(TAU / f64::from(positions.max(1)) * timer_hz / (8.0 * f64::from(nominal)));
+        c.tolerances.glitch_fraction = glitch;
+        let Ok(enc) = Encoder::new(c) else { return Ok(()); };
         let w = WindowConfig { length: WindowLength::Revolutions(revs), steady_tolerance: steady };
-        let Ok(mut m) = DeltaMonitor::new(enc, w, Some(AlarmConfig::new(limit))) else {
+        let Ok(mut m) = DeltaMonitor::<32, Corrected<32>>::new(enc, w, Some(AlarmConfig::new(limit))) else {
             return Ok(());
         };
+        let mut learner: Option<ToothLearner<32>> = None;
         let mut t = 0u32;
-        let missing = match framing {
-            Framing::MissingTooth { missing } => u32::from(missing),
+        let missing = match c.wheel {
+            Wheel::Pattern(_) => u32::from(missing),
             _ => 0,
         };
         let mut windows = Vec::new();
@@ -1887,12 +1922,15 @@ proptest! {
                             let phase = TAU * (tooth as f64 / positions as f64 + r as f64 * 0.37);
                             let f = 1.0 + ripple * phase.sin();
                             let gap = if tooth == missing { missing + 1 } else { 1 };
-                            if tooth == missing && framing == Framing::Index {
-                                m.on_index();
+                            if tooth == missing && wheel == 1 {
+                                m.on_index(t.wrapping_add(1));
                             }
                             let dt = (nominal as f64 * gap as f64 / f) as u32;
                             t = t.wrapping_add(dt);
-                            windows.extend(m.on_edge(t, Some(Direction::Forward)));
+                            match learner.as_mut() {
+                                Some(l) => windows.extend(m.on_edge_observed(t, Some(Direction::Forward), l)),
+                                None => windows.extend(m.on_edge(t, Some(Direction::Forward))),
+                            }
                         }
                     }
                     windows.pop()
@@ -1908,7 +1946,7 @@ proptest! {
                     m.on_edge(t, d)
                 }
                 Op::Index => {
-                    m.on_index();
+                    m.on_index(t);
                     None
                 }
                 Op::Poll(dt) => m.poll(t.wrapping_add(dt)),
@@ -1917,19 +1955,22 @@ proptest! {
                     None
                 }
                 Op::Learn(tol) => {
-                    m.start_learning(tol);
+                    learner = ToothLearner::new(m.encoder(), tol).ok();
                     None
                 }
                 Op::Finish(n) => {
                     let mut table = [0.0f32; 32];
-                    let _ = m.finish_learning(n, &mut table);
+                    if let Some(l) = learner.take() {
+                        if let Ok(p) = l.pitches(n, &mut table) {
+                            let _ = m.set_pitches(p);
+                        }
+                    }
                     None
                 }
             };
             prop_assert!(m.speed().is_finite() && m.speed() >= 0.0);
             for o in windows.drain(..).chain(out) {
-                let r = o.report;
-                if r.valid() {
+                if let Some(r) = o.report.measurement() {
                     prop_assert!(r.delta.is_finite() && (0.0..2.0).contains(&r.delta), "{:?}", r);
                     prop_assert!(r.omega_min >= 0.0 && r.omega_min <= r.omega_max, "{:?}", r);
                     prop_assert!(r.omega_max.is_finite() && r.omega_mean.is_finite(), "{:?}", r);

@@ -31,7 +31,7 @@ fn stream() -> Vec<u32> {
 }
 
 fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
-    let mut c = EncoderConfig::new(LINES, TIMER_HZ);
+    let mut c = EncoderConfig::indexed(LINES, TIMER_HZ);
     c.estimator = Estimator::Edges(k);
     c.min_speed = 10.0;
     let enc = Encoder::new(c).expect("encoder");
@@ -47,11 +47,26 @@ fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32]) -> u32 {
     let mut windows = 0;
     for (i, &t) in ticks.iter().enumerate() {
         if i % usize::from(LINES) == 0 {
-            m.on_index();
+            m.on_index(t.wrapping_sub(1));
         }
         if black_box(m.on_edge(black_box(t), Some(Direction::Forward))).is_some() {
             windows += 1;
         }
+    }
+    windows
+}
+
+/// Feeds the stream in batches of `batch` captures (a DMA ring's halves), the index pulse
+/// reported before the batch holding its edge.
+fn feed_batches(m: &mut DeltaMonitor<1024>, ticks: &[u32], batch: usize) -> u32 {
+    let mut windows = 0;
+    for (c, chunk) in ticks.chunks(batch).enumerate() {
+        let first = c * batch;
+        let index = first.div_ceil(usize::from(LINES)) * usize::from(LINES);
+        if index < first + chunk.len() {
+            m.on_index(ticks[index].wrapping_sub(1));
+        }
+        m.on_captures(black_box(chunk), |_| windows += 1);
     }
     windows
 }
@@ -72,6 +87,14 @@ fn bench_monitor(c: &mut Criterion) {
             b.iter_batched_ref(|| fresh.clone(), |m| feed(m, &ticks), BatchSize::LargeInput)
         });
     }
+    let fresh = monitor(16, 8);
+    g.bench_function("on_captures/64 k=16", |b| {
+        b.iter_batched_ref(
+            || fresh.clone(),
+            |m| feed_batches(m, &ticks, 64),
+            BatchSize::LargeInput,
+        )
+    });
     g.finish();
 }
 

@@ -36,7 +36,7 @@ fn generate(ticks: &mut [u32; EDGES]) {
 }
 
 fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
-    let mut c = EncoderConfig::new(LINES, TIMER_HZ);
+    let mut c = EncoderConfig::indexed(LINES, TIMER_HZ);
     c.estimator = Estimator::Edges(k);
     c.min_speed = 10.0;
     let Ok(enc) = Encoder::new(c) else {
@@ -59,16 +59,18 @@ fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32; EDGES], print: bool) -> (u64, 
     let start = icount::instructions();
     for (i, &t) in ticks.iter().enumerate() {
         if i % LINES as usize == 0 {
-            m.on_index();
+            m.on_index(t.wrapping_sub(1));
         }
         if let Some(o) = black_box(m.on_edge(black_box(t), Some(Direction::Forward))) {
             windows += 1;
             if print {
-                let r = o.report;
-                hprintln!(
-                    "window: delta {:.6} omega max {:.3} min {:.3} mean {:.3} floor {:.1e} valid {} steady {}",
-                    r.delta, r.omega_max, r.omega_min, r.omega_mean, r.noise_floor, r.valid(), r.steady
-                );
+                match o.report.measurement() {
+                    Some(r) => hprintln!(
+                        "window: delta {:.6} omega max {:.3} min {:.3} mean {:.3} floor {:.1e} steady {}",
+                        r.delta, r.omega_max, r.omega_min, r.omega_mean, r.noise_floor, r.steady
+                    ),
+                    None => hprintln!("window: invalid {:?}", o.report.fault()),
+                }
             }
         }
     }
@@ -120,8 +122,8 @@ fn window_finish(ticks: &[u32; EDGES]) -> (u64, u32) {
         let mut long = monitor(16, MAX_WINDOW_REVS);
         for (i, &t) in ticks.iter().enumerate() {
             if i % LINES as usize == 0 {
-                short.on_index();
-                long.on_index();
+                short.on_index(t.wrapping_sub(1));
+                long.on_index(t.wrapping_sub(1));
                 let (a, ended) = timed_edge(&mut short, t);
                 let (b, ended_long) = timed_edge(&mut long, t);
                 if ended && !ended_long {
@@ -208,10 +210,10 @@ pub fn run() {
     let mut last = None;
     for (i, &t) in ticks.iter().enumerate() {
         if i % LINES as usize == 0 {
-            check.on_index();
+            check.on_index(t.wrapping_sub(1));
         }
         if let Some(o) = check.on_edge(t, Some(Direction::Forward)) {
-            last = Some(o.report);
+            last = o.report.measurement().copied();
         }
     }
     let Some(r) = last else {

@@ -24,8 +24,8 @@ use crate::engine::vibration::{
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
 use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
-use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
+use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
 use drive_monitor::supports::{Level, SupportAnalysis};
 use serde::Serialize;
@@ -293,11 +293,23 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
     let Some(e) = &scene.encoder else {
         return Ok(None);
     };
-    let mut c = EncoderConfig::new(e.lines, e.timer_hz);
-    c.framing = match e.framing {
-        FramingSpec::Index => Framing::Index,
-        FramingSpec::MissingTooth => Framing::MissingTooth { missing: e.missing },
-        FramingSpec::None => Framing::None,
+    let mut c = match e.framing {
+        FramingSpec::Index => EncoderConfig::indexed(e.lines, e.timer_hz),
+        FramingSpec::MissingTooth => {
+            let positions = u8::try_from(e.lines).map_err(|_| {
+                SceneError::value(
+                    file,
+                    "encoder.lines",
+                    format!(
+                        "a missing-tooth wheel has at most {} positions, got {}",
+                        drive_monitor::encoder::MAX_PATTERN_POSITIONS,
+                        e.lines
+                    ),
+                )
+            })?;
+            EncoderConfig::missing_teeth(positions, e.missing, e.timer_hz)
+        }
+        FramingSpec::None => EncoderConfig::unframed(e.lines, e.timer_hz),
     };
     c.counter_bits = e.counter_bits;
     c.estimator = Estimator::Edges(e.estimator_edges);
@@ -387,7 +399,7 @@ struct Collector<'a> {
     trace: Vec<(f64, f64)>,
     trace_every: u64,
     edges: u64,
-    last_window: Option<WindowReport>,
+    last_window: Option<Measurement>,
     vibration: Option<(&'a VibrationMachine, std::ops::Range<usize>)>,
     samples: Vec<RegimeSample>,
     sample_every: f64,
@@ -404,23 +416,24 @@ impl Observer for Collector<'_> {
             return;
         };
         if edge.index {
-            m.on_index();
+            m.on_index(edge.ticks);
             return;
         }
         self.edges += 1;
         if let Some(o) = m.on_edge(edge.ticks, Some(edge.direction)) {
             let r = o.report;
+            let m = r.measurement();
             self.windows.push(WindowOut {
                 time: edge.true_time,
-                delta: r.delta as f64,
-                omega_mean: r.omega_mean as f64,
-                noise_floor: r.noise_floor as f64,
+                delta: m.map_or(0.0, |m| f64::from(m.delta)),
+                omega_mean: m.map_or(0.0, |m| f64::from(m.omega_mean)),
+                noise_floor: m.map_or(0.0, |m| f64::from(m.noise_floor)),
                 valid: r.valid(),
-                steady: r.steady,
-                fault: r.fault.map(fault_name),
+                steady: m.is_some_and(|m| m.steady),
+                fault: r.fault().map(fault_name),
             });
-            if r.valid() {
-                self.last_window = Some(r);
+            if let Some(m) = m {
+                self.last_window = Some(*m);
             }
             if let Some(e) = o.event {
                 self.alarms.push(AlarmOut {

@@ -19,7 +19,7 @@
 //! clock shrinks the first, fewer averaged edges (or more lines) the second.
 
 use drive_monitor::alarm::AlarmConfig;
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength};
 use drive_monitor::monitor::DeltaMonitor;
 use drive_monitor::speed::Direction;
@@ -128,16 +128,15 @@ pub fn measure_case(
     if usize::from(lines) > MAX_LINES {
         return Err(ConfigError::Capacity("lines"));
     }
-    let mut c = EncoderConfig::new(lines, timer_hz);
-    c.framing = Framing::Index;
+    let mut c = EncoderConfig::indexed(lines, timer_hz);
     c.estimator = Estimator::Edges(k);
     c.min_speed = omega_mean / 10.0;
-    let encoder = Encoder::<MAX_LINES>::new(c)?;
+    let encoder = Encoder::new(c)?;
     let window = WindowConfig {
         length: WindowLength::Revolutions(WINDOW_REVS),
         steady_tolerance: 0.02,
     };
-    let mut monitor = Box::new(DeltaMonitor::new(
+    let mut monitor = Box::new(DeltaMonitor::<MAX_LINES>::new(
         encoder,
         window,
         Some(AlarmConfig::new((4.0 * epsilon) as f32)),
@@ -148,11 +147,11 @@ pub fn measure_case(
     let (mut n, mut sum, mut worst, mut floor) = (0u32, 0.0, 0.0f64, 0.0);
     for (i, &t) in ticks.iter().enumerate() {
         if i % usize::from(lines) == 0 {
-            monitor.on_index();
+            // The index pulse one tick before the edge that follows it.
+            monitor.on_index(t.wrapping_sub(1));
         }
         if let Some(o) = monitor.on_edge(t, Some(Direction::Forward)) {
-            let r = o.report;
-            if r.valid() {
+            if let Some(r) = o.report.measurement() {
                 n += 1;
                 sum += f64::from(r.delta);
                 worst = worst.max((f64::from(r.delta) / delta - 1.0).abs());
