@@ -252,6 +252,13 @@ pub struct Prediction {
     pub autobalancer: Option<AutobalancerOut>,
 }
 
+impl Prediction {
+    /// Whether the scene gave nothing to predict (no drive model, rotor or vibration machine).
+    pub fn is_empty(&self) -> bool {
+        self.irregularity.is_none() && self.supports.is_none() && self.autobalancer.is_none()
+    }
+}
+
 /// Computes the design-time results of `scene`.
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();

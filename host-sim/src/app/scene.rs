@@ -442,17 +442,47 @@ pub struct ProcessLoadSpec {
 }
 
 impl Scene {
-    /// Reads and parses a scene file.
+    /// Reads and parses a scene file of at most [`MAX_SCENE_BYTES`].
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        use std::io::Read;
+        let io = |source| SceneError::Io {
             file: path.to_path_buf(),
             source,
+        };
+        let file = std::fs::File::open(path).map_err(io)?;
+        // Read one byte past the limit, so a larger file (or an endless one: /dev/zero) is
+        // refused after at most that much.
+        let mut bytes = Vec::new();
+        file.take(MAX_SCENE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        if bytes.len() as u64 > MAX_SCENE_BYTES {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("larger than the limit of {MAX_SCENE_BYTES} bytes for a scene file"),
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not UTF-8 text ({e})"),
+            ))
         })?;
         Scene::parse(&text, path)
     }
 
     /// Parses scene text; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let blank = text
+            .lines()
+            .map(str::trim)
+            .all(|l| l.is_empty() || l.starts_with('#'));
+        if blank {
+            return Err(SceneError::Parse {
+                file: path.to_path_buf(),
+                message: "the file is empty: a scene needs at least one table (see `drive-sim scenes` for examples)".into(),
+            });
+        }
         let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: path.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
@@ -566,37 +596,45 @@ pub const BUNDLED: &[(&str, &str)] = &[
 ];
 
 /// The default scene of `drive-sim` without arguments.
-pub const DEFAULT_SCENE: &str = "kneader.toml";
+pub const DEFAULT_SCENE: &str = "kneader";
 
-/// Loads `name`: a file if one exists at that path, else a bundled scene by file name (with or
-/// without `.toml`). Returns the scene and the path errors should name.
+/// Largest scene file read, bytes (the bundled scenes are about 1 kB).
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// The bundled scene called `name` (its file name without `.toml`, as `drive-sim scenes`
+/// lists it): (file name, text).
+pub fn bundled(name: &str) -> Option<(&'static str, &'static str)> {
+    BUNDLED
+        .iter()
+        .find(|(n, _)| n.strip_suffix(".toml") == Some(name))
+        .copied()
+}
+
+/// Loads `name`: a bundled scene when `name` is one of their names (`kneader`, as `drive-sim
+/// scenes` lists them), else the scene file at the path `name`. A path that does not exist is
+/// an error, never a bundled scene of the same file name. Returns the scene and the path
+/// errors should name.
 pub fn resolve(name: &str) -> Result<(Scene, PathBuf), SceneError> {
+    if let Some((n, text)) = bundled(name) {
+        let shown = PathBuf::from(format!("host-sim/scenes/{n}"));
+        return Ok((Scene::parse(text, &shown)?, shown));
+    }
     let path = Path::new(name);
-    if path.exists() {
-        return Ok((Scene::load(path)?, path.to_path_buf()));
-    }
-    let file = if name.ends_with(".toml") {
-        name.to_string()
-    } else {
-        format!("{name}.toml")
-    };
-    let base = Path::new(&file)
-        .file_name()
-        .and_then(|f| f.to_str())
-        .unwrap_or("");
-    match BUNDLED.iter().find(|(n, _)| *n == base) {
-        Some((n, text)) => {
-            let shown = PathBuf::from(format!("host-sim/scenes/{n}"));
-            Ok((Scene::parse(text, &shown)?, shown))
-        }
-        None => Err(SceneError::Io {
-            file: path.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                "no such file, and no bundled scene of that name (see `drive-sim scenes`)",
+    if !path.exists() {
+        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+        let hint = match bundled(stem) {
+            Some(_) => format!(
+                "no such file (the bundled scene `{stem}` is asked for by its name alone: `drive-sim run {stem}`)"
             ),
-        }),
+            None => "no such file, and no bundled scene of that name (see `drive-sim scenes`)"
+                .to_string(),
+        };
+        return Err(SceneError::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, hint),
+        });
     }
+    Ok((Scene::load(path)?, path.to_path_buf()))
 }
 
 #[cfg(test)]
@@ -611,9 +649,10 @@ mod tests {
 
     #[test]
     fn bundled_scenes_parse() {
-        for (name, _) in BUNDLED {
+        for (file, _) in BUNDLED {
+            let name = file.strip_suffix(".toml").unwrap();
             let (scene, path) = resolve(name).unwrap();
-            assert!(path.ends_with(name));
+            assert!(path.ends_with(file));
             assert!(scene.description.is_some(), "{name}");
         }
         assert!(resolve("kneader").is_ok());
