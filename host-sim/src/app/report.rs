@@ -250,7 +250,8 @@ pub fn run_plots(
     }
     if let Some((rotor, limits)) = predict::rotor(scene, file).map_err(|e| e.to_string())? {
         let path = dir.join(format!("{stem}-supports.svg"));
-        let analysis = drive_monitor::supports::SupportAnalysis::new(&rotor, &limits);
+        let analysis =
+            predict::analysis(scene, &rotor, &limits, file).map_err(|e| e.to_string())?;
         let top = analysis
             .max_safe_speed()
             .filter(|w| w.is_finite())

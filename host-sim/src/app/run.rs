@@ -6,7 +6,7 @@
 //! core's classifiers judge the measured speed. The report puts the core's measurements next
 //! to the design-time prediction and to what the simulation itself did.
 
-use crate::app::predict::{self, value_error};
+use crate::app::predict::{self, core_error};
 use crate::app::scene::{
     BalancerKindSpec, FramingSpec, IntegratorKind, MotorSpec, Scene, SceneError,
 };
@@ -27,7 +27,7 @@ use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
-use drive_monitor::supports::{Level, SupportAnalysis};
+use drive_monitor::supports::Level;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -285,7 +285,7 @@ fn rotor_loads(scene: &Scene, file: &Path) -> Result<Option<RotorLoads>, SceneEr
     };
     RotorLoads::new(&params)
         .map(Some)
-        .map_err(|e| value_error(file, "rotor", e))
+        .map_err(|e| core_error(scene, file, "rotor", e))
 }
 
 /// The core's monitor for the scene's encoder.
@@ -303,7 +303,7 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
     c.estimator = Estimator::Edges(e.estimator_edges);
     let m = scene.monitor.clone().unwrap_or_default();
     c.min_speed = m.min_speed.unwrap_or(1.0);
-    let enc = Encoder::new(c).map_err(|er| value_error(file, "encoder", er))?;
+    let enc = Encoder::new(c).map_err(|er| core_error(scene, file, "encoder", er))?;
     let revs = match m.window_revolutions {
         Some(n) => WindowLength::Revolutions(n),
         None => {
@@ -328,7 +328,7 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
     let alarm = m.delta_limit.map(|l| AlarmConfig::new(l as f32));
     DeltaMonitor::new(enc, window, alarm)
         .map(Some)
-        .map_err(|er| value_error(file, "monitor", er))
+        .map_err(|er| core_error(scene, file, "monitor", er))
 }
 
 fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
@@ -359,7 +359,7 @@ fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
     c.glitch_probability = e.glitch_probability;
     c.seed = scene.simulation.seed;
     crate::engine::encoder::Encoder::new(c.clone())
-        .map_err(|er| value_error(file, "encoder", er))?;
+        .map_err(|er| core_error(scene, file, "encoder", er))?;
     Ok(c)
 }
 
@@ -497,7 +497,7 @@ pub fn regime_classifier(
         .and_then(|m| m.regime_margin)
         .map_or(DEFAULT_MARGIN, |m| m as f32);
     let classifier = Classifier::new(machine, margin, 0.5 * margin)
-        .map_err(|e| value_error(file, "monitor", e))?;
+        .map_err(|e| core_error(scene, file, "monitor", e))?;
     Ok((classifier, margin))
 }
 
@@ -573,7 +573,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     let vib_params = vibration_params(scene, over.loads_together, rotor_speed0);
     let vib_machine = match &vib_params {
         Some(p) => {
-            Some(VibrationMachine::new(p).map_err(|e| value_error(file, "autobalancer", e))?)
+            Some(VibrationMachine::new(p).map_err(|e| core_error(scene, file, "autobalancer", e))?)
         }
         None => None,
     };
@@ -586,7 +586,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         effects.push(Box::new(*r));
         names.push("rotor-loads");
     }
-    let system = System::new(shaft, effects).map_err(|e| value_error(file, "shaft", e))?;
+    let system = System::new(shaft, effects).map_err(|e| core_error(scene, file, "shaft", e))?;
     let vib_range = names
         .iter()
         .position(|n| *n == "vibration")
@@ -595,7 +595,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     let integ = integrator(scene);
     integ
         .validate()
-        .map_err(|e| value_error(file, "simulation", e))?;
+        .map_err(|e| core_error(scene, file, "simulation", e))?;
     let mut sim = Simulation::new(system, integ.clone(), sim_encoder(scene, file)?)
         .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let duration = scene.simulation.duration;
@@ -687,9 +687,12 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     }
     report.capture = capture_analysis(scene, file, vib_params.as_ref(), &col.samples)?;
     if let Some((rotor, limits)) = predict::rotor(scene, file)? {
-        let analysis = SupportAnalysis::new(&rotor, &limits);
+        let analysis = predict::analysis(scene, &rotor, &limits, file)?;
         let speed = report.speed_measured.unwrap_or(limits.service_speed());
-        let status = analysis.monitor().update(speed as f32);
+        let status = analysis
+            .monitor()
+            .map_err(|e| core_error(scene, file, "rotor", e))?
+            .update(speed as f32);
         report.supports = Some(SupportsRunOut {
             speed,
             peak_load: status.peak_load.map(f64::from),

@@ -27,6 +27,31 @@ pub enum SceneError {
         /// The parser's message (names the key and the line).
         message: String,
     },
+    /// A value outside what its key allows, quoted as written.
+    #[error("{file}: `{key} = {value}`: {rule}")]
+    Rule {
+        /// The scene file.
+        file: PathBuf,
+        /// The key, e.g. `platform[2].mass`.
+        key: String,
+        /// Its value as written in the file.
+        value: String,
+        /// What is allowed.
+        rule: String,
+    },
+    /// Values the core rejected together, each key quoted with its value as written
+    /// ([`crate::app::check::core_keys`]).
+    #[error("{file}: {keys}: {message}")]
+    Core {
+        /// The scene file.
+        file: PathBuf,
+        /// The key most likely responsible.
+        key: String,
+        /// Every key involved, with its value.
+        keys: String,
+        /// What the core found.
+        message: String,
+    },
     /// A value that parses but is impossible.
     #[error("{file}: `{key}`: {message}")]
     Value {
@@ -85,6 +110,9 @@ pub struct Scene {
     pub unbalance: Vec<UnbalanceSpec>,
     /// A distributed process load on that rotor.
     pub process_load: Option<ProcessLoadSpec>,
+    /// The values as written in the file, for errors.
+    #[serde(skip)]
+    pub written: crate::app::check::Written,
 }
 
 /// How to integrate.
@@ -184,9 +212,10 @@ pub struct Harmonic {
     pub phase: f64,
 }
 
-/// `[motor]`.
+/// `[motor]`. Read through [`MotorTable`], so that an error names the key inside the table
+/// (a tagged enum would report only the table).
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields, tag = "model", rename_all = "lowercase")]
+#[serde(try_from = "MotorTable")]
 pub enum MotorSpec {
     /// Parabolic characteristic through (ω0, 0) and (ω_m, M_m) (seed 000, eq. 3–4).
     Parabola {
@@ -220,6 +249,111 @@ pub enum MotorSpec {
         /// Ramp time, s.
         duration: f64,
     },
+}
+
+/// `[motor] model`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotorModel {
+    /// [`MotorSpec::Parabola`].
+    Parabola,
+    /// [`MotorSpec::Kloss`].
+    Kloss,
+    /// [`MotorSpec::Speed`].
+    Speed,
+    /// [`MotorSpec::Ramp`].
+    Ramp,
+}
+
+/// `[motor]` as written: the model and every key any model has, each with its own type.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorTable {
+    /// The model.
+    pub model: MotorModel,
+    /// Parabola: ω0.
+    pub no_load_speed: Option<f64>,
+    /// Parabola: ω_m.
+    pub breakdown_speed: Option<f64>,
+    /// Parabola and Kloss: M_m.
+    pub breakdown_torque: Option<f64>,
+    /// Kloss: ω_s.
+    pub synchronous_speed: Option<f64>,
+    /// Kloss: σ_m.
+    pub breakdown_slip: Option<f64>,
+    /// Speed: ω.
+    pub speed: Option<f64>,
+    /// Ramp: start speed.
+    pub from: Option<f64>,
+    /// Ramp: end speed.
+    pub to: Option<f64>,
+    /// Ramp: ramp time.
+    pub duration: Option<f64>,
+}
+
+impl TryFrom<MotorTable> for MotorSpec {
+    type Error = String;
+
+    fn try_from(t: MotorTable) -> Result<Self, String> {
+        let (model, keys): (&str, &[&str]) = match t.model {
+            MotorModel::Parabola => (
+                "parabola",
+                &["no_load_speed", "breakdown_speed", "breakdown_torque"],
+            ),
+            MotorModel::Kloss => (
+                "kloss",
+                &["synchronous_speed", "breakdown_slip", "breakdown_torque"],
+            ),
+            MotorModel::Speed => ("speed", &["speed"]),
+            MotorModel::Ramp => ("ramp", &["from", "to", "duration"]),
+        };
+        let given = [
+            ("no_load_speed", t.no_load_speed),
+            ("breakdown_speed", t.breakdown_speed),
+            ("breakdown_torque", t.breakdown_torque),
+            ("synchronous_speed", t.synchronous_speed),
+            ("breakdown_slip", t.breakdown_slip),
+            ("speed", t.speed),
+            ("from", t.from),
+            ("to", t.to),
+            ("duration", t.duration),
+        ];
+        for (key, value) in given {
+            if value.is_some() && !keys.contains(&key) {
+                return Err(format!(
+                    "`motor.{key}` does not belong to model = \"{model}\" (its keys: {})",
+                    keys.join(", ")
+                ));
+            }
+        }
+        let get = |key: &str| -> Result<f64, String> {
+            given
+                .iter()
+                .find(|(k, _)| *k == key)
+                .and_then(|(_, v)| *v)
+                .ok_or_else(|| format!("missing key `motor.{key}` (model = \"{model}\")"))
+        };
+        Ok(match t.model {
+            MotorModel::Parabola => MotorSpec::Parabola {
+                no_load_speed: get("no_load_speed")?,
+                breakdown_speed: get("breakdown_speed")?,
+                breakdown_torque: get("breakdown_torque")?,
+            },
+            MotorModel::Kloss => MotorSpec::Kloss {
+                synchronous_speed: get("synchronous_speed")?,
+                breakdown_slip: get("breakdown_slip")?,
+                breakdown_torque: get("breakdown_torque")?,
+            },
+            MotorModel::Speed => MotorSpec::Speed {
+                speed: get("speed")?,
+            },
+            MotorModel::Ramp => MotorSpec::Ramp {
+                from: get("from")?,
+                to: get("to")?,
+                duration: get("duration")?,
+            },
+        })
+    }
 }
 
 /// `[load]`: M_c(φ) = mean + Σ amplitude·sin(order·φ + phase).
@@ -483,95 +617,18 @@ impl Scene {
                 message: "the file is empty: a scene needs at least one table (see `drive-sim scenes` for examples)".into(),
             });
         }
-        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: path.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
         })?;
-        scene.check(path)?;
+        scene.written = crate::app::check::Written::parse(text);
+        crate::app::check::check(&scene, &scene.checker(path))?;
         Ok(scene)
     }
 
-    fn check(&self, path: &Path) -> Result<(), SceneError> {
-        let bad = |key: &str, message: &str| SceneError::value(path, key, message);
-        let s = &self.simulation;
-        let positive = |key: &str, x: f64| {
-            if !x.is_finite() {
-                Err(bad(key, &format!("must be finite, got {x}")))
-            } else if x <= 0.0 {
-                Err(bad(key, &format!("must be positive, got {x}")))
-            } else {
-                Ok(())
-            }
-        };
-        positive("simulation.duration", s.duration)?;
-        positive("simulation.rtol", s.rtol)?;
-        positive("simulation.atol", s.atol)?;
-        positive("simulation.step", s.step)?;
-        if let Some(t) = s.settle {
-            if !(t.is_finite() && t >= 0.0 && t < s.duration) {
-                return Err(bad(
-                    "simulation.settle",
-                    &format!("must be in [0, duration), got {t}"),
-                ));
-            }
-        }
-        if let Some(l) = self.monitor.as_ref().and_then(|m| m.delta_limit) {
-            // A limit finer than f64 resolves the speed can be neither designed for
-            // (`DriveModel::flywheel_for`) nor monitored: one check for every command.
-            if l.is_nan() || l < drive_monitor::drive::MIN_DELTA_TARGET {
-                return Err(bad(
-                    "monitor.delta_limit",
-                    &format!(
-                        "must be at least {:e} (finer than f64 resolves the speed), got {l}",
-                        drive_monitor::drive::MIN_DELTA_TARGET
-                    ),
-                ));
-            }
-        }
-        if self.platform.len() > 3 {
-            return Err(bad("platform", "at most 3 platforms"));
-        }
-        if !self.platform.is_empty() && self.autobalancer.is_none() {
-            return Err(bad(
-                "autobalancer",
-                "missing: a vibration machine needs its auto-balancer",
-            ));
-        }
-        if self.autobalancer.is_some() && self.platform.is_empty() {
-            return Err(bad(
-                "platform",
-                "missing: the auto-balancer needs a platform",
-            ));
-        }
-        if (!self.unbalance.is_empty() || self.process_load.is_some()) && self.rotor.is_none() {
-            return Err(bad("rotor", "missing: unbalances need a [rotor]"));
-        }
-        if let Some(e) = &self.encoder {
-            if e.framing == FramingSpec::MissingTooth && e.missing == 0 {
-                return Err(bad(
-                    "encoder.missing",
-                    "missing-tooth framing needs missing = 1..3",
-                ));
-            }
-            for (key, x) in [
-                ("encoder.drop_probability", e.drop_probability),
-                ("encoder.glitch_probability", e.glitch_probability),
-            ] {
-                if !(0.0..=0.5).contains(&x) {
-                    return Err(bad(key, &format!("must be in [0, 0.5], got {x}")));
-                }
-            }
-            for (key, x) in [
-                ("encoder.jitter", e.jitter),
-                ("encoder.runout", e.runout),
-                ("encoder.pitch_error", e.pitch_error),
-            ] {
-                if !(x.is_finite() && x >= 0.0) {
-                    return Err(bad(key, &format!("must be finite and ≥ 0, got {x}")));
-                }
-            }
-        }
-        Ok(())
+    /// The errors of this scene's file `path`, quoting its values as written.
+    pub fn checker<'a>(&'a self, path: &'a Path) -> crate::app::check::Checker<'a> {
+        crate::app::check::Checker::new(path, &self.written)
     }
 }
 
