@@ -53,7 +53,7 @@ pub const MAX_LINES: u16 = crate::app::run::MAX_LINES as u16;
 /// `load.harmonics[1].order`, `rotor.support_load_limit[2]`.
 #[derive(Debug, Clone, Default)]
 pub struct Written {
-    values: BTreeMap<String, String>,
+    values: BTreeMap<String, (String, Option<std::ops::Range<usize>>)>,
     text: String,
 }
 
@@ -73,7 +73,14 @@ impl Written {
 
     /// The value at `key` as written, if the file gives it.
     pub fn get(&self, key: &str) -> Option<&str> {
-        self.values.get(key).map(String::as_str)
+        self.values.get(key).map(|(v, _)| v.as_str())
+    }
+
+    /// Every value: its key, its text as written and where that text is in the file (bytes).
+    pub fn entries(&self) -> impl Iterator<Item = (&str, &str, Option<std::ops::Range<usize>>)> {
+        self.values
+            .iter()
+            .map(|(k, (v, span))| (k.as_str(), v.as_str(), span.clone()))
     }
 
     fn table(&mut self, prefix: &str, t: &toml_edit::Table) {
@@ -106,8 +113,9 @@ impl Written {
             }
             _ => {
                 // The value's own text in the file (its span), else toml_edit's rendering.
-                let written = v
-                    .span()
+                let span = v.span();
+                let written = span
+                    .clone()
                     .and_then(|span| self.text.get(span))
                     .map(|t| t.trim().to_string())
                     .unwrap_or_else(|| {
@@ -115,7 +123,7 @@ impl Written {
                         bare.decor_mut().clear();
                         bare.to_string()
                     });
-                self.values.insert(key.to_string(), written);
+                self.values.insert(key.to_string(), (written, span));
             }
         }
     }
@@ -179,7 +187,10 @@ impl<'a> Checker<'a> {
         unit: &str,
     ) -> Result<(), SceneError> {
         let above = if open { x > lo } else { x >= lo };
-        if x.is_finite() && above && x <= hi {
+        // Subnormal numbers are refused too: they are not physical and lose their digits in the
+        // first division (the core refuses them the same way).
+        let subnormal = x != 0.0 && x.abs() < f64::MIN_POSITIVE;
+        if x.is_finite() && above && x <= hi && !subnormal {
             return Ok(());
         }
         let unit = if unit.is_empty() {
@@ -188,10 +199,11 @@ impl<'a> Checker<'a> {
             format!(" {unit}")
         };
         let bracket = if open { "(" } else { "[" };
+        let note = if subnormal { " (not subnormal)" } else { "" };
         Err(self.bad(
             key,
             x,
-            format!("allowed {bracket}{}, {}]{unit}", num(lo), num(hi)),
+            format!("allowed {bracket}{}, {}]{unit}{note}", num(lo), num(hi)),
         ))
     }
 

@@ -7,6 +7,11 @@ use crate::app::scene::Scene;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
+/// A noise floor as text (`–` when no window was counted).
+fn floor(x: Option<f64>) -> String {
+    x.map_or("–".to_string(), |x| format!("{x:.1e}"))
+}
+
 /// A run as text.
 pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     let mut s = String::new();
@@ -27,6 +32,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         r.steps[1],
         r.edges
     );
+    if let Some(why) = &r.no_measurement {
+        let _ = writeln!(s, "NOTHING MEASURED by the core: {why}");
+    }
     if r.windows > 0 {
         let _ = writeln!(s, "Measured by the core from the encoder edges");
         let _ = writeln!(
@@ -57,17 +65,22 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             (Some(m), Some(p)) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}: {:+.2} %, noise floor {:.1e}",
+                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{}, noise floor {}",
                     r.settle,
-                    100.0 * (m / p - 1.0),
-                    r.noise_floor.unwrap_or(f64::NAN)
+                    // A drive without load ripple is predicted δ = 0: no relative difference.
+                    if p > 0.0 {
+                        format!(": {:+.2} %", 100.0 * (m / p - 1.0))
+                    } else {
+                        String::new()
+                    },
+                    floor(r.noise_floor)
                 );
             }
             (Some(m), None) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6}, noise floor {:.1e}",
-                    r.noise_floor.unwrap_or(f64::NAN)
+                    "  δ measured {m:.6}, noise floor {}",
+                    floor(r.noise_floor)
                 );
             }
             _ => {}
@@ -84,30 +97,50 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
         let _ = writeln!(
             s,
-            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {:.2e} of the rotor's)",
+            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {} of the rotor's)",
             r.regime_class.unwrap_or("?"),
-            r.residual_relative.unwrap_or(f64::NAN)
+            r.residual_relative
+                .map_or("–".to_string(), |x| format!("{x:.2e}"))
         );
     }
     if let Some(c) = &r.capture {
         s.push_str(&crate::app::capture::summary(c));
     }
     if let Some(u) = &r.supports {
-        let _ = writeln!(
-            s,
-            "Supports at {:.2} rad/s: peak loads A {:.1} N ({}), B {:.1} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}",
-            u.speed,
-            u.peak_load[0],
+        s.push_str(&supports_text(u));
+    }
+    s
+}
+
+/// The supports line of a run: the core's judgement at the measured speed, or, without one,
+/// the simulated reactions against the load limits.
+fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
+    let load = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.1}"));
+    match (u.speed, u.simulated_reaction_level) {
+        (Some(speed), _) => format!(
+            "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}\n",
+            load(u.peak_load[0]),
             u.load_level[0],
-            u.peak_load[1],
+            load(u.peak_load[1]),
             u.load_level[1],
             u.simulated_peak_reaction[0],
             u.simulated_peak_reaction[1],
             u.unbalance_level[0],
             u.unbalance_level[1]
-        );
+        ),
+        (None, levels) => {
+            let levels = levels.unwrap_or(["unknown"; 2]);
+            format!(
+                "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {:.1} N ({} against the load limit), B {:.1} N ({}); unbalance A {}, B {}\n",
+                u.simulated_peak_reaction[0],
+                levels[0],
+                u.simulated_peak_reaction[1],
+                levels[1],
+                u.unbalance_level[0],
+                u.unbalance_level[1]
+            )
+        }
     }
-    s
 }
 
 /// Writes the plots a run calls for into `dir`; returns the files written.

@@ -229,7 +229,11 @@ fn run_cmd(name: &str, json: bool, plot: Option<&Path>, out: Option<&Path>) -> R
     if let Some(dir) = out {
         writable_dir("--out", dir)?;
     }
-    let report = host_sim::app::run::run(&scene, &path, Default::default())?;
+    let options = host_sim::app::run::RunOptions {
+        progress: !json,
+        keep_windows: plot.is_some(),
+    };
+    let report = host_sim::app::run::run_with(&scene, &path, Default::default(), options)?;
     let mut text = String::new();
     if let Some(dir) = out {
         let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
