@@ -158,66 +158,10 @@ pub fn run_plots(
         .unwrap_or("scene")
         .to_string();
     if !r.speed_trace.is_empty() {
-        let path = dir.join(format!("{stem}-speed.svg"));
-        let mut marks: Vec<Mark> = r
-            .window_list
-            .iter()
-            .filter(|w| !w.valid)
-            .map(|w| {
-                Mark::VLine(
-                    format!("invalid window ({})", w.fault.unwrap_or("?")),
-                    w.time,
-                )
-            })
-            .take(5)
-            .collect();
-        marks.push(Mark::Band("settling".into(), 0.0, r.settle, true));
-        write_svg(
-            &path,
-            &Chart {
-                title: "Shaft speed measured by the core (per speed sample)",
-                x_label: "time, s",
-                y_label: "ω, rad/s",
-                series: vec![Series {
-                    label: "ω".into(),
-                    points: r.speed_trace.clone(),
-                    markers: false,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(speed_plot(r, &dir.join(format!("{stem}-speed.svg")))?);
     }
     if !r.window_list.is_empty() {
-        let path = dir.join(format!("{stem}-delta.svg"));
-        let mut marks = Vec::new();
-        if let Some(l) = r.delta_limit {
-            marks.push(Mark::HLine(format!("limit {l}"), l));
-        }
-        if let Some(p) = r.delta_predicted {
-            marks.push(Mark::HLine(format!("predicted {p:.5}"), p));
-        }
-        let valid: Vec<(f64, f64)> = r
-            .window_list
-            .iter()
-            .filter(|w| w.valid)
-            .map(|w| (w.time, w.delta))
-            .collect();
-        write_svg(
-            &path,
-            &Chart {
-                title: "δ per window (one load cycle each)",
-                x_label: "time, s",
-                y_label: "δ",
-                series: vec![Series {
-                    label: "δ measured".into(),
-                    points: valid,
-                    markers: true,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(delta_plot(r, &dir.join(format!("{stem}-delta.svg")))?);
     }
     let machine = predict::machine(scene, file).map_err(|e| e.to_string())?;
     if let (Some(c), Some(machine)) = (&r.capture, &machine) {
@@ -235,108 +179,195 @@ pub fn run_plots(
     }
     if let Some(machine) = &machine {
         let path = dir.join(format!("{stem}-regimes.svg"));
-        let top = machine
-            .resonant_speeds()
-            .iter()
-            .copied()
-            .fold(0.0, f64::max)
-            * 1.6;
-        let mut marks: Vec<Mark> = machine
-            .zones()
-            .iter()
-            .map(|z| {
-                Mark::Band(
-                    z.kind.name().into(),
-                    z.from,
-                    z.to.unwrap_or(top),
-                    z.kind.name() == "gathering",
-                )
-            })
-            .collect();
-        if let Some(w) = r.speed_measured {
-            marks.push(Mark::VLine(format!("measured speed {w:.2} rad/s"), w));
-        }
-        let n = 400;
-        let re: Vec<(f64, f64)> = (1..=n)
-            .map(|i| {
-                let w = top * i as f64 / n as f64;
-                let (re, _) = machine.receptance(w);
-                (w, re)
-            })
-            .collect();
-        let scale = re.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(1e-300);
-        write_svg(
-            &path,
-            &Chart {
-                title: "Auto-balancer zones (criterion: balancing where Re H < 0)",
-                x_label: "rotor speed, rad/s",
-                y_label: "Re H / max |Re H|",
-                series: vec![Series {
-                    label: "Re H of the exciter platform".into(),
-                    points: re.into_iter().map(|(w, v)| (w, v / scale)).collect(),
-                    markers: false,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(regimes_plot(r, machine, &path)?);
     }
     if let Some((rotor, limits)) = predict::rotor(scene, file).map_err(|e| e.to_string())? {
         let path = dir.join(format!("{stem}-supports.svg"));
-        let analysis =
-            predict::analysis(scene, &rotor, &limits, file).map_err(|e| e.to_string())?;
-        let top = analysis
-            .max_safe_speed()
-            .filter(|w| w.is_finite())
-            .unwrap_or(3.0 * limits.service_speed())
-            * 1.2;
-        let n = 300;
-        let curve = |k: usize| -> Vec<(f64, f64)> {
-            (0..=n)
-                .map(|i| {
-                    let w = top * i as f64 / n as f64;
-                    (w, rotor.loads(w)[k].peak)
-                })
-                .collect()
-        };
-        let mut marks = Vec::new();
-        if let Some(l) = scene.rotor.as_ref().and_then(|r| r.support_load_limit) {
-            marks.push(Mark::HLine(format!("limit A {} N", l[0]), l[0]));
-            if l[1] != l[0] {
-                marks.push(Mark::HLine(format!("limit B {} N", l[1]), l[1]));
-            }
-        }
-        marks.push(Mark::VLine(
-            format!("service speed {} rad/s", limits.service_speed()),
-            limits.service_speed(),
-        ));
-        if let Some(w) = r.speed_measured {
-            marks.push(Mark::VLine(format!("measured {w:.1} rad/s"), w));
-        }
-        write_svg(
-            &path,
-            &Chart {
-                title: "Peak support load per turn against speed",
-                x_label: "speed, rad/s",
-                y_label: "load, N",
-                series: vec![
-                    Series {
-                        label: "support A".into(),
-                        points: curve(0),
-                        markers: false,
-                    },
-                    Series {
-                        label: "support B".into(),
-                        points: curve(1),
-                        markers: false,
-                    },
-                ],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(supports_plot(scene, file, r, &rotor, &limits, &path)?);
     }
     Ok(out)
+}
+
+/// The speed the core measured against time, with the first invalid windows and the
+/// settling time marked.
+fn speed_plot(r: &RunReport, path: &Path) -> Result<PathBuf, String> {
+    let mut marks: Vec<Mark> = r
+        .window_list
+        .iter()
+        .filter(|w| !w.valid)
+        .map(|w| {
+            Mark::VLine(
+                format!("invalid window ({})", w.fault.unwrap_or("?")),
+                w.time,
+            )
+        })
+        .take(5)
+        .collect();
+    marks.push(Mark::Band("settling".into(), 0.0, r.settle, true));
+    write_svg(
+        path,
+        &Chart {
+            title: "Shaft speed measured by the core (per speed sample)",
+            x_label: "time, s",
+            y_label: "ω, rad/s",
+            series: vec![Series {
+                label: "ω".into(),
+                points: r.speed_trace.clone(),
+                markers: false,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// δ of every valid window against time, with the limit and the prediction.
+fn delta_plot(r: &RunReport, path: &Path) -> Result<PathBuf, String> {
+    let mut marks = Vec::new();
+    if let Some(l) = r.delta_limit {
+        marks.push(Mark::HLine(format!("limit {l}"), l));
+    }
+    if let Some(p) = r.delta_predicted {
+        marks.push(Mark::HLine(format!("predicted {p:.5}"), p));
+    }
+    let valid: Vec<(f64, f64)> = r
+        .window_list
+        .iter()
+        .filter(|w| w.valid)
+        .map(|w| (w.time, w.delta))
+        .collect();
+    write_svg(
+        path,
+        &Chart {
+            title: "δ per window (one load cycle each)",
+            x_label: "time, s",
+            y_label: "δ",
+            series: vec![Series {
+                label: "δ measured".into(),
+                points: valid,
+                markers: true,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// The auto-balancer's zones along the speed axis over Re H of the exciter platform, with
+/// the measured speed.
+fn regimes_plot(
+    r: &RunReport,
+    machine: &drive_monitor::balancer::Machine,
+    path: &Path,
+) -> Result<PathBuf, String> {
+    let top = machine
+        .resonant_speeds()
+        .iter()
+        .copied()
+        .fold(0.0, f64::max)
+        * 1.6;
+    let mut marks: Vec<Mark> = machine
+        .zones()
+        .iter()
+        .map(|z| {
+            Mark::Band(
+                z.kind.name().into(),
+                z.from,
+                z.to.unwrap_or(top),
+                z.kind.name() == "gathering",
+            )
+        })
+        .collect();
+    if let Some(w) = r.speed_measured {
+        marks.push(Mark::VLine(format!("measured speed {w:.2} rad/s"), w));
+    }
+    let n = 400;
+    let re: Vec<(f64, f64)> = (1..=n)
+        .map(|i| {
+            let w = top * i as f64 / n as f64;
+            let (re, _) = machine.receptance(w);
+            (w, re)
+        })
+        .collect();
+    let scale = re.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(1e-300);
+    write_svg(
+        path,
+        &Chart {
+            title: "Auto-balancer zones (criterion: balancing where Re H < 0)",
+            x_label: "rotor speed, rad/s",
+            y_label: "Re H / max |Re H|",
+            series: vec![Series {
+                label: "Re H of the exciter platform".into(),
+                points: re.into_iter().map(|(w, v)| (w, v / scale)).collect(),
+                markers: false,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// The peak support loads per turn against speed, with the load limits, the service speed
+/// and the measured speed.
+fn supports_plot(
+    scene: &Scene,
+    file: &Path,
+    r: &RunReport,
+    rotor: &drive_monitor::supports::Rotor<{ predict::MAX_UNBALANCES }>,
+    limits: &drive_monitor::supports::Limits,
+    path: &Path,
+) -> Result<PathBuf, String> {
+    let analysis = predict::analysis(scene, rotor, limits, file).map_err(|e| e.to_string())?;
+    let top = analysis
+        .max_safe_speed()
+        .filter(|w| w.is_finite())
+        .unwrap_or(3.0 * limits.service_speed())
+        * 1.2;
+    let n = 300;
+    let curve = |k: usize| -> Vec<(f64, f64)> {
+        (0..=n)
+            .map(|i| {
+                let w = top * i as f64 / n as f64;
+                (w, rotor.loads(w)[k].peak)
+            })
+            .collect()
+    };
+    let mut marks = Vec::new();
+    if let Some(l) = scene.rotor.as_ref().and_then(|r| r.support_load_limit) {
+        marks.push(Mark::HLine(format!("limit A {} N", l[0]), l[0]));
+        if l[1] != l[0] {
+            marks.push(Mark::HLine(format!("limit B {} N", l[1]), l[1]));
+        }
+    }
+    marks.push(Mark::VLine(
+        format!("service speed {} rad/s", limits.service_speed()),
+        limits.service_speed(),
+    ));
+    if let Some(w) = r.speed_measured {
+        marks.push(Mark::VLine(format!("measured {w:.1} rad/s"), w));
+    }
+    write_svg(
+        path,
+        &Chart {
+            title: "Peak support load per turn against speed",
+            x_label: "speed, rad/s",
+            y_label: "load, N",
+            series: vec![
+                Series {
+                    label: "support A".into(),
+                    points: curve(0),
+                    markers: false,
+                },
+                Series {
+                    label: "support B".into(),
+                    points: curve(1),
+                    markers: false,
+                },
+            ],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
 }
 
 /// The design-time results as text.
