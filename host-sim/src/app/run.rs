@@ -545,8 +545,10 @@ struct Progress {
 
 impl Progress {
     fn new(duration: f64, show: bool) -> Self {
-        let bar =
-            crate::app::progress::progress_bar((duration * 1e3) as usize, "ms simulated", false);
+        // Hidden until the run has taken a second; a hidden bar has no length of its own.
+        let len = (duration * 1e3) as usize;
+        let bar = crate::app::progress::progress_bar(len, "ms simulated", false);
+        bar.set_length(len as u64);
         Progress {
             bar,
             show,
