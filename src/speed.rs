@@ -796,8 +796,6 @@ impl SpeedTracker {
         let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
         let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
         let pitch = |k: u16| enc.grid_pitch(k) as f32 / base as f32;
-        // Per-base intervals of a hypothesis: e1 is tooth `first` (spanning `spans` pitches
-        // from the last accepted edge), the following edges the teeth after it.
         // A hypothesis: e1 is tooth `first`, its interval spanning `spans` base pitches from the
         // last accepted edge, which was tooth `before`; the following edges are the teeth
         // after `first` (for a glitch, e1 and e2 merged are `first`). Its cost: the squared log
@@ -810,7 +808,7 @@ impl SpeedTracker {
                 let Some(d2) = d2 else {
                     return f32::INFINITY;
                 };
-                terms[0] = ((d1 + d2) as f32 / spans, first);
+                terms[0] = ((d1 as f32 + d2 as f32) / spans, first);
                 [d3, None]
             } else {
                 terms[0] = (x / spans, first);
@@ -1233,7 +1231,7 @@ impl SpeedTracker {
     fn stop_after(&self, enc: &Encoder, tooth: u16) -> u16 {
         let edges = enc.edges();
         match enc.framing() {
-            Framing::Index | Framing::None => edges - 1,
+            Framing::Index | Framing::None => edges.saturating_sub(1),
             Framing::Pattern => {
                 let special = enc.long_teeth() | enc.short_teeth() | 1;
                 let mut k = tooth_after(tooth, 1, edges);

@@ -115,7 +115,10 @@ fn bench_supports(c: &mut Criterion) {
     .expect("rotor");
     let limits =
         Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), DEFAULT_WARNING_FRACTION).expect("limits");
-    let monitor = SupportAnalysis::new(&rotor, &limits).monitor();
+    let monitor = SupportAnalysis::new(&rotor, &limits)
+        .expect("analysis")
+        .monitor()
+        .expect("monitor");
     let speeds: Vec<f32> = (0..64).map(|i| 60.0 * i as f32).collect();
     let mut g = c.benchmark_group("supports");
     g.throughput(Throughput::Elements(speeds.len() as u64));

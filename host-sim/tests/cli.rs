@@ -44,7 +44,10 @@ fn scenes_lists_every_bundled_scene() {
         "two-mass",
         "three-mass",
     ] {
-        assert!(out.contains(&format!("{s}.toml")), "{s}: {out}");
+        assert!(
+            out.lines().any(|l| l.split_whitespace().next() == Some(s)),
+            "{s}: {out}"
+        );
     }
 }
 
@@ -248,4 +251,157 @@ fn criterion_writes_its_page_and_json() {
             .starts_with("<svg"));
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scratch directory for one test, removed by the test.
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("drive-sim-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn bundled_scenes_only_by_name_and_a_missing_path_is_an_error() {
+    // Issue 16, finding 1: a mistyped path used to run the bundled scene of that file name.
+    let (ok, out, err) = drive_sim(&["run", "/no/such/dir/kneader.toml", "--json"]);
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(
+        err.contains("/no/such/dir/kneader.toml") && err.contains("no such file"),
+        "{err}"
+    );
+    assert!(err.contains("drive-sim run kneader"), "{err}");
+    let (ok, _, err) = drive_sim(&["predict", "kneader.toml"]);
+    assert!(!ok && err.contains("kneader.toml: cannot read"), "{err}");
+    // A scene file at a path runs from that path.
+    let dir = scratch("by-path");
+    let path = dir.join("kneader.toml");
+    std::fs::write(
+        &path,
+        include_str!("../scenes/kneader.toml")
+            .replace("duration = 30.0", "duration = 3.0")
+            .replace("settle = 10.0", "settle = 1.0"),
+    )
+    .unwrap();
+    let v = json(&["run", path.to_str().unwrap(), "--json"]);
+    assert_eq!(v["simulated_seconds"], 3.0);
+    assert_eq!(v["scene"], path.to_str().unwrap());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scene_files_are_bounded_and_an_empty_scene_is_an_error() {
+    // Finding 2 (/dev/zero read without end) and finding 7 (`predict /dev/null --json` → `{}`).
+    if std::path::Path::new("/dev/zero").exists() {
+        let (ok, _, err) = drive_sim(&["run", "/dev/zero"]);
+        assert!(
+            !ok && err.contains("/dev/zero") && err.contains("limit"),
+            "{err}"
+        );
+    }
+    let dir = scratch("empty");
+    let empty = dir.join("empty.toml");
+    std::fs::write(&empty, "# nothing here\n\n").unwrap();
+    let only = dir.join("only-description.toml");
+    std::fs::write(&only, "description = \"a scene without tables\"\n").unwrap();
+    for (file, what) in [(&empty, "empty"), (&only, "nothing to predict")] {
+        let (ok, out, err) = drive_sim(&["predict", file.to_str().unwrap(), "--json"]);
+        assert!(!ok && out.is_empty(), "{out}");
+        assert!(
+            err.contains(file.to_str().unwrap()) && err.contains(what),
+            "{err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_closed_pipe_or_a_full_disk_ends_quietly_with_a_failure() {
+    // Finding 4: these panicked ("failed printing to stdout", exit 101).
+    // A socket whose other end is closed before the command starts: every write to it fails
+    // with a broken pipe, without depending on timing.
+    #[cfg(unix)]
+    {
+        use std::os::fd::OwnedFd;
+        use std::os::unix::net::UnixStream;
+        use std::process::Stdio;
+        let (ours, theirs) = UnixStream::pair().unwrap();
+        drop(theirs);
+        let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
+            .args(["predict", "kneader", "--json"])
+            .stdout(Stdio::from(OwnedFd::from(ours)))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.is_empty(), "{err}");
+    }
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
+            .args(["predict", "kneader"])
+            .stdout(full)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("cannot write the output") && !err.contains("panicked"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn output_directories_are_checked_before_simulating() {
+    // Finding 9: a bad --plot/--out failed after the whole run, without the path.
+    let dir = scratch("outdirs");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "").unwrap();
+    let below = file.join("plots");
+    // A scene that fails only when simulated: the directory error must come first.
+    let scene = dir.join("no-motor.toml");
+    std::fs::write(&scene, "[encoder]\nlines = 64\ntimer_hz = 1e6\n").unwrap();
+    for option in ["--plot", "--out"] {
+        for target in [&file, &below] {
+            let (ok, _, err) = drive_sim(&[
+                "run",
+                scene.to_str().unwrap(),
+                option,
+                target.to_str().unwrap(),
+            ]);
+            assert!(!ok, "{option} {}", target.display());
+            assert!(
+                err.contains(option) && err.contains(target.to_str().unwrap()),
+                "{err}"
+            );
+            assert!(!err.contains("motor"), "{err}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sweep_steps_and_criterion_machines_are_bounded() {
+    // Finding 2: `--steps 18446744073709551615` and `--machines` as large never ended.
+    let cases: [&[&str]; 4] = [
+        &[
+            "sweep",
+            "one-mass",
+            "--from",
+            "40",
+            "--to",
+            "110",
+            "--steps",
+            "18446744073709551615",
+        ],
+        &[
+            "sweep", "one-mass", "--from", "40", "--to", "110", "--steps", "1001",
+        ],
+        &["criterion", "--machines", "18446744073709551615"],
+        &["criterion", "--machines", "0"],
+    ];
+    for args in cases {
+        let (ok, _, err) = drive_sim(args);
+        assert!(!ok, "{args:?}");
+        assert!(err.contains("allowed"), "{args:?}: {err}");
+    }
 }

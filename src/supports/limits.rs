@@ -191,11 +191,18 @@ pub struct SupportsReport {
 
 impl SupportAnalysis {
     /// Analyse `rotor` against `limits`.
-    pub fn new<const N: usize>(rotor: &Rotor<N>, limits: &Limits) -> Self {
+    ///
+    /// Errors when a result is not usable: a permissible residual unbalance `G·m/ω` that is
+    /// not a positive finite f64 (`OutOfRange("grade")`), or a number the f32
+    /// [`SupportMonitor`] would hold as infinity or zero (see [`SupportMonitor::new`]). An
+    /// analysis from here always gives a monitor.
+    pub fn new<const N: usize>(rotor: &Rotor<N>, limits: &Limits) -> Result<Self, ConfigError> {
         let unbalance = rotor.support_unbalance();
         let static_load = rotor.static_load();
         let u_per =
             permissible_residual_unbalance(limits.grade, rotor.mass(), limits.service_speed);
+        // Grade, mass and speed are each positive and finite; their quotient need not be.
+        positive("grade", u_per).map_err(|_| ConfigError::OutOfRange("grade"))?;
         let permissible = allocate(
             u_per,
             rotor.support_a(),
@@ -210,14 +217,16 @@ impl SupportAnalysis {
                 max_safe_speed(sb.norm(), db.norm(), fb),
             ]
         });
-        SupportAnalysis {
+        let analysis = SupportAnalysis {
             unbalance,
             static_load,
             permissible,
             load_limit: limits.load_limit,
             max_speed,
             warning_fraction: limits.warning_fraction,
-        }
+        };
+        SupportMonitor::new(&analysis)?;
+        Ok(analysis)
     }
 
     /// Maximum safe speed over both supports, rad/s; `None` without load limits.
@@ -237,8 +246,10 @@ impl SupportAnalysis {
         }
     }
 
-    /// The f32 runtime monitor for the speed updates.
-    pub fn monitor(&self) -> SupportMonitor {
+    /// The f32 runtime monitor for the speed updates. Never fails for an analysis built by
+    /// [`SupportAnalysis::new`] and left as it was (its fields are public: see
+    /// [`SupportMonitor::new`] for what is checked).
+    pub fn monitor(&self) -> Result<SupportMonitor, ConfigError> {
         SupportMonitor::new(self)
     }
 }

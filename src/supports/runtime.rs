@@ -1,6 +1,7 @@
 //! The per-speed-update path: f32, O(1), total.
 
 use super::limits::SupportAnalysis;
+use crate::error::ConfigError;
 use crate::math::Math;
 
 /// Where a value stands against its limit.
@@ -69,24 +70,47 @@ pub struct SupportMonitor {
 
 impl SupportMonitor {
     /// Precompute from an analysis (configuration time).
-    pub fn new(analysis: &SupportAnalysis) -> Self {
+    ///
+    /// Every number is converted to f32 once, here, and checked: an unbalance, static load,
+    /// load limit or permissible unbalance that is not finite as an f32 (beyond 3.4e38), or a
+    /// permissible unbalance or load limit below f32's normal range (0 or subnormal), is an `OutOfRange` error naming
+    /// the rotor's parameter (`unbalances`, `process_load.per_length`, `support_load_limit.a`
+    /// or `.b`, `grade`); unchecked, the monitor would judge against infinities and report
+    /// infinite or NaN loads for a finite speed. A maximum safe speed beyond f32 becomes
+    /// infinity (no speed an f32 holds reaches it).
+    pub fn new(analysis: &SupportAnalysis) -> Result<Self, ConfigError> {
         let w = analysis.warning_fraction;
         let [da, db] = analysis.unbalance;
         let [sa, sb] = analysis.static_load;
         let p = analysis.permissible;
-        let load_limit = analysis.load_limit;
         let max_speed = analysis.max_speed.unwrap_or([f64::INFINITY; 2]);
-        SupportMonitor {
-            unbalance: [da.norm() as f32, db.norm() as f32],
-            permissible: [p.a as f32, p.b as f32],
+        let load_limit = match analysis.load_limit {
+            Some([a, b]) => Some([
+                to_f32_positive(a, "support_load_limit.a")?,
+                to_f32_positive(b, "support_load_limit.b")?,
+            ]),
+            None => None,
+        };
+        Ok(SupportMonitor {
+            unbalance: [
+                to_f32(da.norm(), "unbalances")?,
+                to_f32(db.norm(), "unbalances")?,
+            ],
+            permissible: [
+                to_f32_positive(p.a, "grade")?,
+                to_f32_positive(p.b, "grade")?,
+            ],
             permissible_warn: [(w * p.a) as f32, (w * p.b) as f32],
-            static_load: [sa.norm() as f32, sb.norm() as f32],
-            load_limit: load_limit.map(|[a, b]| [a as f32, b as f32]),
-            load_warn: load_limit.map_or([f32::INFINITY; 2], |[a, b]| {
+            static_load: [
+                to_f32(sa.norm(), "process_load.per_length")?,
+                to_f32(sb.norm(), "process_load.per_length")?,
+            ],
+            load_warn: analysis.load_limit.map_or([f32::INFINITY; 2], |[a, b]| {
                 [(w * a) as f32, (w * b) as f32]
             }),
+            load_limit,
             max_speed: [max_speed[0] as f32, max_speed[1] as f32],
-        }
+        })
     }
 
     /// Loads and flags at speed `omega` rad/s. Total: any f32 gives a defined status.
@@ -185,5 +209,23 @@ fn pick(a: [f32; 2], i: usize) -> f32 {
 fn set<T: Copy>(a: &mut [T; 2], i: usize, v: T) {
     if let Some(slot) = a.get_mut(i) {
         *slot = v;
+    }
+}
+
+/// `x` (finite, not negative) as a finite f32, else `OutOfRange(name)`.
+fn to_f32(x: f64, name: &'static str) -> Result<f32, ConfigError> {
+    let y = x as f32;
+    if y.is_finite() && y >= 0.0 {
+        Ok(y)
+    } else {
+        Err(ConfigError::OutOfRange(name))
+    }
+}
+
+/// Like [`to_f32`], and a normal f32 (not 0 or subnormal: a positive f64 below f32's range).
+fn to_f32_positive(x: f64, name: &'static str) -> Result<f32, ConfigError> {
+    match to_f32(x, name)? {
+        y if y >= f32::MIN_POSITIVE => Ok(y),
+        _ => Err(ConfigError::OutOfRange(name)),
     }
 }

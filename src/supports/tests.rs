@@ -565,7 +565,7 @@ fn auger(gravity: bool) -> (Rotor<4>, Limits) {
 #[test]
 fn bundled_auger_scene_worked_numbers() {
     let (rotor, limits) = auger(true);
-    let an = SupportAnalysis::new(&rotor, &limits);
+    let an = SupportAnalysis::new(&rotor, &limits).unwrap();
     let rep = an.report();
     // D = 2e-3 at z = 1.2 on 0…4: D_A = 2e-3·2.8/4, D_B = 2e-3·1.2/4.
     assert_close(rep.unbalance_a, 1.4e-3, 1e-18, "unbalance_a");
@@ -598,7 +598,7 @@ fn bundled_auger_scene_worked_numbers() {
     assert_eq!(ma, rep.max_speed.unwrap());
     // Without gravity only the process load's 600 N remains.
     let (r0, _) = auger(false);
-    let an0 = SupportAnalysis::new(&r0, &limits);
+    let an0 = SupportAnalysis::new(&r0, &limits).unwrap();
     assert_close(an0.static_load[0].norm(), 600.0, 1e-9, "no gravity S_A");
     assert_close(
         an0.max_safe_speed().unwrap(),
@@ -608,7 +608,13 @@ fn bundled_auger_scene_worked_numbers() {
     );
     // Without load limits there is no max speed.
     let nl = Limits::new(6.3, 60.0, None, 0.8).unwrap();
-    assert_eq!(SupportAnalysis::new(&rotor, &nl).report().max_speed, None);
+    assert_eq!(
+        SupportAnalysis::new(&rotor, &nl)
+            .unwrap()
+            .report()
+            .max_speed,
+        None
+    );
 }
 
 #[test]
@@ -630,7 +636,7 @@ fn overhung_auger_variant_is_sensible() {
     )
     .unwrap();
     let limits = Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), 0.8).unwrap();
-    let an = SupportAnalysis::new(&rotor, &limits);
+    let an = SupportAnalysis::new(&rotor, &limits).unwrap();
     let rep = an.report();
     // Lever: D_A = D·(1.5 − 3.5)/1.5 (opposite to D), D_B = D·3.5/1.5.
     assert_close(
@@ -747,8 +753,8 @@ fn max_safe_speed_edge_cases() {
 #[test]
 fn runtime_speeds_near_zero_and_near_the_limit() {
     let (rotor, limits) = auger(true);
-    let an = SupportAnalysis::new(&rotor, &limits);
-    let mon = an.monitor();
+    let an = SupportAnalysis::new(&rotor, &limits).unwrap();
+    let mon = an.monitor().unwrap();
     let s = [
         an.static_load[0].norm() as f32,
         an.static_load[1].norm() as f32,
@@ -782,7 +788,10 @@ fn runtime_speeds_near_zero_and_near_the_limit() {
 #[test]
 fn runtime_matches_the_f64_analysis_and_reverse_speed() {
     let (rotor, limits) = auger(true);
-    let mon = SupportAnalysis::new(&rotor, &limits).monitor();
+    let mon = SupportAnalysis::new(&rotor, &limits)
+        .unwrap()
+        .monitor()
+        .unwrap();
     for w in [10.0f32, 100.0, 777.0, 1500.0, 2100.0, 5000.0] {
         let st = mon.update(w);
         let back = mon.update(-w);
@@ -801,7 +810,10 @@ fn runtime_matches_the_f64_analysis_and_reverse_speed() {
 #[test]
 fn runtime_unbalance_flags_and_update() {
     let (rotor, limits) = auger(true);
-    let mut mon = SupportAnalysis::new(&rotor, &limits).monitor();
+    let mut mon = SupportAnalysis::new(&rotor, &limits)
+        .unwrap()
+        .monitor()
+        .unwrap();
     // Permissible A = 0.01929375, warning from 0.015435.
     assert!(mon.set_unbalance::<Libm>(0.015, 0.0));
     assert_eq!(mon.update(60.0).unbalance[0], Level::Normal);
@@ -839,9 +851,9 @@ fn runtime_unbalance_flags_and_update() {
 fn static_overload_means_no_safe_speed() {
     let (rotor, _) = auger(true);
     let limits = Limits::new(6.3, 60.0, Some([2000.0, 8000.0]), 0.8).unwrap();
-    let an = SupportAnalysis::new(&rotor, &limits);
+    let an = SupportAnalysis::new(&rotor, &limits).unwrap();
     assert_eq!(an.max_safe_speed(), Some(0.0));
-    let mon = an.monitor();
+    let mon = an.monitor().unwrap();
     assert_eq!(mon.update(0.0).load[0], Level::Over);
     assert_eq!(mon.max_safe_speed(), Some(0.0));
 }
@@ -849,7 +861,10 @@ fn static_overload_means_no_safe_speed() {
 #[test]
 fn runtime_special_speeds() {
     let (rotor, limits) = auger(true);
-    let mon = SupportAnalysis::new(&rotor, &limits).monitor();
+    let mon = SupportAnalysis::new(&rotor, &limits)
+        .unwrap()
+        .monitor()
+        .unwrap();
     let nan = mon.update(f32::NAN);
     assert!(!nan.speed_valid);
     assert_eq!(nan.load, [Level::Unknown; 2]);
@@ -862,7 +877,10 @@ fn runtime_special_speeds() {
     assert_eq!(huge.load, [Level::Over; 2]);
     // No load limits: loads reported, levels unknown, no max speed.
     let nl = Limits::new(6.3, 60.0, None, 0.8).unwrap();
-    let m2 = SupportAnalysis::new(&rotor, &nl).monitor();
+    let m2 = SupportAnalysis::new(&rotor, &nl)
+        .unwrap()
+        .monitor()
+        .unwrap();
     let st = m2.update(100.0);
     assert_eq!(st.load, [Level::Unknown; 2]);
     assert_eq!(st.max_safe_speed, None);
@@ -1076,7 +1094,7 @@ proptest! {
         let rotor = Rotor::<1>::new(mass, 1.0, 0.0, 4.0, &[Unbalance::new(zu, amount, 0.3)], None)
             .unwrap();
         let limits = Limits::new(6.3, 60.0, Some([limit, limit]), frac).unwrap();
-        let mut mon = SupportAnalysis::new(&rotor, &limits).monitor();
+        let mut mon = SupportAnalysis::new(&rotor, &limits).unwrap().monitor().unwrap();
         let accepted = mon.set_unbalance::<Libm>(a, b);
         prop_assert_eq!(accepted, a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0);
         let st = mon.update(w);
@@ -1112,9 +1130,98 @@ proptest! {
                 prop_assert!(c1.is_finite() && c2.is_finite());
             }
             if let Ok(l) = Limits::new(g, zm, Some([q, amount]), 0.8) {
-                let an = SupportAnalysis::new(&r, &l);
-                let _ = an.monitor().update(1.0);
+                // An analysis is an error or always gives a monitor whose loads at a finite
+                // speed are numbers, never NaN.
+                if let Ok(an) = SupportAnalysis::new(&r, &l) {
+                    let st = an.monitor().unwrap().update(1.0);
+                    prop_assert!(st.peak_load.iter().chain(&st.min_load).all(|x| !x.is_nan()));
+                    prop_assert!(an.permissible.a.is_finite() && an.permissible.b.is_finite());
+                }
             }
         }
     }
+}
+
+#[test]
+fn results_beyond_f32_or_f64_are_typed_errors_not_infinities() {
+    // Issue 16, finding 5: a grade of 1.7e308 passed `Limits::new` and gave an infinite
+    // permissible unbalance; a process load of 2e48 N/m gave static loads beyond f32, so the
+    // monitor reported an infinite peak and a NaN minimum for a valid speed.
+    let (rotor, _) = auger(true);
+    // G·m/ω beyond f64 (infinite), and finite in f64 but beyond f32.
+    for service_speed in [1e-3, 60.0] {
+        let huge_grade = Limits::new(1.7e308, service_speed, Some([8000.0, 8000.0]), 0.8).unwrap();
+        assert_eq!(
+            SupportAnalysis::new(&rotor, &huge_grade),
+            Err(ConfigError::OutOfRange("grade"))
+        );
+    }
+    // G·m/ω below f64's range: no permissible unbalance to judge against.
+    let tiny_grade = Limits::new(1e-300, 1e10, None, 0.8).unwrap();
+    assert_eq!(
+        SupportAnalysis::new(&rotor, &tiny_grade),
+        Err(ConfigError::OutOfRange("grade"))
+    );
+    // Finite in f64, zero in f32.
+    let f32_zero = Limits::new(1e-40, 60.0, None, 0.8).unwrap();
+    assert_eq!(
+        SupportAnalysis::new(&rotor, &f32_zero),
+        Err(ConfigError::OutOfRange("grade"))
+    );
+    let heavy = |per_length: f64| {
+        Rotor::<4>::new(
+            350.0,
+            1.9,
+            0.0,
+            4.0,
+            &[Unbalance::new(1.2, 2.0e-3, 0.5)],
+            Some(ProcessLoad {
+                per_length,
+                from: 0.5,
+                to: 3.5,
+                angle: 4.712,
+            }),
+        )
+        .unwrap()
+    };
+    let limits = Limits::new(6.3, 60.0, None, 0.8).unwrap();
+    assert_eq!(
+        SupportAnalysis::new(&heavy(2e48), &limits),
+        Err(ConfigError::OutOfRange("process_load.per_length"))
+    );
+    // Just inside f32: accepted, and every load at a finite speed is a number.
+    let an = SupportAnalysis::new(&heavy(1e37), &limits).unwrap();
+    let st = an.monitor().unwrap().update(60.0);
+    assert!(st.speed_valid);
+    for k in 0..2 {
+        assert!(
+            st.peak_load[k].is_finite() && st.min_load[k].is_finite(),
+            "{st:?}"
+        );
+    }
+    let big_unbalance = Rotor::<4>::new(
+        350.0,
+        1.9,
+        0.0,
+        4.0,
+        &[Unbalance::new(1.2, 1e39, 0.0)],
+        None,
+    )
+    .unwrap();
+    assert_eq!(
+        SupportAnalysis::new(&big_unbalance, &limits),
+        Err(ConfigError::OutOfRange("unbalances"))
+    );
+    let limit_beyond_f32 = Limits::new(6.3, 60.0, Some([1e39, 8000.0]), 0.8).unwrap();
+    assert_eq!(
+        SupportAnalysis::new(&rotor, &limit_beyond_f32),
+        Err(ConfigError::OutOfRange("support_load_limit.a"))
+    );
+    // The monitor checks an analysis changed after it was built (its fields are public).
+    let mut an = SupportAnalysis::new(&rotor, &limits).unwrap();
+    an.load_limit = Some([8000.0, f64::INFINITY]);
+    assert_eq!(
+        an.monitor(),
+        Err(ConfigError::OutOfRange("support_load_limit.b"))
+    );
 }

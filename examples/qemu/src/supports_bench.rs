@@ -48,11 +48,17 @@ pub fn run() {
     // Configuration time: validation, plane split, static loads, ISO allocation, limits.
     measure("supports::configure f64", 20, || {
         let a = SupportAnalysis::new(&black_box(rotor()), &black_box(limits()));
-        black_box(a);
+        let _ = black_box(a);
     });
     let rotor = rotor();
-    let analysis = SupportAnalysis::new(&rotor, &limits());
-    let monitor = analysis.monitor();
+    let analysis = match SupportAnalysis::new(&rotor, &limits()) {
+        Ok(a) => a,
+        Err(e) => fail(format_args!("analysis rejected: {}", e)),
+    };
+    let monitor = match analysis.monitor() {
+        Ok(m) => m,
+        Err(e) => fail(format_args!("monitor rejected: {}", e)),
+    };
     let Some(max_speed) = analysis.max_safe_speed() else {
         fail(format_args!("no maximum safe speed with load limits set"));
     };

@@ -3,6 +3,7 @@
 //! the report with its plots ([`report`], [`plot`]), progress bars ([`progress`]).
 
 pub mod capture;
+pub mod check;
 pub mod plot;
 pub mod predict;
 pub mod progress;

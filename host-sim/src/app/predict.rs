@@ -14,9 +14,17 @@ use std::path::Path;
 /// Largest number of unbalances a scene may give.
 pub const MAX_UNBALANCES: usize = 32;
 
-/// Turns a core configuration error into a scene error naming `section.parameter`.
+/// Turns a core configuration error into a scene error naming the scene key the core's
+/// parameter stands for ([`crate::app::check::core_keys`]), without the values.
 pub fn value_error(file: &Path, section: &str, e: ConfigError) -> SceneError {
-    SceneError::value(file, &format!("{section}.{}", e.parameter()), e.to_string())
+    let key = crate::app::check::core_keys(section, e.parameter()).remove(0);
+    SceneError::value(file, &key, e.to_string())
+}
+
+/// Turns a core configuration error for `scene` into a scene error naming every scene key
+/// the core's parameter stands for, with its value as written.
+pub fn core_error(scene: &Scene, file: &Path, section: &str, e: ConfigError) -> SceneError {
+    scene.checker(file).core(scene, section, e)
 }
 
 /// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
@@ -32,7 +40,7 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
             breakdown_torque,
         } => Motor::parabola(
             Parabola::new(*no_load_speed, *breakdown_speed, *breakdown_torque)
-                .map_err(|e| value_error(file, "motor", e))?,
+                .map_err(|e| core_error(scene, file, "motor", e))?,
         ),
         MotorSpec::Kloss {
             synchronous_speed,
@@ -40,9 +48,9 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
             breakdown_torque,
         } => {
             let k = Kloss::new(*synchronous_speed, *breakdown_slip, *breakdown_torque)
-                .map_err(|e| value_error(file, "motor", e))?;
+                .map_err(|e| core_error(scene, file, "motor", e))?;
             Motor::kloss(k, KlossFit::SynchronousTangent)
-                .map_err(|e| value_error(file, "motor", e))?
+                .map_err(|e| core_error(scene, file, "motor", e))?
         }
         MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } => return Ok(None),
     };
@@ -50,10 +58,10 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
     for h in &load.harmonics {
         harmonics.push(
             Harmonic::new(h.order, h.amplitude, h.phase)
-                .map_err(|e| value_error(file, "load.harmonics", e))?,
+                .map_err(|e| core_error(scene, file, "load.harmonics", e))?,
         );
     }
-    let load = Load::new(load.mean, &harmonics).map_err(|e| value_error(file, "load", e))?;
+    let load = Load::new(load.mean, &harmonics).map_err(|e| core_error(scene, file, "load", e))?;
     let Some(shaft) = &scene.shaft else {
         return Err(SceneError::value(
             file,
@@ -63,7 +71,7 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
     };
     DriveModel::new(motor, load, shaft.inertia, shaft.flywheel)
         .map(Some)
-        .map_err(|e| value_error(file, "shaft", e))
+        .map_err(|e| core_error(scene, file, "shaft", e))
 }
 
 /// The rotor on two supports and its limits (`None` without `[rotor]`).
@@ -100,15 +108,25 @@ pub fn rotor(
         &unbalances,
         process,
     )
-    .map_err(|e| value_error(file, "rotor", e))?;
+    .map_err(|e| core_error(scene, file, "rotor", e))?;
     let warning = scene
         .monitor
         .as_ref()
         .and_then(|m| m.warning_fraction)
         .unwrap_or(0.8);
     let limits = Limits::new(r.grade, r.service_speed, r.support_load_limit, warning)
-        .map_err(|e| value_error(file, "rotor", e))?;
+        .map_err(|e| core_error(scene, file, "rotor", e))?;
     Ok(Some((rotor, limits)))
+}
+
+/// The support analysis of a scene's rotor against its limits.
+pub fn analysis(
+    scene: &Scene,
+    rotor: &Rotor<MAX_UNBALANCES>,
+    limits: &Limits,
+    file: &Path,
+) -> Result<SupportAnalysis, SceneError> {
+    SupportAnalysis::new(rotor, limits).map_err(|e| core_error(scene, file, "rotor", e))
 }
 
 /// The vibration machine with its auto-balancer (`None` without platforms).
@@ -157,10 +175,10 @@ pub fn machine(scene: &Scene, file: &Path) -> Result<Option<Machine>, SceneError
         viscosity: ab.viscosity,
     };
     let config = MachineConfig::new(&platforms, &couplings, balancer)
-        .map_err(|e| value_error(file, "autobalancer", e))?;
+        .map_err(|e| core_error(scene, file, "autobalancer", e))?;
     Machine::new(config, SearchOptions::default())
         .map(Some)
-        .map_err(|e| value_error(file, "autobalancer", e))
+        .map_err(|e| core_error(scene, file, "autobalancer", e))
 }
 
 /// One zone of the regime map.
@@ -252,6 +270,13 @@ pub struct Prediction {
     pub autobalancer: Option<AutobalancerOut>,
 }
 
+impl Prediction {
+    /// Whether the scene gave nothing to predict (no drive model, rotor or vibration machine).
+    pub fn is_empty(&self) -> bool {
+        self.irregularity.is_none() && self.supports.is_none() && self.autobalancer.is_none()
+    }
+}
+
 /// Computes the design-time results of `scene`.
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();
@@ -259,7 +284,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
         let irr = model
             .irregularity(limit)
-            .map_err(|e| value_error(file, "monitor", e))?;
+            .map_err(|e| core_error(scene, file, "monitor", e))?;
         let sens = model.sensitivity();
         p.irregularity = Some(IrregularityOut {
             omega_max: irr.omega_max,
@@ -272,7 +297,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         });
     }
     if let Some((rotor, limits)) = rotor(scene, file)? {
-        let a = SupportAnalysis::new(&rotor, &limits);
+        let a = analysis(scene, &rotor, &limits, file)?;
         let r = a.report();
         let loads = rotor.loads(limits.service_speed());
         p.supports = Some(SupportsOut {

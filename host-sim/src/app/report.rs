@@ -7,6 +7,11 @@ use crate::app::scene::Scene;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
+/// A noise floor as text (`–` when no window was counted).
+fn floor(x: Option<f64>) -> String {
+    x.map_or("–".to_string(), |x| format!("{x:.1e}"))
+}
+
 /// A run as text.
 pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     let mut s = String::new();
@@ -27,6 +32,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         r.steps[1],
         r.edges
     );
+    if let Some(why) = &r.no_measurement {
+        let _ = writeln!(s, "NOTHING MEASURED by the core: {why}");
+    }
     if r.windows > 0 {
         let _ = writeln!(s, "Measured by the core from the encoder edges");
         let _ = writeln!(
@@ -57,17 +65,22 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             (Some(m), Some(p)) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}: {:+.2} %, noise floor {:.1e}",
+                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{}, noise floor {}",
                     r.settle,
-                    100.0 * (m / p - 1.0),
-                    r.noise_floor.unwrap_or(f64::NAN)
+                    // A drive without load ripple is predicted δ = 0: no relative difference.
+                    if p > 0.0 {
+                        format!(": {:+.2} %", 100.0 * (m / p - 1.0))
+                    } else {
+                        String::new()
+                    },
+                    floor(r.noise_floor)
                 );
             }
             (Some(m), None) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6}, noise floor {:.1e}",
-                    r.noise_floor.unwrap_or(f64::NAN)
+                    "  δ measured {m:.6}, noise floor {}",
+                    floor(r.noise_floor)
                 );
             }
             _ => {}
@@ -84,30 +97,50 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
         let _ = writeln!(
             s,
-            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {:.2e} of the rotor's)",
+            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {} of the rotor's)",
             r.regime_class.unwrap_or("?"),
-            r.residual_relative.unwrap_or(f64::NAN)
+            r.residual_relative
+                .map_or("–".to_string(), |x| format!("{x:.2e}"))
         );
     }
     if let Some(c) = &r.capture {
         s.push_str(&crate::app::capture::summary(c));
     }
     if let Some(u) = &r.supports {
-        let _ = writeln!(
-            s,
-            "Supports at {:.2} rad/s: peak loads A {:.1} N ({}), B {:.1} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}",
-            u.speed,
-            u.peak_load[0],
+        s.push_str(&supports_text(u));
+    }
+    s
+}
+
+/// The supports line of a run: the core's judgement at the measured speed, or, without one,
+/// the simulated reactions against the load limits.
+fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
+    let load = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.1}"));
+    match (u.speed, u.simulated_reaction_level) {
+        (Some(speed), _) => format!(
+            "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}\n",
+            load(u.peak_load[0]),
             u.load_level[0],
-            u.peak_load[1],
+            load(u.peak_load[1]),
             u.load_level[1],
             u.simulated_peak_reaction[0],
             u.simulated_peak_reaction[1],
             u.unbalance_level[0],
             u.unbalance_level[1]
-        );
+        ),
+        (None, levels) => {
+            let levels = levels.unwrap_or(["unknown"; 2]);
+            format!(
+                "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {:.1} N ({} against the load limit), B {:.1} N ({}); unbalance A {}, B {}\n",
+                u.simulated_peak_reaction[0],
+                levels[0],
+                u.simulated_peak_reaction[1],
+                levels[1],
+                u.unbalance_level[0],
+                u.unbalance_level[1]
+            )
+        }
     }
-    s
 }
 
 /// Writes the plots a run calls for into `dir`; returns the files written.
@@ -125,66 +158,10 @@ pub fn run_plots(
         .unwrap_or("scene")
         .to_string();
     if !r.speed_trace.is_empty() {
-        let path = dir.join(format!("{stem}-speed.svg"));
-        let mut marks: Vec<Mark> = r
-            .window_list
-            .iter()
-            .filter(|w| !w.valid)
-            .map(|w| {
-                Mark::VLine(
-                    format!("invalid window ({})", w.fault.unwrap_or("?")),
-                    w.time,
-                )
-            })
-            .take(5)
-            .collect();
-        marks.push(Mark::Band("settling".into(), 0.0, r.settle, true));
-        write_svg(
-            &path,
-            &Chart {
-                title: "Shaft speed measured by the core (per speed sample)",
-                x_label: "time, s",
-                y_label: "ω, rad/s",
-                series: vec![Series {
-                    label: "ω".into(),
-                    points: r.speed_trace.clone(),
-                    markers: false,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(speed_plot(r, &dir.join(format!("{stem}-speed.svg")))?);
     }
     if !r.window_list.is_empty() {
-        let path = dir.join(format!("{stem}-delta.svg"));
-        let mut marks = Vec::new();
-        if let Some(l) = r.delta_limit {
-            marks.push(Mark::HLine(format!("limit {l}"), l));
-        }
-        if let Some(p) = r.delta_predicted {
-            marks.push(Mark::HLine(format!("predicted {p:.5}"), p));
-        }
-        let valid: Vec<(f64, f64)> = r
-            .window_list
-            .iter()
-            .filter(|w| w.valid)
-            .map(|w| (w.time, w.delta))
-            .collect();
-        write_svg(
-            &path,
-            &Chart {
-                title: "δ per window (one load cycle each)",
-                x_label: "time, s",
-                y_label: "δ",
-                series: vec![Series {
-                    label: "δ measured".into(),
-                    points: valid,
-                    markers: true,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(delta_plot(r, &dir.join(format!("{stem}-delta.svg")))?);
     }
     let machine = predict::machine(scene, file).map_err(|e| e.to_string())?;
     if let (Some(c), Some(machine)) = (&r.capture, &machine) {
@@ -202,107 +179,195 @@ pub fn run_plots(
     }
     if let Some(machine) = &machine {
         let path = dir.join(format!("{stem}-regimes.svg"));
-        let top = machine
-            .resonant_speeds()
-            .iter()
-            .copied()
-            .fold(0.0, f64::max)
-            * 1.6;
-        let mut marks: Vec<Mark> = machine
-            .zones()
-            .iter()
-            .map(|z| {
-                Mark::Band(
-                    z.kind.name().into(),
-                    z.from,
-                    z.to.unwrap_or(top),
-                    z.kind.name() == "gathering",
-                )
-            })
-            .collect();
-        if let Some(w) = r.speed_measured {
-            marks.push(Mark::VLine(format!("measured speed {w:.2} rad/s"), w));
-        }
-        let n = 400;
-        let re: Vec<(f64, f64)> = (1..=n)
-            .map(|i| {
-                let w = top * i as f64 / n as f64;
-                let (re, _) = machine.receptance(w);
-                (w, re)
-            })
-            .collect();
-        let scale = re.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(1e-300);
-        write_svg(
-            &path,
-            &Chart {
-                title: "Auto-balancer zones (criterion: balancing where Re H < 0)",
-                x_label: "rotor speed, rad/s",
-                y_label: "Re H / max |Re H|",
-                series: vec![Series {
-                    label: "Re H of the exciter platform".into(),
-                    points: re.into_iter().map(|(w, v)| (w, v / scale)).collect(),
-                    markers: false,
-                }],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(regimes_plot(r, machine, &path)?);
     }
     if let Some((rotor, limits)) = predict::rotor(scene, file).map_err(|e| e.to_string())? {
         let path = dir.join(format!("{stem}-supports.svg"));
-        let analysis = drive_monitor::supports::SupportAnalysis::new(&rotor, &limits);
-        let top = analysis
-            .max_safe_speed()
-            .filter(|w| w.is_finite())
-            .unwrap_or(3.0 * limits.service_speed())
-            * 1.2;
-        let n = 300;
-        let curve = |k: usize| -> Vec<(f64, f64)> {
-            (0..=n)
-                .map(|i| {
-                    let w = top * i as f64 / n as f64;
-                    (w, rotor.loads(w)[k].peak)
-                })
-                .collect()
-        };
-        let mut marks = Vec::new();
-        if let Some(l) = scene.rotor.as_ref().and_then(|r| r.support_load_limit) {
-            marks.push(Mark::HLine(format!("limit A {} N", l[0]), l[0]));
-            if l[1] != l[0] {
-                marks.push(Mark::HLine(format!("limit B {} N", l[1]), l[1]));
-            }
-        }
-        marks.push(Mark::VLine(
-            format!("service speed {} rad/s", limits.service_speed()),
-            limits.service_speed(),
-        ));
-        if let Some(w) = r.speed_measured {
-            marks.push(Mark::VLine(format!("measured {w:.1} rad/s"), w));
-        }
-        write_svg(
-            &path,
-            &Chart {
-                title: "Peak support load per turn against speed",
-                x_label: "speed, rad/s",
-                y_label: "load, N",
-                series: vec![
-                    Series {
-                        label: "support A".into(),
-                        points: curve(0),
-                        markers: false,
-                    },
-                    Series {
-                        label: "support B".into(),
-                        points: curve(1),
-                        markers: false,
-                    },
-                ],
-                marks,
-            },
-        )?;
-        out.push(path);
+        out.push(supports_plot(scene, file, r, &rotor, &limits, &path)?);
     }
     Ok(out)
+}
+
+/// The speed the core measured against time, with the first invalid windows and the
+/// settling time marked.
+fn speed_plot(r: &RunReport, path: &Path) -> Result<PathBuf, String> {
+    let mut marks: Vec<Mark> = r
+        .window_list
+        .iter()
+        .filter(|w| !w.valid)
+        .map(|w| {
+            Mark::VLine(
+                format!("invalid window ({})", w.fault.unwrap_or("?")),
+                w.time,
+            )
+        })
+        .take(5)
+        .collect();
+    marks.push(Mark::Band("settling".into(), 0.0, r.settle, true));
+    write_svg(
+        path,
+        &Chart {
+            title: "Shaft speed measured by the core (per speed sample)",
+            x_label: "time, s",
+            y_label: "ω, rad/s",
+            series: vec![Series {
+                label: "ω".into(),
+                points: r.speed_trace.clone(),
+                markers: false,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// δ of every valid window against time, with the limit and the prediction.
+fn delta_plot(r: &RunReport, path: &Path) -> Result<PathBuf, String> {
+    let mut marks = Vec::new();
+    if let Some(l) = r.delta_limit {
+        marks.push(Mark::HLine(format!("limit {l}"), l));
+    }
+    if let Some(p) = r.delta_predicted {
+        marks.push(Mark::HLine(format!("predicted {p:.5}"), p));
+    }
+    let valid: Vec<(f64, f64)> = r
+        .window_list
+        .iter()
+        .filter(|w| w.valid)
+        .map(|w| (w.time, w.delta))
+        .collect();
+    write_svg(
+        path,
+        &Chart {
+            title: "δ per window (one load cycle each)",
+            x_label: "time, s",
+            y_label: "δ",
+            series: vec![Series {
+                label: "δ measured".into(),
+                points: valid,
+                markers: true,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// The auto-balancer's zones along the speed axis over Re H of the exciter platform, with
+/// the measured speed.
+fn regimes_plot(
+    r: &RunReport,
+    machine: &drive_monitor::balancer::Machine,
+    path: &Path,
+) -> Result<PathBuf, String> {
+    let top = machine
+        .resonant_speeds()
+        .iter()
+        .copied()
+        .fold(0.0, f64::max)
+        * 1.6;
+    let mut marks: Vec<Mark> = machine
+        .zones()
+        .iter()
+        .map(|z| {
+            Mark::Band(
+                z.kind.name().into(),
+                z.from,
+                z.to.unwrap_or(top),
+                z.kind.name() == "gathering",
+            )
+        })
+        .collect();
+    if let Some(w) = r.speed_measured {
+        marks.push(Mark::VLine(format!("measured speed {w:.2} rad/s"), w));
+    }
+    let n = 400;
+    let re: Vec<(f64, f64)> = (1..=n)
+        .map(|i| {
+            let w = top * i as f64 / n as f64;
+            let (re, _) = machine.receptance(w);
+            (w, re)
+        })
+        .collect();
+    let scale = re.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(1e-300);
+    write_svg(
+        path,
+        &Chart {
+            title: "Auto-balancer zones (criterion: balancing where Re H < 0)",
+            x_label: "rotor speed, rad/s",
+            y_label: "Re H / max |Re H|",
+            series: vec![Series {
+                label: "Re H of the exciter platform".into(),
+                points: re.into_iter().map(|(w, v)| (w, v / scale)).collect(),
+                markers: false,
+            }],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
+}
+
+/// The peak support loads per turn against speed, with the load limits, the service speed
+/// and the measured speed.
+fn supports_plot(
+    scene: &Scene,
+    file: &Path,
+    r: &RunReport,
+    rotor: &drive_monitor::supports::Rotor<{ predict::MAX_UNBALANCES }>,
+    limits: &drive_monitor::supports::Limits,
+    path: &Path,
+) -> Result<PathBuf, String> {
+    let analysis = predict::analysis(scene, rotor, limits, file).map_err(|e| e.to_string())?;
+    let top = analysis
+        .max_safe_speed()
+        .filter(|w| w.is_finite())
+        .unwrap_or(3.0 * limits.service_speed())
+        * 1.2;
+    let n = 300;
+    let curve = |k: usize| -> Vec<(f64, f64)> {
+        (0..=n)
+            .map(|i| {
+                let w = top * i as f64 / n as f64;
+                (w, rotor.loads(w)[k].peak)
+            })
+            .collect()
+    };
+    let mut marks = Vec::new();
+    if let Some(l) = scene.rotor.as_ref().and_then(|r| r.support_load_limit) {
+        marks.push(Mark::HLine(format!("limit A {} N", l[0]), l[0]));
+        if l[1] != l[0] {
+            marks.push(Mark::HLine(format!("limit B {} N", l[1]), l[1]));
+        }
+    }
+    marks.push(Mark::VLine(
+        format!("service speed {} rad/s", limits.service_speed()),
+        limits.service_speed(),
+    ));
+    if let Some(w) = r.speed_measured {
+        marks.push(Mark::VLine(format!("measured {w:.1} rad/s"), w));
+    }
+    write_svg(
+        path,
+        &Chart {
+            title: "Peak support load per turn against speed",
+            x_label: "speed, rad/s",
+            y_label: "load, N",
+            series: vec![
+                Series {
+                    label: "support A".into(),
+                    points: curve(0),
+                    markers: false,
+                },
+                Series {
+                    label: "support B".into(),
+                    points: curve(1),
+                    markers: false,
+                },
+            ],
+            marks,
+        },
+    )?;
+    Ok(path.to_path_buf())
 }
 
 /// The design-time results as text.

@@ -6,7 +6,7 @@
 //! core's classifiers judge the measured speed. The report puts the core's measurements next
 //! to the design-time prediction and to what the simulation itself did.
 
-use crate::app::predict::{self, value_error};
+use crate::app::predict::{self, core_error};
 use crate::app::scene::{
     BalancerKindSpec, FramingSpec, IntegratorKind, MotorSpec, Scene, SceneError,
 };
@@ -24,10 +24,11 @@ use crate::engine::vibration::{
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
 use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
+use drive_monitor::drive::DriveModel;
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
-use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength};
+use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
-use drive_monitor::supports::{Level, SupportAnalysis};
+use drive_monitor::supports::Level;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -67,10 +68,11 @@ pub struct AlarmOut {
 /// Support results at the measured speed.
 #[derive(Debug, Clone, Serialize)]
 pub struct SupportsRunOut {
-    /// Speed the core measured, rad/s.
-    pub speed: f64,
-    /// Peak support loads per turn from the core at that speed, N.
-    pub peak_load: [f64; 2],
+    /// Speed the core measured, rad/s (null when it measured none).
+    pub speed: Option<f64>,
+    /// Peak support loads per turn from the core at that speed, N (null without a measured
+    /// speed, or beyond f32).
+    pub peak_load: [Option<f64>; 2],
     /// Largest support reaction seen in the simulation over the last second, N.
     pub simulated_peak_reaction: [f64; 2],
     /// Level of each support load: "normal" | "warning" | "over" | "unknown".
@@ -79,6 +81,10 @@ pub struct SupportsRunOut {
     pub unbalance_level: [&'static str; 2],
     /// Largest safe speed, rad/s.
     pub max_safe_speed: Option<f64>,
+    /// When the core measured no speed: the simulated reactions against the scene's load
+    /// limits ("normal" | "warning" | "over" | "unknown" without limits).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulated_reaction_level: Option<[&'static str; 2]>,
 }
 
 /// What a run produced.
@@ -120,6 +126,9 @@ pub struct RunReport {
     pub rejected_edges: [u32; 3],
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
+    /// Why the core measured nothing, when it has an encoder and no valid window.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub no_measurement: Option<String>,
     /// Regime the core predicts at the measured speed: "balancing" | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_predicted: Option<&'static str>,
@@ -285,7 +294,7 @@ fn rotor_loads(scene: &Scene, file: &Path) -> Result<Option<RotorLoads>, SceneEr
     };
     RotorLoads::new(&params)
         .map(Some)
-        .map_err(|e| value_error(file, "rotor", e))
+        .map_err(|e| core_error(scene, file, "rotor", e))
 }
 
 /// The core's monitor for the scene's encoder.
@@ -315,7 +324,7 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
     c.estimator = Estimator::Edges(e.estimator_edges);
     let m = scene.monitor.clone().unwrap_or_default();
     c.min_speed = m.min_speed.unwrap_or(1.0);
-    let enc = Encoder::new(c).map_err(|er| value_error(file, "encoder", er))?;
+    let enc = Encoder::new(c).map_err(|er| core_error(scene, file, "encoder", er))?;
     let revs = match m.window_revolutions {
         Some(n) => WindowLength::Revolutions(n),
         None => {
@@ -340,7 +349,7 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
     let alarm = m.delta_limit.map(|l| AlarmConfig::new(l as f32));
     DeltaMonitor::new(enc, window, alarm)
         .map(Some)
-        .map_err(|er| value_error(file, "monitor", er))
+        .map_err(|er| core_error(scene, file, "monitor", er))
 }
 
 fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
@@ -371,7 +380,7 @@ fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
     c.glitch_probability = e.glitch_probability;
     c.seed = scene.simulation.seed;
     crate::engine::encoder::Encoder::new(c.clone())
-        .map_err(|er| value_error(file, "encoder", er))?;
+        .map_err(|er| core_error(scene, file, "encoder", er))?;
     Ok(c)
 }
 
@@ -392,26 +401,229 @@ fn median(v: &mut [f64]) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
+/// Most encoder edges one run may produce (about a minute of work in release).
+pub const MAX_EDGES: f64 = 2e8;
+/// Most integrator steps one run may take.
+pub const MAX_STEPS: u64 = 50_000_000;
+
+/// How a run is carried out (not what it simulates).
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Show a progress bar on stderr once the run has taken a second (never when stderr is
+    /// not a terminal).
+    pub progress: bool,
+    /// Keep every δ window ([`RunReport::window_list`], for plots). Without it a run keeps only
+    /// δ and the noise floor of the counted windows (for their medians), 8 bytes per window.
+    pub keep_windows: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            progress: false,
+            keep_windows: true,
+        }
+    }
+}
+
+/// Why a run stopped before its duration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Stop {
+    Edges,
+    Steps,
+}
+
+/// The regime classification's reductions over the run, kept as the samples arrive so that
+/// memory does not grow with the duration: the same numbers
+/// [`crate::engine::vibration::classify`] computes from the whole list of samples.
+struct RegimeStream {
+    first: Option<RegimeSample>,
+    last: Option<RegimeSample>,
+    /// Samples whose membership of the judged final part is decided only by the last sample's
+    /// time (those near `window_fraction` of the way).
+    undecided: Vec<RegimeSample>,
+    /// Earliest time that certainly lies in the judged part, and the reductions from it on.
+    sure_from: f64,
+    sure_first: Option<RegimeSample>,
+    residual_max: f64,
+    coherence_min: f64,
+    /// Earliest time that may lie in the judged part.
+    maybe_from: f64,
+}
+
+impl RegimeStream {
+    /// For a run of `duration` s sampled every `every` s, judged over its final
+    /// `window_fraction`.
+    fn new(duration: f64, every: f64, window_fraction: f64) -> Self {
+        // The last sample lies in (duration − 2·every, duration]; the judged part starts at
+        // (1 − window_fraction) of the last sample's time.
+        let keep = 1.0 - window_fraction;
+        RegimeStream {
+            first: None,
+            last: None,
+            undecided: Vec::new(),
+            sure_from: keep * duration,
+            sure_first: None,
+            residual_max: 0.0,
+            coherence_min: 1.0,
+            maybe_from: keep * (duration - 2.0 * every),
+        }
+    }
+
+    fn push(&mut self, s: RegimeSample) {
+        if self.first.is_none() {
+            self.first = Some(s);
+        }
+        if s.t > self.sure_from {
+            if self.sure_first.is_none() {
+                self.sure_first = Some(s);
+            }
+            self.residual_max = self.residual_max.max(s.residual);
+            self.coherence_min = self.coherence_min.min(s.coherence);
+        } else if s.t >= self.maybe_from {
+            self.undecided.push(s);
+        }
+        self.last = Some(s);
+    }
+
+    /// The samples `classify` needs, in time order: the first (the initial residual), every
+    /// sample that may begin the judged part, a stand-in for the part certainly judged (its
+    /// first sample, with that part's largest residual and smallest coherence: `classify`
+    /// only folds those) and the last.
+    fn samples(&self) -> Vec<RegimeSample> {
+        let (Some(first), Some(last)) = (self.first, self.last) else {
+            return Vec::new();
+        };
+        let mut out = vec![first];
+        out.extend(self.undecided.iter().copied().filter(|s| s.t > first.t));
+        if let Some(s) = self.sure_first.filter(|s| s.t > first.t) {
+            out.push(RegimeSample {
+                residual: self.residual_max,
+                coherence: self.coherence_min,
+                ..s
+            });
+        }
+        if out.last().is_some_and(|s| last.t > s.t) {
+            out.push(last);
+        }
+        out
+    }
+}
+
+/// What the run keeps of the vibration machine's motion.
+enum Samples {
+    /// Every sample (the capture analysis of loads started together needs the whole run).
+    All(Vec<RegimeSample>),
+    /// Only the regime classification's reductions.
+    Stream(Box<RegimeStream>),
+}
+
 struct Collector<'a> {
     monitor: Option<DeltaMonitor<MAX_LINES>>,
+    keep_windows: bool,
     windows: Vec<WindowOut>,
+    /// δ and noise floor of the counted windows (valid, steady, after `settle`).
+    counted: Vec<(f32, f32)>,
+    settle: f64,
+    window_count: u32,
+    invalid_reasons: BTreeMap<&'static str, u32>,
     alarms: Vec<AlarmOut>,
     trace: Vec<(f64, f64)>,
     trace_every: u64,
     edges: u64,
+    all_edges: u64,
+    reverse_edges: u64,
+    steps: u64,
+    stop: Option<Stop>,
     last_window: Option<Measurement>,
     vibration: Option<(&'a VibrationMachine, std::ops::Range<usize>)>,
-    samples: Vec<RegimeSample>,
+    samples: Samples,
     sample_every: f64,
     next_sample: f64,
     rotor: Option<RotorLoads>,
     reactions: [f64; 2],
     reactions_from: f64,
     state: Vec<f64>,
+    progress: Progress,
+}
+
+/// A progress bar over simulated time that appears once the run has taken a second.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    show: bool,
+    shown: bool,
+    started: Instant,
+}
+
+impl Progress {
+    fn new(duration: f64, show: bool) -> Self {
+        // Hidden until the run has taken a second; a hidden bar has no length of its own.
+        let len = (duration * 1e3) as usize;
+        let bar = crate::app::progress::progress_bar(len, "ms simulated", false);
+        bar.set_length(len as u64);
+        Progress {
+            bar,
+            show,
+            shown: false,
+            started: Instant::now(),
+        }
+    }
+
+    fn at(&mut self, t: f64) {
+        if !self.show {
+            return;
+        }
+        if !self.shown && self.started.elapsed().as_secs_f64() > 1.0 {
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            self.shown = true;
+        }
+        if self.shown {
+            self.bar.set_position((t * 1e3) as u64);
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+impl Collector<'_> {
+    fn window(&mut self, time: f64, report: WindowReport) {
+        self.window_count += 1;
+        let m = report.measurement().copied();
+        let w = WindowOut {
+            time,
+            delta: m.map_or(0.0, |m| f64::from(m.delta)),
+            omega_mean: m.map_or(0.0, |m| f64::from(m.omega_mean)),
+            noise_floor: m.map_or(0.0, |m| f64::from(m.noise_floor)),
+            valid: report.valid(),
+            steady: m.is_some_and(|m| m.steady),
+            fault: report.fault().map(fault_name),
+        };
+        if !w.valid {
+            *self
+                .invalid_reasons
+                .entry(w.fault.unwrap_or("unknown"))
+                .or_default() += 1;
+        }
+        if let Some(r) = m {
+            if r.steady && w.time >= self.settle {
+                self.counted.push((r.delta, r.noise_floor));
+            }
+            self.last_window = Some(r);
+        }
+        if self.keep_windows {
+            self.windows.push(w);
+        }
+    }
 }
 
 impl Observer for Collector<'_> {
     fn edge(&mut self, edge: &crate::engine::encoder::Edge) {
+        self.all_edges += 1;
         let Some(m) = self.monitor.as_mut() else {
             return;
         };
@@ -420,21 +632,13 @@ impl Observer for Collector<'_> {
             return;
         }
         self.edges += 1;
-        if let Some(o) = m.on_edge(edge.ticks, Some(edge.direction)) {
-            let r = o.report;
-            let m = r.measurement();
-            self.windows.push(WindowOut {
-                time: edge.true_time,
-                delta: m.map_or(0.0, |m| f64::from(m.delta)),
-                omega_mean: m.map_or(0.0, |m| f64::from(m.omega_mean)),
-                noise_floor: m.map_or(0.0, |m| f64::from(m.noise_floor)),
-                valid: r.valid(),
-                steady: m.is_some_and(|m| m.steady),
-                fault: r.fault().map(fault_name),
-            });
-            if let Some(m) = m {
-                self.last_window = Some(*m);
-            }
+        if edge.direction == crate::engine::encoder::Direction::Reverse {
+            self.reverse_edges += 1;
+        }
+        let outcome = m.on_edge(edge.ticks, Some(edge.direction));
+        let speed = m.speed();
+        if let Some(o) = outcome {
+            self.window(edge.true_time, o.report);
             if let Some(e) = o.event {
                 self.alarms.push(AlarmOut {
                     time: edge.true_time,
@@ -446,19 +650,23 @@ impl Observer for Collector<'_> {
             }
         }
         // The trace starts with the first speed sample (0 before it is "no sample yet").
-        if self.edges % self.trace_every == 0 && (m.speed() > 0.0 || !self.trace.is_empty()) {
-            self.trace.push((edge.true_time, m.speed() as f64));
+        if self.edges % self.trace_every == 0 && (speed > 0.0 || !self.trace.is_empty()) {
+            self.trace.push((edge.true_time, speed as f64));
         }
     }
 
     fn step(&mut self, step: &StepView<'_>) {
+        self.steps += 1;
         if let Some((vm, range)) = &self.vibration {
             while self.next_sample <= step.t1() {
                 let t = self.next_sample.max(step.t0());
                 step.state_into(t, &mut self.state);
                 let shaft = step.shaft(t);
-                self.samples
-                    .push(vm.sample(t, shaft, &self.state[range.clone()]));
+                let sample = vm.sample(t, shaft, &self.state[range.clone()]);
+                match &mut self.samples {
+                    Samples::All(v) => v.push(sample),
+                    Samples::Stream(s) => s.push(sample),
+                }
                 self.next_sample += self.sample_every;
             }
         }
@@ -470,6 +678,16 @@ impl Observer for Collector<'_> {
                 }
             }
         }
+        if self.all_edges as f64 > MAX_EDGES {
+            self.stop = Some(Stop::Edges);
+        } else if self.steps > MAX_STEPS {
+            self.stop = Some(Stop::Steps);
+        }
+        self.progress.at(step.t1());
+    }
+
+    fn proceed(&self) -> bool {
+        self.stop.is_none()
     }
 }
 
@@ -510,32 +728,48 @@ pub fn regime_classifier(
         .and_then(|m| m.regime_margin)
         .map_or(DEFAULT_MARGIN, |m| m as f32);
     let classifier = Classifier::new(machine, margin, 0.5 * margin)
-        .map_err(|e| value_error(file, "monitor", e))?;
+        .map_err(|e| core_error(scene, file, "monitor", e))?;
     Ok((classifier, margin))
 }
 
-/// Simulates `scene` and reports.
-pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, SceneError> {
-    let started = Instant::now();
-    let model = predict::drive_model(scene, file)?;
-    let mut effects: Vec<Box<dyn Effect>> = Vec::new();
-    let mut names = Vec::new();
+/// The machine a run simulates: the system and what the report needs to know of it.
+struct Assembly {
+    system: System,
+    names: Vec<&'static str>,
+    vib_params: Option<VibrationMachineParams>,
+    vib_machine: Option<VibrationMachine>,
+    rotor: Option<RotorLoads>,
+}
+
+/// The shaft of `scene`: a prescribed law (the override's or the scene's speed, or its ramp),
+/// or a dynamic shaft driven by the motor, whose effect is appended to `effects`.
+fn shaft_model(
+    scene: &Scene,
+    file: &Path,
+    model: Option<&DriveModel>,
+    over: Overrides,
+    effects: &mut Vec<Box<dyn Effect>>,
+    names: &mut Vec<&'static str>,
+) -> Result<ShaftModel, SceneError> {
     let prescribed = over.speed.or(match &scene.motor {
         Some(MotorSpec::Speed { speed }) => Some(*speed),
         _ => None,
     });
-    let shaft = match (prescribed, &scene.motor) {
-        (Some(omega), _) => ShaftModel::Prescribed(SpeedLaw::Constant { omega, phi0: 0.0 }),
+    match (prescribed, &scene.motor) {
+        (Some(omega), _) => Ok(ShaftModel::Prescribed(SpeedLaw::Constant {
+            omega,
+            phi0: 0.0,
+        })),
         (None, Some(MotorSpec::Ramp { from, to, duration })) => {
-            ShaftModel::Prescribed(SpeedLaw::RampTo {
+            Ok(ShaftModel::Prescribed(SpeedLaw::RampTo {
                 omega0: *from,
                 omega1: *to,
                 ramp_time: *duration,
                 phi0: 0.0,
-            })
+            }))
         }
         (None, Some(_)) => {
-            let Some(model) = &model else {
+            let Some(model) = model else {
                 return Err(SceneError::value(
                     file,
                     "load",
@@ -551,7 +785,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
             let omega0 = shaft
                 .initial_speed
                 .unwrap_or_else(|| model.u_mean().max(0.0).sqrt());
-            ShaftModel::Dynamic(DynamicShaft {
+            Ok(ShaftModel::Dynamic(DynamicShaft {
                 inertia: shaft.inertia,
                 flywheel: shaft.flywheel,
                 harmonics: shaft
@@ -565,17 +799,28 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
                     .collect(),
                 phi0: 0.0,
                 omega0,
-            })
+            }))
         }
-        (None, None) => {
-            return Err(SceneError::value(
-                file,
-                "motor",
-                "missing: a scene to run needs [motor] (a torque model or a prescribed speed)",
-            ))
-        }
-    };
-    if let (Some(model), true) = (&model, matches!(shaft, ShaftModel::Dynamic(_))) {
+        (None, None) => Err(SceneError::value(
+            file,
+            "motor",
+            "missing: a scene to run needs [motor] (a torque model or a prescribed speed)",
+        )),
+    }
+}
+
+/// The system of `scene`: its shaft and the effects it calls for, in assembly order (motor,
+/// load, vibration machine, rotor loads).
+fn assemble(
+    scene: &Scene,
+    file: &Path,
+    model: Option<&DriveModel>,
+    over: Overrides,
+) -> Result<Assembly, SceneError> {
+    let mut effects: Vec<Box<dyn Effect>> = Vec::new();
+    let mut names = Vec::new();
+    let shaft = shaft_model(scene, file, model, over, &mut effects, &mut names)?;
+    if let (Some(model), true) = (model, matches!(shaft, ShaftModel::Dynamic(_))) {
         effects.push(Box::new(model.load().clone()));
         names.push("load");
     }
@@ -586,7 +831,7 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     let vib_params = vibration_params(scene, over.loads_together, rotor_speed0);
     let vib_machine = match &vib_params {
         Some(p) => {
-            Some(VibrationMachine::new(p).map_err(|e| value_error(file, "autobalancer", e))?)
+            Some(VibrationMachine::new(p).map_err(|e| core_error(scene, file, "autobalancer", e))?)
         }
         None => None,
     };
@@ -599,7 +844,114 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         effects.push(Box::new(*r));
         names.push("rotor-loads");
     }
-    let system = System::new(shaft, effects).map_err(|e| value_error(file, "shaft", e))?;
+    let system = System::new(shaft, effects).map_err(|e| core_error(scene, file, "shaft", e))?;
+    Ok(Assembly {
+        system,
+        names,
+        vib_params,
+        vib_machine,
+        rotor,
+    })
+}
+
+/// The largest shaft speed the run can reach, rad/s, as far as the scene tells before it is
+/// simulated: the prescribed speeds, or for a motor its no-load (synchronous) speed, twice
+/// over for the transient, or the initial speed.
+fn speed_bound(scene: &Scene, over: Overrides) -> f64 {
+    let initial = scene
+        .shaft
+        .as_ref()
+        .and_then(|s| s.initial_speed)
+        .unwrap_or(0.0)
+        .abs();
+    let motor = match &scene.motor {
+        _ if over.speed.is_some() => over.speed.unwrap_or(0.0).abs(),
+        Some(MotorSpec::Speed { speed }) => speed.abs(),
+        Some(MotorSpec::Ramp { from, to, .. }) => from.abs().max(to.abs()),
+        Some(MotorSpec::Parabola { no_load_speed, .. }) => 2.0 * no_load_speed,
+        Some(MotorSpec::Kloss {
+            synchronous_speed, ..
+        }) => 2.0 * synchronous_speed,
+        None => 0.0,
+    };
+    motor.max(initial)
+}
+
+/// Refuses, before anything is simulated, a run that would produce more than [`MAX_EDGES`]
+/// edges or take more than [`MAX_STEPS`] integrator steps of the largest size allowed.
+fn check_work(
+    scene: &Scene,
+    file: &Path,
+    over: Overrides,
+    integ: &Integrator,
+) -> Result<(), SceneError> {
+    let c = scene.checker(file);
+    let duration = scene.simulation.duration;
+    let speed_key = match (&scene.motor, over.speed) {
+        (_, Some(_)) => "the sweep's speed",
+        (Some(MotorSpec::Speed { .. }), _) => "motor.speed",
+        (Some(MotorSpec::Ramp { .. }), _) => "motor.from/to",
+        (Some(MotorSpec::Parabola { .. }), _) => "motor.no_load_speed",
+        (Some(MotorSpec::Kloss { .. }), _) => "motor.synchronous_speed",
+        (None, _) => "motor",
+    };
+    if let Some(e) = &scene.encoder {
+        let edges =
+            speed_bound(scene, over) * duration / std::f64::consts::TAU * f64::from(e.lines);
+        if edges > MAX_EDGES {
+            return Err(c.bad(
+                "simulation.duration",
+                duration,
+                format!(
+                    "with {speed_key} and encoder.lines = {} the run would produce about {edges:.2e} edges, \
+                     more than the limit of {MAX_EDGES:.0e} (shorten the duration)",
+                    c.shown("encoder.lines", e.lines)
+                ),
+            ));
+        }
+    }
+    let (largest_step, key) = match integ {
+        Integrator::Rk4 { step } => (*step, "simulation.step"),
+        Integrator::Dopri5 { max_step, .. } | Integrator::Dop853 { max_step, .. } => {
+            (max_step.unwrap_or(f64::INFINITY), "simulation.step (× 100)")
+        }
+    };
+    let steps = duration / largest_step;
+    if steps > MAX_STEPS as f64 {
+        return Err(c.bad(
+            "simulation.duration",
+            duration,
+            format!(
+                "needs at least {steps:.2e} integrator steps of {key}, more than the limit of {MAX_STEPS}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Simulates `scene` and reports, keeping every window and without a progress bar.
+pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, SceneError> {
+    run_with(scene, file, over, RunOptions::default())
+}
+
+/// Simulates `scene` and reports. The work is bounded up front ([`MAX_EDGES`], [`MAX_STEPS`],
+/// checked again while running); memory grows with the duration only by what `options`
+/// keeps for plots and by 8 bytes per counted δ window.
+pub fn run_with(
+    scene: &Scene,
+    file: &Path,
+    over: Overrides,
+    options: RunOptions,
+) -> Result<RunReport, SceneError> {
+    let started = Instant::now();
+    let model = predict::drive_model(scene, file)?;
+    let Assembly {
+        system,
+        names,
+        vib_params,
+        vib_machine,
+        rotor,
+    } = assemble(scene, file, model.as_ref(), over)?;
     let vib_range = names
         .iter()
         .position(|n| *n == "vibration")
@@ -608,10 +960,12 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     let integ = integrator(scene);
     integ
         .validate()
-        .map_err(|e| value_error(file, "simulation", e))?;
+        .map_err(|e| core_error(scene, file, "simulation", e))?;
+    check_work(scene, file, over, &integ)?;
     let mut sim = Simulation::new(system, integ.clone(), sim_encoder(scene, file)?)
         .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let duration = scene.simulation.duration;
+    let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
     let lines = scene.encoder.as_ref().map_or(1, |e| e.lines as u64);
     let expected_edges = model
         .as_ref()
@@ -620,28 +974,57 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         * duration
         / std::f64::consts::TAU
         * lines as f64;
+    // 4000 samples a run, and at least 100 a second (a capture's slip beats need them).
+    let sample_every = (duration / 4000.0).min(0.01);
+    let together = vib_params
+        .as_ref()
+        .is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
     let mut col = Collector {
         monitor: core_monitor(scene, file)?,
+        keep_windows: options.keep_windows,
         windows: Vec::new(),
+        counted: Vec::new(),
+        settle,
+        window_count: 0,
+        invalid_reasons: BTreeMap::new(),
         alarms: Vec::new(),
         trace: Vec::new(),
         trace_every: ((expected_edges / 4000.0) as u64).max(1),
         edges: 0,
+        all_edges: 0,
+        reverse_edges: 0,
+        steps: 0,
+        stop: None,
         last_window: None,
         vibration: vib_machine.as_ref().zip(vib_range),
-        samples: Vec::new(),
-        // 4000 samples a run, and at least 100 a second (a capture's slip beats need them).
-        sample_every: (duration / 4000.0).min(0.01),
+        samples: if together {
+            Samples::All(Vec::new())
+        } else {
+            let fraction = RegimeCriteria::new(1.0).window_fraction;
+            Samples::Stream(Box::new(RegimeStream::new(
+                duration,
+                sample_every,
+                fraction,
+            )))
+        },
+        sample_every,
         next_sample: 0.0,
         rotor,
         reactions: [0.0; 2],
         reactions_from: (duration - 1.0).max(0.0),
         state: vec![0.0; dim],
+        progress: Progress::new(duration, options.progress),
     };
     let stats = sim
         .run_observed(duration, &mut col)
-        .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
-    let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
+        .map_err(|e| integration_error(scene, file, &e))?;
+    drop(std::mem::replace(
+        &mut col.progress,
+        Progress::new(0.0, false),
+    ));
+    if let Some(stop) = col.stop {
+        return Err(stopped(scene, file, stop, stats.time));
+    }
     let mut report = RunReport {
         scene: file.display().to_string(),
         effects: names,
@@ -662,26 +1045,131 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     if let Some(model) = &model {
         report.delta_predicted = model.predict().steady().map(|s| s.delta);
     }
-    if let Some(m) = &col.monitor {
-        let d = m.diagnostics();
-        report.windows = d.valid_windows + d.invalid_windows;
-        report.invalid_windows = d.invalid_windows;
-        report.rejected_edges = [d.edges.glitches, d.edges.missing, d.edges.extra];
-        for w in col.windows.iter().filter(|w| !w.valid) {
-            *report
-                .invalid_reasons
-                .entry(w.fault.unwrap_or("unknown"))
-                .or_default() += 1;
-        }
-        let counted: Vec<&WindowOut> = col
-            .windows
+    let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
+        Samples::All(v) => v,
+        Samples::Stream(s) => s.samples(),
+    };
+    measurement(&mut report, &mut col);
+    regime(scene, file, &mut report, vib_machine.as_ref(), &samples)?;
+    report.capture = capture_analysis(scene, file, vib_params.as_ref(), &samples)?;
+    supports(scene, file, &mut report, col.reactions)?;
+    report.alarms = col.alarms;
+    report.window_list = col.windows;
+    report.speed_trace = col.trace;
+    report.wall_seconds = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// An integration failure, with the scene keys that set the integration up.
+fn integration_error(
+    scene: &Scene,
+    file: &Path,
+    e: &crate::engine::system::SimError,
+) -> SceneError {
+    let c = scene.checker(file);
+    let s = &scene.simulation;
+    SceneError::value(
+        file,
+        "simulation",
+        format!(
+            "{e}: the scene's time scales are beyond what the integrator resolves with \
+             simulation.rtol = {}, atol = {}, step = {}; check the inertias, masses, stiffnesses \
+             and speeds of the scene against each other",
+            c.shown("simulation.rtol", s.rtol),
+            c.shown("simulation.atol", s.atol),
+            c.shown("simulation.step", s.step)
+        ),
+    )
+}
+
+/// A run ended by the limits while running (their estimate up front was too low).
+fn stopped(scene: &Scene, file: &Path, stop: Stop, t: f64) -> SceneError {
+    let c = scene.checker(file);
+    let what = match stop {
+        Stop::Edges => format!("more than {MAX_EDGES:.0e} encoder edges"),
+        Stop::Steps => format!("more than {MAX_STEPS} integrator steps"),
+    };
+    c.bad(
+        "simulation.duration",
+        scene.simulation.duration,
+        format!("stopped at t = {t:.3} s: the run produced {what} (shorten the duration)"),
+    )
+}
+
+/// What the core measured: windows, rejected edges, δ, and why nothing was measured.
+fn measurement(report: &mut RunReport, col: &mut Collector) {
+    let Some(m) = &col.monitor else {
+        return;
+    };
+    let d = m.diagnostics();
+    report.windows = d.valid_windows + d.invalid_windows;
+    report.invalid_windows = d.invalid_windows;
+    report.rejected_edges = [d.edges.glitches, d.edges.missing, d.edges.extra];
+    report.invalid_reasons = std::mem::take(&mut col.invalid_reasons);
+    report.delta_measured = median(
+        &mut col
+            .counted
             .iter()
-            .filter(|w| w.valid && w.steady && w.time >= settle)
-            .collect();
-        report.delta_measured = median(&mut counted.iter().map(|w| w.delta).collect::<Vec<_>>());
-        report.noise_floor = median(&mut counted.iter().map(|w| w.noise_floor).collect::<Vec<_>>());
-        report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
+            .map(|w| f64::from(w.0))
+            .collect::<Vec<_>>(),
+    );
+    report.noise_floor = median(
+        &mut col
+            .counted
+            .iter()
+            .map(|w| f64::from(w.1))
+            .collect::<Vec<_>>(),
+    );
+    report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
+    if d.valid_windows == 0 {
+        report.no_measurement = Some(nothing_measured(report, col.edges, col.reverse_edges));
     }
+}
+
+/// Why the core measured no valid window, from what the run saw.
+fn nothing_measured(r: &RunReport, edges: u64, reverse: u64) -> String {
+    let mut why = Vec::new();
+    if edges == 0 {
+        why.push("the encoder produced no edge (the shaft did not turn)".to_string());
+    }
+    if reverse > 0 {
+        why.push(format!(
+            "{reverse} of {edges} edges came in reverse (the shaft turned backwards)"
+        ));
+    }
+    let rejected: u64 = r.rejected_edges.iter().map(|&n| u64::from(n)).sum();
+    if edges > 0 && rejected > 0 {
+        why.push(format!(
+            "{rejected} of {edges} edges were rejected ({} as glitches, {} missing, {} extra): \
+             edges too close for the timer, or too much jitter",
+            r.rejected_edges[0], r.rejected_edges[1], r.rejected_edges[2]
+        ));
+    }
+    if r.invalid_windows > 0 {
+        let reasons: Vec<String> = r
+            .invalid_reasons
+            .iter()
+            .map(|(k, v)| format!("{v} {k}"))
+            .collect();
+        why.push(format!(
+            "all {} windows were invalid ({})",
+            r.invalid_windows,
+            reasons.join(", ")
+        ));
+    } else if edges > 0 {
+        why.push("no window was completed (the run is shorter than one window, or never framed a revolution)".to_string());
+    }
+    format!("no valid δ window: {}", why.join("; "))
+}
+
+/// The regime the core predicts at the measured speed and what the loads did.
+fn regime(
+    scene: &Scene,
+    file: &Path,
+    report: &mut RunReport,
+    vib_machine: Option<&VibrationMachine>,
+    samples: &[RegimeSample],
+) -> Result<(), SceneError> {
     if let Some(machine) = predict::machine(scene, file)? {
         let (classifier, _) = regime_classifier(scene, file, &machine)?;
         if let Some(w) = report.speed_measured {
@@ -690,34 +1178,116 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
             report.regime_predicted = Some(machine.zone_kind_at(w).name());
         }
     }
-    if let Some(vm) = &vib_machine {
+    if let Some(vm) = vib_machine {
         let criteria = RegimeCriteria::new(vm.reference_unbalance());
-        if let Some(r) = classify(&col.samples, &criteria) {
+        if let Some(r) = classify(samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());
             report.residual_relative = Some(r.residual_relative);
             report.regime_detail = Some(r);
         }
     }
-    report.capture = capture_analysis(scene, file, vib_params.as_ref(), &col.samples)?;
-    if let Some((rotor, limits)) = predict::rotor(scene, file)? {
-        let analysis = SupportAnalysis::new(&rotor, &limits);
-        let speed = report.speed_measured.unwrap_or(limits.service_speed());
-        let status = analysis.monitor().update(speed as f32);
-        report.supports = Some(SupportsRunOut {
-            speed,
-            peak_load: status.peak_load.map(f64::from),
-            simulated_peak_reaction: col.reactions,
-            load_level: status.load.map(level),
-            unbalance_level: status.unbalance.map(level),
-            max_safe_speed: status
-                .max_safe_speed
-                .map(f64::from)
-                .filter(|v| v.is_finite()),
-        });
+    Ok(())
+}
+
+/// The supports judged by the core at the measured speed, beside the simulated reactions.
+/// Without a measured speed the core's levels are unknown: the reactions are then judged
+/// against the scene's load limits directly.
+fn supports(
+    scene: &Scene,
+    file: &Path,
+    report: &mut RunReport,
+    reactions: [f64; 2],
+) -> Result<(), SceneError> {
+    let Some((rotor, limits)) = predict::rotor(scene, file)? else {
+        return Ok(());
+    };
+    let analysis = predict::analysis(scene, &rotor, &limits, file)?;
+    let monitor = analysis
+        .monitor()
+        .map_err(|e| core_error(scene, file, "rotor", e))?;
+    let finite = |v: f32| Some(f64::from(v)).filter(|v| v.is_finite());
+    let out = match report.speed_measured {
+        Some(speed) => {
+            let status = monitor.update(speed as f32);
+            SupportsRunOut {
+                speed: Some(speed),
+                peak_load: status.peak_load.map(finite),
+                simulated_peak_reaction: reactions,
+                load_level: status.load.map(level),
+                unbalance_level: status.unbalance.map(level),
+                max_safe_speed: status.max_safe_speed.and_then(finite),
+                simulated_reaction_level: None,
+            }
+        }
+        None => {
+            let status = monitor.update(0.0);
+            let judged = limits.support_load_limit().map(|l| {
+                let w = limits.warning_fraction();
+                [0, 1].map(|k| {
+                    let (f, limit) = (reactions[k], l[k]);
+                    if f > limit {
+                        "over"
+                    } else if f > w * limit {
+                        "warning"
+                    } else {
+                        "normal"
+                    }
+                })
+            });
+            SupportsRunOut {
+                speed: None,
+                peak_load: [None; 2],
+                simulated_peak_reaction: reactions,
+                load_level: ["unknown"; 2],
+                unbalance_level: status.unbalance.map(level),
+                max_safe_speed: status.max_safe_speed.and_then(finite),
+                simulated_reaction_level: Some(judged.unwrap_or(["unknown"; 2])),
+            }
+        }
+    };
+    report.supports = Some(out);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The streamed reductions give `classify` exactly what it computes from every sample, for
+    /// runs whose last sample falls anywhere in the last two sampling intervals.
+    #[test]
+    fn streamed_regime_equals_the_whole_list() {
+        let criteria = RegimeCriteria::new(0.05);
+        for (duration, every, jiggle) in
+            [(40.0, 0.01, 0.0), (7.3, 0.01, 0.004), (1.0, 0.00025, 0.0)]
+        {
+            let mut all = Vec::new();
+            let mut stream = RegimeStream::new(duration, every, criteria.window_fraction);
+            let mut t = 0.0;
+            let mut k = 0u32;
+            while t <= duration - jiggle {
+                // A residual with a peak early in the judged part and a coherence dip late.
+                let x = f64::from(k);
+                let s = RegimeSample {
+                    t,
+                    residual: 1e-3 * (1.0 + (0.37 * x).sin()) + if k == 3100 { 0.2 } else { 0.0 },
+                    coherence: 0.5 + 0.4 * (0.11 * x).cos(),
+                    mean_load_angle: 0.9 * t + 0.01 * (x * 0.7).sin(),
+                    rotor_angle: 100.0 * t,
+                };
+                all.push(s);
+                stream.push(s);
+                t += every;
+                k += 1;
+            }
+            let whole = classify(&all, &criteria).unwrap();
+            let streamed = classify(&stream.samples(), &criteria).unwrap();
+            assert_eq!(
+                format!("{whole:?}"),
+                format!("{streamed:?}"),
+                "{duration} {every}"
+            );
+            assert!(stream.samples().len() < 20);
+        }
     }
-    report.alarms = col.alarms;
-    report.window_list = col.windows;
-    report.speed_trace = col.trace;
-    report.wall_seconds = started.elapsed().as_secs_f64();
-    Ok(report)
 }

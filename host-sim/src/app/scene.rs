@@ -27,6 +27,31 @@ pub enum SceneError {
         /// The parser's message (names the key and the line).
         message: String,
     },
+    /// A value outside what its key allows, quoted as written.
+    #[error("{file}: `{key} = {value}`: {rule}")]
+    Rule {
+        /// The scene file.
+        file: PathBuf,
+        /// The key, e.g. `platform[2].mass`.
+        key: String,
+        /// Its value as written in the file.
+        value: String,
+        /// What is allowed.
+        rule: String,
+    },
+    /// Values the core rejected together, each key quoted with its value as written
+    /// ([`crate::app::check::core_keys`]).
+    #[error("{file}: {keys}: {message}")]
+    Core {
+        /// The scene file.
+        file: PathBuf,
+        /// The key most likely responsible.
+        key: String,
+        /// Every key involved, with its value.
+        keys: String,
+        /// What the core found.
+        message: String,
+    },
     /// A value that parses but is impossible.
     #[error("{file}: `{key}`: {message}")]
     Value {
@@ -85,6 +110,9 @@ pub struct Scene {
     pub unbalance: Vec<UnbalanceSpec>,
     /// A distributed process load on that rotor.
     pub process_load: Option<ProcessLoadSpec>,
+    /// The values as written in the file, for errors.
+    #[serde(skip)]
+    pub written: crate::app::check::Written,
 }
 
 /// How to integrate.
@@ -184,9 +212,10 @@ pub struct Harmonic {
     pub phase: f64,
 }
 
-/// `[motor]`.
+/// `[motor]`. Read through [`MotorTable`], so that an error names the key inside the table
+/// (a tagged enum would report only the table).
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields, tag = "model", rename_all = "lowercase")]
+#[serde(try_from = "MotorTable")]
 pub enum MotorSpec {
     /// Parabolic characteristic through (ω0, 0) and (ω_m, M_m) (seed 000, eq. 3–4).
     Parabola {
@@ -220,6 +249,111 @@ pub enum MotorSpec {
         /// Ramp time, s.
         duration: f64,
     },
+}
+
+/// `[motor] model`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MotorModel {
+    /// [`MotorSpec::Parabola`].
+    Parabola,
+    /// [`MotorSpec::Kloss`].
+    Kloss,
+    /// [`MotorSpec::Speed`].
+    Speed,
+    /// [`MotorSpec::Ramp`].
+    Ramp,
+}
+
+/// `[motor]` as written: the model and every key any model has, each with its own type.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorTable {
+    /// The model.
+    pub model: MotorModel,
+    /// Parabola: ω0.
+    pub no_load_speed: Option<f64>,
+    /// Parabola: ω_m.
+    pub breakdown_speed: Option<f64>,
+    /// Parabola and Kloss: M_m.
+    pub breakdown_torque: Option<f64>,
+    /// Kloss: ω_s.
+    pub synchronous_speed: Option<f64>,
+    /// Kloss: σ_m.
+    pub breakdown_slip: Option<f64>,
+    /// Speed: ω.
+    pub speed: Option<f64>,
+    /// Ramp: start speed.
+    pub from: Option<f64>,
+    /// Ramp: end speed.
+    pub to: Option<f64>,
+    /// Ramp: ramp time.
+    pub duration: Option<f64>,
+}
+
+impl TryFrom<MotorTable> for MotorSpec {
+    type Error = String;
+
+    fn try_from(t: MotorTable) -> Result<Self, String> {
+        let (model, keys): (&str, &[&str]) = match t.model {
+            MotorModel::Parabola => (
+                "parabola",
+                &["no_load_speed", "breakdown_speed", "breakdown_torque"],
+            ),
+            MotorModel::Kloss => (
+                "kloss",
+                &["synchronous_speed", "breakdown_slip", "breakdown_torque"],
+            ),
+            MotorModel::Speed => ("speed", &["speed"]),
+            MotorModel::Ramp => ("ramp", &["from", "to", "duration"]),
+        };
+        let given = [
+            ("no_load_speed", t.no_load_speed),
+            ("breakdown_speed", t.breakdown_speed),
+            ("breakdown_torque", t.breakdown_torque),
+            ("synchronous_speed", t.synchronous_speed),
+            ("breakdown_slip", t.breakdown_slip),
+            ("speed", t.speed),
+            ("from", t.from),
+            ("to", t.to),
+            ("duration", t.duration),
+        ];
+        for (key, value) in given {
+            if value.is_some() && !keys.contains(&key) {
+                return Err(format!(
+                    "`motor.{key}` does not belong to model = \"{model}\" (its keys: {})",
+                    keys.join(", ")
+                ));
+            }
+        }
+        let get = |key: &str| -> Result<f64, String> {
+            given
+                .iter()
+                .find(|(k, _)| *k == key)
+                .and_then(|(_, v)| *v)
+                .ok_or_else(|| format!("missing key `motor.{key}` (model = \"{model}\")"))
+        };
+        Ok(match t.model {
+            MotorModel::Parabola => MotorSpec::Parabola {
+                no_load_speed: get("no_load_speed")?,
+                breakdown_speed: get("breakdown_speed")?,
+                breakdown_torque: get("breakdown_torque")?,
+            },
+            MotorModel::Kloss => MotorSpec::Kloss {
+                synchronous_speed: get("synchronous_speed")?,
+                breakdown_slip: get("breakdown_slip")?,
+                breakdown_torque: get("breakdown_torque")?,
+            },
+            MotorModel::Speed => MotorSpec::Speed {
+                speed: get("speed")?,
+            },
+            MotorModel::Ramp => MotorSpec::Ramp {
+                from: get("from")?,
+                to: get("to")?,
+                duration: get("duration")?,
+            },
+        })
+    }
 }
 
 /// `[load]`: M_c(φ) = mean + Σ amplitude·sin(order·φ + phase).
@@ -442,106 +576,59 @@ pub struct ProcessLoadSpec {
 }
 
 impl Scene {
-    /// Reads and parses a scene file.
+    /// Reads and parses a scene file of at most [`MAX_SCENE_BYTES`].
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        use std::io::Read;
+        let io = |source| SceneError::Io {
             file: path.to_path_buf(),
             source,
+        };
+        let file = std::fs::File::open(path).map_err(io)?;
+        // Read one byte past the limit, so a larger file (or an endless one: /dev/zero) is
+        // refused after at most that much.
+        let mut bytes = Vec::new();
+        file.take(MAX_SCENE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        if bytes.len() as u64 > MAX_SCENE_BYTES {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("larger than the limit of {MAX_SCENE_BYTES} bytes for a scene file"),
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not UTF-8 text ({e})"),
+            ))
         })?;
         Scene::parse(&text, path)
     }
 
     /// Parses scene text; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
-        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+        let blank = text
+            .lines()
+            .map(str::trim)
+            .all(|l| l.is_empty() || l.starts_with('#'));
+        if blank {
+            return Err(SceneError::Parse {
+                file: path.to_path_buf(),
+                message: "the file is empty: a scene needs at least one table (see `drive-sim scenes` for examples)".into(),
+            });
+        }
+        let mut scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: path.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
         })?;
-        scene.check(path)?;
+        scene.written = crate::app::check::Written::parse(text);
+        crate::app::check::check(&scene, &scene.checker(path))?;
         Ok(scene)
     }
 
-    fn check(&self, path: &Path) -> Result<(), SceneError> {
-        let bad = |key: &str, message: &str| SceneError::value(path, key, message);
-        let s = &self.simulation;
-        let positive = |key: &str, x: f64| {
-            if !x.is_finite() {
-                Err(bad(key, &format!("must be finite, got {x}")))
-            } else if x <= 0.0 {
-                Err(bad(key, &format!("must be positive, got {x}")))
-            } else {
-                Ok(())
-            }
-        };
-        positive("simulation.duration", s.duration)?;
-        positive("simulation.rtol", s.rtol)?;
-        positive("simulation.atol", s.atol)?;
-        positive("simulation.step", s.step)?;
-        if let Some(t) = s.settle {
-            if !(t.is_finite() && t >= 0.0 && t < s.duration) {
-                return Err(bad(
-                    "simulation.settle",
-                    &format!("must be in [0, duration), got {t}"),
-                ));
-            }
-        }
-        if let Some(l) = self.monitor.as_ref().and_then(|m| m.delta_limit) {
-            // A limit finer than f64 resolves the speed can be neither designed for
-            // (`DriveModel::flywheel_for`) nor monitored: one check for every command.
-            if l.is_nan() || l < drive_monitor::drive::MIN_DELTA_TARGET {
-                return Err(bad(
-                    "monitor.delta_limit",
-                    &format!(
-                        "must be at least {:e} (finer than f64 resolves the speed), got {l}",
-                        drive_monitor::drive::MIN_DELTA_TARGET
-                    ),
-                ));
-            }
-        }
-        if self.platform.len() > 3 {
-            return Err(bad("platform", "at most 3 platforms"));
-        }
-        if !self.platform.is_empty() && self.autobalancer.is_none() {
-            return Err(bad(
-                "autobalancer",
-                "missing: a vibration machine needs its auto-balancer",
-            ));
-        }
-        if self.autobalancer.is_some() && self.platform.is_empty() {
-            return Err(bad(
-                "platform",
-                "missing: the auto-balancer needs a platform",
-            ));
-        }
-        if (!self.unbalance.is_empty() || self.process_load.is_some()) && self.rotor.is_none() {
-            return Err(bad("rotor", "missing: unbalances need a [rotor]"));
-        }
-        if let Some(e) = &self.encoder {
-            if e.framing == FramingSpec::MissingTooth && e.missing == 0 {
-                return Err(bad(
-                    "encoder.missing",
-                    "missing-tooth framing needs missing = 1..3",
-                ));
-            }
-            for (key, x) in [
-                ("encoder.drop_probability", e.drop_probability),
-                ("encoder.glitch_probability", e.glitch_probability),
-            ] {
-                if !(0.0..=0.5).contains(&x) {
-                    return Err(bad(key, &format!("must be in [0, 0.5], got {x}")));
-                }
-            }
-            for (key, x) in [
-                ("encoder.jitter", e.jitter),
-                ("encoder.runout", e.runout),
-                ("encoder.pitch_error", e.pitch_error),
-            ] {
-                if !(x.is_finite() && x >= 0.0) {
-                    return Err(bad(key, &format!("must be finite and ≥ 0, got {x}")));
-                }
-            }
-        }
-        Ok(())
+    /// The errors of this scene's file `path`, quoting its values as written.
+    pub fn checker<'a>(&'a self, path: &'a Path) -> crate::app::check::Checker<'a> {
+        crate::app::check::Checker::new(path, &self.written)
     }
 }
 
@@ -566,37 +653,45 @@ pub const BUNDLED: &[(&str, &str)] = &[
 ];
 
 /// The default scene of `drive-sim` without arguments.
-pub const DEFAULT_SCENE: &str = "kneader.toml";
+pub const DEFAULT_SCENE: &str = "kneader";
 
-/// Loads `name`: a file if one exists at that path, else a bundled scene by file name (with or
-/// without `.toml`). Returns the scene and the path errors should name.
+/// Largest scene file read, bytes (the bundled scenes are about 1 kB).
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// The bundled scene called `name` (its file name without `.toml`, as `drive-sim scenes`
+/// lists it): (file name, text).
+pub fn bundled(name: &str) -> Option<(&'static str, &'static str)> {
+    BUNDLED
+        .iter()
+        .find(|(n, _)| n.strip_suffix(".toml") == Some(name))
+        .copied()
+}
+
+/// Loads `name`: a bundled scene when `name` is one of their names (`kneader`, as `drive-sim
+/// scenes` lists them), else the scene file at the path `name`. A path that does not exist is
+/// an error, never a bundled scene of the same file name. Returns the scene and the path
+/// errors should name.
 pub fn resolve(name: &str) -> Result<(Scene, PathBuf), SceneError> {
+    if let Some((n, text)) = bundled(name) {
+        let shown = PathBuf::from(format!("host-sim/scenes/{n}"));
+        return Ok((Scene::parse(text, &shown)?, shown));
+    }
     let path = Path::new(name);
-    if path.exists() {
-        return Ok((Scene::load(path)?, path.to_path_buf()));
-    }
-    let file = if name.ends_with(".toml") {
-        name.to_string()
-    } else {
-        format!("{name}.toml")
-    };
-    let base = Path::new(&file)
-        .file_name()
-        .and_then(|f| f.to_str())
-        .unwrap_or("");
-    match BUNDLED.iter().find(|(n, _)| *n == base) {
-        Some((n, text)) => {
-            let shown = PathBuf::from(format!("host-sim/scenes/{n}"));
-            Ok((Scene::parse(text, &shown)?, shown))
-        }
-        None => Err(SceneError::Io {
-            file: path.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                "no such file, and no bundled scene of that name (see `drive-sim scenes`)",
+    if !path.exists() {
+        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+        let hint = match bundled(stem) {
+            Some(_) => format!(
+                "no such file (the bundled scene `{stem}` is asked for by its name alone: `drive-sim run {stem}`)"
             ),
-        }),
+            None => "no such file, and no bundled scene of that name (see `drive-sim scenes`)"
+                .to_string(),
+        };
+        return Err(SceneError::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, hint),
+        });
     }
+    Ok((Scene::load(path)?, path.to_path_buf()))
 }
 
 #[cfg(test)]
@@ -611,9 +706,10 @@ mod tests {
 
     #[test]
     fn bundled_scenes_parse() {
-        for (name, _) in BUNDLED {
+        for (file, _) in BUNDLED {
+            let name = file.strip_suffix(".toml").unwrap();
             let (scene, path) = resolve(name).unwrap();
-            assert!(path.ends_with(name));
+            assert!(path.ends_with(file));
             assert!(scene.description.is_some(), "{name}");
         }
         assert!(resolve("kneader").is_ok());

@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 use host_sim::app::predict::predict;
 use host_sim::app::scene::{resolve, BUNDLED, DEFAULT_SCENE};
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -20,22 +22,22 @@ struct Cli {
 enum Command {
     /// Simulate a scene, feed its encoder edges to the core, report.
     Run {
-        /// Scene file, or the name of a bundled scene.
+        /// The name of a bundled scene (`drive-sim scenes`), or a scene file's path.
         scene: String,
         /// Print JSON.
         #[arg(long)]
         json: bool,
         /// Write SVG plots into this directory.
         #[arg(long)]
-        plot: Option<std::path::PathBuf>,
+        plot: Option<PathBuf>,
         /// Write the capture page of a run-up (loads together, prescribed ramp) into this
         /// directory: Markdown and SVGs, the scene repeated at slower and faster ramps.
         #[arg(long)]
-        out: Option<std::path::PathBuf>,
+        out: Option<PathBuf>,
     },
     /// Design-time results only (no simulation): predicted δ, support limits, regime zones.
     Predict {
-        /// Scene file, or the name of a bundled scene.
+        /// The name of a bundled scene (`drive-sim scenes`), or a scene file's path.
         scene: String,
         /// Print JSON.
         #[arg(long)]
@@ -44,7 +46,7 @@ enum Command {
     /// Run a vibration-machine scene at prescribed rotor speeds from A to B rad/s, in
     /// parallel: the criterion's regime against what the loads did.
     Sweep {
-        /// Scene file, or the name of a bundled scene.
+        /// The name of a bundled scene (`drive-sim scenes`), or a scene file's path.
         scene: String,
         /// Lowest speed, rad/s.
         #[arg(long)]
@@ -52,8 +54,8 @@ enum Command {
         /// Highest speed, rad/s.
         #[arg(long)]
         to: f64,
-        /// Number of speeds.
-        #[arg(long, default_value_t = 20)]
+        /// Number of speeds (2 to 1000).
+        #[arg(long, default_value_t = 20, value_parser = sweep_steps)]
         steps: usize,
         /// Start the loads together at rest instead of near the balancing position.
         #[arg(long)]
@@ -63,13 +65,13 @@ enum Command {
         json: bool,
         /// Write the regime map (Markdown table and SVG) into this directory.
         #[arg(long)]
-        out: Option<std::path::PathBuf>,
+        out: Option<PathBuf>,
     },
     /// Check the auto-balancing criterion against simulation on randomised machines (seed 001):
     /// agreement, simulated boundary shifts and the margin band they need.
     Criterion {
-        /// Number of machines (platforms cycle 1, 2, 3).
-        #[arg(long, default_value_t = 30)]
+        /// Number of machines (platforms cycle 1, 2, 3; 1 to 1000).
+        #[arg(long, default_value_t = 30, value_parser = criterion_machines)]
         machines: usize,
         /// Seed of the draws.
         #[arg(long, default_value_t = 1)]
@@ -79,13 +81,13 @@ enum Command {
         json: bool,
         /// Write the report (Markdown and SVG) into this directory.
         #[arg(long)]
-        out: Option<std::path::PathBuf>,
+        out: Option<PathBuf>,
     },
     /// Measure what accuracy costs and write Markdown tables and SVG plots into a directory.
     Accuracy {
         /// Output directory (e.g. docs/).
         #[arg(long, default_value = "docs")]
-        out: std::path::PathBuf,
+        out: PathBuf,
         /// Also build and run the firmware under QEMU (needs the thumbv7em target and
         /// qemu-system-arm) and include its instruction counts.
         #[arg(long)]
@@ -93,6 +95,52 @@ enum Command {
     },
     /// List the bundled scenes.
     Scenes,
+}
+
+/// Most speeds `sweep --steps` accepts (each is a whole simulation of the scene).
+const MAX_SWEEP_STEPS: usize = 1000;
+/// Most machines `criterion --machines` accepts (each is a grid of simulations).
+const MAX_CRITERION_MACHINES: usize = 1000;
+
+/// `--steps`: 2 to [`MAX_SWEEP_STEPS`].
+fn sweep_steps(text: &str) -> Result<usize, String> {
+    bounded(text, 2, MAX_SWEEP_STEPS)
+}
+
+/// `--machines`: 1 to [`MAX_CRITERION_MACHINES`].
+fn criterion_machines(text: &str) -> Result<usize, String> {
+    bounded(text, 1, MAX_CRITERION_MACHINES)
+}
+
+fn bounded(text: &str, min: usize, max: usize) -> Result<usize, String> {
+    let n: u128 = text
+        .trim()
+        .parse()
+        .map_err(|e| format!("not a whole number ({e}); allowed {min} to {max}"))?;
+    match usize::try_from(n) {
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(format!("allowed {min} to {max}")),
+    }
+}
+
+/// Why a command failed.
+enum Failure {
+    /// A message for stderr.
+    Message(String),
+    /// Whoever read stdout has gone (`| head`): end quietly.
+    BrokenPipe,
+}
+
+impl From<String> for Failure {
+    fn from(m: String) -> Self {
+        Failure::Message(m)
+    }
+}
+
+impl From<host_sim::app::scene::SceneError> for Failure {
+    fn from(e: host_sim::app::scene::SceneError) -> Self {
+        Failure::Message(e.to_string())
+    }
 }
 
 fn main() -> ExitCode {
@@ -121,59 +169,92 @@ fn main() -> ExitCode {
             json,
             out,
         }) => criterion_cmd(machines, seed, json, out.as_deref()),
-        Some(Command::Accuracy { out, target }) => {
-            host_sim::studies::publish::accuracy(&out, target).map(|files| list(&files, "wrote"))
-        }
+        Some(Command::Accuracy { out, target }) => accuracy_cmd(&out, target),
         Some(Command::Scenes) => {
-            for (name, text) in BUNDLED {
-                let desc = text
+            let mut text = String::new();
+            for (file, body) in BUNDLED {
+                let name = file.strip_suffix(".toml").unwrap_or(file);
+                let desc = body
                     .lines()
                     .find_map(|l| l.strip_prefix("description = "))
                     .unwrap_or("")
                     .trim_matches('"');
-                println!("{name:<22} {desc}");
+                text.push_str(&format!("{name:<22} {desc}\n"));
             }
-            Ok(())
+            write_out(&text)
         }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("drive-sim: {e}");
+        Err(Failure::BrokenPipe) => ExitCode::FAILURE,
+        Err(Failure::Message(e)) => {
+            // stderr may be gone too: nothing more to do then.
+            let _ = writeln!(std::io::stderr(), "drive-sim: {e}");
             ExitCode::FAILURE
         }
     }
 }
 
-fn run_cmd(
-    name: &str,
-    json: bool,
-    plot: Option<&std::path::Path>,
-    out: Option<&std::path::Path>,
-) -> Result<(), String> {
-    let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
-    let report =
-        host_sim::app::run::run(&scene, &path, Default::default()).map_err(|e| e.to_string())?;
+/// Writes `text` to stdout and flushes: a reader that has gone is [`Failure::BrokenPipe`], any
+/// other error (a full disk) a message naming it.
+fn write_out(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::BrokenPipe => Failure::BrokenPipe,
+            _ => Failure::Message(format!("cannot write the output: {e}")),
+        })
+}
+
+/// Checks before any work that `dir` (for `option`) is, or can be made, a writable directory.
+fn writable_dir(option: &str, dir: &Path) -> Result<(), Failure> {
+    let fail = |why: String| Failure::Message(format!("{option} {}: {why}", dir.display()));
+    if dir.exists() && !dir.is_dir() {
+        return Err(fail("exists and is not a directory".into()));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| fail(format!("cannot create the directory: {e}")))?;
+    let probe = dir.join(format!(".drive-sim-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| fail(format!("cannot write into it: {e}")))?;
+    // The probe is ours; failing to remove it is not worth failing the command.
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+fn run_cmd(name: &str, json: bool, plot: Option<&Path>, out: Option<&Path>) -> Result<(), Failure> {
+    let (scene, path) = resolve(name)?;
+    if let Some(dir) = plot {
+        writable_dir("--plot", dir)?;
+    }
+    if let Some(dir) = out {
+        writable_dir("--out", dir)?;
+    }
+    let options = host_sim::app::run::RunOptions {
+        progress: !json,
+        keep_windows: plot.is_some(),
+    };
+    let report = host_sim::app::run::run_with(&scene, &path, Default::default(), options)?;
+    let mut text = String::new();
     if let Some(dir) = out {
         let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
         if !json {
-            list(&files, "wrote");
+            text.push_str(&list(&files, "wrote"));
         }
     }
     if let Some(dir) = plot {
         let files = host_sim::app::report::run_plots(&scene, &path, &report, dir)?;
         if !json {
-            list(&files, "plot:");
+            text.push_str(&list(&files, "plot:"));
         }
     }
     if json {
-        print_json(&report)?;
+        text.push_str(&to_json(&report)?);
     } else {
-        let p = predict(&scene, &path).map_err(|e| e.to_string())?;
-        print!("{}", host_sim::app::report::run_text(&scene, &report));
-        print!("{}", host_sim::app::report::prediction_text(&p));
+        let p = predict(&scene, &path)?;
+        text.push_str(&host_sim::app::report::run_text(&scene, &report));
+        text.push_str(&host_sim::app::report::prediction_text(&p));
     }
-    Ok(())
+    write_out(&text)
 }
 
 fn sweep_cmd(
@@ -183,102 +264,121 @@ fn sweep_cmd(
     steps: usize,
     together: bool,
     json: bool,
-    out: Option<&std::path::Path>,
-) -> Result<(), String> {
-    let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
+    out: Option<&Path>,
+) -> Result<(), Failure> {
+    let (scene, path) = resolve(name)?;
+    if let Some(dir) = out {
+        writable_dir("--out", dir)?;
+    }
     let request = host_sim::studies::sweep::SweepRequest {
         from,
         to,
         steps,
         together,
     };
-    let s = host_sim::studies::sweep::sweep(&scene, &path, &request, true)
-        .map_err(|e| e.to_string())?;
+    let s = host_sim::studies::sweep::sweep(&scene, &path, &request, !json)?;
+    let mut text = String::new();
     if let Some(dir) = out {
         let files = s.publish(name, &path, dir)?;
         if !json {
-            list(&files, "wrote");
+            text.push_str(&list(&files, "wrote"));
         }
     }
     if json {
-        print_json(&s)?;
+        text.push_str(&to_json(&s)?);
     } else {
-        println!(
-            "{:>10}  {:<10} {:<20} {:<10} {:>10}",
+        text.push_str(&format!(
+            "{:>10}  {:<10} {:<20} {:<10} {:>10}\n",
             "speed", "criterion", "core class", "simulated", "residual"
-        );
+        ));
         for p in &s.points {
             let mark = if p.regime_predicted == p.regime_simulated {
                 ""
             } else {
                 "  ≠"
             };
-            println!(
-                "{:>10.3}  {:<10} {:<20} {:<10} {:>10.2e}{mark}",
+            text.push_str(&format!(
+                "{:>10.3}  {:<10} {:<20} {:<10} {:>10.2e}{mark}\n",
                 p.speed,
                 p.regime_predicted,
                 p.regime_class,
                 p.regime_simulated,
                 p.residual_relative
-            );
+            ));
         }
         let agree = s
             .points
             .iter()
             .filter(|p| p.regime_predicted == p.regime_simulated)
             .count();
-        println!(
-            "agreement: {agree} of {} speeds; away from the characteristic speeds {} of {}",
+        text.push_str(&format!(
+            "agreement: {agree} of {} speeds; away from the characteristic speeds {} of {}\n",
             s.points.len(),
             s.agreeing,
             s.away_from_characteristic
-        );
+        ));
     }
-    Ok(())
+    write_out(&text)
 }
 
 fn criterion_cmd(
     machines: usize,
     seed: u64,
     json: bool,
-    out: Option<&std::path::Path>,
-) -> Result<(), String> {
-    let s = host_sim::studies::criterion::study(seed, machines, true).map_err(|e| e.to_string())?;
+    out: Option<&Path>,
+) -> Result<(), Failure> {
+    if let Some(dir) = out {
+        writable_dir("--out", dir)?;
+    }
+    let s = host_sim::studies::criterion::study(seed, machines, !json)?;
+    let mut text = String::new();
     if let Some(dir) = out {
         let files = host_sim::studies::criterion::publish(&s, dir)?;
         if !json {
-            list(&files, "wrote");
+            text.push_str(&list(&files, "wrote"));
         }
     }
     if json {
-        print_json(&s)?;
+        text.push_str(&to_json(&s)?);
     } else {
-        print!("{}", host_sim::studies::criterion::summary_text(&s));
+        text.push_str(&host_sim::studies::criterion::summary_text(&s));
     }
-    Ok(())
+    write_out(&text)
 }
 
-fn predict_cmd(name: &str, json: bool) -> Result<(), String> {
-    let (scene, path) = resolve(name).map_err(|e| e.to_string())?;
-    let p = predict(&scene, &path).map_err(|e| e.to_string())?;
+fn accuracy_cmd(out: &Path, target: bool) -> Result<(), Failure> {
+    writable_dir("--out", out)?;
+    let files = host_sim::studies::publish::accuracy(out, target)?;
+    write_out(&list(&files, "wrote"))
+}
+
+fn predict_cmd(name: &str, json: bool) -> Result<(), Failure> {
+    let (scene, path) = resolve(name)?;
+    let p = predict(&scene, &path)?;
+    if p.is_empty() {
+        return Err(Failure::Message(format!(
+            "{}: nothing to predict: the scene has no [motor] with [load] and [shaft], no \
+             [rotor] and no [[platform]] with [autobalancer]",
+            path.display()
+        )));
+    }
     if json {
-        print_json(&p)?;
+        write_out(&to_json(&p)?)
     } else {
-        println!("{}", host_sim::app::report::prediction_text(&p));
+        write_out(&format!("{}\n", host_sim::app::report::prediction_text(&p)))
     }
-    Ok(())
 }
 
-/// Prints `value` as pretty JSON on stdout.
-fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
+/// `value` as pretty JSON with a final newline.
+fn to_json<T: serde::Serialize>(value: &T) -> Result<String, Failure> {
     let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
-    println!("{text}");
-    Ok(())
+    Ok(text + "\n")
 }
 
-/// Prints one line per file written: `what path`.
-fn list(files: &[std::path::PathBuf], what: &str) {
-    for f in files {
-        println!("{what} {}", f.display());
-    }
+/// One line per file written: `what path`.
+fn list(files: &[PathBuf], what: &str) -> String {
+    files
+        .iter()
+        .map(|f| format!("{what} {}\n", f.display()))
+        .collect()
 }

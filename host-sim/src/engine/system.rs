@@ -514,6 +514,11 @@ pub trait Observer {
     fn edge(&mut self, edge: &Edge);
     /// Called after every step, after that step's edges.
     fn step(&mut self, _step: &StepView<'_>) {}
+    /// Asked after every step: `false` ends the run there (the observer keeps the reason; the
+    /// run returns its counters as usual).
+    fn proceed(&self) -> bool {
+        true
+    }
 }
 
 struct EdgeFn<F>(F);
@@ -618,7 +623,7 @@ impl Simulation {
     }
 
     /// Like [`Simulation::run`], also reporting every step to `observer` (for sampling the
-    /// state).
+    /// state); ends early when [`Observer::proceed`] says so.
     pub fn run_observed<O: Observer + ?Sized>(
         &mut self,
         duration: f64,
@@ -656,6 +661,9 @@ impl Simulation {
                 system: &self.system,
             };
             observer.step(&view);
+            if !observer.proceed() {
+                break;
+            }
         }
         Ok(self.stats())
     }

@@ -1,0 +1,279 @@
+//! Issue 16's findings on bad input, one test each: errors name the key as written and are
+//! raised before any simulation; no NaN or inf is printed; a run that measures nothing says
+//! so; work is bounded up front.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use host_sim::app::predict::predict;
+use host_sim::app::report::{prediction_text, run_text};
+use host_sim::app::run::{run, run_with, Overrides, RunOptions};
+use host_sim::app::scene::{Scene, BUNDLED};
+use std::path::Path;
+
+fn bundled(name: &str) -> &'static str {
+    BUNDLED
+        .iter()
+        .find(|(n, _)| n.strip_suffix(".toml") == Some(name))
+        .map(|(_, t)| *t)
+        .unwrap()
+}
+
+/// The error of `scene` with `from` replaced by `to` (parse, predict or run).
+fn error(scene: &str, from: &str, to: &str) -> String {
+    let text = bundled(scene);
+    assert!(text.contains(from), "{scene} has no `{from}`");
+    let text = text.replacen(from, to, 1);
+    let path = Path::new("bad.toml");
+    let s = match Scene::parse(&text, path) {
+        Ok(s) => s,
+        Err(e) => return e.to_string(),
+    };
+    if let Err(e) = predict(&s, path) {
+        return e.to_string();
+    }
+    match run(&s, path, Overrides::default()) {
+        Ok(_) => panic!("{scene} with `{to}` was accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_names(e: &str, want: &[&str]) {
+    for w in want {
+        assert!(e.contains(w), "`{w}` not in: {e}");
+    }
+    assert!(e.starts_with("bad.toml: "), "{e}");
+}
+
+#[test]
+fn errors_name_the_key_and_the_value_as_written() {
+    // Finding 3: these named another key, or only the table.
+    let e = error("one-mass", "housing_mass = 5.0", "housing_mass = 1e308");
+    assert_names(
+        &e,
+        &["`autobalancer.housing_mass = 1e308`", "allowed [0, 1e9] kg"],
+    );
+    let e = error(
+        "kneader",
+        "delta_limit = 0.06",
+        "delta_limit = 0.06\nmin_speed = 1e308",
+    );
+    assert_names(&e, &["`monitor.min_speed = 1e308`", "allowed"]);
+    let e = error(
+        "auger",
+        "speed = 60.0              # rad/s, prescribed",
+        "speed = nan",
+    );
+    assert_names(&e, &["`motor.speed = nan`", "allowed [-1e5, 1e5] rad/s"]);
+    let e = error("kneader", "lines = 1024", "lines = 1");
+    assert_names(&e, &["`encoder.lines = 1`", "allowed 2 to 8192"]);
+    // A value the ranges allow but the core's encoder refuses together with others: every key
+    // involved is quoted, the one changed among them.
+    let e = error(
+        "kneader",
+        "timer_hz = 84e6\n\n[monitor]\ndelta_limit = 0.06",
+        "timer_hz = 1e6\n\n[monitor]\ndelta_limit = 0.06\nmin_speed = 5e4",
+    );
+    assert_names(
+        &e,
+        &[
+            "`monitor.min_speed = 5e4`",
+            "`encoder.timer_hz = 1e6`",
+            "contradict",
+        ],
+    );
+    // Wrong types inside [motor] name the key, not only the table.
+    for (from, to, key) in [
+        (
+            "no_load_speed = 145.0",
+            "no_load_speed = \"fast\"",
+            "no_load_speed",
+        ),
+        (
+            "breakdown_torque = 158.0",
+            "breakdown_torque = [158.0]",
+            "breakdown_torque",
+        ),
+    ] {
+        let e = error("kneader", from, to);
+        assert!(e.contains("TOML parse error") && e.contains(key), "{e}");
+    }
+    let e = error(
+        "kneader",
+        "breakdown_speed = 36.0",
+        "breakdwon_speed = 36.0",
+    );
+    assert!(e.contains("breakdwon_speed"), "{e}");
+    let e = error(
+        "auger",
+        "speed = 60.0              # rad/s, prescribed",
+        "speed = 60.0\nbreakdown_torque = 1.0",
+    );
+    assert!(
+        e.contains("`motor.breakdown_torque` does not belong to model = \"speed\""),
+        "{e}"
+    );
+    // What used to end as "integration failed: step size underflow at t = 0" is refused up
+    // front, naming the key.
+    let e = error("one-mass", "atol = 1e-10", "atol = 1e-308");
+    assert_names(&e, &["`simulation.atol = 1e-308`", "not subnormal"]);
+    let e = error("one-mass", "rtol = 1e-8", "rtol = 1e-300");
+    assert_names(&e, &["`simulation.rtol = 1e-300`"]);
+}
+
+#[test]
+fn values_that_gave_nan_or_inf_results_are_refused_by_key() {
+    // Finding 5: platform mass ≥ 1e155 gave a NaN resonant speed, service_speed = 1e308 an
+    // infinite peak load.
+    let e = error("one-mass", "mass = 100.0 ", "mass = 1e155 ");
+    assert_names(&e, &["`platform[1].mass = 1e155`"]);
+    let e = error("three-mass", "mass = 150.0 ", "mass = 2e200 ");
+    assert_names(&e, &["`platform[3].mass = 2e200`"]);
+    let e = error("auger", "service_speed = 60.0", "service_speed = 1e308");
+    assert_names(&e, &["`rotor.service_speed = 1e308`"]);
+    let e = error("auger", "per_length = 400.0", "per_length = 2e48");
+    assert_names(&e, &["`process_load.per_length = 2e48`"]);
+    let e = error("auger", "grade = 6.3", "grade = 1.7e308");
+    assert_names(&e, &["`rotor.grade = 1.7e308`"]);
+    // At the ends of every range the results print as numbers.
+    for (scene, from, to) in [
+        ("one-mass", "mass = 100.0 ", "mass = 1e9 "),
+        ("one-mass", "stiffness = 4.0e5", "stiffness = 1e15"),
+        ("auger", "service_speed = 60.0", "service_speed = 1e5"),
+        ("auger", "per_length = 400.0", "per_length = 1e12"),
+        ("auger", "grade = 6.3", "grade = 1e4"),
+        ("auger", "amount = 2.0e-3", "amount = 1e6"),
+        (
+            "kneader",
+            "breakdown_torque = 158.0",
+            "breakdown_torque = 1e9",
+        ),
+    ] {
+        let text = bundled(scene).replacen(from, to, 1);
+        let s = Scene::parse(&text, Path::new("edge.toml")).unwrap();
+        match predict(&s, Path::new("edge.toml")) {
+            Ok(p) => {
+                let t = prediction_text(&p);
+                assert!(!t.contains("NaN") && !t.contains("inf"), "{to}: {t}");
+            }
+            Err(e) => assert!(e.to_string().contains(to.split(' ').next().unwrap()), "{e}"),
+        }
+    }
+}
+
+#[test]
+fn keys_a_scene_does_not_use_are_still_checked() {
+    // Finding 6: accepted because nothing read them.
+    let e = error(
+        "one-mass",
+        "kind = \"ball\"",
+        "kind = \"ball\"\npendulum_inertia = nan",
+    );
+    assert_names(&e, &["`autobalancer.pendulum_inertia = nan`"]);
+    let e = error(
+        "auger",
+        "timer_hz = 10e6",
+        "timer_hz = 10e6\nrunout_phase = inf",
+    );
+    assert_names(&e, &["`encoder.runout_phase = inf`"]);
+    let e = error(
+        "kneader",
+        "delta_limit = 0.06",
+        "delta_limit = 0.06\nregime_margin = nan",
+    );
+    assert_names(&e, &["`monitor.regime_margin = nan`"]);
+    let e = error(
+        "kneader",
+        "delta_limit = 0.06",
+        "delta_limit = 0.06\nwarning_fraction = -1",
+    );
+    assert_names(&e, &["`monitor.warning_fraction = -1`"]);
+    let e = error(
+        "kneader",
+        "timer_hz = 84e6",
+        "timer_hz = 84e6\nmissing = 255",
+    );
+    assert_names(
+        &e,
+        &[
+            "`encoder.missing = 255`",
+            "only with framing = \"missing-tooth\"",
+        ],
+    );
+    let e = error(
+        "kneader",
+        "timer_hz = 84e6",
+        "timer_hz = 84e6\njitter = 1e308",
+    );
+    assert_names(&e, &["`encoder.jitter = 1e308`", "allowed [0, 0.001] s"]);
+}
+
+#[test]
+fn a_run_that_measures_nothing_says_why_and_does_not_judge_the_supports_normal() {
+    // Finding 8: the measurement section was dropped silently and the supports were judged
+    // "normal" at the service speed whatever the simulation did.
+    let text = bundled("auger").replacen(
+        "speed = 60.0              # rad/s, prescribed",
+        "speed = -60.0",
+        1,
+    );
+    let s = Scene::parse(&text, Path::new("reverse.toml")).unwrap();
+    let r = run(&s, Path::new("reverse.toml"), Overrides::default()).unwrap();
+    let why = r.no_measurement.as_deref().unwrap();
+    assert!(why.contains("reverse"), "{why}");
+    let sup = r.supports.as_ref().unwrap();
+    assert_eq!(sup.speed, None);
+    assert_eq!(sup.load_level, ["unknown"; 2]);
+    assert_eq!(sup.simulated_reaction_level, Some(["normal"; 2]));
+    let text = run_text(&s, &r);
+    assert!(
+        text.contains("NOTHING MEASURED") && text.contains("NOT JUDGED"),
+        "{text}"
+    );
+    // Edges too jittery for the core: most rejected, no window; reactions over the limit are
+    // reported as over, not as normal.
+    let text = bundled("auger")
+        .replacen("timer_hz = 10e6", "timer_hz = 10e6\njitter = 1e-3", 1)
+        .replacen(
+            "support_load_limit = [8000.0, 8000.0]",
+            "support_load_limit = [2000.0, 8000.0]",
+            1,
+        );
+    let s = Scene::parse(&text, Path::new("jitter.toml")).unwrap();
+    let r = run(&s, Path::new("jitter.toml"), Overrides::default()).unwrap();
+    let why = r.no_measurement.as_deref().unwrap();
+    assert!(why.contains("rejected"), "{why}");
+    let sup = r.supports.as_ref().unwrap();
+    assert_eq!(sup.simulated_reaction_level, Some(["over", "normal"]));
+    // A bundled scene measures: no such note.
+    let s = Scene::parse(bundled("auger"), Path::new("auger.toml")).unwrap();
+    let r = run(&s, Path::new("auger.toml"), Overrides::default()).unwrap();
+    assert!(r.no_measurement.is_none());
+    assert!(r.supports.unwrap().speed.is_some());
+}
+
+#[test]
+fn work_is_bounded_before_simulating() {
+    // Finding 2: `duration = 1e308` was accepted and ran without end; `motor.speed = 1e308`
+    // looped forever; memory grew with the duration.
+    let e = error("kneader", "duration = 30.0", "duration = 1e308");
+    assert_names(&e, &["`simulation.duration = 1e308`", "allowed (0, 1e6] s"]);
+    let e = error(
+        "auger",
+        "speed = 60.0              # rad/s, prescribed",
+        "speed = 1e308",
+    );
+    assert_names(&e, &["`motor.speed = 1e308`"]);
+    // Within every range, the edges it would produce are over the limit: refused up front.
+    let e = error("auger", "duration = 5.0", "duration = 1e6");
+    assert_names(&e, &["`simulation.duration = 1e6`", "edges", "motor.speed"]);
+    // A long run without an encoder keeps no per-step trace: the regime is judged from
+    // reductions, not from 100 samples per simulated second.
+    let text = bundled("one-mass").replacen("duration = 40.0", "duration = 400.0", 1);
+    let s = Scene::parse(&text, Path::new("long.toml")).unwrap();
+    let options = RunOptions {
+        progress: false,
+        keep_windows: false,
+    };
+    let r = run_with(&s, Path::new("long.toml"), Overrides::default(), options).unwrap();
+    assert!(r.window_list.is_empty());
+    assert_eq!(r.regime_simulated, Some("balancing"));
+}
