@@ -32,9 +32,12 @@ pub const MAX_PATTERN_POSITIONS: u8 = 128;
 /// Most teeth a [`Pattern`] may have (its alignment search is a `u64` bit mask).
 pub const MAX_PATTERN_TEETH: usize = 64;
 /// Largest `K` of the `K`-edge speed estimator (the length of the timestamp ring).
-pub const MAX_SPAN: usize = 64;
+pub const MAX_SPAN: usize = 32;
 /// Angle units per grid position (one nominal pitch).
 pub const PITCH_UNITS: u32 = 1 << 16;
+
+// Ring and history indices are masked with these: they must be powers of two.
+const _: () = assert!(MAX_SPAN.is_power_of_two() && MAX_PATTERN_TEETH.is_power_of_two());
 
 /// A toothed wheel: teeth at some of `positions` equally spaced grid positions.
 ///
@@ -291,10 +294,14 @@ pub struct Encoder {
     k: u16,
     mask: u32,
     timeout: u32,
-    /// `accept` and its inverse as 0.32 fixed-point fractions: the band of the next interval
-    /// is `[prev·lo/2^32, prev + prev·hi/2^32]` for a tooth of the previous one's pitch.
+    /// The accept band as 0.32 fixed-point fractions of the sum of the last `K` intervals: its
+    /// lower end `1/(accept·K)` and half its width `(accept − 1/accept)/(2K)` (below 1 for
+    /// `accept` ≤ 2).
     band_lo: u32,
-    band_hi: u32,
+    band_half_width: u32,
+    /// The largest `K`-interval sum whose band stays within the timeout (above it the shaft
+    /// is near the minimum speed and every edge is judged carefully).
+    band_sum_max: u32,
     timer_hz: f32,
     /// Radians per angle unit.
     unit_rad: f32,
@@ -333,7 +340,8 @@ impl Encoder {
         mask: u32::MAX,
         timeout: 0,
         band_lo: 0,
-        band_hi: 0,
+        band_half_width: 0,
+        band_sum_max: 0,
         timer_hz: 0.0,
         unit_rad: 0.0,
         pattern: [0; MAX_PATTERN_TEETH],
@@ -445,8 +453,21 @@ impl Encoder {
             k,
             mask,
             timeout: libm::ceil(timeout) as u32,
-            band_lo: fraction_q32(1.0 / f64::from(t.accept)),
-            band_hi: fraction_q32(f64::from(t.accept) - 1.0),
+            band_lo: fraction_q32(1.0 / f64::from(t.accept) / f64::from(k)),
+            band_half_width: fraction_q32(
+                (f64::from(t.accept) - 1.0 / f64::from(t.accept)) / 2.0 / f64::from(k),
+            ),
+            // The band's top is mean·accept + 2 ticks at most: keep it at or below the timeout.
+            band_sum_max: {
+                let m = (libm::floor(timeout) - 4.0) * f64::from(k) / f64::from(t.accept);
+                if m <= 0.0 {
+                    0
+                } else if m >= f64::from(u32::MAX) {
+                    u32::MAX
+                } else {
+                    m as u32
+                }
+            },
             timer_hz: timer_hz as f32,
             unit_rad: (grid / f64::from(PITCH_UNITS)) as f32,
             pattern,
@@ -528,11 +549,26 @@ impl Encoder {
     pub fn uniform_span(&self) -> u32 {
         self.uniform_span
     }
-    /// Lower and upper fast-path band factors (0.32 fixed point; the upper one is the excess
-    /// over 1).
-    pub(crate) fn band(&self) -> (u32, u32) {
-        (self.band_lo, self.band_hi)
+    /// The accept band around the mean of the last `K` intervals, whose sum is `sum`:
+    /// `[mean/accept, mean·accept]`, widened by a tick each way for quantization, as
+    /// `(lo, width)` for the modular test `dt − lo ≤ width` (`lo` may wrap below 0 for one-tick
+    /// intervals: the test stays right). `None` near the minimum speed (a sum above
+    /// `band_sum_max`), where the band would reach past the timeout.
+    #[inline]
+    pub(crate) fn band(&self, sum: u32) -> Option<(u32, u32)> {
+        if sum > self.band_sum_max {
+            return None;
+        }
+        let lo = mul_hi(sum, self.band_lo).wrapping_sub(1);
+        let width = (mul_hi(sum, self.band_half_width) << 1).wrapping_add(3);
+        Some((lo, width))
     }
+}
+
+/// `(x·f) >> 32`: the high word of the 64-bit product, one instruction on a Cortex-M4.
+#[inline(always)]
+fn mul_hi(x: u32, f: u32) -> u32 {
+    ((u64::from(x) * u64::from(f)) >> 32) as u32
 }
 
 /// `x` (in `[0, 1)`) as a 0.32 fixed-point fraction.
@@ -827,7 +863,7 @@ mod tests {
             Some(ConfigError::OutOfRange("estimator.edges"))
         );
         assert_eq!(
-            with(&|c| c.estimator = Estimator::Edges(65)),
+            with(&|c| c.estimator = Estimator::Edges(33)),
             Some(ConfigError::OutOfRange("estimator.edges"))
         );
         assert_eq!(

@@ -169,11 +169,8 @@ pub struct WindowState {
     revs: u16,
     /// Sum of the window's intervals, ticks.
     ticks: u64,
-    samples: u32,
     start_edge: u32,
     start_ticks: u32,
-    last_edge: u32,
-    last_ticks: u32,
     max: Sample,
     min: Sample,
     /// Mean speed of the previous valid window (0 when none).
@@ -202,6 +199,13 @@ fn u64_to_f32(x: u64) -> f32 {
 }
 
 const NO_SAMPLE: Sample = Sample { span: 0, ticks: 0 };
+/// The extremes a window starts from: slower and faster than any sample (speed 0 and ∞), so
+/// the first sample replaces both without a separate first-sample test per edge.
+const SLOWEST: Sample = Sample {
+    span: 0,
+    ticks: u32::MAX,
+};
+const FASTEST: Sample = Sample { span: 1, ticks: 0 };
 
 impl WindowState {
     /// No window in progress.
@@ -210,11 +214,8 @@ impl WindowState {
             started: false,
             revs: 0,
             ticks: 0,
-            samples: 0,
             start_edge: 0,
             start_ticks: 0,
-            last_edge: 0,
-            last_ticks: 0,
             max: NO_SAMPLE,
             min: NO_SAMPLE,
             prev_mean: 0.0,
@@ -230,58 +231,60 @@ impl WindowState {
         self.started = true;
         self.revs = 0;
         self.ticks = 0;
-        self.samples = 0;
         self.start_edge = edge;
         self.start_ticks = ticks;
-        self.last_edge = edge;
-        self.last_ticks = ticks;
+        self.max = SLOWEST;
+        self.min = FASTEST;
     }
 
-    /// Takes one speed sample: integer compares, no division (the extremes are exact).
+    /// Takes one speed sample: integer compares, no division (the extremes are exact). With
+    /// `uniform` spans (every sample the same angle) only the tick counts are compared.
     #[inline(always)]
-    pub(crate) fn take(&mut self, s: Sample) {
-        // A window holds at most MAX_WINDOW_REVS·65535 < 2^26 edges: the count cannot wrap.
-        self.samples = self.samples.wrapping_add(1);
-        if self.samples == 1 {
-            self.max = s;
-            self.min = s;
-            return;
-        }
-        // Equal spans (a uniform disc) compare the tick counts; others the cross products,
-        // exact in 64 bits (spans ≤ 2^30, ticks < 2^32).
-        if s.span == self.max.span {
+    fn take(&mut self, s: Sample, uniform: bool) {
+        if uniform {
             if s.ticks < self.max.ticks {
                 self.max = s;
             }
-        } else if u64::from(s.span) * u64::from(self.max.ticks)
+            if s.ticks > self.min.ticks {
+                self.min = s;
+            }
+            return;
+        }
+        // Cross products, exact in 64 bits (spans ≤ 2^30, ticks < 2^32).
+        if u64::from(s.span) * u64::from(self.max.ticks)
             > u64::from(self.max.span) * u64::from(s.ticks)
         {
             self.max = s;
         }
-        if s.span == self.min.span {
-            if s.ticks > self.min.ticks {
-                self.min = s;
-            }
-        } else if u64::from(s.span) * u64::from(self.min.ticks)
+        if u64::from(s.span) * u64::from(self.min.ticks)
             < u64::from(self.min.span) * u64::from(s.ticks)
         {
             self.min = s;
         }
     }
 
-    /// Adds an ordinary tooth (not a frame) to the window in progress.
+    /// Adds an ordinary tooth (not a frame) of `dt` ticks with its sample to the window in
+    /// progress, if any: the per-edge work of a window. Every accepted edge of a running
+    /// window brings a sample (the `K`-edge ring is full whenever a window runs: a start is a
+    /// frame at least a revolution after any reset), so the window's samples are its edges.
     #[inline(always)]
-    pub(crate) fn add(&mut self, index: u32, time: u32, dt: u32, sample: Option<Sample>) {
+    pub(crate) fn add(&mut self, dt: u32, sample: Option<Sample>, uniform: bool) {
+        // Before a window starts this accumulates nothing that matters: a start resets it all.
         // Bounded like the sample count: the wrapping add is exact.
         self.ticks = self.ticks.wrapping_add(u64::from(dt));
-        self.last_edge = index;
-        self.last_ticks = time;
         if let Some(s) = sample {
-            self.take(s);
+            self.take(s, uniform);
         }
     }
 
-    fn measurement(&self, window: &Window, unit_rad: f32, timer_hz: f32, k: u16) -> Measurement {
+    fn measurement(
+        &self,
+        window: &Window,
+        end_edge: u32,
+        unit_rad: f32,
+        timer_hz: f32,
+        k: u16,
+    ) -> Measurement {
         let (a1, t1) = (u64::from(self.max.span), u64::from(self.max.ticks));
         let (a2, t2) = (u64::from(self.min.span), u64::from(self.min.ticks));
         // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1), from the
@@ -318,7 +321,8 @@ impl WindowState {
             0.0
         };
         // Mean ticks per K-edge sample: K times the mean interval of the window's edges.
-        let edges = self.last_edge.wrapping_sub(self.start_edge);
+        let edges = end_edge.wrapping_sub(self.start_edge);
+        let samples = edges;
         let noise_floor = if self.ticks > 0 && edges > 0 {
             2.0 * edges as f32 / (f32::from(k.max(1)) * u64_to_f32(self.ticks))
         } else {
@@ -333,23 +337,29 @@ impl WindowState {
             delta,
             spread,
             noise_floor,
-            samples: self.samples,
+            samples,
             steady,
         }
     }
 
-    fn report(&self, result: Result<Measurement, Fault>) -> WindowReport {
+    fn report(
+        &self,
+        end_edge: u32,
+        end_ticks: u32,
+        result: Result<Measurement, Fault>,
+    ) -> WindowReport {
         WindowReport {
             start_edge: self.start_edge,
-            end_edge: self.last_edge,
+            end_edge,
             start_ticks: self.start_ticks,
-            end_ticks: self.last_ticks,
+            end_ticks,
             revolutions: self.revs,
             result,
         }
     }
 
-    /// Feeds one accepted edge; returns a report when a window ends. `unit_rad`, `timer_hz` and `k` are the encoder's (see
+    /// Feeds one accepted edge; returns a report when a window ends. `uniform`: every sample
+    /// spans the same angle (a uniform disc at its nominal pitches). `unit_rad`, `timer_hz` and `k` are the encoder's (see
     /// [`crate::encoder::Encoder`]).
     pub fn on_tooth(
         &mut self,
@@ -358,6 +368,7 @@ impl WindowState {
         unit_rad: f32,
         timer_hz: f32,
         k: u16,
+        uniform: bool,
     ) -> Option<WindowReport> {
         if !tooth.synced {
             return None;
@@ -368,12 +379,12 @@ impl WindowState {
             }
             return None;
         }
-        self.add(tooth.index, tooth.time, tooth.dt, tooth.sample);
+        self.add(tooth.dt, tooth.sample, uniform);
         if tooth.frame {
             self.revs = self.revs.saturating_add(1);
             if self.revs >= window.revolutions {
-                let m = self.measurement(window, unit_rad, timer_hz, k);
-                let r = self.report(Ok(m));
+                let m = self.measurement(window, tooth.index, unit_rad, timer_hz, k);
+                let r = self.report(tooth.index, tooth.time, Ok(m));
                 self.prev_mean = m.omega_mean;
                 self.restart(tooth.index, tooth.time);
                 return Some(r);
@@ -382,14 +393,14 @@ impl WindowState {
         None
     }
 
-    /// Ends the window in progress as invalid with `fault`, found at `time`.
-    pub fn abort(&mut self, fault: Fault, time: u32) -> Option<WindowReport> {
+    /// Ends the window in progress as invalid with `fault`, found at `time` after the
+    /// accepted edge numbered `last_edge`.
+    pub fn abort(&mut self, fault: Fault, time: u32, last_edge: u32) -> Option<WindowReport> {
         let was = self.started;
         self.started = false;
         self.prev_mean = 0.0;
         if was {
-            self.last_ticks = time;
-            Some(self.report(Err(fault)))
+            Some(self.report(last_edge, time, Err(fault)))
         } else {
             None
         }
@@ -467,13 +478,14 @@ mod tests {
         ] {
             let mut st = WindowState::new();
             let span = 1 << 20;
-            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1e-6, 1e6, 16);
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1e-6, 1e6, 16, false);
             st.on_tooth(
                 &w,
                 &tooth(1, 1, 1, false, Some(Sample { span, ticks: t1 })),
                 1e-6,
                 1e6,
                 16,
+                false,
             );
             let r = st
                 .on_tooth(
@@ -482,6 +494,7 @@ mod tests {
                     1e-6,
                     1e6,
                     16,
+                    false,
                 )
                 .unwrap();
             let m = r.measurement().unwrap();
@@ -512,13 +525,14 @@ mod tests {
             let t = 1 + next() % (1 << 20);
             let m = 1 + next() % 1000;
             let mut st = WindowState::new();
-            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1.0e-5, 84e6, 1);
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1.0e-5, 84e6, 1, false);
             st.on_tooth(
                 &w,
                 &tooth(1, 1, t, false, Some(Sample { span: a, ticks: t })),
                 1.0e-5,
                 84e6,
                 1,
+                false,
             );
             let r = st
                 .on_tooth(
@@ -536,6 +550,7 @@ mod tests {
                     1.0e-5,
                     84e6,
                     1,
+                    false,
                 )
                 .unwrap();
             let m = r.measurement().unwrap();
@@ -548,7 +563,7 @@ mod tests {
     fn an_aborted_window_carries_its_span_and_no_numbers() {
         let w = window(4);
         let mut st = WindowState::new();
-        st.on_tooth(&w, &tooth(7, 100, 0, true, None), 1e-6, 1e6, 1);
+        st.on_tooth(&w, &tooth(7, 100, 0, true, None), 1e-6, 1e6, 1, false);
         st.on_tooth(
             &w,
             &tooth(
@@ -564,14 +579,15 @@ mod tests {
             1e-6,
             1e6,
             1,
+            false,
         );
-        let r = st.abort(Fault::Glitch, 250).unwrap();
+        let r = st.abort(Fault::Glitch, 250, 8).unwrap();
         assert_eq!(r.result, Err(Fault::Glitch));
         assert_eq!(
             (r.start_edge, r.end_edge, r.start_ticks, r.end_ticks),
             (7, 8, 100, 250)
         );
         assert!(r.measurement().is_none());
-        assert!(st.abort(Fault::Glitch, 260).is_none());
+        assert!(st.abort(Fault::Glitch, 260, 8).is_none());
     }
 }

@@ -81,6 +81,9 @@ pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
 /// the caller's window callback.
 struct Feed<'a, O: EdgeSink, F: FnMut(WindowOutcome)> {
     encoder: &'a Encoder,
+    uniform: bool,
+    /// Number of the last accepted edge (where an aborted window ends).
+    last_edge: u32,
     window: &'a Window,
     state: &'a mut WindowState,
     alarm: &'a mut Option<DeltaAlarm>,
@@ -93,6 +96,7 @@ impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
     #[inline(always)]
     fn tooth(&mut self, tooth: &Tooth) {
         self.observer.tooth(tooth);
+        self.last_edge = tooth.index;
         let e = self.encoder;
         if let Some(r) = self.state.on_tooth(
             self.window,
@@ -100,6 +104,7 @@ impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
             e.unit_rad(),
             e.timer_hz(),
             e.samples_span(),
+            self.uniform,
         ) {
             let o = finish(self.alarm, self.diag, r);
             (self.out)(o);
@@ -109,7 +114,7 @@ impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
     #[inline]
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
-        if let Some(r) = self.state.abort(fault, time) {
+        if let Some(r) = self.state.abort(fault, time, self.last_edge) {
             let o = finish(self.alarm, self.diag, r);
             (self.out)(o);
         }
@@ -313,15 +318,40 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     /// One encoder edge captured at `ticks` (raw counter value), with the direction if known.
     /// Returns a window when one ends (a second window ended by the same edge, which a late
     /// judgement can cause, is returned by the next call).
-    #[inline]
+    #[inline(always)]
     pub fn on_edge(&mut self, ticks: u32, direction: Option<Direction>) -> Option<WindowOutcome> {
         self.on_edge_observed(ticks, direction, &mut ())
     }
 
     /// [`DeltaMonitor::on_edge`], also telling `observer` every accepted tooth and fault (e.g.
     /// a [`crate::learn::ToothLearner`], or a recorder of per-edge decisions).
-    #[inline]
+    #[inline(always)]
     pub fn on_edge_observed<O: EdgeSink>(
+        &mut self,
+        ticks: u32,
+        direction: Option<Direction>,
+        observer: &mut O,
+    ) -> Option<WindowOutcome> {
+        if direction != Some(Direction::Reverse) {
+            // The fast path: an ordinary tooth never ends a window (and a window spilled to
+            // the next call keeps the fast path closed until it is returned).
+            let uniform = self.encoder.is_uniform() && P::NOMINAL;
+            if let Some(tooth) = self
+                .tracker
+                .try_fast(&self.encoder, &self.table, ticks, uniform)
+            {
+                observer.tooth(&tooth);
+                self.state.add(tooth.dt, tooth.sample, uniform);
+                return None;
+            }
+        }
+        self.slow_edge(ticks, direction, observer)
+    }
+
+    /// Everything but the fast path, out of line.
+    #[cold]
+    #[inline(never)]
+    fn slow_edge<O: EdgeSink>(
         &mut self,
         ticks: u32,
         direction: Option<Direction>,
@@ -330,7 +360,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         let mut first = self.spill.take();
         let spill = &mut self.spill;
         let mut feed = Feed {
+            last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
+            uniform: self.encoder.is_uniform() && P::NOMINAL,
             window: &self.window,
             state: &mut self.state,
             alarm: &mut self.alarm,
@@ -340,6 +372,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         };
         self.tracker
             .on_edge(&self.encoder, &self.table, ticks, direction, &mut feed);
+        if self.spill.is_some() {
+            self.tracker.block_fast();
+        }
         first
     }
 
@@ -362,7 +397,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             on_window(o);
         }
         let mut feed = Feed {
+            last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
+            uniform: self.encoder.is_uniform() && P::NOMINAL,
             window: &self.window,
             state: &mut self.state,
             alarm: &mut self.alarm,
@@ -370,14 +407,24 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             observer,
             out: on_window,
         };
+        let uniform = self.encoder.is_uniform() && P::NOMINAL;
         for &t in captures {
-            self.tracker.on_edge(
-                &self.encoder,
-                &self.table,
-                t,
-                Some(Direction::Forward),
-                &mut feed,
-            );
+            if let Some(tooth) = self
+                .tracker
+                .try_fast(&self.encoder, &self.table, t, uniform)
+            {
+                feed.observer.tooth(&tooth);
+                feed.state.add(tooth.dt, tooth.sample, uniform);
+            } else {
+                feed.last_edge = self.tracker.counters().accepted;
+                self.tracker.on_edge(
+                    &self.encoder,
+                    &self.table,
+                    t,
+                    Some(Direction::Forward),
+                    &mut feed,
+                );
+            }
         }
     }
 
@@ -386,7 +433,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         let mut first = self.spill.take();
         let spill = &mut self.spill;
         let mut feed = Feed {
+            last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
+            uniform: self.encoder.is_uniform() && P::NOMINAL,
             window: &self.window,
             state: &mut self.state,
             alarm: &mut self.alarm,

@@ -185,38 +185,50 @@ pub struct EdgeCounters {
 const PENDING: usize = 3;
 /// Index timestamps that may wait for their edge.
 const INDEXES: usize = 4;
+/// The band is refreshed after every this many intervals pushed (a power of two).
+pub(crate) const BAND_REFRESH: u32 = 16;
 /// Faults within one revolution after which the count is no longer trusted.
 const FAULTS_TO_RESYNC: u8 = 3;
 
 /// Per-edge state of the timing front end. Total: every input sequence is handled without
-/// panicking, and every path is O(1). Memory: about 340 bytes (the 64-slot interval ring).
+/// panicking, and every path is O(1). Memory: about 500 bytes (the 32-slot interval ring and
+/// the 64-tooth history of small wheels).
 #[derive(Debug, Clone)]
 pub struct SpeedTracker {
-    /// Everything the fast path needs holds (running, synced, ring full, nothing pending).
-    fast: bool,
     state: ShaftState,
     sync: SyncState,
     /// `last` is a time reference (an accepted or starting edge).
     has_ref: bool,
     last: u32,
-    /// Latest raw edge time (for timeouts while edges are pending).
+    /// Latest raw edge time while edges are pending (`last` otherwise).
     latest: u32,
-    /// The previous accepted interval scaled to one base pitch (0: none).
+    /// The previous accepted interval scaled to one base pitch (0: none), as of the last
+    /// careful acceptance (the fast path's intervals are the ring's newest).
     prev: u32,
-    /// Acceptance band of the next interval, ticks (valid when `fast`).
-    lo: u32,
-    hi: u32,
+    /// Edges accepted by the careful path, and the tooth it last accepted: the fast path
+    /// moves the tooth on without counting, so `accepted + (tooth − anchor)` is the count.
+    accepted: u32,
+    anchor: u16,
     /// Tooth of the last accepted edge.
     tooth: u16,
-    /// The fast path stops after this tooth: the next one is special.
+    /// The accept band of an ordinary interval, ticks: `[lo, lo + width]` (modular), around the
+    /// mean of the last `K` intervals as of the last refresh. It is refreshed when the fast path
+    /// opens and after every [`BAND_REFRESH`]-th interval pushed (a rule of the ring position
+    /// alone, so a batch of captures reproduces it exactly).
+    lo: u32,
+    width: u32,
+    /// The fast path stops after this tooth: the next one is special, or (`stop == tooth`)
+    /// something needs the careful path first (not running or synced, edges pending, an index
+    /// waiting, the ring not full).
     stop: u16,
-    /// Accepted edges since the last frame (or since the frame candidate).
+    /// Accepted edges since the frame candidate (kept while confirming an index frame).
     count: u16,
     /// Faults since the last frame.
     faults: u8,
-    /// The last `K` accepted intervals, ticks; `pos` is the oldest, `fill` how many are held.
+    /// The last accepted intervals, ticks, at `pos − 1`, `pos − 2`, … (modulo 64: `pos` runs
+    /// on and the index is masked); `fill` of them (at most `K`) belong to the current run.
     ring: [u32; MAX_SPAN],
-    pos: u8,
+    pos: u32,
     fill: u8,
     /// Their sum (exact: `K` intervals within the timeout fit in 32 bits) and the angle they
     /// span in units (kept only when pitches differ): the latest speed sample.
@@ -229,8 +241,13 @@ pub struct SpeedTracker {
     hist: [u32; MAX_PATTERN_TEETH],
     hist_teeth: u16,
     history: bool,
+    /// The last tooth's interval, written to `hist` only when the next tooth has been judged
+    /// against the previous revolution (tooth, per-base interval).
+    held: Option<(u16, u32)>,
     pending: [u32; PENDING],
     npend: u8,
+    /// `pending[0]` came with the fast path open and fell outside its band.
+    out_of_band: bool,
     index: [u32; INDEXES],
     nidx: u8,
     /// Pattern acquisition: alignments still possible for the last accepted edge (bit k:
@@ -248,12 +265,6 @@ impl Default for SpeedTracker {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// `(x·f) >> 32`: the high word of the 64-bit product, one instruction on a Cortex-M4.
-#[inline(always)]
-fn mul_hi(x: u32, f: u32) -> u32 {
-    ((u64::from(x) * u64::from(f)) >> 32) as u32
 }
 
 /// Squared natural log of `a/b` for tick counts known to ±1 tick: the ratio is taken at the
@@ -309,15 +320,16 @@ impl SpeedTracker {
     /// A tracker that has seen nothing yet.
     pub const fn new() -> Self {
         SpeedTracker {
-            fast: false,
             state: ShaftState::NoSignal,
             sync: SyncState::Searching,
             has_ref: false,
             last: 0,
             latest: 0,
             prev: 0,
+            accepted: 0,
+            anchor: 0,
             lo: 0,
-            hi: 0,
+            width: 0,
             tooth: 0,
             stop: 0,
             count: 0,
@@ -330,8 +342,10 @@ impl SpeedTracker {
             hist: [0; MAX_PATTERN_TEETH],
             hist_teeth: 0,
             history: false,
+            held: None,
             pending: [0; PENDING],
             npend: 0,
+            out_of_band: false,
             index: [0; INDEXES],
             nidx: 0,
             viable: 0,
@@ -376,13 +390,42 @@ impl SpeedTracker {
 
     /// The counters.
     pub fn counters(&self) -> EdgeCounters {
-        self.counters
+        EdgeCounters {
+            accepted: self.accepted_now(),
+            ..self.counters
+        }
+    }
+
+    /// Edges accepted so far: the careful path's count plus the fast path's teeth since.
+    #[inline(always)]
+    fn accepted_now(&self) -> u32 {
+        self.accepted
+            .wrapping_add(u32::from(self.tooth.wrapping_sub(self.anchor)))
+    }
+
+    /// Brings the careful path's bookkeeping up to date with what the fast path did: the
+    /// accepted count, and the previous interval (the ring's newest: fast teeth are ordinary
+    /// teeth, so their interval is per base pitch already).
+    fn settle(&mut self) {
+        if self.tooth != self.anchor {
+            self.accepted = self.accepted_now();
+            self.anchor = self.tooth;
+            self.prev = self.newest();
+        }
+    }
+
+    /// The newest interval in the ring.
+    fn newest(&self) -> u32 {
+        self.ring
+            .get(self.pos.wrapping_sub(1) as usize & (MAX_SPAN - 1))
+            .copied()
+            .unwrap_or(0)
     }
 
     /// The latest speed sample (the last `K` accepted intervals) while running; `None` before
     /// `K` intervals are known (and, on a pattern wheel, before the teeth are identified).
     pub fn recent_sample(&self, enc: &Encoder) -> Option<Sample> {
-        if self.state != ShaftState::Running || self.fill < enc.samples_span() as u8 {
+        if self.state != ShaftState::Running || u16::from(self.fill) < enc.samples_span() {
             return None;
         }
         if enc.framing() == Framing::Pattern && self.sync != SyncState::Synced {
@@ -438,7 +481,7 @@ impl SpeedTracker {
             *slot = t;
             self.nidx += 1;
         }
-        self.fast = false;
+        self.block_fast();
     }
 
     /// Checks for a timeout at time `now` (ticks). Call it at least once per counter period:
@@ -454,11 +497,18 @@ impl SpeedTracker {
         if self.state == ShaftState::NoSignal || enc.edges() == 0 {
             return;
         }
-        let elapsed = (now & enc.mask()).wrapping_sub(self.latest) & enc.mask();
+        let latest = if self.npend > 0 {
+            self.latest
+        } else {
+            self.last
+        };
+        let elapsed = (now & enc.mask()).wrapping_sub(latest) & enc.mask();
         if elapsed > enc.timeout_ticks() {
+            self.settle();
             self.flush(enc, table, sink);
             self.stop_running(now & enc.mask(), sink);
             self.has_ref = false;
+            self.update_fast(enc);
         }
     }
 
@@ -472,109 +522,78 @@ impl SpeedTracker {
         direction: Option<Direction>,
         sink: &mut S,
     ) {
-        let t = ticks & enc.mask();
-        let dt = t.wrapping_sub(self.last) & enc.mask();
-        if !self.fast
-            || direction == Some(Direction::Reverse)
-            || self.tooth == self.stop
-            || dt.wrapping_sub(self.lo) > self.hi.wrapping_sub(self.lo)
-        {
-            self.careful(enc, table, t, direction, sink);
-            return;
+        if direction != Some(Direction::Reverse) {
+            let uniform = enc.is_uniform() && P::NOMINAL;
+            if let Some(tooth) = self.try_fast(enc, table, ticks, uniform) {
+                sink.tooth(&tooth);
+                return;
+            }
         }
-        self.accept_fast(enc, table, t, dt, sink);
+        self.careful(enc, table, ticks & enc.mask(), direction, sink);
     }
 
-    /// The fast path's acceptance: the next tooth, ordinary pitch, inside the band.
+    /// The path nearly every edge takes: running and synced with nothing pending, the next
+    /// tooth an ordinary one, the interval within the accept band of the mean of the last `K`.
+    /// Accepts the edge and returns it (never a frame, always with a sample); `None`, with
+    /// nothing changed, when the edge needs the careful judgement. Integer arithmetic only, no
+    /// branch that can panic. `uniform`: every sample spans the same angle.
     #[inline(always)]
-    fn accept_fast<P: PitchTable, S: EdgeSink>(
+    pub(crate) fn try_fast<P: PitchTable>(
         &mut self,
         enc: &Encoder,
         table: &P,
-        t: u32,
-        dt: u32,
-        sink: &mut S,
-    ) {
-        let edges = enc.edges();
-        let tooth = if self.tooth + 1 >= edges {
-            0
-        } else {
-            self.tooth + 1
-        };
+        ticks: u32,
+        uniform: bool,
+    ) -> Option<Tooth> {
+        let mask = enc.mask();
+        let t = ticks & mask;
+        let dt = t.wrapping_sub(self.last) & mask;
+        if self.tooth == self.stop || dt.wrapping_sub(self.lo) > self.width {
+            return None;
+        }
+        let sum = self.sum;
+        // `stop` is at most the tooth before the frame (tooth 0 is always special), so the
+        // next tooth does not wrap.
+        let tooth = self.tooth.wrapping_add(1);
         self.tooth = tooth;
         self.last = t;
-        self.latest = t;
-        self.count = self.count.wrapping_add(1);
-        if self.history {
-            if let Some(h) = self.hist.get_mut(usize::from(tooth)) {
-                *h = dt;
-            }
+        // The ring is full on the fast path: the oldest of the last K intervals leaves the sum.
+        let k = enc.samples_span();
+        let pos = self.pos;
+        let oldest = self
+            .ring
+            .get(pos.wrapping_sub(u32::from(k)) as usize & (MAX_SPAN - 1))
+            .copied()
+            .unwrap_or(0);
+        if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
+            *slot = dt;
         }
-        self.set_band(enc, dt, tooth);
-        self.counters.accepted = self.counters.accepted.wrapping_add(1);
-        // The ring is full on the fast path: evict the oldest interval, add this one.
-        let k = usize::from(enc.samples_span());
-        let pos = usize::from(self.pos);
-        let oldest = match self.ring.get_mut(pos) {
-            Some(slot) => core::mem::replace(slot, dt),
-            None => dt,
-        };
-        self.pos = if pos + 1 >= k { 0 } else { (pos + 1) as u8 };
-        let ticks = self.sum.wrapping_add(dt).wrapping_sub(oldest);
+        let pos = pos.wrapping_add(1);
+        self.pos = pos;
+        let ticks = sum.wrapping_add(dt).wrapping_sub(oldest);
         self.sum = ticks;
-        let span = if enc.is_uniform() && P::NOMINAL {
+        if pos & (BAND_REFRESH - 1) == 0 {
+            self.refresh_band(enc);
+        }
+        let span = if uniform {
             enc.uniform_span()
         } else {
-            let out = tooth_back(tooth, k as u16, edges);
+            let out = tooth_back(tooth, k, enc.edges());
             self.span = self
                 .span
                 .wrapping_add(self.pitch(enc, table, tooth))
                 .wrapping_sub(self.pitch(enc, table, out));
             self.span
         };
-        sink.tooth(&Tooth {
-            index: self.counters.accepted,
+        Some(Tooth {
+            index: self.accepted_now(),
             time: t,
             dt,
             tooth,
             synced: true,
             frame: false,
             sample: Some(Sample { span, ticks }),
-        });
-    }
-
-    /// Sets the acceptance band of the next interval from this one (`per_base`: scaled to a
-    /// base pitch), which ended at `tooth`: around this interval, or around the swing the next
-    /// tooth had one revolution earlier when that is known.
-    #[inline(always)]
-    fn set_band(&mut self, enc: &Encoder, per_base: u32, tooth: u16) {
-        let (lo, hi) = enc.band();
-        self.prev = per_base;
-        let expected = if self.history {
-            self.expected_after(enc, per_base, tooth)
-        } else {
-            per_base
-        };
-        // ±1 tick of quantization on both counts.
-        self.lo = mul_hi(expected, lo).saturating_sub(1);
-        self.hi = expected
-            .saturating_add(mul_hi(expected, hi))
-            .saturating_add(1)
-            .min(enc.timeout_ticks());
-    }
-
-    /// The per-base interval expected after one of `per_base` ending at `tooth`, from the
-    /// recorded revolution.
-    #[inline]
-    fn expected_after(&self, enc: &Encoder, per_base: u32, tooth: u16) -> u32 {
-        let next = tooth_after(tooth, 1, enc.edges());
-        let here = self.hist.get(usize::from(tooth)).copied().unwrap_or(0);
-        let there = self.hist.get(usize::from(next)).copied().unwrap_or(0);
-        if here == 0 {
-            return per_base;
-        }
-        let e = u64::from(per_base) * u64::from(there) / u64::from(here);
-        u32::try_from(e).unwrap_or(u32::MAX)
+        })
     }
 
     /// The swing tooth `to` had against tooth `from` one revolution earlier (1 without a
@@ -597,11 +616,13 @@ impl SpeedTracker {
         if usize::from(enc.edges()) > MAX_PATTERN_TEETH {
             return;
         }
-        if let Some(h) = self.hist.get_mut(usize::from(tooth)) {
-            *h = per_base;
-            self.hist_teeth = self.hist_teeth.saturating_add(1);
-            if self.hist_teeth >= enc.edges() {
-                self.history = true;
+        if let Some((k, v)) = self.held.replace((tooth, per_base)) {
+            if let Some(h) = self.hist.get_mut(usize::from(k)) {
+                *h = v;
+                self.hist_teeth = self.hist_teeth.saturating_add(1);
+                if self.hist_teeth >= enc.edges() {
+                    self.history = true;
+                }
             }
         }
     }
@@ -618,11 +639,28 @@ impl SpeedTracker {
         direction: Option<Direction>,
         sink: &mut S,
     ) {
-        self.fast = false;
         if enc.edges() == 0 {
             // An unconfigured monitor ignores everything.
             return;
         }
+        self.settle();
+        // With the fast path open, an ordinary edge comes here only from outside its band.
+        let open = self.stop != self.tooth;
+        self.block_fast();
+        self.judge_edge(enc, table, t, open, direction, sink);
+        // Whatever happened, the fast path opens again only where it may.
+        self.update_fast(enc);
+    }
+
+    fn judge_edge<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        t: u32,
+        open: bool,
+        direction: Option<Direction>,
+        sink: &mut S,
+    ) {
         if direction == Some(Direction::Reverse) {
             self.flush(enc, table, sink);
             if self.state == ShaftState::Running {
@@ -645,7 +683,12 @@ impl SpeedTracker {
             self.index_at_reference(enc, t);
             return;
         }
-        let since_latest = t.wrapping_sub(self.latest) & enc.mask();
+        let latest = if self.npend > 0 {
+            self.latest
+        } else {
+            self.last
+        };
+        let since_latest = t.wrapping_sub(latest) & enc.mask();
         if since_latest > enc.timeout_ticks() {
             // Too long since the last edge: whatever was pending is judged as it stands, and
             // this edge is a new time reference.
@@ -667,6 +710,9 @@ impl SpeedTracker {
             return;
         }
         if let Some(slot) = self.pending.get_mut(usize::from(self.npend)) {
+            if self.npend == 0 {
+                self.out_of_band = open;
+            }
             *slot = t;
             self.npend += 1;
         }
@@ -721,10 +767,10 @@ impl SpeedTracker {
                 }
             }
         }
-        self.update_fast(enc);
     }
 
     fn pop(&mut self) {
+        self.out_of_band = false;
         self.pending.copy_within(1.., 0);
         self.npend = self.npend.saturating_sub(1);
     }
@@ -778,7 +824,14 @@ impl SpeedTracker {
         }
         let special = synced && self.is_special(enc, next);
         let accept = tol.accept;
-        let in_band = x + 1.0 >= (expected - 1.0) / accept && x - 1.0 <= (expected + 1.0) * accept;
+        // An ordinary tooth's band is the fast path's own, so both judge alike.
+        // An ordinary edge that fell outside the fast path's band is judged with what follows,
+        // so a batch of captures and edge-by-edge calls decide alike.
+        let in_band = if self.out_of_band {
+            false
+        } else {
+            x + 1.0 >= (expected - 1.0) / accept && x - 1.0 <= (expected + 1.0) * accept
+        };
         // In the band an ordinary tooth is taken at once, and so is the frame of an index disc
         // when its index pulse is there (the count is checked on acceptance) or of an unframed
         // one; a pattern's special teeth are always judged with what follows.
@@ -984,7 +1037,6 @@ impl SpeedTracker {
         sink: &mut S,
     ) {
         self.accept(enc, table, t, true, sink);
-        self.update_fast(enc);
     }
 
     /// Accepts the edge at `t` as the tooth after the current one (or as framed by an index).
@@ -1117,12 +1169,13 @@ impl SpeedTracker {
             self.record(enc, tooth, per_base);
         }
         if had_ref {
-            self.set_band(enc, per_base, tooth);
+            self.prev = per_base;
         }
         self.last = t;
-        self.counters.accepted = self.counters.accepted.wrapping_add(1);
+        self.accepted = self.accepted.wrapping_add(1);
+        self.anchor = tooth;
         sink.tooth(&Tooth {
-            index: self.counters.accepted,
+            index: self.accepted,
             time: t,
             dt,
             tooth,
@@ -1130,9 +1183,6 @@ impl SpeedTracker {
             frame,
             sample,
         });
-        if synced {
-            self.stop = self.stop_after(enc, tooth);
-        }
     }
 
     /// Counts a missing frame for every three revolutions' worth of edges searched without one
@@ -1246,15 +1296,28 @@ impl SpeedTracker {
         }
     }
 
-    /// Recomputes whether the next edge may take the fast path.
+    /// Recomputes where the fast path must stop.
     fn update_fast(&mut self, enc: &Encoder) {
-        self.fast = self.state == ShaftState::Running
+        let fast = self.state == ShaftState::Running
             && self.sync == SyncState::Synced
             && self.has_ref
             && self.prev != 0
             && self.npend == 0
             && self.nidx == 0
-            && usize::from(self.fill) >= usize::from(enc.samples_span());
+            && !self.history
+            && u16::from(self.fill) >= enc.samples_span();
+        self.stop = if fast {
+            self.refresh_band(enc);
+            self.stop_after(enc, self.tooth)
+        } else {
+            self.tooth
+        };
+    }
+
+    /// The next edge takes the careful path.
+    #[inline]
+    pub(crate) fn block_fast(&mut self) {
+        self.stop = self.tooth;
     }
 
     /// The running shaft stopped (a timeout): count it once, lose sync.
@@ -1265,7 +1328,7 @@ impl SpeedTracker {
             self.lose_sync(false);
         }
         self.state = ShaftState::Standstill;
-        self.fast = false;
+        self.block_fast();
     }
 
     /// `t` is a new time reference: no interval, nothing pending.
@@ -1275,7 +1338,8 @@ impl SpeedTracker {
         self.latest = t;
         self.prev = 0;
         self.npend = 0;
-        self.fast = false;
+        self.out_of_band = false;
+        self.block_fast();
         self.acq = [0; 2];
         self.forget_history();
         self.reset_ring();
@@ -1298,18 +1362,20 @@ impl SpeedTracker {
         dt: u32,
     ) -> Option<Sample> {
         let k = enc.samples_span();
-        let pos = usize::from(self.pos);
-        let oldest = match self.ring.get_mut(pos) {
-            Some(slot) => core::mem::replace(slot, dt),
-            None => dt,
-        };
-        self.pos = if pos + 1 >= usize::from(k) {
-            0
-        } else {
-            (pos + 1) as u8
-        };
+        let pos = self.pos;
+        let oldest = self
+            .ring
+            .get(pos.wrapping_sub(u32::from(k)) as usize & (MAX_SPAN - 1))
+            .copied()
+            .unwrap_or(0);
+        if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
+            *slot = dt;
+        }
+        let pos = pos.wrapping_add(1);
+        self.pos = pos;
         let uniform = enc.is_uniform() && P::NOMINAL;
-        if self.fill >= k as u8 {
+        let refresh = pos & (BAND_REFRESH - 1) == 0;
+        if u16::from(self.fill) >= k {
             self.sum = self.sum.wrapping_add(dt).wrapping_sub(oldest);
             if !uniform {
                 let out = tooth_back(tooth, k, enc.edges());
@@ -1319,14 +1385,17 @@ impl SpeedTracker {
                     .wrapping_sub(self.pitch(enc, table, out));
             }
         } else {
-            self.fill += 1;
+            self.fill = self.fill.saturating_add(1);
             self.sum = self.sum.wrapping_add(dt);
             if !uniform {
                 self.span = self.span.wrapping_add(self.pitch(enc, table, tooth));
             }
-            if self.fill < k as u8 {
+            if u16::from(self.fill) < k {
                 return None;
             }
+        }
+        if refresh {
+            self.refresh_band(enc);
         }
         let span = if uniform {
             enc.uniform_span()
@@ -1337,6 +1406,21 @@ impl SpeedTracker {
             span,
             ticks: self.sum,
         })
+    }
+
+    /// Sets the band around the mean of the last `K` intervals (when the ring is full; an
+    /// empty band otherwise, and near the minimum speed, so nothing but the careful path
+    /// takes an edge).
+    #[inline]
+    pub(crate) fn refresh_band(&mut self, enc: &Encoder) {
+        let (lo, width) = if u16::from(self.fill) >= enc.samples_span() {
+            enc.band(self.sum)
+        } else {
+            None
+        }
+        .unwrap_or((u32::MAX, 0));
+        self.lo = lo;
+        self.width = width;
     }
 
     /// Teeth are no longer identified.
@@ -1351,7 +1435,7 @@ impl SpeedTracker {
         self.count = 0;
         self.faults = 0;
         self.searched = 0;
-        self.fast = false;
+        self.block_fast();
         self.forget_history();
         self.reset_ring();
     }
@@ -1359,6 +1443,7 @@ impl SpeedTracker {
     fn forget_history(&mut self) {
         self.hist_teeth = 0;
         self.history = false;
+        self.held = None;
     }
 }
 

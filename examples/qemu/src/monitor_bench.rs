@@ -1,10 +1,18 @@
 //! The irregularity monitor on the target: a pulse sequence of known δ through the public API,
-//! what the core reports, checks on it, and instructions per encoder edge.
+//! what the core reports, checks on it, and what it costs per edge, in RAM and in stack.
 //!
 //! The sequence is the capture timestamps of a 1024-line disc (index framing, 84 MHz 32-bit
 //! timer) on a shaft running ω(φ) = ω̄·(1 + ε·sin(φ/8)) with ω̄ = 134 rad/s: a load cycle of
 //! 8 revolutions like the seed's kneader, and δ = 2ε exactly. Timestamps are generated in f64
-//! (midpoint rule per pitch, error far below one tick) before anything is measured.
+//! (midpoint rule per pitch, error far below one tick) before anything is measured. The index
+//! pulse of each revolution is reported (with its timestamp, one tick before the revolution's
+//! first edge) before that revolution's edges, as an index capture interrupt would.
+//!
+//! Lines printed (the names are a contract, `docs/accuracy.md` quotes them):
+//! `bench monitor::on_edge`, `bench monitor::on_edge+learner`, `bench monitor::on_captures/64`
+//! (instructions per edge), `bench monitor::window_finish` (per window),
+//! `memory: DeltaMonitor<1024>`, `memory: DeltaMonitor<1024>+learner` (bytes),
+//! `stack: construct` (bytes).
 
 use core::hint::black_box;
 
@@ -12,20 +20,27 @@ use cortex_m_semihosting::hprintln;
 use drive_monitor::alarm::AlarmConfig;
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, MAX_WINDOW_REVS};
+use drive_monitor::learn::ToothLearner;
 use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::pitch::Corrected;
 use drive_monitor::speed::Direction;
 
 use crate::bench::ensure;
 use crate::icount;
 
 const LINES: u16 = 1024;
+const PER_REV: usize = LINES as usize;
 const TIMER_HZ: f64 = 84e6;
 const REVS: usize = 8 * 5 + 2;
-const EDGES: usize = LINES as usize * REVS;
+const EDGES: usize = PER_REV * REVS;
 const EPS: f64 = 0.015;
 const OMEGA: f64 = 134.0;
+/// Captures per batch, as half of a 128-entry DMA ring delivers them.
+const BATCH: usize = 64;
 
-fn generate(ticks: &mut [u32; EDGES]) {
+type Ticks = [u32; EDGES];
+
+fn generate(ticks: &mut Ticks) {
     let pitch = core::f64::consts::TAU / f64::from(LINES);
     let mut t = 0.0f64;
     for (i, slot) in ticks.iter_mut().enumerate() {
@@ -35,41 +50,63 @@ fn generate(ticks: &mut [u32; EDGES]) {
     }
 }
 
-fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
+fn encoder_config(k: u16) -> EncoderConfig {
     let mut c = EncoderConfig::indexed(LINES, TIMER_HZ);
     c.estimator = Estimator::Edges(k);
     c.min_speed = 10.0;
-    let Ok(enc) = Encoder::new(c) else {
-        crate::bench::fail(format_args!("encoder config rejected"));
-    };
-    let w = WindowConfig {
+    c
+}
+
+fn window(revs: u16) -> WindowConfig {
+    WindowConfig {
         length: WindowLength::Revolutions(revs),
         steady_tolerance: 0.02,
-    };
-    match DeltaMonitor::new(enc, w, Some(AlarmConfig::new(0.06))) {
+    }
+}
+
+fn encoder(k: u16) -> Encoder {
+    match Encoder::new(encoder_config(k)) {
+        Ok(e) => e,
+        Err(e) => crate::bench::fail(format_args!("encoder config rejected: {}", e)),
+    }
+}
+
+fn monitor(k: u16, revs: u16) -> DeltaMonitor<1024> {
+    match DeltaMonitor::new(encoder(k), window(revs), Some(AlarmConfig::new(0.06))) {
         Ok(m) => m,
         Err(e) => crate::bench::fail(format_args!("monitor config rejected: {}", e)),
     }
 }
 
-/// Feeds the stream (index pulse before every tooth 0); returns (instructions, windows).
+/// The index capture of revolution `rev`: one tick before its first edge.
+fn index_of(ticks: &Ticks, rev: usize) -> u32 {
+    ticks
+        .get(rev * PER_REV)
+        .copied()
+        .unwrap_or(0)
+        .wrapping_sub(1)
+}
+
+/// Feeds the stream edge by edge; returns (instructions, windows).
 #[inline(never)]
-fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32; EDGES], print: bool) -> (u64, u32) {
+fn feed(m: &mut DeltaMonitor<1024>, ticks: &Ticks, print: bool) -> (u64, u32) {
     let mut windows = 0;
     let start = icount::instructions();
-    for (i, &t) in ticks.iter().enumerate() {
-        if i % LINES as usize == 0 {
-            m.on_index(t.wrapping_sub(1));
-        }
-        if let Some(o) = black_box(m.on_edge(black_box(t), Some(Direction::Forward))) {
-            windows += 1;
-            if print {
-                match o.report.measurement() {
-                    Some(r) => hprintln!(
-                        "window: delta {:.6} omega max {:.3} min {:.3} mean {:.3} floor {:.1e} steady {}",
-                        r.delta, r.omega_max, r.omega_min, r.omega_mean, r.noise_floor, r.steady
-                    ),
-                    None => hprintln!("window: invalid {:?}", o.report.fault()),
+    for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+        m.on_index(index_of(ticks, rev));
+        for &t in edges {
+            // Only the outcome's presence is looked at in the timed passes, as a caller that
+            // acts on windows would (the report itself is read when one is there).
+            if let Some(o) = m.on_edge(black_box(t), Some(Direction::Forward)) {
+                windows += 1;
+                if print {
+                    match o.report.measurement() {
+                        Some(r) => hprintln!(
+                            "window: delta {:.6} omega max {:.3} min {:.3} mean {:.3} floor {:.1e} steady {}",
+                            r.delta, r.omega_max, r.omega_min, r.omega_mean, r.noise_floor, r.steady
+                        ),
+                        None => hprintln!("window: invalid {:?}", o.report.fault()),
+                    }
                 }
             }
         }
@@ -77,15 +114,65 @@ fn feed(m: &mut DeltaMonitor<1024>, ticks: &[u32; EDGES], print: bool) -> (u64, 
     (icount::instructions() - start, windows)
 }
 
-/// The same loop without the monitor: what the loop itself costs.
+/// [`feed`] with a learner watching every tooth.
 #[inline(never)]
-fn feed_empty(ticks: &[u32; EDGES]) -> u64 {
+fn feed_learning(
+    m: &mut DeltaMonitor<1024>,
+    learner: &mut ToothLearner<1024>,
+    ticks: &Ticks,
+) -> (u64, u32) {
+    let mut windows = 0;
     let start = icount::instructions();
-    for (i, &t) in ticks.iter().enumerate() {
-        if i % LINES as usize == 0 {
-            black_box(());
+    for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+        m.on_index(index_of(ticks, rev));
+        for &t in edges {
+            if m.on_edge_observed(black_box(t), Some(Direction::Forward), learner)
+                .is_some()
+            {
+                windows += 1;
+            }
         }
-        black_box(black_box(t));
+    }
+    (icount::instructions() - start, windows)
+}
+
+/// The same loops without the monitor: what they cost themselves.
+#[inline(never)]
+fn feed_empty(ticks: &Ticks) -> u64 {
+    let start = icount::instructions();
+    for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+        black_box(index_of(ticks, rev));
+        for &t in edges {
+            black_box(t);
+        }
+    }
+    icount::instructions() - start
+}
+
+/// Feeds the stream in batches of [`BATCH`] captures, the index pulse reported before the batch
+/// holding its edge; returns (instructions, windows).
+#[inline(never)]
+fn feed_batches(m: &mut DeltaMonitor<1024>, ticks: &Ticks) -> (u64, u32) {
+    let mut windows = 0;
+    let start = icount::instructions();
+    for (b, batch) in ticks.chunks_exact(BATCH).enumerate() {
+        if (b * BATCH) % PER_REV == 0 {
+            m.on_index(index_of(ticks, b * BATCH / PER_REV));
+        }
+        m.on_captures(black_box(batch), |_| windows += 1);
+    }
+    (icount::instructions() - start, windows)
+}
+
+/// The batch loop without the monitor.
+#[inline(never)]
+fn feed_batches_empty(ticks: &Ticks) -> u64 {
+    let start = icount::instructions();
+    for (b, batch) in ticks.chunks_exact(BATCH).enumerate() {
+        if (b * BATCH) % PER_REV == 0 {
+            black_box(index_of(ticks, b * BATCH / PER_REV));
+        }
+        black_box(batch);
     }
     icount::instructions() - start
 }
@@ -109,31 +196,28 @@ fn timed_edge(m: &mut DeltaMonitor<1024>, t: u32) -> (u64, bool) {
 /// one revolution (every frame edge once the first window has started ends one) and
 /// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in
 /// both; the cost is the mean difference over the edges that ended a window.
-///
-/// Differencing whole streams with short and long windows instead would also count per-sample
-/// work that the window length changes: the running extremes move far more often in short
-/// windows (on this stream ~250 more extremum updates per one-revolution window than in
-/// eight-revolution windows), each a few instructions on the per-edge path.
 #[inline(never)]
-fn window_finish(ticks: &[u32; EDGES]) -> (u64, u32) {
+fn window_finish(ticks: &Ticks) -> (u64, u32) {
     let (mut with, mut without, mut n) = (0u64, 0u64, 0u32);
     for _ in 0..FINISH_PASSES {
         let mut short = monitor(16, 1);
         let mut long = monitor(16, MAX_WINDOW_REVS);
-        for (i, &t) in ticks.iter().enumerate() {
-            if i % LINES as usize == 0 {
-                short.on_index(t.wrapping_sub(1));
-                long.on_index(t.wrapping_sub(1));
-                let (a, ended) = timed_edge(&mut short, t);
-                let (b, ended_long) = timed_edge(&mut long, t);
-                if ended && !ended_long {
-                    with += a;
-                    without += b;
-                    n += 1;
+        for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+            short.on_index(index_of(ticks, rev));
+            long.on_index(index_of(ticks, rev));
+            for (i, &t) in edges.iter().enumerate() {
+                if i == 0 {
+                    let (a, ended) = timed_edge(&mut short, t);
+                    let (b, ended_long) = timed_edge(&mut long, t);
+                    if ended && !ended_long {
+                        with += a;
+                        without += b;
+                        n += 1;
+                    }
+                } else {
+                    black_box(short.on_edge(black_box(t), Some(Direction::Forward)));
+                    black_box(long.on_edge(black_box(t), Some(Direction::Forward)));
                 }
-            } else {
-                black_box(short.on_edge(black_box(t), Some(Direction::Forward)));
-                black_box(long.on_edge(black_box(t), Some(Direction::Forward)));
             }
         }
     }
@@ -141,8 +225,28 @@ fn window_finish(ticks: &[u32; EDGES]) -> (u64, u32) {
     ((d + u64::from(n) / 2) / u64::from(n.max(1)), n)
 }
 
+/// Stack used to configure a monitor held in a `static`, in place.
+fn construct_stack() -> usize {
+    let Some(m) = cortex_m::singleton!(: DeltaMonitor<1024> = DeltaMonitor::unconfigured()) else {
+        crate::bench::fail(format_args!("monitor static taken twice"));
+    };
+    let used = crate::stack::used_by(|| {
+        let r = m.configure_from(
+            black_box(encoder_config(16)),
+            black_box(window(8)),
+            black_box(Some(AlarmConfig::new(0.06))),
+        );
+        ensure!(r.is_ok(), "configuring in place failed: {:?}", r);
+    });
+    ensure!(
+        m.encoder().edges() == LINES,
+        "configured monitor has the wrong disc"
+    );
+    used
+}
+
 pub fn run() {
-    let Some(ticks) = cortex_m::singleton!(: [u32; EDGES] = [0; EDGES]) else {
+    let Some(ticks) = cortex_m::singleton!(: Ticks = [0; EDGES]) else {
         crate::bench::fail(format_args!("edge buffer taken twice"));
     };
     generate(ticks);
@@ -152,15 +256,27 @@ pub fn run() {
         REVS,
         2.0 * EPS
     );
-    let empty = feed_empty(ticks);
     hprintln!(
         "memory: DeltaMonitor<1024> {} bytes",
         core::mem::size_of::<DeltaMonitor<1024>>()
     );
+    hprintln!(
+        "memory: DeltaMonitor<1024,Corrected<1024>> {} bytes",
+        core::mem::size_of::<DeltaMonitor<1024, Corrected<1024>>>()
+    );
+    hprintln!(
+        "memory: DeltaMonitor<1024>+learner {} bytes",
+        core::mem::size_of::<DeltaMonitor<1024, Corrected<1024>>>()
+            + core::mem::size_of::<ToothLearner<1024>>()
+    );
+    hprintln!("stack: construct {} bytes", construct_stack());
 
     // The report, with 16-edge speed samples and 8-revolution windows (printed in a pass of
     // its own, so formatting stays out of the measured passes).
     feed(&mut monitor(16, 8), ticks, true);
+    let empty = feed_empty(ticks);
+    let per_edge =
+        |total: u64, empty: u64| (total.saturating_sub(empty) + EDGES as u64 / 2) / EDGES as u64;
     let mut m = monitor(16, 8);
     let (total16, windows) = feed(&mut m, ticks, false);
     let d = m.diagnostics();
@@ -175,24 +291,63 @@ pub fn run() {
         d
     );
     ensure!(
-        d.edges.glitches == 0 && d.edges.missing == 0,
+        d.edges.glitches == 0 && d.edges.missing == 0 && d.edges.missing_frames == 0,
         "unexpected faults {:?}",
         d
     );
-
     // Instructions per edge, amortised over the stream (windows included).
-    let per_edge = |total: u64| (total.saturating_sub(empty) + EDGES as u64 / 2) / EDGES as u64;
     hprintln!(
         "bench {:<28} {:>7}",
-        "monitor::on_edge k=16",
-        per_edge(total16)
+        "monitor::on_edge",
+        per_edge(total16, empty)
     );
-    let mut m1 = monitor(1, 8);
-    let (total1, _) = feed(&mut m1, ticks, false);
+    let (total1, _) = feed(&mut monitor(1, 8), ticks, false);
     hprintln!(
         "bench {:<28} {:>7}",
         "monitor::on_edge k=1",
-        per_edge(total1)
+        per_edge(total1, empty)
+    );
+
+    // With the learner watching (a per-tooth correction being learned).
+    let mut learning = monitor(16, 8);
+    let Some(learner) = cortex_m::singleton!(: Option<ToothLearner<1024>> = None) else {
+        crate::bench::fail(format_args!("learner taken twice"));
+    };
+    let Ok(l) = ToothLearner::new(learning.encoder(), 0.01) else {
+        crate::bench::fail(format_args!("learner rejected"));
+    };
+    let learner = learner.insert(l);
+    let (total_learning, learned_windows) = feed_learning(&mut learning, learner, ticks);
+    ensure!(
+        learned_windows == 5,
+        "learning changed the windows: {}",
+        learned_windows
+    );
+    ensure!(
+        learner.revolutions() >= 25,
+        "the learner folded only {} revolutions",
+        learner.revolutions()
+    );
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "monitor::on_edge+learner",
+        per_edge(total_learning, empty)
+    );
+
+    // In batches, as a DMA half-buffer delivers them: the same windows, edge for edge.
+    let mut batched = monitor(16, 8);
+    let (total_batches, batch_windows) = feed_batches(&mut batched, ticks);
+    let empty_batches = feed_batches_empty(ticks);
+    ensure!(
+        batch_windows == 5 && batched.diagnostics() == m.diagnostics(),
+        "batches differ from edge by edge: {:?} vs {:?}",
+        batched.diagnostics(),
+        m.diagnostics()
+    );
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "monitor::on_captures/64",
+        per_edge(total_batches, empty_batches)
     );
 
     // Window finishing (δ report, alarm, restart), per window.
@@ -208,16 +363,16 @@ pub fn run() {
     // Check the δ the target computed against the known ripple (quantization floor ≈ 3e-5).
     let mut check = monitor(16, 8);
     let mut last = None;
-    for (i, &t) in ticks.iter().enumerate() {
-        if i % LINES as usize == 0 {
-            check.on_index(t.wrapping_sub(1));
-        }
-        if let Some(o) = check.on_edge(t, Some(Direction::Forward)) {
-            last = o.report.measurement().copied();
+    for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+        check.on_index(index_of(ticks, rev));
+        for &t in edges {
+            if let Some(o) = check.on_edge(t, Some(Direction::Forward)) {
+                last = o.report.measurement().copied();
+            }
         }
     }
     let Some(r) = last else {
-        crate::bench::fail(format_args!("no window reported"));
+        crate::bench::fail(format_args!("no valid window reported"));
     };
     let err = libm::fabs(f64::from(r.delta) / (2.0 * EPS) - 1.0);
     hprintln!(

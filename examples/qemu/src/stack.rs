@@ -28,3 +28,29 @@ pub fn peak() -> (usize, usize) {
     }
     (top - p, top - bottom)
 }
+
+/// Bytes of stack `f` uses beyond the caller's frame: the free stack below the current stack
+/// pointer is painted again, `f` runs, and the deepest overwritten word is found. (The paint
+/// below the caller is the only state touched; `peak` afterwards still reports the run's peak.)
+#[inline(never)]
+pub fn used_by<F: FnOnce()>(f: F) -> usize {
+    let bottom = addr_of!(_stack_end) as usize;
+    let sp = cortex_m::register::msp::read() as usize;
+    // Leave a margin for this function's own frame and the call into `f`.
+    let top = sp.saturating_sub(64) & !3;
+    let mut p = bottom;
+    while p < top {
+        // SAFETY: [bottom, top) lies below the live stack (the stack grows down from `sp`,
+        // and `top` is under it with a margin), inside the region the linker reserves for the
+        // stack; nothing lives there now, so painting it cannot corrupt live data.
+        unsafe { core::ptr::write_volatile(p as *mut u32, STACK_PAINT_VALUE) };
+        p += 4;
+    }
+    f();
+    let mut p = bottom;
+    // SAFETY: the same words as above, read back.
+    while p < top && unsafe { read_volatile(p as *const u32) } == STACK_PAINT_VALUE {
+        p += 4;
+    }
+    sp.saturating_sub(p)
+}
