@@ -302,6 +302,8 @@ pub struct Encoder {
     /// The largest `K`-interval sum whose band stays within the timeout (above it the shaft
     /// is near the minimum speed and every edge is judged carefully).
     band_sum_max: u32,
+    /// Most intervals whose total is sure to fit in 32 bits (each within the timeout).
+    bulk_max: u32,
     timer_hz: f32,
     /// Radians per angle unit.
     unit_rad: f32,
@@ -342,6 +344,7 @@ impl Encoder {
         band_lo: 0,
         band_half_width: 0,
         band_sum_max: 0,
+        bulk_max: 0,
         timer_hz: 0.0,
         unit_rad: 0.0,
         pattern: [0; MAX_PATTERN_TEETH],
@@ -468,6 +471,7 @@ impl Encoder {
                     m as u32
                 }
             },
+            bulk_max: (f64::from(u32::MAX) / libm::ceil(timeout)) as u32,
             timer_hz: timer_hz as f32,
             unit_rad: (grid / f64::from(PITCH_UNITS)) as f32,
             pattern,
@@ -510,6 +514,10 @@ impl Encoder {
     /// Radians per angle unit.
     pub fn unit_rad(&self) -> f32 {
         self.unit_rad
+    }
+    /// Most intervals a batch may take in one run (their total fits in 32 bits).
+    pub(crate) fn bulk_max(&self) -> usize {
+        self.bulk_max as usize
     }
     /// Whether every tooth has the same nominal pitch (a uniform disc).
     pub fn is_uniform(&self) -> bool {

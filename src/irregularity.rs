@@ -277,6 +277,28 @@ impl WindowState {
         }
     }
 
+    /// The window's extremes as tick counts of samples of equal span (uniform discs): the
+    /// slowest and the fastest.
+    #[inline]
+    pub(crate) fn uniform_extremes(&self) -> (u32, u32) {
+        (self.min.ticks, self.max.ticks)
+    }
+
+    /// Folds a run of ordinary teeth into the window: `ticks` more, extremes now `(slowest,
+    /// fastest)` as tick counts of samples spanning `span` units each.
+    #[inline]
+    pub(crate) fn add_run(&mut self, ticks: u64, (slowest, fastest): (u32, u32), span: u32) {
+        self.ticks = self.ticks.wrapping_add(ticks);
+        self.min = Sample {
+            span,
+            ticks: slowest,
+        };
+        self.max = Sample {
+            span,
+            ticks: fastest,
+        };
+    }
+
     fn measurement(
         &self,
         window: &Window,

@@ -53,6 +53,7 @@ pub struct WindowOutcome {
 
 /// An observer that wants nothing.
 impl EdgeSink for () {
+    const WATCHES_TEETH: bool = false;
     #[inline(always)]
     fn tooth(&mut self, _tooth: &Tooth) {}
     #[inline(always)]
@@ -397,7 +398,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             on_window(o);
         }
         let mut feed = Feed {
-            last_edge: self.tracker.counters().accepted,
+            // Set before each edge that can end a window (the careful path).
+            last_edge: 0,
             encoder: &self.encoder,
             uniform: self.encoder.is_uniform() && P::NOMINAL,
             window: &self.window,
@@ -408,7 +410,23 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             out: on_window,
         };
         let uniform = self.encoder.is_uniform() && P::NOMINAL;
-        for &t in captures {
+        let mut rest = captures;
+        while !rest.is_empty() {
+            if !O::WATCHES_TEETH && uniform {
+                // The ordinary teeth in one tight loop, as the fast path would take them.
+                let mut extremes = feed.state.uniform_extremes();
+                let (taken, ticks) = self.tracker.bulk(&self.encoder, rest, &mut extremes);
+                if taken > 0 {
+                    feed.state
+                        .add_run(ticks, extremes, self.encoder.uniform_span());
+                    rest = rest.get(taken..).unwrap_or(&[]);
+                    continue;
+                }
+            }
+            let Some((&t, tail)) = rest.split_first() else {
+                break;
+            };
+            rest = tail;
             if let Some(tooth) = self
                 .tracker
                 .try_fast(&self.encoder, &self.table, t, uniform)
@@ -425,6 +443,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                     &mut feed,
                 );
             }
+        }
+        if self.spill.is_some() {
+            self.tracker.block_fast();
         }
     }
 
@@ -865,6 +886,11 @@ mod tests {
             }
         }
         b.on_captures(&chunk, |o| batch.push(o));
+        std::println!(
+            "bulk took {} of {}",
+            crate::speed::BULK.load(core::sync::atomic::Ordering::Relaxed),
+            base.len()
+        );
         assert_eq!(one, batch);
         assert_eq!(a.diagnostics(), b.diagnostics());
     }

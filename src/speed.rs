@@ -148,6 +148,9 @@ pub struct Tooth {
 
 /// Receives what the tracker finds, in order.
 pub trait EdgeSink {
+    /// Whether the sink looks at ordinary teeth at all. A sink that does not (the `()` sink)
+    /// lets a batch of captures run through the tracker's bulk path, which reports no teeth.
+    const WATCHES_TEETH: bool = true;
     /// An edge accepted as a tooth.
     fn tooth(&mut self, tooth: &Tooth);
     /// A fault found at `time` (a rejected glitch, a missing edge, a timeout...).
@@ -186,7 +189,7 @@ const PENDING: usize = 3;
 /// Index timestamps that may wait for their edge.
 const INDEXES: usize = 4;
 /// The band is refreshed after every this many intervals pushed (a power of two).
-pub(crate) const BAND_REFRESH: u32 = 16;
+pub(crate) const BAND_REFRESH: u32 = 64;
 /// Faults within one revolution after which the count is no longer trusted.
 const FAULTS_TO_RESYNC: u8 = 3;
 
@@ -221,8 +224,6 @@ pub struct SpeedTracker {
     /// something needs the careful path first (not running or synced, edges pending, an index
     /// waiting, the ring not full).
     stop: u16,
-    /// Accepted edges since the frame candidate (kept while confirming an index frame).
-    count: u16,
     /// Faults since the last frame.
     faults: u8,
     /// The last accepted intervals, ticks, at `pos − 1`, `pos − 2`, … (modulo 64: `pos` runs
@@ -332,7 +333,6 @@ impl SpeedTracker {
             width: 0,
             tooth: 0,
             stop: 0,
-            count: 0,
             faults: 0,
             ring: [0; MAX_SPAN],
             pos: 0,
@@ -590,7 +590,7 @@ impl SpeedTracker {
             time: t,
             dt,
             tooth,
-            synced: true,
+            synced: self.sync == SyncState::Synced,
             frame: false,
             sample: Some(Sample { span, ticks }),
         })
@@ -1001,7 +1001,6 @@ impl SpeedTracker {
         if framed {
             self.sync = SyncState::Confirming;
             self.tooth = 0;
-            self.count = 0;
             self.searched = 0;
         }
     }
@@ -1087,20 +1086,19 @@ impl SpeedTracker {
                     }
                     SyncState::Confirming => {
                         if indexed {
-                            if self.count == edges - 1 {
+                            // Counted from the candidate, the index is due at tooth 0.
+                            if tooth == 0 {
                                 self.sync = SyncState::Synced;
                                 self.counters.syncs = self.counters.syncs.wrapping_add(1);
                                 frame = true;
                             }
                             tooth = 0;
-                            self.count = 0;
                         }
                     }
                     SyncState::Searching => {
                         if indexed {
                             self.sync = SyncState::Confirming;
                             tooth = 0;
-                            self.count = 0;
                             self.searched = 0;
                         } else {
                             self.count_search(enc);
@@ -1134,12 +1132,6 @@ impl SpeedTracker {
         if frame {
             self.faults = 0;
         }
-        // Edges counted since tooth 0 (the frame, or the candidate being confirmed).
-        self.count = if tooth == 0 {
-            0
-        } else {
-            self.count.wrapping_add(1)
-        };
         self.tooth = tooth;
         let synced = self.sync == SyncState::Synced;
         let known = self.teeth_known(enc);
@@ -1298,8 +1290,12 @@ impl SpeedTracker {
 
     /// Recomputes where the fast path must stop.
     fn update_fast(&mut self, enc: &Encoder) {
+        // Confirming an index frame, the teeth are numbered by count already: ordinary teeth
+        // take the fast path and the next index is checked where the count puts tooth 0.
+        let numbered = self.sync == SyncState::Synced
+            || (self.sync == SyncState::Confirming && enc.framing() == Framing::Index);
         let fast = self.state == ShaftState::Running
-            && self.sync == SyncState::Synced
+            && numbered
             && self.has_ref
             && self.prev != 0
             && self.npend == 0
@@ -1408,6 +1404,102 @@ impl SpeedTracker {
         })
     }
 
+    /// Takes the leading captures of `caps` that the fast path would take one by one — forward
+    /// running on a uniform wheel at its nominal pitches with a 32-bit counter — in tight
+    /// loops, and returns how many, with the ticks they span; the extremes of their `K`-edge
+    /// samples are folded into `extremes` (slowest and fastest, as tick counts of samples of
+    /// equal span). The first capture it stops at (outside the band, or a special tooth next)
+    /// is left for [`SpeedTracker::on_edge`]. Identical results: the band test and its refresh
+    /// points are the fast path's, and the state it leaves is the one the fast path would.
+    ///
+    /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
+    /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), two compares
+    /// for the extremes. The capture times before the batch come from the ring once per call,
+    /// and the ring is written once, at the end.
+    pub(crate) fn bulk(
+        &mut self,
+        enc: &Encoder,
+        caps: &[u32],
+        extremes: &mut (u32, u32),
+    ) -> (usize, u64) {
+        if self.stop == self.tooth || enc.mask() != u32::MAX || !enc.is_uniform() {
+            return (0, 0);
+        }
+        let room = usize::from(self.stop.wrapping_sub(self.tooth));
+        let n = caps.len().min(room).min(enc.bulk_max());
+        let k = usize::from(enc.samples_span());
+        let last0 = self.last;
+        let pos0 = self.pos;
+        let mut run = Run {
+            first_start: last0.wrapping_sub(self.sum),
+            last: last0,
+            lo: self.lo,
+            width: self.width,
+            slowest: extremes.0,
+            fastest: extremes.1,
+        };
+        let mut i = 0usize;
+        while i < n {
+            // Up to the next band refresh: it follows the interval that brings the ring
+            // position to a multiple of BAND_REFRESH.
+            let gap = BAND_REFRESH - (pos0.wrapping_add(i as u32) & (BAND_REFRESH - 1));
+            let end = n.min(i + gap as usize);
+            let taken = if i < k {
+                // Samples that start before the batch: at the capture K edges back, which the
+                // ring's intervals give one after the other from the oldest sample's start.
+                let stop = end.min(k);
+                run.take_from_ring(caps.get(i..stop).unwrap_or(&[]), &self.ring, pos0, i, k)
+            } else {
+                run.take(
+                    caps.get(i..end).unwrap_or(&[]),
+                    caps.get(i - k..).unwrap_or(&[]),
+                )
+            };
+            let segment = if i < k { end.min(k) - i } else { end - i };
+            i += taken;
+            if taken < segment {
+                break;
+            }
+            if pos0.wrapping_add(i as u32) & (BAND_REFRESH - 1) == 0 {
+                let sum = run
+                    .last
+                    .wrapping_sub(run.start_of(caps, &self.ring, pos0, i - 1, k));
+                let (l, w) = enc.band(sum).unwrap_or((u32::MAX, 0));
+                run.lo = l;
+                run.width = w;
+            }
+        }
+        if i == 0 {
+            return (0, 0);
+        }
+        // Leave what the fast path would have left.
+        for j in i.saturating_sub(k)..i {
+            let prior = if j == 0 {
+                last0
+            } else {
+                caps.get(j - 1).copied().unwrap_or(last0)
+            };
+            let dt = caps.get(j).copied().unwrap_or(prior).wrapping_sub(prior);
+            if let Some(slot) = self
+                .ring
+                .get_mut(pos0.wrapping_add(j as u32) as usize & (MAX_SPAN - 1))
+            {
+                *slot = dt;
+            }
+        }
+        self.pos = pos0.wrapping_add(i as u32);
+        self.tooth = self.tooth.wrapping_add(i as u16);
+        self.last = run.last;
+        self.sum = run
+            .last
+            .wrapping_sub(run.start_of(caps, &self.ring, pos0, i - 1, k));
+        self.lo = run.lo;
+        self.width = run.width;
+        *extremes = (run.slowest, run.fastest);
+        // At most `bulk_max` intervals within the timeout: their total fits in 32 bits.
+        (i, u64::from(run.last.wrapping_sub(last0)))
+    }
+
     /// Sets the band around the mean of the last `K` intervals (when the ring is full; an
     /// empty band otherwise, and near the minimum speed, so nothing but the careful path
     /// takes an edge).
@@ -1432,7 +1524,6 @@ impl SpeedTracker {
         self.viable = 0;
         self.confirm = 0;
         self.seen_special = false;
-        self.count = 0;
         self.faults = 0;
         self.searched = 0;
         self.block_fast();
@@ -1444,6 +1535,104 @@ impl SpeedTracker {
         self.hist_teeth = 0;
         self.history = false;
         self.held = None;
+    }
+}
+
+/// The state of a bulk run in registers: the last capture, the band, the extremes.
+struct Run {
+    /// The capture `K + 1` edges before the batch (the last one less the ring's sum).
+    first_start: u32,
+    last: u32,
+    lo: u32,
+    width: u32,
+    slowest: u32,
+    fastest: u32,
+}
+
+impl Run {
+    /// [`Run::take`] for captures `now`, the `i`-th onwards of the batch (`i` < `K`), whose
+    /// samples start before the batch: the start of capture `i` is the first start moved on by
+    /// the ring's intervals (`pos0` the ring position at the batch's start).
+    #[inline(always)]
+    fn take_from_ring(
+        &mut self,
+        now: &[u32],
+        ring: &[u32; MAX_SPAN],
+        pos0: u32,
+        i: usize,
+        k: usize,
+    ) -> usize {
+        let mut start = self.start_of_ring(ring, pos0, i, k);
+        let mut taken = 0;
+        for (j, &c) in now.iter().enumerate() {
+            if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
+                break;
+            }
+            let ticks = c.wrapping_sub(start);
+            if ticks > self.slowest {
+                self.slowest = ticks;
+            }
+            if ticks < self.fastest {
+                self.fastest = ticks;
+            }
+            self.last = c;
+            taken += 1;
+            // The next sample starts one interval later.
+            let at = pos0.wrapping_add((i + j + 1) as u32).wrapping_sub(k as u32);
+            start =
+                start.wrapping_add(ring.get(at as usize & (MAX_SPAN - 1)).copied().unwrap_or(0));
+        }
+        taken
+    }
+
+    /// When the sample ending at capture `i` (< `K`) of the batch starts: `K` edges before it,
+    /// the first start (`K + 1` edges before the batch) moved on by the intervals between.
+    fn start_of_ring(&self, ring: &[u32; MAX_SPAN], pos0: u32, i: usize, k: usize) -> u32 {
+        let mut start = self.first_start;
+        for j in 0..=i {
+            let at = pos0.wrapping_add(j as u32).wrapping_sub(k as u32);
+            start =
+                start.wrapping_add(ring.get(at as usize & (MAX_SPAN - 1)).copied().unwrap_or(0));
+        }
+        start
+    }
+
+    /// When the sample ending at capture `i` of the batch starts.
+    fn start_of(&self, caps: &[u32], ring: &[u32; MAX_SPAN], pos0: u32, i: usize, k: usize) -> u32 {
+        if i >= k {
+            caps.get(i - k).copied().unwrap_or(0)
+        } else {
+            self.start_of_ring(ring, pos0, i, k)
+        }
+    }
+
+    /// Takes captures `now` while their intervals are in the band; `start[j]` is when the
+    /// `K`-edge sample ending at `now[j]` starts. Returns how many were taken. Out of line and
+    /// with its state in locals, so the loop runs in registers (about 16 instructions per
+    /// capture on a Cortex-M4).
+    #[inline(never)]
+    fn take(&mut self, now: &[u32], start: &[u32]) -> usize {
+        let (lo, width) = (self.lo, self.width);
+        let (mut last, mut slowest, mut fastest) = (self.last, self.slowest, self.fastest);
+        let mut taken = 0;
+        for (&c, &s) in now.iter().zip(start) {
+            if c.wrapping_sub(last).wrapping_sub(lo) > width {
+                break;
+            }
+            let ticks = c.wrapping_sub(s);
+            if ticks > slowest {
+                slowest = ticks;
+            }
+            if ticks < fastest {
+                fastest = ticks;
+            }
+            last = c;
+            taken += 1;
+        }
+        self.last = last;
+        self.slowest = slowest;
+        self.fastest = fastest;
+        taken
     }
 }
 
