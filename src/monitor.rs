@@ -886,11 +886,6 @@ mod tests {
             }
         }
         b.on_captures(&chunk, |o| batch.push(o));
-        std::println!(
-            "bulk took {} of {}",
-            crate::speed::BULK.load(core::sync::atomic::Ordering::Relaxed),
-            base.len()
-        );
         assert_eq!(one, batch);
         assert_eq!(a.diagnostics(), b.diagnostics());
     }
