@@ -246,10 +246,19 @@ pub struct SpeedTracker {
     /// against the previous revolution (tooth, per-base interval).
     held: Option<(u16, u32)>,
     pending: [u32; PENDING],
+    /// Arrival number of each pending edge (see `arrivals`).
+    pending_seq: [u32; PENDING],
     npend: u8,
     /// `pending[0]` came with the fast path open and fell outside its band.
     out_of_band: bool,
-    index: [u32; INDEXES],
+    /// Waiting index timestamps, each with the number of edges that had arrived when it was
+    /// reported: an index belongs to an edge that arrived after it. (Modulo the counter a
+    /// timestamp alone cannot say which edge it falls before once intervals approach the
+    /// counter's period.)
+    index: [(u32, u32); INDEXES],
+    /// Edges that have reached the careful path (a running number; pending edges and index
+    /// pulses are ordered by it).
+    arrivals: u32,
     nidx: u8,
     /// Pattern acquisition: alignments still possible for the last accepted edge (bit k:
     /// it is tooth k), the two previous unsynced intervals, and the confirmation countdown.
@@ -344,9 +353,11 @@ impl SpeedTracker {
             history: false,
             held: None,
             pending: [0; PENDING],
+            pending_seq: [0; PENDING],
             npend: 0,
             out_of_band: false,
-            index: [0; INDEXES],
+            index: [(0, 0); INDEXES],
+            arrivals: 0,
             nidx: 0,
             viable: 0,
             acq: [0; 2],
@@ -478,7 +489,7 @@ impl SpeedTracker {
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
         }
         if let Some(slot) = self.index.get_mut(usize::from(self.nidx)) {
-            *slot = t;
+            *slot = (t, self.arrivals);
             self.nidx += 1;
         }
         self.block_fast();
@@ -644,6 +655,7 @@ impl SpeedTracker {
             return;
         }
         self.settle();
+        self.arrivals = self.arrivals.wrapping_add(1);
         // With the fast path open, an ordinary edge comes here only from outside its band.
         let open = self.stop != self.tooth;
         self.block_fast();
@@ -714,6 +726,9 @@ impl SpeedTracker {
                 self.out_of_band = open;
             }
             *slot = t;
+            if let Some(seq) = self.pending_seq.get_mut(usize::from(self.npend)) {
+                *seq = self.arrivals;
+            }
             self.npend += 1;
         }
         self.latest = t;
@@ -730,6 +745,7 @@ impl SpeedTracker {
     ) {
         while self.npend > 0 {
             let e1 = self.pending[0];
+            let s1 = self.pending_seq[0];
             match self.judge(enc, flushing) {
                 Verdict::Wait => return,
                 Verdict::Glitch => {
@@ -738,7 +754,7 @@ impl SpeedTracker {
                 }
                 Verdict::Tooth => {
                     self.pop();
-                    self.accept(enc, table, e1, true, sink);
+                    self.accept(enc, table, e1, s1, true, sink);
                 }
                 Verdict::Missing(n) => {
                     self.pop();
@@ -746,7 +762,7 @@ impl SpeedTracker {
                     sink.fault(Fault::MissingEdge, e1);
                     self.fault_in_revolution();
                     self.advance_after_fault(enc, n);
-                    self.accept(enc, table, e1, false, sink);
+                    self.accept(enc, table, e1, s1, false, sink);
                 }
                 Verdict::Behind => {
                     self.pop();
@@ -755,7 +771,7 @@ impl SpeedTracker {
                     self.fault_in_revolution();
                     self.tooth = tooth_back(self.tooth, 1, enc.edges());
                     self.reset_ring();
-                    self.accept(enc, table, e1, false, sink);
+                    self.accept(enc, table, e1, s1, false, sink);
                 }
                 Verdict::Ahead => {
                     self.pop();
@@ -763,7 +779,7 @@ impl SpeedTracker {
                     sink.fault(Fault::MissingEdge, e1);
                     self.fault_in_revolution();
                     self.advance_after_fault(enc, 1);
-                    self.accept(enc, table, e1, false, sink);
+                    self.accept(enc, table, e1, s1, false, sink);
                 }
             }
         }
@@ -772,6 +788,7 @@ impl SpeedTracker {
     fn pop(&mut self) {
         self.out_of_band = false;
         self.pending.copy_within(1.., 0);
+        self.pending_seq.copy_within(1.., 0);
         self.npend = self.npend.saturating_sub(1);
     }
 
@@ -837,7 +854,7 @@ impl SpeedTracker {
         // one; a pattern's special teeth are always judged with what follows.
         let plain = !special
             || enc.framing() == Framing::None
-            || (enc.framing() == Framing::Index && self.index_covers(enc, e1));
+            || (enc.framing() == Framing::Index && self.index_covers(enc, e1, self.pending_seq[0]));
         if in_band && plain {
             return Verdict::Tooth;
         }
@@ -928,40 +945,43 @@ impl SpeedTracker {
                 && ((enc.long_teeth() | enc.short_teeth()) >> tooth) & 1 == 1)
     }
 
-    /// Whether a waiting index timestamp lies between the last accepted edge and `t`.
-    fn index_covers(&self, enc: &Encoder, t: u32) -> bool {
+    /// Whether a waiting index reported before the edge at `t` (arrival `seq`) lies between
+    /// the last accepted edge and it.
+    fn index_covers(&self, enc: &Encoder, t: u32, seq: u32) -> bool {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
         self.index
             .iter()
             .take(usize::from(self.nidx))
-            .any(|&i| (i.wrapping_sub(self.last) & m) <= d && (i.wrapping_sub(self.last) & m) > 0)
+            .any(|&(x, q)| {
+                let since = x.wrapping_sub(self.last) & m;
+                reported_before(q, seq) && since > 0 && since <= d
+            })
     }
 
     /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
     /// ending at `t`. Timestamps older than the last accepted edge lost their edge: each is
     /// counted as a missing frame.
-    fn take_index(&mut self, enc: &Encoder, t: u32) -> bool {
+    fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> bool {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
         let mut framed = false;
         let mut keep = 0usize;
         for i in 0..usize::from(self.nidx) {
-            let x = self.index.get(i).copied().unwrap_or(0);
+            let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
             let since = x.wrapping_sub(self.last) & m;
-            if since == 0 || since > d {
-                if since > d && since < m / 2 {
-                    // Still ahead of this edge: keep it.
-                    if let Some(slot) = self.index.get_mut(keep) {
-                        *slot = x;
-                    }
-                    keep += 1;
-                } else if self.sync == SyncState::Synced {
-                    // An index that framed no edge: its edge was not seen.
-                    self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
+            let ahead = !reported_before(q, seq) || (since > d && since < m / 2);
+            if ahead {
+                // Reported after this edge arrived, or timed after it: a later edge's.
+                if let Some(slot) = self.index.get_mut(keep) {
+                    *slot = (x, q);
                 }
-            } else {
+                keep += 1;
+            } else if since > 0 && since <= d {
                 framed = true;
+            } else if self.sync == SyncState::Synced {
+                // An index that framed no edge: its edge was not seen.
+                self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
             }
         }
         self.nidx = keep as u8;
@@ -978,23 +998,18 @@ impl SpeedTracker {
         let mut framed = false;
         let mut keep = 0usize;
         for i in 0..usize::from(self.nidx) {
-            let x = self.index.get(i).copied().unwrap_or(0);
+            let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
             let before = t.wrapping_sub(x) & m;
-            if before <= enc.timeout_ticks() {
-                framed |= before > 0;
-                if before == 0 {
-                    // At the same tick: it belongs to the next edge.
-                    if let Some(slot) = self.index.get_mut(keep) {
-                        *slot = x;
-                    }
-                    keep += 1;
-                }
-            } else if before > m / 2 {
-                // Ahead of this edge: keep it.
+            let later = !reported_before(q, self.arrivals) || before == 0 || before > m / 2;
+            if later {
+                // Reported after this edge arrived, at its tick, or ahead of it: the next
+                // edge's.
                 if let Some(slot) = self.index.get_mut(keep) {
-                    *slot = x;
+                    *slot = (x, q);
                 }
                 keep += 1;
+            } else if before <= enc.timeout_ticks() {
+                framed = true;
             }
         }
         self.nidx = keep as u8;
@@ -1035,7 +1050,7 @@ impl SpeedTracker {
         t: u32,
         sink: &mut S,
     ) {
-        self.accept(enc, table, t, true, sink);
+        self.accept(enc, table, t, self.arrivals, true, sink);
     }
 
     /// Accepts the edge at `t` as the tooth after the current one (or as framed by an index).
@@ -1044,6 +1059,7 @@ impl SpeedTracker {
         enc: &Encoder,
         table: &P,
         t: u32,
+        seq: u32,
         clean: bool,
         sink: &mut S,
     ) {
@@ -1057,7 +1073,7 @@ impl SpeedTracker {
         let old_tooth = self.tooth;
         match enc.framing() {
             Framing::Index => {
-                let indexed = self.take_index(enc, t);
+                let indexed = self.take_index(enc, t, seq);
                 match self.sync {
                     SyncState::Synced => {
                         if indexed {
@@ -1685,6 +1701,13 @@ fn exp(x: f32) -> f32 {
         }
     }
     sum * scale
+}
+
+/// Whether an index numbered `index_seq` (the arrivals before it) was reported before the
+/// edge numbered `edge_seq` arrived.
+#[inline]
+fn reported_before(index_seq: u32, edge_seq: u32) -> bool {
+    (edge_seq.wrapping_sub(index_seq) as i32) > 0
 }
 
 /// `bits` rotated left by one within `n` bits.
