@@ -7,12 +7,15 @@
 //! 1/8, say) averages out over many revolutions; ripple synchronous with the revolution cannot
 //! be told from pitch error, so learn at light, steady load.
 //!
-//! The learner lives outside the monitor (it costs 8 bytes per tooth, only while learning) and
-//! watches its edges as an [`EdgeSink`]: pass it to
-//! [`crate::monitor::DeltaMonitor::on_edge_observed`]. Per-edge work is O(1): the intervals of a
-//! revolution are staged, and each is folded into its tooth's running mean when the same tooth
-//! comes round again in the next revolution, which by then is known to have been counted
-//! correctly and steady.
+//! The learner lives outside the monitor (8 bytes per tooth, only while learning) and watches
+//! its edges as an [`EdgeSink`]: pass it to
+//! [`crate::monitor::DeltaMonitor::on_edge_observed`]. The intervals of a revolution are
+//! staged; each is folded into its tooth's running mean when the same tooth comes round again
+//! in the next revolution, which by then is known to have been counted whole and steady.
+//!
+//! The per-edge work has no branch: every tooth is staged and folded, and a revolution that
+//! may not be folded (the first, an unsteady one, one cut by a fault) is folded with weight 0,
+//! which leaves the means exactly as they were.
 
 use crate::encoder::Encoder;
 use crate::error::{positive_f32, ConfigError};
@@ -21,21 +24,18 @@ use crate::speed::{EdgeSink, Fault, Tooth};
 /// Per-tooth running means of the revolution fraction. Memory: 8·N bytes and a few words.
 #[derive(Debug, Clone)]
 pub struct ToothLearner<const N: usize> {
+    /// This revolution's interval of every tooth, ticks.
     staged: [u32; N],
+    /// Every tooth's learned share of a revolution.
     mean: [f32; N],
     /// Revolutions folded into every tooth (a revolution is folded whole).
     folded: u16,
     edges: u16,
-    /// Interval sum of the revolution being staged.
-    rev_ticks: u64,
-    edges_in_rev: u16,
-    /// The last tooth seen in the revolution being staged.
-    last_tooth: u16,
-    /// 1/T of the last staged revolution and 1/(folds + 1), if it may be folded.
-    fold: Option<(f32, f32)>,
-    prev_rev_ticks: u64,
+    /// The revolution being staged runs from a frame in sync with no fault since.
+    whole: bool,
+    /// Period of the previous whole revolution, ticks (0: none).
+    prev_period: u64,
     steady_tolerance: f32,
-    started: bool,
 }
 
 impl<const N: usize> ToothLearner<N> {
@@ -54,23 +54,18 @@ impl<const N: usize> ToothLearner<N> {
             mean: [0.0; N],
             folded: 0,
             edges: encoder.edges(),
-            rev_ticks: 0,
-            edges_in_rev: 0,
-            last_tooth: 0,
-            fold: None,
-            prev_rev_ticks: 0,
+            whole: false,
+            prev_period: 0,
             steady_tolerance: t,
-            started: false,
         })
     }
 
     /// Forgets everything learned.
     pub fn reset(&mut self) {
-        self.folded = 0;
         self.mean = [0.0; N];
-        self.started = false;
-        self.fold = None;
-        self.prev_rev_ticks = 0;
+        self.folded = 0;
+        self.whole = false;
+        self.prev_period = 0;
     }
 
     /// Revolutions folded into every tooth.
@@ -99,83 +94,54 @@ impl<const N: usize> ToothLearner<N> {
         }
         Ok(out.get(..edges).unwrap_or(&[]))
     }
+
+    /// A revolution ended at a frame: if it was staged whole and steady, fold every tooth's
+    /// share of it into the running means (the staged intervals of a whole revolution add up
+    /// to its period). Once per revolution, out of line.
+    #[cold]
+    #[inline(never)]
+    fn end_revolution(&mut self) {
+        let edges = usize::from(self.edges);
+        if self.whole {
+            let t: u64 = self.staged.iter().take(edges).map(|&d| u64::from(d)).sum();
+            let prev = self.prev_period;
+            self.prev_period = t;
+            let steady =
+                prev > 0 && ((t as f32) - (prev as f32)).abs() < self.steady_tolerance * t as f32;
+            if steady && t > 0 {
+                // Running mean: no growing sum to lose digits over long learning runs.
+                let weight = 1.0 / (f32::from(self.folded) + 1.0);
+                let (keep, take) = (1.0 - weight, weight / t as f32);
+                for (m, &d) in self.mean.iter_mut().zip(self.staged.iter()).take(edges) {
+                    *m = keep * *m + take * d as f32;
+                }
+                self.folded = self.folded.saturating_add(1);
+            }
+        }
+        // The revolution starting here is whole if nothing cuts it.
+        self.whole = true;
+    }
 }
 
 impl<const N: usize> EdgeSink for ToothLearner<N> {
+    /// Stages this tooth's interval: one store on the ordinary tooth. Teeth before sync are
+    /// staged too but never folded: a revolution is folded only from frame to frame, frames
+    /// come in sync, and sync is lost only through a fault, which cuts the revolution.
     #[inline]
     fn tooth(&mut self, ev: &Tooth) {
-        if !ev.synced {
-            self.started = false;
-            return;
+        // `tooth` < edges ≤ N, so the remainder is the tooth itself; it spares a bounds
+        // branch (an `and` when N is a power of two).
+        if let Some(s) = self.staged.get_mut(usize::from(ev.tooth) % N.max(1)) {
+            *s = ev.dt;
         }
-        if !self.started {
-            if ev.frame {
-                self.started = true;
-                self.rev_ticks = 0;
-                self.edges_in_rev = 0;
-            }
-            return;
-        }
-        let k = usize::from(ev.tooth);
-        if let (Some((inv_t, inv_n)), Some(slot), Some(mean)) =
-            (self.fold, self.staged.get_mut(k), self.mean.get_mut(k))
-        {
-            // Running mean: no growing sum to lose digits over long learning runs.
-            *mean += (*slot as f32 * inv_t - *mean) * inv_n;
-            *slot = ev.dt;
-        } else if let Some(slot) = self.staged.get_mut(k) {
-            *slot = ev.dt;
-        }
-        self.rev_ticks = self.rev_ticks.wrapping_add(u64::from(ev.dt));
-        self.edges_in_rev = self.edges_in_rev.wrapping_add(1);
-        self.last_tooth = ev.tooth;
         if ev.frame {
             self.end_revolution();
         }
     }
 
     fn fault(&mut self, _fault: Fault, _time: u32) {
-        self.finish_fold();
-        self.started = false;
-        self.prev_rev_ticks = 0;
-    }
-}
-
-impl<const N: usize> ToothLearner<N> {
-    /// A revolution was staged: it may be folded if it was counted whole and steady (the
-    /// previous fold, if any, is complete now: every tooth came round once).
-    /// A fold in progress is cut short: the teeth it has not reached still hold the staged
-    /// revolution's intervals, so fold them now and every tooth keeps the same count.
-    #[cold]
-    fn finish_fold(&mut self) {
-        let Some((inv_t, inv_n)) = self.fold.take() else {
-            return;
-        };
-        let from = usize::from(self.last_tooth) + 1;
-        let edges = usize::from(self.edges);
-        for k in (from..edges).chain(core::iter::once(0)) {
-            if let (Some(&slot), Some(mean)) = (self.staged.get(k), self.mean.get_mut(k)) {
-                *mean += (slot as f32 * inv_t - *mean) * inv_n;
-            }
-        }
-        self.folded = self.folded.saturating_add(1);
-    }
-
-    #[cold]
-    fn end_revolution(&mut self) {
-        if self.fold.is_some() {
-            self.folded = self.folded.saturating_add(1);
-        }
-        let t = self.rev_ticks;
-        let steady = self.prev_rev_ticks > 0
-            && ((t as f32) - (self.prev_rev_ticks as f32)).abs() < self.steady_tolerance * t as f32;
-        self.fold = if steady && self.edges_in_rev == self.edges && t > 0 {
-            Some((1.0 / t as f32, 1.0 / (f32::from(self.folded) + 1.0)))
-        } else {
-            None
-        };
-        self.prev_rev_ticks = t;
-        self.rev_ticks = 0;
-        self.edges_in_rev = 0;
+        // The revolution in progress cannot be trusted, nor compared with the next.
+        self.whole = false;
+        self.prev_period = 0;
     }
 }
