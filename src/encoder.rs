@@ -515,6 +515,12 @@ impl Encoder {
     pub fn unit_rad(&self) -> f32 {
         self.unit_rad
     }
+    /// Whether the interval ring holds capture times (a 32-bit counter: a `K`-edge sample is
+    /// one exact difference) rather than intervals.
+    #[inline(always)]
+    pub(crate) fn ring_times(&self) -> bool {
+        self.mask == u32::MAX
+    }
     /// Most intervals a batch may take in one run (their total fits in 32 bits).
     pub(crate) fn bulk_max(&self) -> usize {
         self.bulk_max as usize

@@ -9,13 +9,10 @@
 //!
 //! The learner lives outside the monitor (8 bytes per tooth, only while learning) and watches
 //! its edges as an [`EdgeSink`]: pass it to
-//! [`crate::monitor::DeltaMonitor::on_edge_observed`]. The intervals of a revolution are
-//! staged; each is folded into its tooth's running mean when the same tooth comes round again
-//! in the next revolution, which by then is known to have been counted whole and steady.
-//!
-//! The per-edge work has no branch: every tooth is staged and folded, and a revolution that
-//! may not be folded (the first, an unsteady one, one cut by a fault) is folded with weight 0,
-//! which leaves the means exactly as they were.
+//! [`crate::monitor::DeltaMonitor::on_edge_observed`]. Per edge it stages the tooth's interval
+//! (one store); at the frame that ends a revolution counted whole (from a frame, in sync, no
+//! fault) and steady (its period within the tolerance of the previous one's), every tooth's
+//! share of it is folded into that tooth's running mean, once per revolution and out of line.
 
 use crate::encoder::Encoder;
 use crate::error::{positive_f32, ConfigError};
@@ -36,6 +33,10 @@ pub struct ToothLearner<const N: usize> {
     /// Period of the previous whole revolution, ticks (0: none).
     prev_period: u64,
     steady_tolerance: f32,
+    /// Time of the last frame; with a 32-bit counter and a revolution within 2^32 ticks
+    /// (`timed`), a period is the difference of two frame times, not a sum of intervals.
+    frame_time: u32,
+    timed: bool,
 }
 
 impl<const N: usize> ToothLearner<N> {
@@ -57,6 +58,11 @@ impl<const N: usize> ToothLearner<N> {
             whole: false,
             prev_period: 0,
             steady_tolerance: t,
+            frame_time: 0,
+            // Every interval is within the timeout, so a revolution is within edges·timeout.
+            timed: encoder.mask() == u32::MAX
+                && f64::from(encoder.edges()) * f64::from(encoder.timeout_ticks())
+                    < f64::from(u32::MAX),
         })
     }
 
@@ -100,10 +106,16 @@ impl<const N: usize> ToothLearner<N> {
     /// to its period). Once per revolution, out of line.
     #[cold]
     #[inline(never)]
-    fn end_revolution(&mut self) {
+    fn end_revolution(&mut self, time: u32) {
         let edges = usize::from(self.edges);
+        let since = time.wrapping_sub(self.frame_time);
+        self.frame_time = time;
         if self.whole {
-            let t: u64 = self.staged.iter().take(edges).map(|&d| u64::from(d)).sum();
+            let t: u64 = if self.timed {
+                u64::from(since)
+            } else {
+                self.staged.iter().take(edges).map(|&d| u64::from(d)).sum()
+            };
             let prev = self.prev_period;
             self.prev_period = t;
             let steady =
@@ -135,7 +147,7 @@ impl<const N: usize> EdgeSink for ToothLearner<N> {
             *s = ev.dt;
         }
         if ev.frame {
-            self.end_revolution();
+            self.end_revolution(ev.time);
         }
     }
 

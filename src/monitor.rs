@@ -865,29 +865,84 @@ mod tests {
         assert_ne!(m.shaft_state(), ShaftState::Running);
     }
 
-    #[test]
-    fn a_batch_gives_the_same_results_as_edge_by_edge() {
-        let base = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));
-        let mut a = monitor(indexed(256, 4, 32, 84e6), 4);
-        let mut b = a.clone();
-        let one = run(&mut a, &base);
-        let mut batch = Vec::new();
+    /// Feeds `evs` in batches of pseudo-random sizes (1 to 150, every few batches a single
+    /// edge through `on_edge` instead), seeded by `seed`.
+    fn run_batched(m: &mut DeltaMonitor<1024>, evs: &[Ev], seed: u64) -> Vec<WindowOutcome> {
+        let mut rng = seed;
+        let mut next = |n: u64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 33) % n
+        };
+        let mut out = Vec::new();
         let mut chunk = Vec::new();
-        for e in &base {
+        let mut size = 1 + next(150) as usize;
+        for e in evs {
             match *e {
-                Ev::Index(t) => b.on_index(t),
+                Ev::Index(t) => m.on_index(t),
                 Ev::Edge(t) => {
                     chunk.push(t);
-                    if chunk.len() == 64 {
-                        b.on_captures(&chunk, |o| batch.push(o));
+                    if chunk.len() >= size {
+                        if chunk.len() == 1 && next(2) == 0 {
+                            out.extend(m.on_edge(t, Some(Direction::Forward)));
+                        } else {
+                            m.on_captures(&chunk, |o| out.push(o));
+                        }
                         chunk.clear();
+                        size = if next(4) == 0 {
+                            1
+                        } else {
+                            1 + next(150) as usize
+                        };
                     }
                 }
             }
         }
-        b.on_captures(&chunk, |o| batch.push(o));
-        assert_eq!(one, batch);
-        assert_eq!(a.diagnostics(), b.diagnostics());
+        m.on_captures(&chunk, |o| out.push(o));
+        out
+    }
+
+    #[test]
+    fn a_batch_gives_the_same_results_as_edge_by_edge() {
+        // Speed swinging by ±35 % three times a revolution (the band refreshed and reopened
+        // often), with noise pulses and dropped edges; sample spans from 1 to 32 edges.
+        let swing = |phi: f64| 134.0 * (1.0 + 0.35 * (3.0 * phi).sin());
+        for (lines, k) in [(64u16, 1u16), (256, 2), (256, 5), (1024, 16), (1024, 32)] {
+            let mut evs = stream(
+                &uniform(u32::from(lines)),
+                Some(0.0),
+                30,
+                84e6,
+                u32::MAX,
+                &swing,
+            );
+            let edges: Vec<usize> = (0..evs.len())
+                .filter(|&i| matches!(evs[i], Ev::Edge(_)))
+                .collect();
+            let per = usize::from(lines);
+            // A dropped edge in revolution 12, a noise pulse at 40 % of a pitch in 18.
+            let glitch = edges[per * 18 + per / 3];
+            let (Ev::Edge(g0), Ev::Edge(g1)) = (evs[glitch], evs[glitch + 1]) else {
+                panic!("edges expected");
+            };
+            evs.insert(glitch + 1, Ev::Edge(g0 + (g1 - g0) * 2 / 5));
+            evs.remove(edges[per * 12 + per / 2]);
+            for seed in 1..4u64 {
+                let mut c = indexed(lines, k, 32, 84e6);
+                c.min_speed = 10.0;
+                let mut a = monitor(c, 2);
+                let mut b = a.clone();
+                let one = run(&mut a, &evs);
+                let batch = run_batched(&mut b, &evs, seed);
+                let d = a.diagnostics();
+                assert!(d.valid_windows >= 5, "{lines} lines, K {k}: {d:?}");
+                assert_eq!((d.edges.glitches, d.edges.missing), (1, 1), "{d:?}");
+                assert_eq!(one, batch, "{lines} lines, K {k}, seed {seed}");
+                assert_eq!(a.diagnostics(), b.diagnostics(), "{lines} lines, K {k}");
+                assert_eq!(a.speed().to_bits(), b.speed().to_bits());
+            }
+        }
     }
 
     #[test]
@@ -992,5 +1047,40 @@ mod tests {
             ToothLearner::<512>::new(plain.encoder(), f32::NAN).err(),
             Some(ConfigError::NonFinite("steady_tolerance"))
         );
+    }
+
+    #[test]
+    fn learning_with_a_narrow_counter_learns_the_same_pitches() {
+        // A 32-bit counter times a revolution by its frames; a 20-bit one (which wraps within
+        // a revolution) adds up its intervals. Same disc, same shaft: the same table.
+        let teeth: Vec<f64> = (0..256)
+            .map(|k| TAU * (f64::from(k) + 0.5) / 256.0 + 1e-4 * (f64::from(k) * 0.7).sin())
+            .collect();
+        let learn = |bits: u8| {
+            let mask = if bits == 32 {
+                u32::MAX
+            } else {
+                (1u32 << bits) - 1
+            };
+            let c = indexed(256, 8, bits, 84e6);
+            let mut m = monitor(c, 8);
+            let mut learner = ToothLearner::<1024>::new(m.encoder(), 0.01).unwrap();
+            for e in stream(&teeth, Some(0.0), 30, 84e6, mask, &kneader(0.0)) {
+                match e {
+                    Ev::Index(t) => m.on_index(t),
+                    Ev::Edge(t) => {
+                        m.on_edge_observed(t, None, &mut learner);
+                    }
+                }
+            }
+            let mut table = [0.0f32; 1024];
+            let pitches = learner.pitches(20, &mut table).unwrap().to_vec();
+            (learner.revolutions(), pitches)
+        };
+        let (wide, narrow) = (learn(32), learn(20));
+        assert_eq!(wide.0, narrow.0);
+        for (a, b) in wide.1.iter().zip(&narrow.1) {
+            assert!((a - b).abs() <= 1e-6 * a, "{a} against {b}");
+        }
     }
 }

@@ -188,8 +188,9 @@ pub struct EdgeCounters {
 const PENDING: usize = 3;
 /// Index timestamps that may wait for their edge.
 const INDEXES: usize = 4;
-/// The band is refreshed after every this many intervals pushed (a power of two).
-pub(crate) const BAND_REFRESH: u32 = 64;
+/// The band is refreshed after every tooth whose number is a multiple of this (a power of
+/// two), and whenever the fast path opens.
+pub(crate) const BAND_REFRESH: u16 = 64;
 /// Faults within one revolution after which the count is no longer trusted.
 const FAULTS_TO_RESYNC: u8 = 3;
 
@@ -216,8 +217,8 @@ pub struct SpeedTracker {
     tooth: u16,
     /// The accept band of an ordinary interval, ticks: `[lo, lo + width]` (modular), around the
     /// mean of the last `K` intervals as of the last refresh. It is refreshed when the fast path
-    /// opens and after every [`BAND_REFRESH`]-th interval pushed (a rule of the ring position
-    /// alone, so a batch of captures reproduces it exactly).
+    /// opens and after every tooth whose number is a multiple of [`BAND_REFRESH`] (a rule of
+    /// the tooth numbers alone, so a batch of captures reproduces it exactly).
     lo: u32,
     width: u32,
     /// The fast path stops after this tooth: the next one is special, or (`stop == tooth`)
@@ -226,8 +227,11 @@ pub struct SpeedTracker {
     stop: u16,
     /// Faults since the last frame.
     faults: u8,
-    /// The last accepted intervals, ticks, at `pos − 1`, `pos − 2`, … (modulo 64: `pos` runs
-    /// on and the index is masked); `fill` of them (at most `K`) belong to the current run.
+    /// The last accepted edges, newest at `pos − 1`, then `pos − 2`, … (`pos` runs on and the
+    /// index is masked; a batch lays them out from the start again): their capture times with a 32-bit counter (a `K`-edge sample is then
+    /// one difference, exact since `K` intervals within the timeout fit in 32 bits), their
+    /// intervals with a narrower one (summed, so a sample may last longer than the counter's
+    /// period). `fill` of them (at most `K`) belong to the current run.
     ring: [u32; MAX_SPAN],
     pos: u32,
     fill: u8,
@@ -417,20 +421,27 @@ impl SpeedTracker {
     /// Brings the careful path's bookkeeping up to date with what the fast path did: the
     /// accepted count, and the previous interval (the ring's newest: fast teeth are ordinary
     /// teeth, so their interval is per base pitch already).
-    fn settle(&mut self) {
+    fn settle(&mut self, enc: &Encoder) {
         if self.tooth != self.anchor {
             self.accepted = self.accepted_now();
             self.anchor = self.tooth;
-            self.prev = self.newest();
+            self.prev = self.newest(enc);
         }
     }
 
-    /// The newest interval in the ring.
-    fn newest(&self) -> u32 {
-        self.ring
-            .get(self.pos.wrapping_sub(1) as usize & (MAX_SPAN - 1))
-            .copied()
-            .unwrap_or(0)
+    /// The newest interval in the ring (the fast path's last interval).
+    fn newest(&self, enc: &Encoder) -> u32 {
+        let at = |back: u32| {
+            self.ring
+                .get(self.pos.wrapping_sub(back) as usize & (MAX_SPAN - 1))
+                .copied()
+                .unwrap_or(0)
+        };
+        if enc.ring_times() {
+            at(1).wrapping_sub(at(2))
+        } else {
+            at(1)
+        }
     }
 
     /// The latest speed sample (the last `K` accepted intervals) while running; `None` before
@@ -515,7 +526,7 @@ impl SpeedTracker {
         };
         let elapsed = (now & enc.mask()).wrapping_sub(latest) & enc.mask();
         if elapsed > enc.timeout_ticks() {
-            self.settle();
+            self.settle(enc);
             self.flush(enc, table, sink);
             self.stop_running(now & enc.mask(), sink);
             self.has_ref = false;
@@ -556,6 +567,22 @@ impl SpeedTracker {
         ticks: u32,
         uniform: bool,
     ) -> Option<Tooth> {
+        // One branch on the ring's kind per edge, each kind's path without a select.
+        if enc.ring_times() {
+            self.try_fast_in::<P, true>(enc, table, ticks, uniform)
+        } else {
+            self.try_fast_in::<P, false>(enc, table, ticks, uniform)
+        }
+    }
+
+    #[inline(always)]
+    fn try_fast_in<P: PitchTable, const TIMES: bool>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        ticks: u32,
+        uniform: bool,
+    ) -> Option<Tooth> {
         let mask = enc.mask();
         let t = ticks & mask;
         let dt = t.wrapping_sub(self.last) & mask;
@@ -568,7 +595,8 @@ impl SpeedTracker {
         let tooth = self.tooth.wrapping_add(1);
         self.tooth = tooth;
         self.last = t;
-        // The ring is full on the fast path: the oldest of the last K intervals leaves the sum.
+        // The ring is full on the fast path: the sample starts K edges back (a time), or the
+        // oldest of the last K intervals leaves the sum.
         let k = enc.samples_span();
         let pos = self.pos;
         let oldest = self
@@ -577,13 +605,14 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = dt;
+            *slot = if TIMES { t } else { dt };
         }
         let pos = pos.wrapping_add(1);
         self.pos = pos;
-        let ticks = sum.wrapping_add(dt).wrapping_sub(oldest);
+        let end = if TIMES { t } else { sum.wrapping_add(dt) };
+        let ticks = end.wrapping_sub(oldest);
         self.sum = ticks;
-        if pos & (BAND_REFRESH - 1) == 0 {
+        if tooth & (BAND_REFRESH - 1) == 0 {
             self.refresh_band(enc);
         }
         let span = if uniform {
@@ -654,7 +683,7 @@ impl SpeedTracker {
             // An unconfigured monitor ignores everything.
             return;
         }
-        self.settle();
+        self.settle(enc);
         self.arrivals = self.arrivals.wrapping_add(1);
         // With the fast path open, an ordinary edge comes here only from outside its band.
         let open = self.stop != self.tooth;
@@ -1157,7 +1186,7 @@ impl SpeedTracker {
         }
         // The ring: the sample ends here. An interval across a fault is no sample.
         let sample = if clean {
-            self.push(enc, table, tooth, dt)
+            self.push(enc, table, tooth, t, dt)
         } else {
             self.reset_ring();
             None
@@ -1371,9 +1400,18 @@ impl SpeedTracker {
         enc: &Encoder,
         table: &P,
         tooth: u16,
+        t: u32,
         dt: u32,
     ) -> Option<Sample> {
         let k = enc.samples_span();
+        let times = enc.ring_times();
+        if times && self.fill == 0 {
+            // A run of times starts with the first interval's start.
+            if let Some(slot) = self.ring.get_mut(self.pos as usize & (MAX_SPAN - 1)) {
+                *slot = self.last;
+            }
+            self.pos = self.pos.wrapping_add(1);
+        }
         let pos = self.pos;
         let oldest = self
             .ring
@@ -1381,14 +1419,18 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = dt;
+            *slot = if times { t } else { dt };
         }
         let pos = pos.wrapping_add(1);
         self.pos = pos;
         let uniform = enc.is_uniform() && P::NOMINAL;
-        let refresh = pos & (BAND_REFRESH - 1) == 0;
+        let refresh = tooth & (BAND_REFRESH - 1) == 0;
         if u16::from(self.fill) >= k {
-            self.sum = self.sum.wrapping_add(dt).wrapping_sub(oldest);
+            self.sum = if times {
+                t.wrapping_sub(oldest)
+            } else {
+                self.sum.wrapping_add(dt).wrapping_sub(oldest)
+            };
             if !uniform {
                 let out = tooth_back(tooth, k, enc.edges());
                 self.span = self
@@ -1404,6 +1446,10 @@ impl SpeedTracker {
             }
             if u16::from(self.fill) < k {
                 return None;
+            }
+            if times {
+                // K intervals now: the sample starts at the run's first time.
+                self.sum = t.wrapping_sub(oldest);
             }
         }
         if refresh {
@@ -1431,23 +1477,31 @@ impl SpeedTracker {
     /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
     /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), two compares
     /// for the extremes. The capture times before the batch come from the ring once per call,
-    /// and the ring is written once, at the end.
+    /// and the ring is written once, at the end. Out of line: the batch loop keeps its state
+    /// in registers whatever the caller.
+    #[inline(never)]
     pub(crate) fn bulk(
         &mut self,
         enc: &Encoder,
         caps: &[u32],
         extremes: &mut (u32, u32),
     ) -> (usize, u64) {
-        if self.stop == self.tooth || enc.mask() != u32::MAX || !enc.is_uniform() {
+        if self.stop == self.tooth || !enc.ring_times() || !enc.is_uniform() {
             return (0, 0);
         }
         let room = usize::from(self.stop.wrapping_sub(self.tooth));
         let n = caps.len().min(room).min(enc.bulk_max());
+        let caps = caps.get(..n).unwrap_or(&[]);
         let k = usize::from(enc.samples_span());
+        // The ring's last `m` times (the last K, and at least two for the newest interval),
+        // laid out from its start: a batch reads the K before it in one piece.
+        let m = k.max(2);
+        if self.pos != m as u32 {
+            self.linearize(m);
+        }
+        let head = self.ring.get(m - k..m).unwrap_or(&[]);
         let last0 = self.last;
-        let pos0 = self.pos;
         let mut run = Run {
-            first_start: last0.wrapping_sub(self.sum),
             last: last0,
             lo: self.lo,
             width: self.width,
@@ -1455,65 +1509,93 @@ impl SpeedTracker {
             fastest: extremes.1,
         };
         let mut i = 0usize;
-        while i < n {
-            // Up to the next band refresh: it follows the interval that brings the ring
-            // position to a multiple of BAND_REFRESH.
-            let gap = BAND_REFRESH - (pos0.wrapping_add(i as u32) & (BAND_REFRESH - 1));
-            let end = n.min(i + gap as usize);
-            let taken = if i < k {
-                // Samples that start before the batch: at the capture K edges back, which the
-                // ring's intervals give one after the other from the oldest sample's start.
-                let stop = end.min(k);
-                run.take_from_ring(caps.get(i..stop).unwrap_or(&[]), &self.ring, pos0, i, k)
-            } else {
-                run.take(
-                    caps.get(i..end).unwrap_or(&[]),
-                    caps.get(i - k..).unwrap_or(&[]),
-                )
-            };
-            let segment = if i < k { end.min(k) - i } else { end - i };
-            i += taken;
-            if taken < segment {
+        // Captures up to and including the next one on a refresh tooth.
+        let mut refresh = usize::from(BAND_REFRESH - (self.tooth & (BAND_REFRESH - 1)));
+        loop {
+            let end = n.min(refresh);
+            // Samples that start before the batch (at the ring's times), then the others (at
+            // the batch's own captures, K back).
+            let mid = end.min(k);
+            if i < mid {
+                i += run.take(
+                    caps.get(i..mid).unwrap_or(&[]),
+                    head.get(i..).unwrap_or(&[]),
+                );
+            }
+            if i >= mid && i < end {
+                let now = caps.get(i..end).unwrap_or(&[]);
+                i += run.take(now, caps.get(i - k..).unwrap_or(&[]));
+            }
+            if i != refresh {
                 break;
             }
-            if pos0.wrapping_add(i as u32) & (BAND_REFRESH - 1) == 0 {
-                let sum = run
-                    .last
-                    .wrapping_sub(run.start_of(caps, &self.ring, pos0, i - 1, k));
-                let (l, w) = enc.band(sum).unwrap_or((u32::MAX, 0));
-                run.lo = l;
-                run.width = w;
+            // The fast path's refresh after this tooth: around the mean of the last K.
+            let from = if i > k {
+                caps.get(i - 1 - k)
+            } else {
+                head.get(i - 1)
+            };
+            (run.lo, run.width) = enc
+                .band(run.last.wrapping_sub(from.copied().unwrap_or(0)))
+                .unwrap_or((u32::MAX, 0));
+            refresh += usize::from(BAND_REFRESH);
+            if i >= n {
+                break;
             }
         }
         if i == 0 {
             return (0, 0);
         }
-        // Leave what the fast path would have left.
-        for j in i.saturating_sub(k)..i {
-            let prior = if j == 0 {
-                last0
-            } else {
-                caps.get(j - 1).copied().unwrap_or(last0)
-            };
-            let dt = caps.get(j).copied().unwrap_or(prior).wrapping_sub(prior);
-            if let Some(slot) = self
-                .ring
-                .get_mut(pos0.wrapping_add(j as u32) as usize & (MAX_SPAN - 1))
-            {
-                *slot = dt;
+        let from = if i > k {
+            caps.get(i - 1 - k)
+        } else {
+            head.get(i - 1)
+        };
+        let sum = run.last.wrapping_sub(from.copied().unwrap_or(0));
+        // Leave what the fast path would have left, laid out from the ring's start: the last
+        // `m` times.
+        if let Some(tail) = i.checked_sub(m).and_then(|from| caps.get(from..i)) {
+            for (d, &c) in self.ring.iter_mut().zip(tail) {
+                *d = c;
+            }
+        } else {
+            // A short batch: the older times move down, the batch's follow.
+            for j in 0..m - i {
+                let v = self.ring.get(j + i).copied().unwrap_or(0);
+                if let Some(d) = self.ring.get_mut(j) {
+                    *d = v;
+                }
+            }
+            for (d, &c) in self.ring.iter_mut().skip(m - i).zip(caps) {
+                *d = c;
             }
         }
-        self.pos = pos0.wrapping_add(i as u32);
+        self.pos = m as u32;
         self.tooth = self.tooth.wrapping_add(i as u16);
         self.last = run.last;
-        self.sum = run
-            .last
-            .wrapping_sub(run.start_of(caps, &self.ring, pos0, i - 1, k));
+        self.sum = sum;
         self.lo = run.lo;
         self.width = run.width;
         *extremes = (run.slowest, run.fastest);
         // At most `bulk_max` intervals within the timeout: their total fits in 32 bits.
         (i, u64::from(run.last.wrapping_sub(last0)))
+    }
+
+    /// Lays the ring's last `m` times out from its start (newest at `m − 1`), `pos` at `m`.
+    #[cold]
+    #[inline(never)]
+    fn linearize(&mut self, m: usize) {
+        let mut laid = [0u32; MAX_SPAN];
+        let first = self.pos.wrapping_sub(m as u32) as usize;
+        for (j, d) in laid.iter_mut().take(m).enumerate() {
+            *d = self
+                .ring
+                .get(first.wrapping_add(j) & (MAX_SPAN - 1))
+                .copied()
+                .unwrap_or(0);
+        }
+        self.ring = laid;
+        self.pos = m as u32;
     }
 
     /// Sets the band around the mean of the last `K` intervals (when the ring is full; an
@@ -1554,10 +1636,9 @@ impl SpeedTracker {
     }
 }
 
-/// The state of a bulk run in registers: the last capture, the band, the extremes.
+/// The state of a bulk run: the last capture, the band, the extremes.
+#[derive(Clone, Copy)]
 struct Run {
-    /// The capture `K + 1` edges before the batch (the last one less the ring's sum).
-    first_start: u32,
     last: u32,
     lo: u32,
     width: u32,
@@ -1566,85 +1647,46 @@ struct Run {
 }
 
 impl Run {
-    /// [`Run::take`] for captures `now`, the `i`-th onwards of the batch (`i` < `K`), whose
-    /// samples start before the batch: the start of capture `i` is the first start moved on by
-    /// the ring's intervals (`pos0` the ring position at the batch's start).
-    #[inline(always)]
-    fn take_from_ring(
-        &mut self,
-        now: &[u32],
-        ring: &[u32; MAX_SPAN],
-        pos0: u32,
-        i: usize,
-        k: usize,
-    ) -> usize {
-        let mut start = self.start_of_ring(ring, pos0, i, k);
-        let mut taken = 0;
-        for (j, &c) in now.iter().enumerate() {
-            if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
-                break;
-            }
-            let ticks = c.wrapping_sub(start);
-            if ticks > self.slowest {
-                self.slowest = ticks;
-            }
-            if ticks < self.fastest {
-                self.fastest = ticks;
-            }
-            self.last = c;
-            taken += 1;
-            // The next sample starts one interval later.
-            let at = pos0.wrapping_add((i + j + 1) as u32).wrapping_sub(k as u32);
-            start =
-                start.wrapping_add(ring.get(at as usize & (MAX_SPAN - 1)).copied().unwrap_or(0));
-        }
-        taken
-    }
-
-    /// When the sample ending at capture `i` (< `K`) of the batch starts: `K` edges before it,
-    /// the first start (`K + 1` edges before the batch) moved on by the intervals between.
-    fn start_of_ring(&self, ring: &[u32; MAX_SPAN], pos0: u32, i: usize, k: usize) -> u32 {
-        let mut start = self.first_start;
-        for j in 0..=i {
-            let at = pos0.wrapping_add(j as u32).wrapping_sub(k as u32);
-            start =
-                start.wrapping_add(ring.get(at as usize & (MAX_SPAN - 1)).copied().unwrap_or(0));
-        }
-        start
-    }
-
-    /// When the sample ending at capture `i` of the batch starts.
-    fn start_of(&self, caps: &[u32], ring: &[u32; MAX_SPAN], pos0: u32, i: usize, k: usize) -> u32 {
-        if i >= k {
-            caps.get(i - k).copied().unwrap_or(0)
-        } else {
-            self.start_of_ring(ring, pos0, i, k)
-        }
-    }
-
     /// Takes captures `now` while their intervals are in the band; `start[j]` is when the
-    /// `K`-edge sample ending at `now[j]` starts. Returns how many were taken. Out of line and
-    /// with its state in locals, so the loop runs in registers (about 16 instructions per
-    /// capture on a Cortex-M4).
+    /// `K`-edge sample ending at `now[j]` starts. Returns how many were taken. Four captures a
+    /// turn; per capture a load, the band test, the sample and two selects for the extremes
+    /// (selects, not branches: a run-up, every sample a new extreme, costs the same as steady
+    /// running).
     #[inline(never)]
     fn take(&mut self, now: &[u32], start: &[u32]) -> usize {
+        let n = now.len().min(start.len());
+        let (now, start) = (now.get(..n).unwrap_or(&[]), start.get(..n).unwrap_or(&[]));
         let (lo, width) = (self.lo, self.width);
         let (mut last, mut slowest, mut fastest) = (self.last, self.slowest, self.fastest);
-        let mut taken = 0;
-        for (&c, &s) in now.iter().zip(start) {
+        let (quads, start_quads) = (now.chunks_exact(4), start.chunks_exact(4));
+        let (now_rest, start_rest) = (quads.remainder(), start_quads.remainder());
+        let full = n - now_rest.len();
+        let mut step = |c: u32, s: u32| {
             if c.wrapping_sub(last).wrapping_sub(lo) > width {
-                break;
+                return false;
             }
-            let ticks = c.wrapping_sub(s);
-            if ticks > slowest {
-                slowest = ticks;
-            }
-            if ticks < fastest {
-                fastest = ticks;
-            }
+            let t = c.wrapping_sub(s);
+            slowest = slowest.max(t);
+            fastest = fastest.min(t);
             last = c;
-            taken += 1;
-        }
+            true
+        };
+        // How many were taken, from where the run stopped (no counter in the loop).
+        let taken = 'run: {
+            for (q, (c4, s4)) in quads.zip(start_quads).enumerate() {
+                for (e, (&c, &s)) in c4.iter().zip(s4).enumerate() {
+                    if !step(c, s) {
+                        break 'run 4 * q + e;
+                    }
+                }
+            }
+            for (e, (&c, &s)) in now_rest.iter().zip(start_rest).enumerate() {
+                if !step(c, s) {
+                    break 'run full + e;
+                }
+            }
+            n
+        };
         self.last = last;
         self.slowest = slowest;
         self.fastest = fastest;

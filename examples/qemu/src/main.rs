@@ -14,6 +14,7 @@
 mod balancer_bench;
 mod bench;
 mod drive_bench;
+mod entry_points;
 mod icount;
 mod math_bench;
 mod monitor_bench;

@@ -26,6 +26,7 @@ use drive_monitor::pitch::Corrected;
 use drive_monitor::speed::Direction;
 
 use crate::bench::ensure;
+use crate::entry_points;
 use crate::icount;
 
 const LINES: u16 = 1024;
@@ -267,6 +268,7 @@ pub fn run() {
         "memory: DeltaMonitor<1024,Corrected<1024>> {} bytes",
         core::mem::size_of::<DeltaMonitor<1024, Corrected<1024>>>()
     );
+    // Learning a correction to apply it: the corrected monitor and the learner.
     hprintln!(
         "memory: DeltaMonitor<1024>+learner {} bytes",
         core::mem::size_of::<DeltaMonitor<1024, Corrected<1024>>>()
@@ -401,5 +403,62 @@ pub fn run() {
         r.steady && !check.alarm_active(),
         "window not steady or alarm raised: {:?}",
         r
+    );
+    entry_points_agree(ticks, r.delta);
+}
+
+/// The out-of-line entry points (which `panic-free.sh` checks) report the windows the inlined
+/// calls do: the last δ of each way of feeding the stream is `delta`, bit for bit.
+fn entry_points_agree(ticks: &Ticks, delta: f32) {
+    let mut each = monitor(16, 8);
+    let mut batched = monitor(16, 8);
+    let mut learning = monitor(16, 8);
+    let Ok(mut learner) = ToothLearner::new(learning.encoder(), 0.01) else {
+        crate::bench::fail(format_args!("learner rejected"));
+    };
+    let Ok(mut corrected) = DeltaMonitor::<1024, Corrected<1024>>::new(
+        encoder(16),
+        window(8),
+        Some(AlarmConfig::new(0.06)),
+    ) else {
+        crate::bench::fail(format_args!("corrected monitor rejected"));
+    };
+    let mut last = [None::<f32>; 4];
+    let mut keep = |slot: usize, o: Option<drive_monitor::monitor::WindowOutcome>| {
+        if let Some(m) = o.and_then(|o| o.report.measurement().copied()) {
+            if let Some(l) = last.get_mut(slot) {
+                *l = Some(m.delta);
+            }
+        }
+    };
+    for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
+        let index = index_of(ticks, rev);
+        entry_points::on_index(&mut each, index);
+        entry_points::on_index(&mut batched, index);
+        entry_points::on_index(&mut learning, index);
+        corrected.on_index(index);
+        for &t in edges {
+            let d = Some(Direction::Forward);
+            keep(0, entry_points::on_edge(&mut each, t, d));
+            keep(
+                2,
+                entry_points::on_edge_learning(&mut learning, &mut learner, t, d),
+            );
+            keep(3, entry_points::on_edge_corrected(&mut corrected, t, d));
+        }
+        for batch in edges.chunks(BATCH) {
+            keep(1, entry_points::on_captures(&mut batched, batch).0);
+        }
+    }
+    let end = ticks.last().copied().unwrap_or(0);
+    ensure!(
+        entry_points::poll(&mut each, end.wrapping_add(1)).is_none(),
+        "poll right after the last edge ended a window"
+    );
+    ensure!(
+        last.iter().all(|d| *d == Some(delta)),
+        "entry points report {:?}, the inlined calls {}",
+        last,
+        delta
     );
 }

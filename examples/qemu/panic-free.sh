@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# Checks the firmware (release build, or with `dev` the debug build, overflow checks on):
+# nothing the core's per-edge entry points (src/entry_points.rs) reach can panic. Walks the call graph of the disassembly (direct calls and jumps between
+# functions) from those functions and fails if it reaches a panic routine of `core` (a bounds
+# check, an unwrap, an overflow, a slice length check, `panic_fmt`) or an indirect call it
+# cannot follow. Builds the firmware first if it is not built.
+#
+# Needs: the rustup component llvm-tools (rustup component add llvm-tools) for llvm-objdump.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")"
+
+profile="${1:-release}"
+case "$profile" in
+release) elf=target/thumbv7em-none-eabihf/release/drive-monitor-firmware
+    [ -f "$elf" ] || cargo build --release --quiet ;;
+dev) elf=target/thumbv7em-none-eabihf/debug/drive-monitor-firmware
+    cargo build --quiet ;;
+*) echo "usage: panic-free.sh [release|dev]" >&2; exit 2 ;;
+esac
+objdump="$(find "$(rustc --print sysroot)" -name llvm-objdump -type f 2>/dev/null | head -n 1)"
+if [ -z "$objdump" ]; then
+    echo "panic-free.sh: llvm-objdump not found; install it with: rustup component add llvm-tools" >&2
+    exit 1
+fi
+
+"$objdump" -d --no-show-raw-insn "$elf" | awk -v profile="$profile" '
+    # A function: "00012345 <symbol>:"
+    /^[0-9a-f]+ <[^>]+>:$/ {
+        cur = substr($2, 2, length($2) - 3)
+        names[cur] = 1
+        next
+    }
+    # A direct call or jump to another function: "bl 0x... <symbol+0x..>"
+    cur != "" && /\t(bl|blx|b|b\.w|bal|beq|bne|bhs|blo|bhi|bls|bge|blt|bgt|ble|bmi|bpl|bvs|bvc|bcs|bcc|cbz|cbnz)(\.w)?\t/ && /</ {
+        t = $0
+        sub(/^[^<]*</, "", t)
+        sub(/>.*$/, "", t)
+        sub(/\+0x[0-9a-f]+$/, "", t)
+        if (t != cur) edges[cur] = edges[cur] " " t
+        next
+    }
+    # An indirect call (a register holds the target): not followed, so not allowed.
+    cur != "" && /\tblx\tr[0-9]+/ { indirect[cur] = 1 }
+    END {
+        n = 0
+        for (f in names) if (f ~ /12entry_points/) { queue[n++] = f; seen[f] = "(entry)" }
+        if (n == 0) { print "panic-free.sh: no entry points found in the image" > "/dev/stderr"; exit 1 }
+        roots = n
+        for (i = 0; i < n; i++) {
+            f = queue[i]
+            if (f ~ /panic|unwrap_failed|expect_failed|slice_(start|end)_index|slice_index|len_mismatch|rust_begin_unwind|index_out_of_bounds/) continue
+            split(edges[f], out, " ")
+            for (j in out) {
+                g = out[j]
+                if (g == "" || g in seen) continue
+                seen[g] = f
+                queue[n++] = g
+            }
+        }
+        bad = 0
+        for (i = 0; i < n; i++) {
+            f = queue[i]
+            why = ""
+            if (f ~ /panic|unwrap_failed|expect_failed|slice_(start|end)_index|slice_index|len_mismatch|rust_begin_unwind|index_out_of_bounds/) why = "can panic"
+            else if (f in indirect) why = "calls through a register"
+            if (why == "") continue
+            bad++
+            chain = f
+            for (g = seen[f]; g != "(entry)"; g = seen[g]) chain = g " -> " chain
+            print "panic-free.sh: " why ": " chain > "/dev/stderr"
+        }
+        if (bad > 0) exit 1
+        printf "panic-free (%s): %d functions reached from %d per-edge entry points, none can panic\n", profile, n, roots
+    }
+'
