@@ -244,6 +244,8 @@ pub(crate) struct ScanAgreement {
     pub scan_missed: usize,
     /// Largest relative difference of a zone boundary.
     pub boundary: f64,
+    /// Largest relative difference of `until` among the agreeing windows.
+    pub until: f64,
     /// Largest relative difference of `at` where both maxima are inside the zone.
     pub at: f64,
 }
@@ -337,6 +339,7 @@ pub(crate) fn compare_with_scan(fast: &Machine, scan: &Machine, what: &str) -> S
             + 2.0 * jitter(s.from);
         if (f.until - s.until).abs() <= allowed {
             agree.agreeing += 1;
+            agree.until = agree.until.max(rel_diff(f.until, s.until));
             if f.at < f.from && s.at < s.from {
                 let r = rel_diff(f.at, s.at);
                 assert!(r <= SCAN_AT_TOL, "{what}: {f:?} vs {s:?}");

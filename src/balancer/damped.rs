@@ -704,7 +704,7 @@ impl Peaks {
         for x in nodes {
             let v = rs.narrow(x);
             if let Some((px, pv)) = prev {
-                if before.map_or(true, |(_, bv)| pv >= bv) && pv > v {
+                if before.is_none_or(|(_, bv)| pv >= bv) && pv > v {
                     self.keep(Peak {
                         lo: f64::from(before.map_or(px, |(bx, _)| bx)),
                         at: f64::from(px),
@@ -717,7 +717,7 @@ impl Peaks {
             prev = Some((x, v));
         }
         if let Some((px, pv)) = prev {
-            if before.map_or(true, |(_, bv)| pv >= bv) {
+            if before.is_none_or(|(_, bv)| pv >= bv) {
                 self.keep(Peak {
                     lo: f64::from(before.map_or(px, |(bx, _)| bx)),
                     at: end,
@@ -841,7 +841,7 @@ pub(crate) fn capture_speed(sys: &System, m: &Machine, omega: f64) -> Option<f64
             let s = phi(x) >= 0.0;
             if s && !prev.1 {
                 let r = super::scanned::bisect(prev.0, x, 1e-13, |y| phi(y) >= 0.0);
-                if z.to.map_or(true, |t| r < t) {
+                if z.to.is_none_or(|t| r < t) {
                     return Some(r);
                 }
             }

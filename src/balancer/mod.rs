@@ -487,6 +487,30 @@ pub struct CaptureWindow {
     pub at: f64,
 }
 
+/// A machine's analysis as plain data, borrowed from a [`Machine`] ([`Machine::table`]) or
+/// written as a `const` by `drive-sim predict SCENE --emit rust`, so firmware can build its
+/// [`Classifier`] at compile time ([`Classifier::from_table`] is a `const fn`) without
+/// analysing the machine at all.
+///
+/// All speeds in rad/s. A table from [`Machine::table`] is always valid;
+/// [`Classifier::from_table`] checks a hand-written one. The fields are public so the table
+/// can be written as a literal; more may be added (the emitted file is regenerated with
+/// them, and a host test keeps the checked-in one current).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MachineTable<'a> {
+    /// Undamped resonant speeds, ascending ([`Machine::resonant_speeds`]).
+    pub resonant: &'a [f64],
+    /// Undamped additional speeds, ascending ([`Machine::additional_speeds`]).
+    pub additional: &'a [f64],
+    /// Damped zones, ascending, covering `[0, ∞)` with alternating kinds: the first starts
+    /// at 0, each ends where the next starts, the last is open (`to: None`)
+    /// ([`Machine::zones`]).
+    pub zones: &'a [Zone],
+    /// Sommerfeld capture windows, at most one per platform ([`Machine::capture_windows`]).
+    pub captures: &'a [CaptureWindow],
+}
+
 /// A machine analysed once at configuration time: characteristic speeds, zones, capture.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -601,6 +625,18 @@ impl Machine {
         self.captures
             .get(..usize::from(self.n_captures))
             .unwrap_or(&[])
+    }
+
+    /// The analysis as plain data: what [`Classifier::from_table`] needs, and what
+    /// `drive-sim predict SCENE --emit rust` writes as a `const` for firmware that should not
+    /// analyse the machine itself.
+    pub fn table(&self) -> MachineTable<'_> {
+        MachineTable {
+            resonant: self.resonant_speeds(),
+            additional: self.additional_speeds(),
+            zones: self.zones(),
+            captures: self.capture_windows(),
+        }
     }
 
     /// Zone kind at `omega` rad/s (`|omega|` is used; NaN falls in the first zone).

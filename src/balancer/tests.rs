@@ -1227,6 +1227,7 @@ fn fast_search_matches_the_scan_on_random_machines() {
         total.agreeing += a.agreeing;
         total.scan_missed += a.scan_missed;
         total.boundary = total.boundary.max(a.boundary);
+        total.until = total.until.max(a.until);
         total.at = total.at.max(a.at);
     }
     std::println!("fast search against the scan: {total:?}");
@@ -1390,4 +1391,137 @@ fn receptance_slope_and_f32_solve_match_references() {
     );
     assert!(worst32 <= 64.0, "{worst32}");
     assert!(checked > 3000, "{checked}");
+}
+
+// ---------------------------------------------------------------------------------------
+// The machine as a const table
+
+/// A table written as a literal, as `drive-sim predict --emit rust` writes one, and the
+/// classifier built from it at compile time.
+const LITERAL: MachineTable<'static> = MachineTable {
+    resonant: &[61.0],
+    additional: &[],
+    zones: &[
+        Zone {
+            from: 0.0,
+            to: Some(61.5),
+            kind: ZoneKind::Gathering,
+        },
+        Zone {
+            from: 61.5,
+            to: None,
+            kind: ZoneKind::Balancing,
+        },
+    ],
+    captures: &[CaptureWindow {
+        from: 61.5,
+        until: 90.0,
+        at: 61.5,
+    }],
+};
+const FROM_LITERAL: Result<Classifier, ConfigError> = Classifier::from_table(&LITERAL, 0.02, 0.01);
+
+#[test]
+fn classifier_from_the_table_equals_classifier_from_the_machine() {
+    // Every machine's own table gives the identical classifier, for several bands.
+    let mut rng = Rng(46);
+    for trial in 0..200 {
+        let n = 1 + trial % 3;
+        let m = Machine::new(
+            comparison_machine(&mut rng, n, trial % 2 == 1),
+            SearchOptions::default(),
+        )
+        .unwrap();
+        for (margin, hysteresis) in [(0.0, 0.0), (0.02, 0.01), (0.05, 0.02), (0.3, 0.4)] {
+            let a = Classifier::new(&m, margin, hysteresis).unwrap();
+            let b = Classifier::from_table(&m.table(), margin, hysteresis).unwrap();
+            assert_eq!(a, b, "trial {trial}");
+        }
+        let t = m.table();
+        assert_eq!(t.resonant, m.resonant_speeds());
+        assert_eq!(t.additional, m.additional_speeds());
+        assert_eq!(t.zones, m.zones());
+        assert_eq!(t.captures, m.capture_windows());
+    }
+    // The literal: gathering below 61.5·(1 − 0.02), near the boundary, bistable up to the
+    // capture limit 90, balancing above.
+    let c = FROM_LITERAL.unwrap();
+    assert_eq!(c.characteristic_speeds(), &[61.5]);
+    assert_eq!(c.classify(50.0), Regime::Gathering);
+    assert_eq!(c.classify(61.0), Regime::NearCharacteristic);
+    assert_eq!(c.classify(70.0), Regime::Bistable);
+    assert_eq!(c.classify(95.0), Regime::Balancing);
+}
+
+#[test]
+fn a_table_unlike_a_machines_is_rejected_by_name() {
+    let z = |from: f64, to: Option<f64>, kind| Zone { from, to, kind };
+    let (g, b) = (ZoneKind::Gathering, ZoneKind::Balancing);
+    let w = CaptureWindow {
+        from: 10.0,
+        until: 12.0,
+        at: 10.0,
+    };
+    let table = |zones: &'static [Zone], captures: &'static [CaptureWindow]| MachineTable {
+        resonant: &[10.0],
+        additional: &[],
+        zones,
+        captures,
+    };
+    let build = |t: &MachineTable| Classifier::from_table(t, 0.02, 0.01);
+    let ok: &'static [Zone] = std::vec![z(0.0, Some(10.0), g), z(10.0, None, b)].leak();
+    assert!(build(&table(ok, std::vec![w].leak())).is_ok());
+    let inconsistent: [&'static [Zone]; 7] = [
+        &[],
+        std::vec![z(1.0, Some(10.0), g), z(10.0, None, b)].leak(),
+        std::vec![z(0.0, Some(10.0), b), z(10.0, None, g)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(11.0, None, b)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(10.0, None, g)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(10.0, Some(20.0), b)].leak(),
+        std::vec![
+            z(0.0, Some(10.0), g),
+            z(10.0, Some(5.0), b),
+            z(5.0, None, g)
+        ]
+        .leak(),
+    ];
+    for zones in inconsistent {
+        assert_eq!(
+            build(&table(zones, &[])),
+            Err(ConfigError::Inconsistent("zones")),
+            "{zones:?}"
+        );
+    }
+    let seven: Vec<Zone> = (0..7)
+        .map(|i| {
+            let kind = if i % 2 == 0 { g } else { b };
+            let to = (i < 6).then_some(f64::from(i + 1));
+            z(f64::from(i), to, kind)
+        })
+        .collect();
+    assert_eq!(
+        build(&table(seven.leak(), &[])),
+        Err(ConfigError::Capacity("zones"))
+    );
+    assert_eq!(
+        build(&table(ok, std::vec![w; 4].leak())),
+        Err(ConfigError::Capacity("captures"))
+    );
+    let nan_zone: &'static [Zone] =
+        std::vec![z(0.0, Some(f64::NAN), g), z(f64::NAN, None, b)].leak();
+    assert_eq!(
+        build(&table(nan_zone, &[])),
+        Err(ConfigError::NonFinite("zones"))
+    );
+    let mut bad = w;
+    bad.until = f64::INFINITY;
+    assert_eq!(
+        build(&table(ok, std::vec![bad].leak())),
+        Err(ConfigError::NonFinite("captures"))
+    );
+    let mut t = table(ok, &[]);
+    t.additional = &[f64::NAN];
+    assert_eq!(build(&t), Err(ConfigError::NonFinite("additional")));
+    t.resonant = &[f64::NEG_INFINITY];
+    assert_eq!(build(&t), Err(ConfigError::NonFinite("resonant")));
 }

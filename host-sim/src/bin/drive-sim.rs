@@ -40,6 +40,13 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Write the auto-balancer machine's speeds, zones and capture windows as source for
+        /// firmware instead (rust: a `const` MachineTable).
+        #[arg(long, value_enum, conflicts_with = "json")]
+        emit: Option<host_sim::app::emit::Format>,
+        /// With --emit: write to this file instead of standard output.
+        #[arg(long, requires = "emit")]
+        out: Option<std::path::PathBuf>,
     },
     /// Run a vibration-machine scene at prescribed rotor speeds from A to B rad/s, in
     /// parallel: the criterion's regime against what the loads did.
@@ -105,7 +112,13 @@ fn main() -> ExitCode {
             plot,
             out,
         }) => run_cmd(&scene, json, plot.as_deref(), out.as_deref()),
-        Some(Command::Predict { scene, json }) => predict_cmd(&scene, json),
+        Some(Command::Predict {
+            scene,
+            emit: Some(format),
+            out,
+            ..
+        }) => host_sim::app::emit::emit(&scene, format, out.as_deref()).map_err(|e| e.to_string()),
+        Some(Command::Predict { scene, json, .. }) => predict_cmd(&scene, json),
         Some(Command::Sweep {
             scene,
             from,
