@@ -47,12 +47,14 @@
 //! node is highest) of `nodes_per_interval / 8` log-spaced nodes, and as many whose distance
 //! below the zone's end falls geometrically to `10⁻⁶` of it (where the peak of a lightly
 //! damped resonance sits when it lies inside the zone), finds the local maxima within `10⁻⁵`
-//! of the highest. Each is refined in f64 between its neighbouring nodes, where the maximum
-//! is the zero of the exact slope `1 + D'(Ω)` (from `dH/dω = −yᵀ·Z'·y`,
-//! [`Solver::receptance_slope`]), until the slope and curvature put it within `1e-9` and its
-//! value within `1e-13`. A maximum at the zone's end with a non-negative slope there costs one
-//! f64 solve. A zone narrower than `10⁻³` (relative), which f32 nodes cannot resolve, is
-//! searched in f64 from its two ends alone.
+//! of the highest (the zone's end, a node of both passes, once, with the narrower bracket).
+//! Each is refined in f64 between its neighbouring nodes (moved uphill first if the slopes
+//! there show the f32 rounding picked a neighbour of the highest node), where the maximum is
+//! the zero of the exact slope `1 + D'(Ω)` (from `dH/dω = −yᵀ·Z'·y`,
+//! [`Solver::receptance_slope`]), bracketed to `1e-9` and until the slopes at the bracket's
+//! ends bound the value to `1e-13`. A maximum at the zone's end with a non-negative slope
+//! there costs one f64 solve. A zone narrower than `10⁻³` (relative), which f32 nodes cannot
+//! resolve, is searched in f64 from its two ends alone.
 
 use super::modal::{Solver, System};
 use super::poly::{self, Poly};
@@ -69,8 +71,9 @@ const MAX_CANDIDATES: usize = 2 * poly::MAX_DEG;
 /// products of up to six entries, sums of up to 36 terms, Horner's rule), with room to spare.
 const ROUNDING: f64 = 64.0 * f64::EPSILON;
 /// Local maxima of the f32 capture scan refined in f64: those within this (relative) of the
-/// highest node, at most [`MAX_PEAKS`] of them.
+/// highest node (f32's rounding of `Ω + D(Ω)` is far below it)...
 const PEAK_TIE: f32 = 1e-5;
+/// ...at most this many of them.
 const MAX_PEAKS: usize = 3;
 /// Zones narrower than this (relative) are searched for capture in f64 from their ends.
 const NARROW: f64 = 1e-3;
@@ -102,7 +105,8 @@ pub(crate) fn scaled(sys: &System) -> Scaled {
     }
 }
 
-/// Sorted, de-duplicated undamped characteristic speeds of `m` in scaled units.
+/// The undamped characteristic speeds of `m` in scaled units, ascending (coinciding ones
+/// kept: they are the hints of [`poly::roots_near`], one per root of `p`).
 pub(crate) fn characteristic(m: &Machine, w_s: f64) -> ([f64; 2 * MAX_PLATFORMS], usize) {
     let mut c = [0.0; 2 * MAX_PLATFORMS];
     let mut n = 0;
@@ -604,36 +608,50 @@ impl RotorSpeed<'_> {
     }
 
     /// The largest `Ω + D(Ω)` on `[lo.w, hi.w]`: at an end, or where the slope falls through
-    /// zero between them. That zero is refined by Illinois steps on the slope until the
-    /// slope at the nearest point, over the curvature the bracket shows (an underestimate
-    /// near a sharp peak, so the estimates are on the safe side), puts the maximum within
-    /// [`AT_TOL`] of it and its value within [`VALUE_TOL`] of the value there.
+    /// zero between them. That zero is bracketed by Illinois steps on the slope until the
+    /// bracket is within [`AT_TOL`] and, with the slopes at its ends, bounds the rise above
+    /// the highest point evaluated to [`VALUE_TOL`] of its value (near a maximum `Ω + D(Ω)`
+    /// is concave: it rises above an end by at most that end's slope times the width).
+    ///
+    /// If the slopes at the ends do not bracket a maximum (the f32 scan's rounding can pick
+    /// a node next to the highest), the bracket first moves uphill by its own width, up to
+    /// eight times, within the zone `[zone.0, zone.1]`.
     #[inline(never)]
-    fn maximum(&self, lo: Sample, hi: Sample) -> Sample {
-        let mut best = if hi.value >= lo.value { hi } else { lo };
-        if !(lo.slope > 0.0 && hi.slope < 0.0) {
-            return best;
-        }
+    fn maximum(&self, lo: Sample, hi: Sample, zone: (f64, f64)) -> Sample {
         let (mut a, mut b) = (lo, hi);
-        let (mut fa, mut fb) = (lo.slope, hi.slope);
-        let mut kept = 0i8;
-        for _ in 0..100 {
+        let mut best = if hi.value >= lo.value { hi } else { lo };
+        for _ in 0..8 {
             let width = b.w - a.w;
-            let curvature = (a.slope - b.slope) / width;
-            let near = if libm::fabs(a.slope) < libm::fabs(b.slope) {
-                a
+            if a.slope <= 0.0 && b.slope <= 0.0 && a.w > zone.0 {
+                b = a;
+                a = self.sample((a.w - width).max(zone.0));
+            } else if a.slope >= 0.0 && b.slope >= 0.0 && b.w < zone.1 {
+                a = b;
+                b = self.sample((b.w + width).min(zone.1));
             } else {
-                b
-            };
-            let off = libm::fabs(near.slope) / curvature;
-            let drop = 0.5 * near.slope * off;
-            if (off <= AT_TOL * near.w && libm::fabs(drop) <= VALUE_TOL * libm::fabs(near.value))
-                || width.is_nan()
-                || width <= 4.0 * f64::EPSILON * b.w
-            {
                 break;
             }
-            let guard = 2.0 * f64::EPSILON * b.w;
+            for s in [a, b] {
+                if s.value > best.value {
+                    best = s;
+                }
+            }
+        }
+        if !(a.slope > 0.0 && b.slope < 0.0) {
+            return best;
+        }
+        let (mut fa, mut fb) = (a.slope, b.slope);
+        let mut kept = 0i8;
+        for _ in 0..200 {
+            let width = b.w - a.w;
+            let steep = a.slope.min(-b.slope);
+            let target = (AT_TOL * b.w).min(VALUE_TOL * libm::fabs(best.value) / steep);
+            let floor = 4.0 * f64::EPSILON * b.w;
+            if width.is_nan() || width <= target || width <= floor {
+                break;
+            }
+            // Each step at least a quarter of the target inside, so both ends close in.
+            let guard = 0.25 * target.max(floor);
             let x = a.w + width * (fa / (fa - fb));
             let x = if x.is_nan() {
                 a.w + 0.5 * width
@@ -679,6 +697,15 @@ struct Peaks([Option<Peak>; MAX_PEAKS]);
 
 impl Peaks {
     fn keep(&mut self, p: Peak) {
+        // The zone's end is a node of both passes: keep its narrower bracket once.
+        for q in self.0.iter_mut().flatten() {
+            if q.at == p.at {
+                if p.hi - p.lo < q.hi - q.lo {
+                    *q = p;
+                }
+                return;
+            }
+        }
         let mut p = Some(p);
         for slot in self.0.iter_mut() {
             match (*slot, p) {
@@ -781,7 +808,7 @@ fn find_captures(scaled: &Scaled, solver: &Solver<f64>, m: &mut Machine, opt: &S
         let best = if hi.partial_cmp(&lo) != Some(core::cmp::Ordering::Greater) {
             at_hi
         } else if hi - lo < NARROW * hi {
-            rs.maximum(rs.sample(lo), at_hi)
+            rs.maximum(rs.sample(lo), at_hi, (lo, at_hi.w))
         } else {
             let peaks = scan(&rs, lo, hi, half);
             let top = peaks
@@ -800,7 +827,7 @@ fn find_captures(scaled: &Scaled, solver: &Solver<f64>, m: &mut Machine, opt: &S
                 } else {
                     let a = rs.sample(p.lo.max(lo));
                     let c = if p.hi >= hi { at_hi } else { rs.sample(p.hi) };
-                    rs.maximum(a, c)
+                    rs.maximum(a, c, (lo, at_hi.w))
                 };
                 if found.value > best.value {
                     best = found;

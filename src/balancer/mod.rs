@@ -540,7 +540,7 @@ impl Machine {
     /// `until` within `1e-9` plus what the boundaries' own difference moves it; `at` within
     /// `1e-7` (the scan's golden section stops near `√ε` of a flat maximum). Where they
     /// differ more, the scan has missed a maximum lying between its last node and the zone's
-    /// end, which this search finds (70 of the 1 538 windows of the test's random machines).
+    /// end, which this search finds (72 of the 1 538 windows of the test's random machines).
     ///
     /// Cost on a Cortex-M4F (soft-float f64): under 1 M instructions for the bundled
     /// three-mass machine (`bash examples/qemu/run.sh` prints it as
