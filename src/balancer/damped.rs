@@ -234,10 +234,10 @@ struct Node {
 /// A root (or near-zero extremum) of `p` in scaled speed: its centre and the bracket its
 /// rounding allows (`lo == hi == w` until that is computed).
 #[derive(Clone, Copy)]
-pub(crate) struct Candidate {
-    pub w: f64,
-    pub lo: f64,
-    pub hi: f64,
+struct Candidate {
+    w: f64,
+    lo: f64,
+    hi: f64,
 }
 
 impl Candidate {
