@@ -25,7 +25,7 @@ pub(crate) const BAD_F32: [f32; 6] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY
 pub(crate) const BAD_F32_NON_NEGATIVE: [f32; 5] =
     [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 1e-40];
 
-use drive_monitor::balancer::{Coupling, MachineConfig, Platform};
+use drive_monitor::balancer::{Coupling, Machine, MachineConfig, Platform};
 use drive_monitor::drive::{DriveModel, Harmonic, Load, Motor, Parabola, SteadyState};
 
 /// The seed 000 kneader: ω0 = 145 rad/s, ω_m = 36 rad/s, M_m = 158 N·m, J = 0.323 kg·m²,
@@ -214,4 +214,160 @@ pub(crate) fn reference_speeds(cfg: &MachineConfig) -> (Vec<f64>, Vec<f64>) {
         inertia_eigenvalues(&k, &m, &all),
         inertia_eigenvalues(&k, &m, &others),
     )
+}
+
+/// Relative difference `|a − b|/max(|a|, |b|)` (0 when equal).
+fn rel_diff(a: f64, b: f64) -> f64 {
+    if a == b {
+        0.0
+    } else {
+        (a - b).abs() / a.abs().max(b.abs())
+    }
+}
+
+/// Tolerance on zone boundaries (and capture `from`) between [`Machine::new`] and the scanned
+/// reference [`Machine::new_scanned`]: both bracket each boundary to `rel_tol` (≤ 1e-12) on the
+/// same solve, so 1e-9 leaves three decades.
+pub(crate) const SCAN_BOUNDARY_TOL: f64 = 1e-9;
+/// Tolerance on a capture maximum's location `at` where both searches find it inside the zone:
+/// the scan's golden section on a flat maximum stops near `√ε` of it (measured up to 1.6e-8 on
+/// 4 000 random machines), the fast search refines the zero of the exact slope to 1e-9.
+pub(crate) const SCAN_AT_TOL: f64 = 1e-7;
+
+/// How the fast analysis of a machine compares with the scanned reference.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct ScanAgreement {
+    /// Capture windows whose `until` agrees.
+    pub agreeing: usize,
+    /// Windows where the scan missed the maximum, which lies between its last node and the
+    /// zone's end, and the fast search found it (checked against a dense search).
+    pub scan_missed: usize,
+    /// Largest relative difference of a zone boundary.
+    pub boundary: f64,
+    /// Largest relative difference of `until` among the agreeing windows.
+    pub until: f64,
+    /// Largest relative difference of `at` where both maxima are inside the zone.
+    pub at: f64,
+}
+
+/// The largest `Ω + D(Ω)` on `[lo, hi]` by a dense search: 20 000 log-spaced nodes, then a
+/// golden section about the best (the reference for maxima the scan missed).
+pub(crate) fn dense_capture_max(m: &Machine, lo: f64, hi: f64) -> (f64, f64) {
+    let f = |w: f64| w + m.capture_lag(w);
+    let n = 20_000;
+    let node = |i: usize| lo * (hi / lo).powf(i as f64 / n as f64);
+    let mut best = (hi, f(hi), n);
+    for i in 0..n {
+        let x = node(i);
+        let v = f(x);
+        if v > best.1 {
+            best = (x, v, i);
+        }
+    }
+    let (mut a, mut b) = (node(best.2.saturating_sub(1)), node((best.2 + 1).min(n)));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..200 {
+        let x1 = b - g * (b - a);
+        let x2 = a + g * (b - a);
+        if f(x1) >= f(x2) {
+            b = x2
+        } else {
+            a = x1
+        }
+    }
+    let x = 0.5 * (a + b);
+    if f(x) > best.1 {
+        (x, f(x))
+    } else {
+        (best.0, best.1)
+    }
+}
+
+/// Checks [`Machine::new`]'s analysis `fast` against the scanned reference `scan` of the same
+/// machine and options:
+/// - characteristic speeds bit-identical (the same code);
+/// - the same zones (count and kinds), boundaries within [`SCAN_BOUNDARY_TOL`];
+/// - the same capture windows, `from` within [`SCAN_BOUNDARY_TOL`], and `until` within 1e-9
+///   relative plus twice what `Ω + D(Ω)` changes between the two `from` and over four
+///   roundings of each (`until` is often the value at the zone's end, where a sharp resonance
+///   makes it steep);
+/// - or else `fast.until` higher: the scan missed a maximum between its last node and the
+///   zone's end. Then the fast value must be attained inside the zone (at `at`, to 1e-12)
+///   and no lower than a dense search finds (to 1e-10: the fast search locates the maximum
+///   to 1e-9, which moves its value by the square of that times the peak's sharpness);
+/// - `at` within [`SCAN_AT_TOL`] where both maxima lie inside the zone.
+pub(crate) fn compare_with_scan(fast: &Machine, scan: &Machine, what: &str) -> ScanAgreement {
+    let mut agree = ScanAgreement::default();
+    assert_eq!(fast.resonant_speeds(), scan.resonant_speeds(), "{what}");
+    assert_eq!(fast.additional_speeds(), scan.additional_speeds(), "{what}");
+    let (fz, sz) = (fast.zones(), scan.zones());
+    assert_eq!(fz.len(), sz.len(), "{what}: zones {fz:?} vs {sz:?}");
+    for (f, s) in fz.iter().zip(sz) {
+        assert_eq!(f.kind, s.kind, "{what}");
+        assert_eq!(f.to.is_some(), s.to.is_some(), "{what}");
+        let r = rel_diff(f.from, s.from);
+        assert!(r <= SCAN_BOUNDARY_TOL, "{what}: zones {fz:?} vs {sz:?}");
+        agree.boundary = agree.boundary.max(r);
+    }
+    let (fc, sc) = (fast.capture_windows(), scan.capture_windows());
+    assert_eq!(fc.len(), sc.len(), "{what}: captures {fc:?} vs {sc:?}");
+    // Ω + D(Ω); on an undamped resonance (a singular solve), the value a few roundings below.
+    let phi = |w: f64| {
+        let mut step = 0.0;
+        loop {
+            let x = w * (1.0 - step);
+            let v = x + fast.capture_lag(x);
+            if !v.is_nan() || step > 1e-3 {
+                return v;
+            }
+            step = if step == 0.0 {
+                4.0 * f64::EPSILON
+            } else {
+                4.0 * step
+            };
+        }
+    };
+    // How much `Ω + D(Ω)` moves over a few roundings of `w` (it is steep at a sharp resonance).
+    let jitter =
+        |w: f64| (phi(w * (1.0 + 4.0 * f64::EPSILON)) - phi(w * (1.0 - 4.0 * f64::EPSILON))).abs();
+    for (f, s) in fc.iter().zip(sc) {
+        let d_from = rel_diff(f.from, s.from);
+        assert!(d_from <= SCAN_BOUNDARY_TOL, "{what}: {f:?} vs {s:?}");
+        let allowed = 1e-9 * s.until.abs()
+            + 2.0 * (phi(f.from) - phi(s.from)).abs()
+            + 2.0 * jitter(f.from)
+            + 2.0 * jitter(s.from);
+        if (f.until - s.until).abs() <= allowed {
+            agree.agreeing += 1;
+            agree.until = agree.until.max(rel_diff(f.until, s.until));
+            if f.at < f.from && s.at < s.from {
+                let r = rel_diff(f.at, s.at);
+                assert!(r <= SCAN_AT_TOL, "{what}: {f:?} vs {s:?}");
+                agree.at = agree.at.max(r);
+            }
+            continue;
+        }
+        assert!(f.until > s.until, "{what}: {f:?} below the scan's {s:?}");
+        let zone = fz
+            .iter()
+            .find(|z| z.to == Some(f.from))
+            .expect("a capture window ends a zone");
+        let lo = zone.from.max(f.from * 1e-3);
+        assert!(
+            f.at >= lo && f.at <= f.from,
+            "{what}: {f:?} outside {zone:?}"
+        );
+        assert!(
+            (f.until - phi(f.at)).abs() <= 1e-12 * f.until + 2.0 * jitter(f.at),
+            "{what}: {f:?} is not attained: {}",
+            phi(f.at)
+        );
+        let (at, dense) = dense_capture_max(fast, lo, f.from);
+        assert!(
+            dense <= f.until * (1.0 + 1e-10),
+            "{what}: {f:?} below the dense search's {dense} at {at}"
+        );
+        agree.scan_missed += 1;
+    }
+    agree
 }

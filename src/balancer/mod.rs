@@ -52,7 +52,9 @@
 mod complex;
 mod damped;
 mod modal;
+mod poly;
 mod runtime;
+mod scanned;
 #[cfg(test)]
 mod tests;
 
@@ -385,17 +387,20 @@ pub struct Dimensionless {
     pub beta: f64,
 }
 
-/// Settings of the damped zone search.
+/// Settings of the damped zone and capture search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SearchOptions {
-    /// The scan ends at this multiple of the highest undamped characteristic speed (it is
-    /// extended by doubling while the criterion there still says gathering).
+    /// The zone search takes the sign of `Re H_ee` at this multiple of the highest zone
+    /// boundary candidate or undamped characteristic speed, and doubles it while the sign
+    /// there still says gathering (the reference scan ends its scan there).
     pub max_factor: f64,
-    /// Scan nodes (log-spaced) in each interval between consecutive undamped characteristic
-    /// speeds, so every undamped zone, however narrow, is sampled inside.
+    /// Scan density. [`Machine::new`]'s capture scan evaluates `nodes_per_interval / 4` f32
+    /// nodes per gathering zone (half log-spaced, half closing in on the zone's end); the
+    /// reference scan of [`Machine::new_scanned`] evaluates this many log-spaced nodes in each
+    /// interval between consecutive undamped characteristic speeds and per gathering zone.
     pub nodes_per_interval: u16,
-    /// Relative bracket width at which the bisection of a zone boundary stops.
+    /// Relative bracket width to which a zone boundary is refined.
     pub rel_tol: f64,
 }
 
@@ -482,6 +487,30 @@ pub struct CaptureWindow {
     pub at: f64,
 }
 
+/// A machine's analysis as plain data, borrowed from a [`Machine`] ([`Machine::table`]) or
+/// written as a `const` by `drive-sim predict SCENE --emit rust`, so firmware can build its
+/// [`Classifier`] at compile time ([`Classifier::from_table`] is a `const fn`) without
+/// analysing the machine at all.
+///
+/// All speeds in rad/s. A table from [`Machine::table`] is always valid;
+/// [`Classifier::from_table`] checks a hand-written one. The fields are public so the table
+/// can be written as a literal; more may be added (the emitted file is regenerated with
+/// them, and a host test keeps the checked-in one current).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MachineTable<'a> {
+    /// Undamped resonant speeds, ascending ([`Machine::resonant_speeds`]).
+    pub resonant: &'a [f64],
+    /// Undamped additional speeds, ascending ([`Machine::additional_speeds`]).
+    pub additional: &'a [f64],
+    /// Damped zones, ascending, covering `[0, ∞)` with alternating kinds: the first starts
+    /// at 0, each ends where the next starts, the last is open (`to: None`)
+    /// ([`Machine::zones`]).
+    pub zones: &'a [Zone],
+    /// Sommerfeld capture windows, at most one per platform ([`Machine::capture_windows`]).
+    pub captures: &'a [CaptureWindow],
+}
+
 /// A machine analysed once at configuration time: characteristic speeds, zones, capture.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -498,14 +527,53 @@ pub struct Machine {
 }
 
 impl Machine {
-    /// Analyses a validated machine. Fails only if the zone search finds more sign changes
-    /// than a machine of this size can have (`Capacity("zones")`), which would mean the
-    /// criterion could not be evaluated reliably.
+    /// Analyses a validated machine: the undamped characteristic speeds, then the damped
+    /// zones from the roots of `Re H_ee`'s numerator (a polynomial in `ω²`) polished on the
+    /// pivoted solve, and the capture windows from an f32 scan refined in f64 on the exact
+    /// slope of `Ω + D(Ω)` (the `damped` module's notes in the source give the method). Fails
+    /// only if the zone search finds more sign changes than a machine of this size can have
+    /// (`Capacity("zones")`), which would mean the criterion could not be evaluated reliably.
+    ///
+    /// Against the reference [`Machine::new_scanned`] (the tests compare the two on the
+    /// bundled machines, every test machine and 1 200 random ones): the same characteristic
+    /// speeds, zones and windows; boundaries and capture `from` within `1e-9` relative;
+    /// `until` within `1e-9` plus what the boundaries' own difference moves it; `at` within
+    /// `1e-7` (the scan's golden section stops near `√ε` of a flat maximum). Where they
+    /// differ more, the scan has missed a maximum lying between its last node and the zone's
+    /// end, which this search finds (72 of the 1 538 windows of the test's random machines).
+    ///
+    /// Cost on a Cortex-M4F (soft-float f64): under 1 M instructions for the bundled
+    /// three-mass machine (`bash examples/qemu/run.sh` prints it as
+    /// `bench balancer::Machine::new`), where the scan took tens of millions.
     pub fn new(config: MachineConfig, options: SearchOptions) -> Result<Self, ConfigError> {
+        let (sys, mut m) = Self::undamped(config);
+        damped::analyse(&sys, &mut m, &options)?;
+        Ok(m)
+    }
+
+    /// The reference analysis by scanning: the zone search evaluates the pivoted solve at
+    /// `nodes_per_interval` log-spaced nodes between consecutive undamped characteristic
+    /// speeds and bisects every sign change to `rel_tol`; the capture windows scan the same
+    /// number of nodes per gathering zone in f64 and refine the best by golden section.
+    ///
+    /// This is the algorithm [`Machine::new`] used before, kept so the faster search can be
+    /// checked against it (the tests compare the two on the bundled machines, the test
+    /// machines and random ones). It is slow on a microcontroller: thousands of solves and
+    /// `pow` calls for three platforms, tens of millions of instructions on a Cortex-M4F.
+    pub fn new_scanned(config: MachineConfig, options: SearchOptions) -> Result<Self, ConfigError> {
+        let (sys, mut m) = Self::undamped(config);
+        scanned::find_zones(&sys, &mut m, &options)?;
+        scanned::find_captures(&sys, &mut m, &options);
+        Ok(m)
+    }
+
+    /// The machine with its undamped characteristic speeds, one open gathering zone and no
+    /// capture windows.
+    fn undamped(config: MachineConfig) -> (modal::System, Self) {
         let sys = modal::System::new(&config);
         let (resonant, n_resonant) = sys.resonant_speeds();
         let (additional, n_additional) = sys.additional_speeds();
-        let mut m = Machine {
+        let m = Machine {
             config,
             resonant,
             n_resonant: n_resonant as u8,
@@ -524,9 +592,7 @@ impl Machine {
             }; MAX_PLATFORMS],
             n_captures: 0,
         };
-        damped::find_zones(&sys, &mut m, &options)?;
-        damped::find_captures(&sys, &mut m, &options);
-        Ok(m)
+        (sys, m)
     }
 
     /// The validated configuration.
@@ -559,6 +625,18 @@ impl Machine {
         self.captures
             .get(..usize::from(self.n_captures))
             .unwrap_or(&[])
+    }
+
+    /// The analysis as plain data: what [`Classifier::from_table`] needs, and what
+    /// `drive-sim predict SCENE --emit rust` writes as a `const` for firmware that should not
+    /// analyse the machine itself.
+    pub fn table(&self) -> MachineTable<'_> {
+        MachineTable {
+            resonant: self.resonant_speeds(),
+            additional: self.additional_speeds(),
+            zones: self.zones(),
+            captures: self.capture_windows(),
+        }
     }
 
     /// Zone kind at `omega` rad/s (`|omega|` is used; NaN falls in the first zone).

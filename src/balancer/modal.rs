@@ -17,7 +17,8 @@
 //!   relevant condition number is that of `diag(K)^{-1/2}·K·diag(K)^{-1/2}`, which does not
 //!   depend on the masses, so a 1e6 mass ratio costs nothing.
 
-use super::complex::C64;
+use super::complex::{Cx, Real, C64};
+use super::poly::Poly;
 use super::{MachineConfig, MAX_PLATFORMS};
 
 /// The machine as matrices (SI units), plus the raw support and coupling values that the
@@ -143,52 +144,17 @@ impl System {
     }
 
     /// Dynamic stiffness `Z(ω) = K − ω²M + iωC` entry.
+    #[cfg(test)]
     pub fn z(&self, i: usize, j: usize, w: f64) -> C64 {
         let m = if i == j { self.m[i] } else { 0.0 };
         C64::new(self.k(i, j) - w * w * m, w * self.c(i, j))
     }
 
     /// Driving-point receptance `H_ee(ω) = [Z(ω)⁻¹]_ee`, m/N: the exciter's entry of the
-    /// solution of `Z·y = e_e`, by complex Gaussian elimination with partial pivoting. The
-    /// exciter is ordered last, so its unknown is the last pivot's quotient (no back
-    /// substitution).
+    /// solution of `Z·y = e_e`, by complex Gaussian elimination with partial pivoting (see
+    /// [`Solver::receptance`]).
     pub fn receptance(&self, w: f64) -> C64 {
-        let ([a0, a1], n_others) = self.others();
-        let order = match n_others {
-            0 => [self.e, 0, 0],
-            1 => [a0, self.e, 0],
-            _ => [a0, a1, self.e],
-        };
-        let n = n_others.min(2) + 1;
-        let idx = order.get(..n).unwrap_or(&[]);
-        let mut a = [[C64::ZERO; MAX_PLATFORMS]; MAX_PLATFORMS];
-        let mut y = [C64::ZERO; MAX_PLATFORMS];
-        for (i, &ri) in idx.iter().enumerate() {
-            for (j, &cj) in idx.iter().enumerate() {
-                a[i][j] = self.z(ri, cj, w);
-            }
-        }
-        y[n - 1] = C64::ONE;
-        for p in 0..n - 1 {
-            let mut piv = p;
-            for i in p + 1..n {
-                if a[i][p].norm_sq() > a[piv][p].norm_sq() {
-                    piv = i;
-                }
-            }
-            a.swap(p, piv);
-            y.swap(p, piv);
-            let inv = C64::ONE.div(a[p][p]);
-            let (pivot_row, yp) = (a[p], y[p]);
-            for i in p + 1..n {
-                let l = a[i][p] * inv;
-                for (x, &u) in a[i].iter_mut().zip(&pivot_row).take(n).skip(p + 1) {
-                    *x = *x - l * u;
-                }
-                y[i] = y[i] - l * yp;
-            }
-        }
-        y[n - 1].div(a[n - 1][n - 1])
+        Solver::new(self).receptance(w)
     }
 
     /// `Re H_ee(ω)`: positive where the loads gather, negative where balancing is stable.
@@ -215,6 +181,224 @@ impl System {
             }
         }
         s
+    }
+}
+
+impl System {
+    /// The numerator of `Re H_ee` over `|det Z|²` as a real polynomial in `x = ω²`, and a
+    /// bound on its rounding.
+    ///
+    /// With `s = iω` every entry of `Z = K + s·C + s²·M` is a real quadratic in `s`, so the
+    /// cofactor `N(s) = det Z_oo` and `Δ(s) = det Z` are real polynomials in `s` and
+    /// `H_ee = N/Δ = N(s)·Δ(−s)/|Δ|²` (`conj s = −s`). `Re H_ee`'s numerator is the even part of
+    /// `N(s)·Δ(−s)`: degree `2·n − 1` in `x`, positive at 0 (`det K_oo·det K`), negative
+    /// leading coefficient (`−Π M_o·Π M`). With `bound`, the same expansion with every term's
+    /// absolute value instead (`|K|`, `|C|`, `M`, sums for differences): `b` with
+    /// `64·ε·b(x)` bounding the rounding of `p(x)` as computed here.
+    pub fn re_numerator(&self, bound: bool) -> Poly {
+        let ([a0, a1], n_others) = self.others();
+        let order = match n_others {
+            0 => [self.e, 0, 0],
+            1 => [a0, self.e, 0],
+            _ => [a0, a1, self.e],
+        };
+        let n = n_others.min(2) + 1;
+        let z = |i: usize, j: usize, abs: bool| {
+            let (ri, cj) = (order[i % 3], order[j % 3]);
+            let m = if ri == cj { self.m[ri] } else { 0.0 };
+            let (k, c) = (self.k(ri, cj), self.c(ri, cj));
+            if abs {
+                Poly::quadratic(libm::fabs(k), libm::fabs(c), m)
+            } else {
+                Poly::quadratic(k, c, m)
+            }
+        };
+        let both = |abs: bool| {
+            let sign = if abs { 1.0 } else { -1.0 };
+            // det of the symmetric 2×2 block (i, j): z_ii·z_jj − z_ij².
+            let det2 = |i: usize, j: usize| {
+                z(i, i, abs)
+                    .mul(&z(j, j, abs))
+                    .add_scaled(&z(i, j, abs).mul(&z(i, j, abs)), sign)
+            };
+            let (cof, det) = match n {
+                1 => (Poly::ONE, z(0, 0, abs)),
+                2 => (z(0, 0, abs), det2(0, 1)),
+                _ => {
+                    // Expansion along the first row of the symmetric 3×3.
+                    let m12 = z(0, 1, abs)
+                        .mul(&z(2, 2, abs))
+                        .add_scaled(&z(1, 2, abs).mul(&z(0, 2, abs)), sign);
+                    let m13 = z(0, 1, abs)
+                        .mul(&z(1, 2, abs))
+                        .add_scaled(&z(1, 1, abs).mul(&z(0, 2, abs)), sign);
+                    let det = z(0, 0, abs)
+                        .mul(&det2(1, 2))
+                        .add_scaled(&z(0, 1, abs).mul(&m12), sign)
+                        .add_scaled(&z(0, 2, abs).mul(&m13), 1.0);
+                    (det2(0, 1), det)
+                }
+            };
+            if abs {
+                cof.mul(&det)
+            } else {
+                cof.mul(&det.reflect())
+            }
+        };
+        if bound {
+            both(true).even_abs()
+        } else {
+            both(false).even_at_i_omega()
+        }
+    }
+}
+
+/// The dynamic stiffness of a machine, ordered with the exciter last and its matrices
+/// assembled once, for repeated solves at configuration time (f64) and for the capture scan
+/// (f32, see [`Solver::narrowed`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Solver<T> {
+    k: [[T; MAX_PLATFORMS]; MAX_PLATFORMS],
+    c: [[T; MAX_PLATFORMS]; MAX_PLATFORMS],
+    m: [T; MAX_PLATFORMS],
+}
+
+impl Solver<f64> {
+    /// The machine's `K`, `C`, `M` with the exciter last. Fewer than three platforms are
+    /// padded in front with unit-stiffness, massless, undamped rows that nothing couples to:
+    /// elimination passes over them without touching the others (their multipliers are
+    /// zero), so one 3×3 solve serves every machine.
+    pub fn new(sys: &System) -> Self {
+        let ([a0, a1], n_others) = sys.others();
+        let n = n_others.min(2) + 1;
+        let pad = MAX_PLATFORMS - n;
+        let order = match n_others {
+            0 => [sys.e, 0, 0],
+            1 => [a0, sys.e, 0],
+            _ => [a0, a1, sys.e],
+        };
+        let mut s = Solver {
+            k: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+            c: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+            m: [0.0; MAX_PLATFORMS],
+        };
+        for i in 0..pad {
+            s.k[i][i] = 1.0;
+        }
+        for (i, &ri) in order.iter().enumerate().take(n) {
+            s.m[pad + i] = sys.m[ri];
+            for (j, &cj) in order.iter().enumerate().take(n) {
+                s.k[pad + i][pad + j] = sys.k(ri, cj);
+                s.c[pad + i][pad + j] = sys.c(ri, cj);
+            }
+        }
+        s
+    }
+
+    /// The same solver in f32 (entries rounded; a scaled system's entries are within f32's
+    /// range for any machine of physical proportions).
+    pub fn narrowed(&self) -> Solver<f32> {
+        Solver {
+            k: self.k.map(|r| r.map(|x| x as f32)),
+            c: self.c.map(|r| r.map(|x| x as f32)),
+            m: self.m.map(|x| x as f32),
+        }
+    }
+}
+
+impl<T: Real> Solver<T> {
+    /// Forward elimination of `Z(w)·y = e_e` with partial pivoting (`N = 3`: padded rows for
+    /// fewer platforms, see [`Solver::new`]).
+    fn eliminate<const N: usize>(&self, w: T) -> ([[Cx<T>; N]; N], [Cx<T>; N]) {
+        let mut a = [[Cx::ZERO; N]; N];
+        let w2 = w * w;
+        for (i, (row, (k, c))) in a.iter_mut().zip(self.k.iter().zip(&self.c)).enumerate() {
+            for (j, (x, (&kij, &cij))) in row.iter_mut().zip(k.iter().zip(c)).enumerate() {
+                let re = if i == j { kij - w2 * self.m[i] } else { kij };
+                *x = Cx::new(re, w * cij);
+            }
+        }
+        let mut y = [Cx::ZERO; N];
+        if let Some(last) = y.last_mut() {
+            *last = Cx::ONE;
+        }
+        for p in 0..N.saturating_sub(1) {
+            let mut piv = p;
+            for i in p + 1..N {
+                if a[i][p].norm_sq() > a[piv][p].norm_sq() {
+                    piv = i;
+                }
+            }
+            a.swap(p, piv);
+            y.swap(p, piv);
+            let inv = a[p][p].recip();
+            let (pivot_row, yp) = (a[p], y[p]);
+            let rhs = yp != Cx::ZERO;
+            for i in p + 1..N {
+                let l = a[i][p] * inv;
+                for (x, &u) in a[i].iter_mut().zip(&pivot_row).skip(p + 1) {
+                    *x = *x - l * u;
+                }
+                if rhs {
+                    y[i] = y[i] - l * yp;
+                }
+            }
+        }
+        (a, y)
+    }
+
+    fn receptance_n<const N: usize>(&self, w: T) -> Cx<T> {
+        let (a, y) = self.eliminate::<N>(w);
+        match (y.last(), a.last().and_then(|r| r.last())) {
+            (Some(&y), Some(&d)) => y.div(d),
+            _ => Cx::ZERO,
+        }
+    }
+
+    /// Driving-point receptance `H_ee(w) = [Z(w)⁻¹]_ee`: the exciter's entry of the solution
+    /// of `Z·y = e_e`, by complex Gaussian elimination with partial pivoting. The exciter is
+    /// ordered last, so its unknown is the last pivot's quotient (no back substitution).
+    /// Stability: the pivoted solve is backward stable, so the sign changes of `Re H_ee` it
+    /// gives lie within rounding of a nearby machine's poles and zeros; the determinant form
+    /// `Re(det Z_oo·conj(det Z))` has a triple root where a double pole cancels against a zero
+    /// (equal partial frequencies) and loses two thirds of its digits there.
+    #[inline(never)]
+    pub fn receptance(&self, w: T) -> Cx<T> {
+        self.receptance_n::<MAX_PLATFORMS>(w)
+    }
+
+    fn receptance_slope_n<const N: usize>(&self, w: T) -> (Cx<T>, T) {
+        let (a, rhs) = self.eliminate::<N>(w);
+        let mut y = [Cx::ZERO; N];
+        for i in (0..N).rev() {
+            let mut s = rhs[i];
+            for (&aij, &yj) in a[i].iter().zip(&y).skip(i + 1) {
+                s = s - aij * yj;
+            }
+            y[i] = s.div(a[i][i]);
+        }
+        // yᵀ·Z'·y = −2w·Σ m_i·y_i² + i·Σ c_ij·y_i·y_j, and Im(dH/dw) = Im(−yᵀ·Z'·y)
+        // = 2w·Σ m_i·Im(y_i²) − Σ c_ij·Re(y_i·y_j), with C symmetric.
+        let two_w = w + w;
+        let mut mass = T::ZERO;
+        let mut damp = T::ZERO;
+        for i in 0..N {
+            let (re, im) = (y[i].re, y[i].im);
+            mass = mass + self.m[i] * (re * im + re * im);
+            let mut cy = self.c[i][i] * (re * re - im * im);
+            for (&cij, yj) in self.c[i].iter().zip(&y).skip(i + 1) {
+                cy = cy + (cij + cij) * (re * yj.re - im * yj.im);
+            }
+            damp = damp + cy;
+        }
+        (y.last().copied().unwrap_or(Cx::ZERO), two_w * mass - damp)
+    }
+
+    /// `(H_ee(w), Im dH_ee/dw)`. With `y = Z⁻¹·e_e` (back substitution after the same
+    /// elimination) and `Z` symmetric, `dH_ee/dw = −yᵀ·Z'(w)·y`, `Z' = −2w·M + i·C`.
+    #[inline(never)]
+    pub fn receptance_slope(&self, w: T) -> (Cx<T>, T) {
+        self.receptance_slope_n::<MAX_PLATFORMS>(w)
     }
 }
 

@@ -1,7 +1,7 @@
 //! Run-time classification of a measured speed (f32, O(log zones), total).
 
-use super::{Machine, ZoneKind, MAX_PLATFORMS, MAX_ZONES};
-use crate::error::{non_negative_f32, ConfigError};
+use super::{Machine, MachineTable, ZoneKind, MAX_PLATFORMS, MAX_ZONES};
+use crate::error::ConfigError;
 
 /// Segments: the zones, with balancing zones split where a capture window ends.
 const MAX_SEGMENTS: usize = MAX_ZONES + MAX_PLATFORMS;
@@ -95,19 +95,120 @@ pub struct Classifier {
 /// capture band ([`Regime::Bistable`]), not by this margin.
 pub const DEFAULT_MARGIN: f32 = 0.05;
 
+/// A relative band in `[0, 0.5)`: the checks of `non_negative_f32` (non-finite, negative, an
+/// f32 subnormal) then the upper limit, in a form a `const fn` can call.
+const fn fraction(name: &'static str, x: f32) -> Result<f32, ConfigError> {
+    if x.is_nan() || x.is_infinite() {
+        Err(ConfigError::NonFinite(name))
+    } else if x < 0.0 {
+        Err(ConfigError::Negative(name))
+    } else if (x != 0.0 && x < f32::MIN_POSITIVE) || x >= 0.5 {
+        Err(ConfigError::OutOfRange(name))
+    } else {
+        Ok(x)
+    }
+}
+
+/// Checks a [`MachineTable`] the way [`Machine`] builds one: 1 to [`MAX_ZONES`] zones, the
+/// first gathering from 0, finite and strictly ascending, each ending where the next starts
+/// (`Inconsistent("zones")` otherwise), kinds alternating, the last open; at most
+/// [`MAX_PLATFORMS`] capture windows; every speed finite (`NonFinite`, naming the field).
+const fn check_table(t: &MachineTable) -> Result<(), ConfigError> {
+    let zones = t.zones;
+    if zones.is_empty() {
+        return Err(ConfigError::Inconsistent("zones"));
+    }
+    if zones.len() > MAX_ZONES {
+        return Err(ConfigError::Capacity("zones"));
+    }
+    if t.captures.len() > MAX_PLATFORMS {
+        return Err(ConfigError::Capacity("captures"));
+    }
+    let mut i = 0;
+    while i < zones.len() {
+        let z = zones[i];
+        let to_finite = match z.to {
+            Some(to) => to.is_finite(),
+            None => true,
+        };
+        if !z.from.is_finite() || !to_finite {
+            return Err(ConfigError::NonFinite("zones"));
+        }
+        let first_ok = i > 0 || (z.from == 0.0 && matches!(z.kind, ZoneKind::Gathering));
+        let next_ok = match (z.to, i + 1 < zones.len()) {
+            (None, false) => true,
+            (Some(to), true) => {
+                let next = zones[i + 1];
+                let alternates = !matches!(
+                    (z.kind, next.kind),
+                    (ZoneKind::Gathering, ZoneKind::Gathering)
+                        | (ZoneKind::Balancing, ZoneKind::Balancing)
+                );
+                to == next.from && to > z.from && alternates
+            }
+            _ => false,
+        };
+        if !first_ok || !next_ok {
+            return Err(ConfigError::Inconsistent("zones"));
+        }
+        i += 1;
+    }
+    let mut j = 0;
+    while j < t.captures.len() {
+        let w = t.captures[j];
+        if !(w.from.is_finite() && w.until.is_finite() && w.at.is_finite()) {
+            return Err(ConfigError::NonFinite("captures"));
+        }
+        j += 1;
+    }
+    let mut k = 0;
+    while k < t.resonant.len() || k < t.additional.len() {
+        if k < t.resonant.len() && !t.resonant[k].is_finite() {
+            return Err(ConfigError::NonFinite("resonant"));
+        }
+        if k < t.additional.len() && !t.additional[k].is_finite() {
+            return Err(ConfigError::NonFinite("additional"));
+        }
+        k += 1;
+    }
+    Ok(())
+}
+
 impl Classifier {
     /// Builds the table. `margin`: relative half-width of the band around each damped
     /// characteristic speed reported as [`Regime::NearCharacteristic`] (e.g. 0.03);
     /// `hysteresis`: relative distance past a boundary the speed must go before
     /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`.
     pub fn new(machine: &Machine, margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
-        let margin = non_negative_f32("margin", margin)?;
-        let hysteresis = non_negative_f32("hysteresis", hysteresis)?;
-        if margin >= 0.5 {
-            return Err(ConfigError::OutOfRange("margin"));
-        }
-        if hysteresis >= 0.5 {
-            return Err(ConfigError::OutOfRange("hysteresis"));
+        Self::from_table(&machine.table(), margin, hysteresis)
+    }
+
+    /// [`Classifier::new`] from a machine's analysis as plain data, as a `const fn`: firmware
+    /// that includes the table `drive-sim predict SCENE --emit rust` writes can build its
+    /// classifier in a `const` item, so neither the analysis nor this runs on the target
+    /// (an invalid table or band is then a compile error). The same table gives the same
+    /// classifier as [`Classifier::new`] on the machine it came from.
+    ///
+    /// Errors: those of [`Classifier::new`] for `margin` and `hysteresis`; for a table that is
+    /// not as [`Machine::table`] makes one, `Inconsistent("zones")` (no zone, a first zone not
+    /// gathering from 0, zones not ascending, not adjoining, not alternating, or a last one
+    /// not open), `Capacity("zones")` (more than [`MAX_ZONES`]), `Capacity("captures")` (more
+    /// than one window per platform) and `NonFinite` naming the field with a NaN or ±∞.
+    pub const fn from_table(
+        table: &MachineTable,
+        margin: f32,
+        hysteresis: f32,
+    ) -> Result<Self, ConfigError> {
+        let margin = match fraction("margin", margin) {
+            Ok(x) => x,
+            Err(e) => return Err(e),
+        };
+        let hysteresis = match fraction("hysteresis", hysteresis) {
+            Ok(x) => x,
+            Err(e) => return Err(e),
+        };
+        if let Err(e) = check_table(table) {
+            return Err(e);
         }
         let mut c = Classifier {
             seg_from: [0.0; MAX_SEGMENTS],
@@ -119,50 +220,62 @@ impl Classifier {
             margin,
             hysteresis,
         };
-        for (i, z) in machine.zones().iter().enumerate() {
-            if let Some(k) = c.zone_kind.get_mut(i) {
-                *k = z.kind;
+        let zones = table.zones;
+        let mut i = 0;
+        // check_table: 1 ≤ zones.len() ≤ MAX_ZONES (the bounds tests only spare the panic).
+        while i < zones.len() && i < MAX_ZONES {
+            let z = zones[i];
+            c.zone_kind[i] = z.kind;
+            if i > 0 && i - 1 < MAX_BOUNDS {
+                c.bounds[i - 1] = z.from as f32;
             }
-            if i > 0 {
-                if let Some(b) = c.bounds.get_mut(i - 1) {
-                    *b = z.from as f32;
-                }
-            }
-            match z.kind {
-                ZoneKind::Gathering => c.push_segment(z.from, Regime::Gathering)?,
+            let pushed = match z.kind {
+                ZoneKind::Gathering => c.with_segment(z.from, Regime::Gathering),
                 ZoneKind::Balancing => {
                     // Capture is possible up to the largest `until` of the windows below.
-                    let until = machine
-                        .capture_windows()
-                        .iter()
-                        .filter(|w| w.from <= z.from)
-                        .fold(0.0f64, |u, w| u.max(w.until));
-                    let to = z.to.unwrap_or(f64::INFINITY);
+                    let mut until = 0.0f64;
+                    let mut j = 0;
+                    while j < table.captures.len() {
+                        let w = table.captures[j];
+                        if w.from <= z.from && w.until > until {
+                            until = w.until;
+                        }
+                        j += 1;
+                    }
+                    let to = match z.to {
+                        Some(to) => to,
+                        None => f64::INFINITY,
+                    };
                     if until > z.from {
-                        c.push_segment(z.from, Regime::Bistable)?;
-                        if until < to {
-                            c.push_segment(until, Regime::Balancing)?;
+                        match c.with_segment(z.from, Regime::Bistable) {
+                            Ok(next) if until < to => next.with_segment(until, Regime::Balancing),
+                            other => other,
                         }
                     } else {
-                        c.push_segment(z.from, Regime::Balancing)?;
+                        c.with_segment(z.from, Regime::Balancing)
                     }
                 }
-            }
+            };
+            c = match pushed {
+                Ok(next) => next,
+                Err(e) => return Err(e),
+            };
+            i += 1;
         }
-        c.n_bounds = machine.zones().len().clamp(1, MAX_ZONES) as u8 - 1;
+        c.n_bounds = i as u8 - 1;
         Ok(c)
     }
 
-    /// Appends a segment starting at `from` rad/s.
-    fn push_segment(&mut self, from: f64, regime: Regime) -> Result<(), ConfigError> {
-        let i = usize::from(self.n_seg);
-        let (Some(f), Some(r)) = (self.seg_from.get_mut(i), self.seg_regime.get_mut(i)) else {
+    /// The classifier with a segment appended, starting at `from` rad/s.
+    const fn with_segment(mut self, from: f64, regime: Regime) -> Result<Self, ConfigError> {
+        let i = self.n_seg as usize;
+        if i >= MAX_SEGMENTS {
             return Err(ConfigError::Capacity("segments"));
-        };
-        *f = from as f32;
-        *r = regime;
+        }
+        self.seg_from[i] = from as f32;
+        self.seg_regime[i] = regime;
         self.n_seg += 1;
-        Ok(())
+        Ok(self)
     }
 
     fn segs(&self) -> &[f32] {
@@ -336,5 +449,43 @@ impl RegimeTracker {
             near_characteristic: c.near(s),
             event: (from != to).then_some(RegimeEvent { from, to, speed: s }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fraction;
+    use crate::error::{non_negative_f32, ConfigError};
+
+    /// The const band check gives exactly what `non_negative_f32` followed by the `< 0.5`
+    /// limit gave before, for every class of f32 (a sweep over bit patterns, both signs,
+    /// subnormals, infinities and NaNs included).
+    #[test]
+    fn const_band_check_matches_the_validators() {
+        let reference = |x: f32| -> Result<f32, ConfigError> {
+            let x = non_negative_f32("margin", x)?;
+            if x >= 0.5 {
+                return Err(ConfigError::OutOfRange("margin"));
+            }
+            Ok(x)
+        };
+        let mut bits = 0u32;
+        let mut checked = 0;
+        loop {
+            let x = f32::from_bits(bits);
+            match (reference(x), fraction("margin", x)) {
+                (Ok(a), Ok(b)) => assert_eq!(a.to_bits(), b.to_bits(), "{x:e}"),
+                (a, b) => assert_eq!(a.err(), b.err(), "{x:e}"),
+            }
+            checked += 1;
+            bits = match bits.checked_add(0x0000_7fff) {
+                Some(b) => b,
+                None => break,
+            };
+        }
+        for x in [0.0, -0.0, 0.5, f32::MIN_POSITIVE, 1e-40, -1e-40, 0.4999999] {
+            assert_eq!(reference(x).ok(), fraction("margin", x).ok(), "{x:e}");
+        }
+        assert!(checked > 100_000);
     }
 }

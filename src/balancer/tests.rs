@@ -13,7 +13,9 @@ extern crate std;
 use super::complex::C64;
 use super::modal::System;
 use super::*;
-use crate::testutil::{assemble, coupling, platform, reference_speeds, scaled_config};
+use crate::testutil::{
+    assemble, compare_with_scan, coupling, platform, reference_speeds, scaled_config, ScanAgreement,
+};
 use std::vec::Vec;
 
 // ---------------------------------------------------------------------------------------
@@ -65,8 +67,13 @@ fn scene(n: usize) -> MachineConfig {
     MachineConfig::new(&p[..n], &c[..n - 1], balancer(e)).unwrap()
 }
 
+/// [`Machine::new`], checked against the scanned reference on every machine of these tests
+/// ([`compare_with_scan`] states the tolerances).
 fn analyse(cfg: MachineConfig) -> Machine {
-    Machine::new(cfg, SearchOptions::default()).unwrap()
+    let m = Machine::new(cfg, SearchOptions::default()).unwrap();
+    let scan = Machine::new_scanned(cfg, SearchOptions::default()).unwrap();
+    compare_with_scan(&m, &scan, &std::format!("{cfg:?}"));
+    m
 }
 
 /// A random machine: masses log-uniform in [1e-3, 1e3] kg (before the balancer is added),
@@ -1150,4 +1157,377 @@ fn kappa_by_kind() {
     assert_eq!(z1, z2);
     assert_eq!(ZoneKind::Balancing.name(), "balancing");
     assert_eq!(ZoneKind::Gathering.name(), "gathering");
+}
+
+// ---------------------------------------------------------------------------------------
+// The fast search against the scan
+
+/// A random machine for the comparison: 1–3 platforms, masses log-uniform in [1e-3, 1e3] kg,
+/// stiffness in [1e2, 1e6] N/m, any coupling pattern (each coupling zero with probability
+/// 1/6), the exciter on any platform, and damping ratios log-uniform in [1e-5, 1e-2] (light)
+/// or [1e-4, 2] (heavy: zones merge and vanish), half of the machines each.
+fn comparison_machine(rng: &mut Rng, n: usize, heavy: bool) -> MachineConfig {
+    let ratio = |rng: &mut Rng| {
+        if heavy {
+            rng.log_uniform(1e-4, 2.0)
+        } else {
+            rng.log_uniform(1e-5, 1e-2)
+        }
+    };
+    let mut ps = Vec::new();
+    for _ in 0..n {
+        let k = rng.log_uniform(1e2, 1e6);
+        let m = rng.log_uniform(1e-3, 1e3);
+        ps.push(platform(m, k, 2.0 * ratio(rng) * (k * m).sqrt()));
+    }
+    let mut cs = Vec::new();
+    for a in 1..=n as u8 {
+        for b in a + 1..=n as u8 {
+            let k = if rng.below(6) == 0 {
+                0.0
+            } else {
+                rng.log_uniform(1e1, 1e6)
+            };
+            let m = ps[usize::from(a) - 1].mass.min(ps[usize::from(b) - 1].mass);
+            cs.push(coupling(
+                a,
+                b,
+                k,
+                2.0 * ratio(rng) * (k.max(1e1) * m).sqrt(),
+            ));
+        }
+    }
+    let mut b = balancer(1 + rng.below(n as u64) as u8);
+    let scale = rng.log_uniform(1e-4, 1.0);
+    b.load_mass *= scale;
+    b.housing_mass *= scale;
+    MachineConfig::new(&ps, &cs, b).unwrap()
+}
+
+/// Randomised comparison of [`Machine::new`] with the scanned reference
+/// [`Machine::new_scanned`] (seeded loop, 1 200 machines; default options for five in eight,
+/// else a 1e-14, a 1e-10 or a 1e-13 bracket with other scan settings). Tolerances (see
+/// [`compare_with_scan`]): the same zones and windows, boundaries and `from` to 1e-9, `until`
+/// to 1e-9 plus the boundary's difference times the slope there, `at` to 1e-7; where the scan
+/// missed a maximum just below a zone's end, the fast value must be attained in the zone and
+/// at least what a dense 20 000-node search finds.
+#[test]
+fn fast_search_matches_the_scan_on_random_machines() {
+    let mut rng = Rng(0x5eed_fa57);
+    let mut total = ScanAgreement::default();
+    for trial in 0..1200 {
+        let n = 1 + trial % 3;
+        let cfg = comparison_machine(&mut rng, n, trial % 2 == 1);
+        let opt = match trial % 8 {
+            0..=4 => SearchOptions::default(),
+            5 => SearchOptions::new(4.0, 256, 1e-14).unwrap(),
+            6 => SearchOptions::new(1.5, 64, 1e-10).unwrap(),
+            _ => SearchOptions::new(8.0, 1024, 1e-13).unwrap(),
+        };
+        let fast = Machine::new(cfg, opt);
+        let scan = Machine::new_scanned(cfg, opt);
+        let (Ok(fast), Ok(scan)) = (fast, scan) else {
+            panic!("trial {trial}: {fast:?} vs {scan:?} for {cfg:?}");
+        };
+        let a = compare_with_scan(&fast, &scan, &std::format!("trial {trial}: {cfg:?}"));
+        total.agreeing += a.agreeing;
+        total.scan_missed += a.scan_missed;
+        total.boundary = total.boundary.max(a.boundary);
+        total.until = total.until.max(a.until);
+        total.at = total.at.max(a.at);
+    }
+    std::println!("fast search against the scan: {total:?}");
+    assert!(total.agreeing > 1000, "{total:?}");
+}
+
+#[test]
+fn debug_cluster() {
+    let eps = 1e-12;
+    let p = [
+        platform(100.0, 4e5, 0.0),
+        platform(100.0, 4e5 * (1.0 + eps), 0.0),
+        platform(100.0, 4e5 * (1.0 - eps), 0.0),
+    ];
+    let cs = [
+        coupling(1, 2, 1e-3, 0.0),
+        coupling(2, 3, 2e-3, 0.0),
+        coupling(1, 3, 1e-3, 0.0),
+    ];
+    let mut b = balancer(1);
+    b.housing_mass = 0.0;
+    b.load_mass = 1e-9;
+    let cfg = MachineConfig::new(&p, &cs, b).unwrap();
+    let m = Machine::new(cfg, SearchOptions::default()).unwrap();
+    std::println!(
+        "chars {:?} {:?}",
+        m.resonant_speeds(),
+        m.additional_speeds()
+    );
+    std::println!("zones {:?}", m.zones());
+    let s = Machine::new_scanned(cfg, SearchOptions::default()).unwrap();
+    std::println!("scan {:?}", s.zones());
+    let sys = System::new(&cfg);
+    let sc = damped::scaled(&sys);
+    let pp = sc.sys.re_numerator(false);
+    std::println!("p {:?}", pp.coefficients());
+    let (ch, nch) = damped::characteristic(&m, sc.w_s);
+    let h: Vec<f64> = ch[..nch].iter().map(|x| x * x).collect();
+    std::println!(
+        "hints {:?} near {:?}",
+        h,
+        super::poly::roots_near(pp.coefficients(), &h, 5e-14)
+    );
+}
+
+/// `Re H_ee`'s numerator polynomial against an independent evaluation: `p(ω²)` must equal
+/// `Re H(ω)·|det Z(ω)|²`, with `H` from the pivoted solve and `det Z` by cofactors in complex
+/// arithmetic, to 1e-9 of `b(ω²)·|det Z|²/|N·Δ|`-free scale `b(ω²)` (the absolute-value
+/// expansion: the largest the terms of `p` get; the rounding of both sides is a few ε of it).
+#[test]
+fn re_numerator_is_re_h_times_det_squared() {
+    let mut rng = Rng(44);
+    for trial in 0..300 {
+        let n = 1 + trial % 3;
+        let cfg = comparison_machine(&mut rng, n, trial % 2 == 1);
+        let s = damped::scaled(&System::new(&cfg)).sys;
+        let p = s.re_numerator(false);
+        let b = s.re_numerator(true);
+        let solver = super::modal::Solver::new(&s);
+        let z = |i: usize, j: usize, w: f64| {
+            let m = if i == j { s.m[i] } else { 0.0 };
+            C64::new(s.k(i, j) - w * w * m, w * s.c(i, j))
+        };
+        for _ in 0..20 {
+            let w = rng.log_uniform(1e-3, 10.0);
+            let det = match n {
+                1 => z(0, 0, w),
+                2 => z(0, 0, w) * z(1, 1, w) - z(0, 1, w) * z(1, 0, w),
+                _ => {
+                    z(0, 0, w) * (z(1, 1, w) * z(2, 2, w) - z(1, 2, w) * z(2, 1, w))
+                        - z(0, 1, w) * (z(1, 0, w) * z(2, 2, w) - z(1, 2, w) * z(2, 0, w))
+                        + z(0, 2, w) * (z(1, 0, w) * z(2, 1, w) - z(1, 1, w) * z(2, 0, w))
+                }
+            };
+            let x = w * w;
+            let want = solver.receptance(w).re * det.norm_sq();
+            let got = super::poly::eval(p.coefficients(), x);
+            let scale = super::poly::eval(b.coefficients(), x);
+            assert!(
+                (got - want).abs() <= 1e-9 * scale,
+                "trial {trial} ω {w}: {got} vs {want} (scale {scale})"
+            );
+        }
+    }
+}
+
+/// The slope `dH/dω` of the solve against a Richardson-extrapolated central difference of
+/// `H` (steps 1e-5 and 5e-6 relative: truncation of order step⁴, rounding ~1e-11), to 1e-7
+/// relative to `|H|/ω + |dH/dω|`, away from features so sharp that the two differences
+/// disagree by more than 1e-3 of that scale; and the f32 solve of the capture scan against the
+/// f64 one there, to 64 f32 roundings times `‖|K| + ω²M + ω|C|‖·‖Z⁻¹‖²` (max-entry norms:
+/// the first-order change of an entry of `Z⁻¹` when the entries of `Z` are rounded to f32
+/// before the diagonal's cancellation; large near a lightly damped resonance, where the scan
+/// only has to tell the highest node).
+#[test]
+fn receptance_slope_and_f32_solve_match_references() {
+    let mut rng = Rng(45);
+    let mut checked = 0;
+    let mut worst32 = 0.0f64;
+    for trial in 0..300 {
+        let n = 1 + trial % 3;
+        let cfg = comparison_machine(&mut rng, n, true);
+        let s = damped::scaled(&System::new(&cfg)).sys;
+        let solver = super::modal::Solver::new(&s);
+        let narrow = solver.narrowed();
+        for _ in 0..20 {
+            let w = rng.log_uniform(1e-2, 5.0);
+            let (h, slope) = solver.receptance_slope(w);
+            assert_eq!(h, solver.receptance(w));
+            let fd =
+                |d: f64| (solver.receptance(w + d).im - solver.receptance(w - d).im) / (2.0 * d);
+            let (coarse, fine) = (fd(1e-5 * w), fd(5e-6 * w));
+            let richardson = (4.0 * fine - coarse) / 3.0;
+            let scale = h.norm_sq().sqrt() / w + slope.abs();
+            if (coarse - fine).abs() > 1e-3 * scale {
+                continue;
+            }
+            assert!(
+                (slope - richardson).abs() <= 1e-7 * scale,
+                "trial {trial} ω {w}: {slope} vs {richardson}"
+            );
+            let h32 = narrow.receptance(w as f32);
+            let err = ((f64::from(h32.re) - h.re).powi(2) + (f64::from(h32.im) - h.im).powi(2))
+                .sqrt()
+                / h.norm_sq().sqrt();
+            // Relative to f32's rounding times max|Z_ij|·max|Z⁻¹_ij|².
+            let zm: Vec<Vec<C64>> = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| {
+                            let m = if i == j { s.m[i] } else { 0.0 };
+                            C64::new(s.k(i, j) - w * w * m, w * s.c(i, j))
+                        })
+                        .collect()
+                })
+                .collect();
+            // The entries' size before the diagonal's cancellation: |K| + ω²·M + ω·|C|.
+            let mut znorm = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let m = if i == j { s.m[i] } else { 0.0 };
+                    znorm = znorm.max(s.k(i, j).abs() + w * w * m + w * s.c(i, j).abs());
+                }
+            }
+            let mut inorm = 0.0f64;
+            for col in 0..n {
+                let mut e = vec![C64::new(0.0, 0.0); n];
+                e[col] = C64::ONE;
+                for v in csolve(zm.clone(), e) {
+                    inorm = inorm.max(v.norm_sq().sqrt());
+                }
+            }
+            let unit = f64::from(f32::EPSILON) / 2.0;
+            let r = err * h.norm_sq().sqrt() / (unit * znorm * inorm * inorm);
+            worst32 = worst32.max(r);
+            checked += 1;
+        }
+    }
+    std::println!(
+        "f32 solve against f64: worst error {worst32:.2} × u32·‖|K| + ω²M + ω|C|‖·‖Z⁻¹‖²"
+    );
+    assert!(worst32 <= 64.0, "{worst32}");
+    assert!(checked > 3000, "{checked}");
+}
+
+// ---------------------------------------------------------------------------------------
+// The machine as a const table
+
+/// A table written as a literal, as `drive-sim predict --emit rust` writes one, and the
+/// classifier built from it at compile time.
+const LITERAL: MachineTable<'static> = MachineTable {
+    resonant: &[61.0],
+    additional: &[],
+    zones: &[
+        Zone {
+            from: 0.0,
+            to: Some(61.5),
+            kind: ZoneKind::Gathering,
+        },
+        Zone {
+            from: 61.5,
+            to: None,
+            kind: ZoneKind::Balancing,
+        },
+    ],
+    captures: &[CaptureWindow {
+        from: 61.5,
+        until: 90.0,
+        at: 61.5,
+    }],
+};
+const FROM_LITERAL: Result<Classifier, ConfigError> = Classifier::from_table(&LITERAL, 0.02, 0.01);
+
+#[test]
+fn classifier_from_the_table_equals_classifier_from_the_machine() {
+    // Every machine's own table gives the identical classifier, for several bands.
+    let mut rng = Rng(46);
+    for trial in 0..200 {
+        let n = 1 + trial % 3;
+        let m = Machine::new(
+            comparison_machine(&mut rng, n, trial % 2 == 1),
+            SearchOptions::default(),
+        )
+        .unwrap();
+        for (margin, hysteresis) in [(0.0, 0.0), (0.02, 0.01), (0.05, 0.02), (0.3, 0.4)] {
+            let a = Classifier::new(&m, margin, hysteresis).unwrap();
+            let b = Classifier::from_table(&m.table(), margin, hysteresis).unwrap();
+            assert_eq!(a, b, "trial {trial}");
+        }
+        let t = m.table();
+        assert_eq!(t.resonant, m.resonant_speeds());
+        assert_eq!(t.additional, m.additional_speeds());
+        assert_eq!(t.zones, m.zones());
+        assert_eq!(t.captures, m.capture_windows());
+    }
+    // The literal: gathering below 61.5·(1 − 0.02), near the boundary, bistable up to the
+    // capture limit 90, balancing above.
+    let c = FROM_LITERAL.unwrap();
+    assert_eq!(c.characteristic_speeds(), &[61.5]);
+    assert_eq!(c.classify(50.0), Regime::Gathering);
+    assert_eq!(c.classify(61.0), Regime::NearCharacteristic);
+    assert_eq!(c.classify(70.0), Regime::Bistable);
+    assert_eq!(c.classify(95.0), Regime::Balancing);
+}
+
+#[test]
+fn a_table_unlike_a_machines_is_rejected_by_name() {
+    let z = |from: f64, to: Option<f64>, kind| Zone { from, to, kind };
+    let (g, b) = (ZoneKind::Gathering, ZoneKind::Balancing);
+    let w = CaptureWindow {
+        from: 10.0,
+        until: 12.0,
+        at: 10.0,
+    };
+    let table = |zones: &'static [Zone], captures: &'static [CaptureWindow]| MachineTable {
+        resonant: &[10.0],
+        additional: &[],
+        zones,
+        captures,
+    };
+    let build = |t: &MachineTable| Classifier::from_table(t, 0.02, 0.01);
+    let ok: &'static [Zone] = std::vec![z(0.0, Some(10.0), g), z(10.0, None, b)].leak();
+    assert!(build(&table(ok, std::vec![w].leak())).is_ok());
+    let inconsistent: [&'static [Zone]; 7] = [
+        &[],
+        std::vec![z(1.0, Some(10.0), g), z(10.0, None, b)].leak(),
+        std::vec![z(0.0, Some(10.0), b), z(10.0, None, g)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(11.0, None, b)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(10.0, None, g)].leak(),
+        std::vec![z(0.0, Some(10.0), g), z(10.0, Some(20.0), b)].leak(),
+        std::vec![
+            z(0.0, Some(10.0), g),
+            z(10.0, Some(5.0), b),
+            z(5.0, None, g)
+        ]
+        .leak(),
+    ];
+    for zones in inconsistent {
+        assert_eq!(
+            build(&table(zones, &[])),
+            Err(ConfigError::Inconsistent("zones")),
+            "{zones:?}"
+        );
+    }
+    let seven: Vec<Zone> = (0..7)
+        .map(|i| {
+            let kind = if i % 2 == 0 { g } else { b };
+            let to = (i < 6).then_some(f64::from(i + 1));
+            z(f64::from(i), to, kind)
+        })
+        .collect();
+    assert_eq!(
+        build(&table(seven.leak(), &[])),
+        Err(ConfigError::Capacity("zones"))
+    );
+    assert_eq!(
+        build(&table(ok, std::vec![w; 4].leak())),
+        Err(ConfigError::Capacity("captures"))
+    );
+    let nan_zone: &'static [Zone] =
+        std::vec![z(0.0, Some(f64::NAN), g), z(f64::NAN, None, b)].leak();
+    assert_eq!(
+        build(&table(nan_zone, &[])),
+        Err(ConfigError::NonFinite("zones"))
+    );
+    let mut bad = w;
+    bad.until = f64::INFINITY;
+    assert_eq!(
+        build(&table(ok, std::vec![bad].leak())),
+        Err(ConfigError::NonFinite("captures"))
+    );
+    let mut t = table(ok, &[]);
+    t.additional = &[f64::NAN];
+    assert_eq!(build(&t), Err(ConfigError::NonFinite("additional")));
+    t.resonant = &[f64::NEG_INFINITY];
+    assert_eq!(build(&t), Err(ConfigError::NonFinite("resonant")));
 }

@@ -1,6 +1,8 @@
 //! The auto-balancer on the target: the three-mass machine's characteristic speeds computed at
-//! configuration time (f64, software-emulated on the M4), and the per-speed-update
-//! classification (f32, binary search over the zones).
+//! configuration time (f64, software-emulated on the M4), the same analysis taken instead from
+//! the table `drive-sim predict three-mass --emit rust` wrote (`three_mass_table.rs`, a classifier
+//! built at compile time), and the per-speed-update classification (f32, binary search over the
+//! zones).
 
 use core::hint::black_box;
 
@@ -12,6 +14,18 @@ use drive_monitor::balancer::{
 
 use crate::bench::{ensure, measure, measure_each};
 use crate::icount;
+use crate::three_mass_table;
+
+/// Margin and hysteresis of the classifier.
+const MARGIN: f32 = 0.02;
+const HYSTERESIS: f32 = 0.01;
+
+/// The classifier of the emitted table, built by the compiler: no analysis on the target.
+const FROM_TABLE: Classifier =
+    match Classifier::from_table(&three_mass_table::MACHINE, MARGIN, HYSTERESIS) {
+        Ok(c) => c,
+        Err(_) => panic!("three_mass_table.rs: not a valid machine table"),
+    };
 
 /// The bundled `three-mass.toml` machine.
 fn config() -> MachineConfig {
@@ -73,10 +87,11 @@ pub fn run() {
         machine.zones().len()
     );
 
-    let classifier = match Classifier::new(&machine, 0.02, 0.01) {
+    let classifier = match Classifier::new(&machine, MARGIN, HYSTERESIS) {
         Ok(c) => c,
         Err(e) => crate::bench::fail(format_args!("classifier rejected: {}", e)),
     };
+    check_table(&machine, &classifier);
     let mut speeds = [0f32; 64];
     for (i, s) in speeds.iter_mut().enumerate() {
         *s = 20.0 + 2.0 * i as f32;
@@ -95,4 +110,68 @@ pub fn run() {
         i = (i + 1) % speeds.len();
         black_box(tracker.update(&classifier, speeds[i]));
     });
+}
+
+/// The table the host wrote against the analysis done here: the same values bit for bit
+/// (host f64 and the M4's soft-float f64 both round correctly, and the literals read back
+/// exactly), and the classifier built from it at compile time classifying a sweep of speeds —
+/// 0 to 200 rad/s in steps of 0.01, and each segment edge and characteristic speed one f32
+/// step either side — and a tracker's run up and down that sweep, exactly like the one built
+/// from `Machine::new`.
+fn check_table(machine: &Machine, classifier: &Classifier) {
+    let table = three_mass_table::MACHINE;
+    ensure!(
+        machine.table() == table,
+        "three_mass_table.rs differs from Machine::new on the target: regenerate it with \
+         `drive-sim predict three-mass --emit rust`"
+    );
+    ensure!(
+        FROM_TABLE == *classifier,
+        "classifier from the table differs"
+    );
+    let mut speeds = 0u32;
+    let mut same = |w: f32| {
+        speeds += 1;
+        FROM_TABLE.classify(w) == classifier.classify(w)
+            && FROM_TABLE.advice(w) == classifier.advice(w)
+    };
+    let mut all = true;
+    for i in 0..=20_000u32 {
+        all &= same(i as f32 * 0.01);
+    }
+    let edges = table
+        .zones
+        .iter()
+        .map(|z| z.from)
+        .chain(table.captures.iter().map(|w| w.until))
+        .chain(table.resonant.iter().copied())
+        .chain(table.additional.iter().copied());
+    for e in edges {
+        for f in [1.0 - MARGIN, 1.0, 1.0 + MARGIN] {
+            let w = (e * f64::from(f)) as f32;
+            all &= same(w) && same(next_down(w)) && same(next_up(w));
+        }
+    }
+    let (mut a, mut b) = (RegimeTracker::new(), RegimeTracker::new());
+    for i in (0..=4_000u32).chain((0..=4_000u32).rev()) {
+        let w = i as f32 * 0.05;
+        all &= a.update(&FROM_TABLE, w) == b.update(classifier, w);
+    }
+    ensure!(all, "the table's classifier disagrees with Machine::new's");
+    hprintln!(
+        "balancer: emitted table equals Machine::new bit for bit; its compile-time classifier agrees at {} speeds and over a tracked sweep",
+        speeds
+    );
+}
+
+fn next_up(x: f32) -> f32 {
+    f32::from_bits(x.to_bits() + 1)
+}
+
+fn next_down(x: f32) -> f32 {
+    if x > 0.0 {
+        f32::from_bits(x.to_bits() - 1)
+    } else {
+        x
+    }
 }

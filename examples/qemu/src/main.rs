@@ -20,6 +20,7 @@ mod math_bench;
 mod monitor_bench;
 mod stack;
 mod supports_bench;
+mod three_mass_table;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};

@@ -1,9 +1,11 @@
 //! The `drive-sim` application: scene files ([`scene`]), a run through the engine and the core
-//! ([`run`]), design-time results ([`predict`]), the run-up's capture analysis ([`capture`]), and
-//! the report with its plots ([`report`], [`plot`]), progress bars ([`progress`]).
+//! ([`run`]), design-time results ([`predict`]) and their Rust table for firmware ([`emit`]),
+//! the run-up's capture analysis ([`capture`]), and the report with its plots ([`report`],
+//! [`plot`]), progress bars ([`progress`]).
 
 pub mod capture;
 pub mod check;
+pub mod emit;
 pub mod plot;
 pub mod predict;
 pub mod progress;

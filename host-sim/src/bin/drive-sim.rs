@@ -42,6 +42,13 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Write the auto-balancer machine's speeds, zones and capture windows as source for
+        /// firmware instead (rust: a `const` MachineTable).
+        #[arg(long, value_enum, conflicts_with = "json")]
+        emit: Option<host_sim::app::emit::Format>,
+        /// With --emit: write to this file instead of standard output.
+        #[arg(long, requires = "emit")]
+        out: Option<std::path::PathBuf>,
     },
     /// Run a vibration-machine scene at prescribed rotor speeds from A to B rad/s, in
     /// parallel: the criterion's regime against what the loads did.
@@ -153,7 +160,13 @@ fn main() -> ExitCode {
             plot,
             out,
         }) => run_cmd(&scene, json, plot.as_deref(), out.as_deref()),
-        Some(Command::Predict { scene, json }) => predict_cmd(&scene, json),
+        Some(Command::Predict {
+            scene,
+            emit: Some(format),
+            out,
+            ..
+        }) => emit_cmd(&scene, format, out.as_deref()),
+        Some(Command::Predict { scene, json, .. }) => predict_cmd(&scene, json),
         Some(Command::Sweep {
             scene,
             from,
@@ -350,6 +363,20 @@ fn accuracy_cmd(out: &Path, target: bool) -> Result<(), Failure> {
     writable_dir("--out", out)?;
     let files = host_sim::studies::publish::accuracy(out, target)?;
     write_out(&list(&files, "wrote"))
+}
+
+/// The machine's table as Rust source, to `out` or stdout.
+fn emit_cmd(
+    name: &str,
+    format: host_sim::app::emit::Format,
+    out: Option<&Path>,
+) -> Result<(), Failure> {
+    let text = host_sim::app::emit::emit_text(name, format).map_err(|e| e.to_string())?;
+    match out {
+        Some(file) => std::fs::write(file, text)
+            .map_err(|e| Failure::Message(format!("--out {}: cannot write: {e}", file.display()))),
+        None => write_out(&text),
+    }
 }
 
 fn predict_cmd(name: &str, json: bool) -> Result<(), Failure> {

@@ -1,0 +1,30 @@
+//! The `three-mass` scene's auto-balancer machine, analysed on the host for firmware:
+//! written by `drive-sim predict three-mass --emit rust`; regenerate rather than edit.
+//!
+//! Three-mass vibration machine, roller auto-balancer on the middle platform (seed 001).
+//!
+//! Speeds in rad/s. Each f64 is Rust's shortest round-trip form of the value
+//! `Machine::new` computed (default `SearchOptions`): it reads back as the same bits.
+
+use drive_monitor::balancer::{CaptureWindow, MachineTable, Zone, ZoneKind};
+
+/// Characteristic speeds, zones and capture windows of the `three-mass` scene's machine
+/// ([`MachineTable`]).
+#[rustfmt::skip]
+pub const MACHINE: MachineTable<'static> = MachineTable {
+    resonant: &[49.45334900613397, 66.43112527392405, 80.42584094726612],
+    additional: &[51.63977794943223, 70.71067811865476],
+    zones: &[
+        Zone { from: 0.0, to: Some(49.74062014725808), kind: ZoneKind::Gathering },
+        Zone { from: 49.74062014725808, to: Some(51.3491542743101), kind: ZoneKind::Balancing },
+        Zone { from: 51.3491542743101, to: Some(66.6231498246738), kind: ZoneKind::Gathering },
+        Zone { from: 66.6231498246738, to: Some(70.57425411122668), kind: ZoneKind::Balancing },
+        Zone { from: 70.57425411122668, to: Some(80.33713623877476), kind: ZoneKind::Gathering },
+        Zone { from: 80.33713623877476, to: None, kind: ZoneKind::Balancing },
+    ],
+    captures: &[
+        CaptureWindow { from: 49.74062014725808, until: 50.95455277616617, at: 49.74062014725808 },
+        CaptureWindow { from: 66.6231498246738, until: 74.55178532208701, at: 66.53934341660285 },
+        CaptureWindow { from: 80.33713623877476, until: 105.82215063858969, at: 80.33713623877476 },
+    ],
+};

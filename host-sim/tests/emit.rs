@@ -1,0 +1,75 @@
+//! `drive-sim predict SCENE --emit rust`: the table the firmware example includes is what the
+//! command writes now (so it cannot go stale), and `--out` writes the same.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn drive_sim(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
+        .args(args)
+        .output()
+        .expect("drive-sim runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The firmware example's checked-in table.
+fn firmware_table() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/qemu/src/three_mass_table.rs")
+}
+
+#[test]
+fn the_firmware_table_is_what_predict_emits_now() {
+    let (ok, out, err) = drive_sim(&["predict", "three-mass", "--emit", "rust"]);
+    assert!(ok, "{err}");
+    let file = std::fs::read_to_string(firmware_table()).expect("the firmware table exists");
+    assert!(
+        out == file,
+        "examples/qemu/src/three_mass_table.rs is stale: regenerate it with \
+         `cargo run --release -p host-sim -- predict three-mass --emit rust \
+         --out examples/qemu/src/three_mass_table.rs`"
+    );
+    assert_eq!(
+        host_sim::app::emit::emit_text("three-mass", host_sim::app::emit::Format::Rust).unwrap(),
+        out
+    );
+}
+
+#[test]
+fn out_writes_the_same_and_errors_name_the_cause() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-emit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("table.rs");
+    let path = file.to_str().unwrap();
+    let (ok, out, err) = drive_sim(&["predict", "two-mass", "--emit", "rust", "--out", path]);
+    assert!(ok && out.is_empty(), "{err}");
+    let (ok, printed, err) = drive_sim(&["predict", "two-mass", "--emit", "rust"]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), printed);
+    assert!(printed.contains("pub const MACHINE: MachineTable<'static>"));
+    std::fs::remove_dir_all(&dir).unwrap();
+    // No machine in the scene; an unwritable output; --out without --emit.
+    let (ok, _, err) = drive_sim(&["predict", "kneader", "--emit", "rust"]);
+    assert!(
+        !ok && err.contains("kneader.toml") && err.contains("[autobalancer]"),
+        "{err}"
+    );
+    let missing = dir.join("no/such/dir/table.rs");
+    let (ok, _, err) = drive_sim(&[
+        "predict",
+        "three-mass",
+        "--emit",
+        "rust",
+        "--out",
+        missing.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("table.rs") && err.contains("cannot write"),
+        "{err}"
+    );
+    let (ok, _, err) = drive_sim(&["predict", "three-mass", "--out", path]);
+    assert!(!ok && err.contains("--emit"), "{err}");
+}
