@@ -221,8 +221,9 @@ fn bad_scenes_name_the_file_and_key_and_fail() {
 
 #[test]
 fn criterion_writes_its_page_and_json() {
-    // One machine (a single platform, so one boundary): the page names the command that
-    // regenerates it, and the JSON carries the machine, its grid and its boundary.
+    // One machine (a single platform, so one criterion boundary): the page names the command
+    // that regenerates it, and the JSON carries the machine, its grid, its exact boundaries
+    // with their checks and the criterion's boundary beside them.
     let dir = std::env::temp_dir().join(format!("drive-sim-criterion-{}", std::process::id()));
     let (ok, out, err) = drive_sim(&[
         "criterion",
@@ -239,7 +240,20 @@ fn criterion_writes_its_page_and_json() {
     let m = &v["machines"][0];
     assert_eq!(m["sample"]["platforms"], 1);
     assert_eq!(m["points"].as_array().unwrap().len(), 40);
-    assert_eq!(m["boundaries"][0]["kind"], "resonance");
+    assert_eq!(m["shifts"][0]["kind"], "resonance");
+    let checks = m["checks"].as_array().unwrap();
+    assert!(!checks.is_empty());
+    assert_eq!(checks[0]["stable_above"], true);
+    assert!(
+        m["design"]["exact"]["map"]["boundaries"]
+            .as_array()
+            .unwrap()
+            .len()
+            == checks.len()
+    );
+    for p in m["points"].as_array().unwrap() {
+        assert!(["balancing", "gathering", "bistable"].contains(&p["class"].as_str().unwrap()));
+    }
     let md = std::fs::read_to_string(dir.join("criterion.md")).unwrap();
     assert!(md.contains("criterion --machines 1 --seed 3 --out"), "{md}");
     for f in ["criterion-resonance.svg", "criterion-additional.svg"] {

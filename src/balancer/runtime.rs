@@ -1,29 +1,26 @@
-//! Run-time classification of a measured speed (f32, O(log zones), total).
+//! Run-time classification of a measured speed (f32, a binary search over at most
+//! [`MAX_SEGMENTS`] table entries, total).
 
-use super::{Machine, ZoneKind, MAX_PLATFORMS, MAX_ZONES};
+use super::table::{speed_f32, MAX_SEGMENTS};
+use super::{BistableReason, Machine, RegimeSegment, RegimeTable, ZoneKind};
 use crate::error::{non_negative_f32, ConfigError};
-
-/// Segments: the zones, with balancing zones split where a capture window ends.
-const MAX_SEGMENTS: usize = MAX_ZONES + MAX_PLATFORMS;
-/// Characteristic speeds (zone boundaries).
-const MAX_BOUNDS: usize = MAX_ZONES - 1;
 
 /// The regime expected at a speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Regime {
-    /// The auto-balancing position is stable and loads gathered below cannot stay captured.
+    /// The loads balance the rotor: the auto-balancing position is stable and no other state
+    /// is known to persist here.
     Balancing,
-    /// The loads gather: the machine works as a vibration exciter.
+    /// The loads do not balance (they gather: the machine works as a vibration exciter). In an
+    /// exact table ([`Classifier::from_table`]) the balancing position is unstable here; in the
+    /// criterion's ([`Classifier::new`]) the criterion says the loads gather.
     Gathering,
-    /// The criterion says balancing, but it is not assured: gathered loads can stay captured
-    /// near the resonance below (Sommerfeld effect), and direct simulation finds the
-    /// balancing position itself unstable just above the resonance (on random machines
-    /// balancing set in a median 17 % above it, `docs/criterion.md`). Which regime sets in
-    /// depends on the machine and its history.
-    Bistable,
-    /// Within the margin band around a damped characteristic speed, where the criterion is
-    /// not to be relied on.
+    /// The balancing position is stable, but another state can persist too ([`BistableReason`]):
+    /// which regime sets in depends on the machine's history.
+    Bistable(BistableReason),
+    /// Within the margin band about a boundary of the table, where the class is not to be
+    /// relied on.
     NearCharacteristic,
     /// The speed is not a number or infinite.
     Unknown,
@@ -36,10 +33,23 @@ impl Regime {
         match self {
             Regime::Balancing => "balancing",
             Regime::Gathering => "gathering",
-            Regime::Bistable => "bistable",
+            Regime::Bistable(_) => "bistable",
             Regime::NearCharacteristic => "near-characteristic",
             Regime::Unknown => "unknown",
         }
+    }
+
+    /// Why the regime is bistable (`None` for the others).
+    pub fn reason(self) -> Option<BistableReason> {
+        match self {
+            Regime::Bistable(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The classifier commits to this regime (`Balancing` or `Gathering`).
+    pub fn committed(self) -> bool {
+        matches!(self, Regime::Balancing | Regime::Gathering)
     }
 }
 
@@ -57,79 +67,81 @@ pub struct SpeedBand {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Advice {
-    /// When balancing (or bistable) at this speed: to get the loads to gather again (re-enter
-    /// the exciter mode), drop the speed below this, rad/s; the speed can be raised again
-    /// once the loads are stuck. `None` when the loads already tend to gather here.
+    /// When the balancing position is stable at this speed (`Balancing` or `Bistable`): to
+    /// get the loads to gather again (re-enter the exciter mode), drop the speed below this,
+    /// the start of the stable stretch shrunk by the margin, rad/s; the speed can be raised
+    /// again once the loads are stuck. `None` when the loads already gather here, or the
+    /// balancing position is stable down to standstill.
     pub drop_below: Option<f32>,
-    /// The gathering zone to run a vibration exciter in: the highest gathering zone starting
-    /// at or below this speed, shrunk by the margin at both finite edges. `None` if the
-    /// margins leave nothing.
+    /// Where to run a vibration exciter: the highest `Gathering` segment starting at or below
+    /// this speed, shrunk by the margin at both edges. `None` if the margins leave nothing or
+    /// that segment is open-ended.
     pub exciter_band: Option<SpeedBand>,
 }
 
-/// Run-time zone table in f32, built once from a [`Machine`].
+/// Run-time regime table in f32, built once from a [`RegimeTable`] (or, for the seed's
+/// criterion, from a [`Machine`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Classifier {
     seg_from: [f32; MAX_SEGMENTS],
     seg_regime: [Regime; MAX_SEGMENTS],
     n_seg: u8,
-    /// Kind of each zone; zone `i > 0` starts at `bounds[i − 1]`, zone 0 at 0.
-    zone_kind: [ZoneKind; MAX_ZONES],
-    bounds: [f32; MAX_BOUNDS],
-    n_bounds: u8,
     margin: f32,
     hysteresis: f32,
 }
 
-/// Default margin band about each damped characteristic speed: 5 %.
+/// Default margin band about each boundary of the table: 5 %.
 ///
-/// Sized from simulation (`drive-sim criterion`, `docs/criterion.md`): on 120 random machines
-/// with `ε` in [0.005, 0.1], `h` in [0.01, 0.2] and `β` in [1, 50], the band an additional
-/// speed's boundary (balancing below, gathering above) needs for the classifier to match the
-/// simulation on both sides was 0.3 % at the median and 2.0 % at the 90th percentile; 5 %
-/// covers 69 of the 71 boundaries (in the other two the gathering zone above the additional
-/// speed shrinks or vanishes in simulation). The needed band did not change measurably with
-/// `ε` (medians and maxima flat across the range; a power-law fit gives `ε^−0.01`), so it is
-/// one constant, not a function of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
-/// capture band ([`Regime::Bistable`]), not by this margin.
+/// Sized from simulation for the seed criterion's table (`drive-sim criterion`,
+/// `docs/criterion.md`): on 120 random machines the band an additional speed's boundary needed
+/// for the criterion's class to match the simulation on both sides was 0.3 % at the median
+/// and 2.0 % at the 90th percentile, and 5 % covered 69 of 71 boundaries.
 pub const DEFAULT_MARGIN: f32 = 0.05;
 
+/// Default margin band about each boundary of an exact table ([`Classifier::from_table`]):
+/// 1 %. The exact boundaries are placed to 1e-6; the band covers the speeds where a
+/// perturbation grows or decays so slowly that the regime takes very long to show, and small
+/// errors in the machine's parameters. Sized from simulation (`drive-sim criterion`,
+/// `docs/criterion.md`, which reports the agreement and commitment at other margins too).
+pub const TABLE_MARGIN: f32 = 0.01;
+
 impl Classifier {
-    /// Builds the table. `margin`: relative half-width of the band around each damped
-    /// characteristic speed reported as [`Regime::NearCharacteristic`] (e.g. 0.03);
-    /// `hysteresis`: relative distance past a boundary the speed must go before
-    /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`.
+    /// Builds the classifier of a validated [`RegimeTable`] (the exact table a host computed,
+    /// see the module docs of [`super::table`]). `margin`: relative half-width of the band
+    /// about each boundary of the table reported as [`Regime::NearCharacteristic`] (e.g.
+    /// 0.02); `hysteresis`: relative distance past a boundary the speed must go before
+    /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`. Errors: those of
+    /// [`RegimeTable::validate`], and `OutOfRange("margin")`/`OutOfRange("hysteresis")`.
+    pub fn from_table(
+        table: &RegimeTable<'_>,
+        margin: f32,
+        hysteresis: f32,
+    ) -> Result<Self, ConfigError> {
+        table.validate()?;
+        let mut c = Self::empty(margin, hysteresis)?;
+        for seg in table.segments {
+            c.push_segment(*seg)?;
+        }
+        Ok(c)
+    }
+
+    /// Builds the seed criterion's classifier of `machine`: its damped zones
+    /// ([`Machine::zones`]), with each balancing zone `Bistable(Capture)` up to where the
+    /// capture windows below it end ([`Machine::capture_windows`]). The criterion is
+    /// approximate (`docs/criterion.md`); a host's exact table ([`Classifier::from_table`])
+    /// is not. `margin` and `hysteresis` as for [`Classifier::from_table`]. A zone or window
+    /// speed f32 cannot hold (rounding to infinity, zero or a subnormal) gives
+    /// `OutOfRange("zones.from")` or `OutOfRange("capture_windows.until")`.
     pub fn new(machine: &Machine, margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
-        let margin = non_negative_f32("margin", margin)?;
-        let hysteresis = non_negative_f32("hysteresis", hysteresis)?;
-        if margin >= 0.5 {
-            return Err(ConfigError::OutOfRange("margin"));
-        }
-        if hysteresis >= 0.5 {
-            return Err(ConfigError::OutOfRange("hysteresis"));
-        }
-        let mut c = Classifier {
-            seg_from: [0.0; MAX_SEGMENTS],
-            seg_regime: [Regime::Gathering; MAX_SEGMENTS],
-            n_seg: 0,
-            zone_kind: [ZoneKind::Gathering; MAX_ZONES],
-            bounds: [0.0; MAX_BOUNDS],
-            n_bounds: 0,
-            margin,
-            hysteresis,
-        };
-        for (i, z) in machine.zones().iter().enumerate() {
-            if let Some(k) = c.zone_kind.get_mut(i) {
-                *k = z.kind;
-            }
-            if i > 0 {
-                if let Some(b) = c.bounds.get_mut(i - 1) {
-                    *b = z.from as f32;
-                }
-            }
+        let mut c = Self::empty(margin, hysteresis)?;
+        for z in machine.zones() {
+            let from = speed_f32("zones.from", z.from)?;
             match z.kind {
-                ZoneKind::Gathering => c.push_segment(z.from, Regime::Gathering)?,
+                ZoneKind::Gathering => c.push_segment(RegimeSegment {
+                    from,
+                    regime: Regime::Gathering,
+                })?,
                 ZoneKind::Balancing => {
                     // Capture is possible up to the largest `until` of the windows below.
                     let until = machine
@@ -139,43 +151,115 @@ impl Classifier {
                         .fold(0.0f64, |u, w| u.max(w.until));
                     let to = z.to.unwrap_or(f64::INFINITY);
                     if until > z.from {
-                        c.push_segment(z.from, Regime::Bistable)?;
+                        c.push_segment(RegimeSegment {
+                            from,
+                            regime: Regime::Bistable(BistableReason::Capture),
+                        })?;
                         if until < to {
-                            c.push_segment(until, Regime::Balancing)?;
+                            c.push_segment(RegimeSegment {
+                                from: speed_f32("capture_windows.until", until)?,
+                                regime: Regime::Balancing,
+                            })?;
                         }
                     } else {
-                        c.push_segment(z.from, Regime::Balancing)?;
+                        c.push_segment(RegimeSegment {
+                            from,
+                            regime: Regime::Balancing,
+                        })?;
                     }
                 }
             }
         }
-        c.n_bounds = machine.zones().len().clamp(1, MAX_ZONES) as u8 - 1;
+        c.check_table()?;
         Ok(c)
     }
 
-    /// Appends a segment starting at `from` rad/s.
-    fn push_segment(&mut self, from: f64, regime: Regime) -> Result<(), ConfigError> {
-        let i = usize::from(self.n_seg);
-        let (Some(f), Some(r)) = (self.seg_from.get_mut(i), self.seg_regime.get_mut(i)) else {
+    fn empty(margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
+        let margin = non_negative_f32("margin", margin)?;
+        let hysteresis = non_negative_f32("hysteresis", hysteresis)?;
+        if margin >= 0.5 {
+            return Err(ConfigError::OutOfRange("margin"));
+        }
+        if hysteresis >= 0.5 {
+            return Err(ConfigError::OutOfRange("hysteresis"));
+        }
+        Ok(Classifier {
+            seg_from: [0.0; MAX_SEGMENTS],
+            seg_regime: [Regime::Gathering; MAX_SEGMENTS],
+            n_seg: 0,
+            margin,
+            hysteresis,
+        })
+    }
+
+    /// Appends a segment. A segment starting where the last one starts (speeds equal once in
+    /// f32) replaces it, and one of the last one's regime extends it, so the table stays
+    /// strictly ascending with neighbours that differ.
+    fn push_segment(&mut self, seg: RegimeSegment) -> Result<(), ConfigError> {
+        let n = usize::from(self.n_seg);
+        if let Some(last) = n.checked_sub(1) {
+            if seg.from <= self.seg_from.get(last).copied().unwrap_or(0.0) {
+                // The last segment is empty: drop it.
+                self.n_seg -= 1;
+            }
+        }
+        self.push_merged(seg)
+    }
+
+    fn push_merged(&mut self, seg: RegimeSegment) -> Result<(), ConfigError> {
+        let n = usize::from(self.n_seg);
+        if let Some(prev) = n.checked_sub(1).and_then(|j| self.seg_regime.get(j)) {
+            if *prev == seg.regime {
+                return Ok(());
+            }
+        }
+        let (Some(f), Some(r)) = (self.seg_from.get_mut(n), self.seg_regime.get_mut(n)) else {
             return Err(ConfigError::Capacity("segments"));
         };
-        *f = from as f32;
-        *r = regime;
+        *f = if n == 0 { 0.0 } else { seg.from };
+        *r = seg.regime;
         self.n_seg += 1;
         Ok(())
+    }
+
+    /// Re-validates the built table (a machine's zones are validated by construction; this
+    /// keeps the invariants `classify` relies on explicit).
+    fn check_table(&self) -> Result<(), ConfigError> {
+        let mut segs = [RegimeSegment {
+            from: 0.0,
+            regime: Regime::Gathering,
+        }; MAX_SEGMENTS];
+        for (s, (f, r)) in segs
+            .iter_mut()
+            .zip(self.segs().iter().zip(&self.seg_regime))
+        {
+            *s = RegimeSegment {
+                from: *f,
+                regime: *r,
+            };
+        }
+        RegimeTable {
+            segments: segs.get(..usize::from(self.n_seg)).unwrap_or(&[]),
+        }
+        .validate()
+    }
+
+    /// The segments as a table (for printing it, or for shipping it to a target).
+    pub fn segments(&self) -> impl Iterator<Item = RegimeSegment> + '_ {
+        self.segs()
+            .iter()
+            .zip(&self.seg_regime)
+            .map(|(&from, &regime)| RegimeSegment { from, regime })
     }
 
     fn segs(&self) -> &[f32] {
         self.seg_from.get(..usize::from(self.n_seg)).unwrap_or(&[])
     }
 
-    fn bounds(&self) -> &[f32] {
-        self.bounds.get(..usize::from(self.n_bounds)).unwrap_or(&[])
-    }
-
-    /// The damped characteristic speeds (zone boundaries), ascending, rad/s.
-    pub fn characteristic_speeds(&self) -> &[f32] {
-        self.bounds()
+    /// The boundaries of the table (every segment's `from` but the first), ascending, rad/s:
+    /// the speeds the margin band is placed about.
+    pub fn boundaries(&self) -> &[f32] {
+        self.segs().get(1..).unwrap_or(&[])
     }
 
     /// Index of the segment containing `s ≥ 0` (binary search).
@@ -198,9 +282,9 @@ impl Classifier {
         (from, to)
     }
 
-    /// Whether `s ≥ 0` lies within the margin band of a characteristic speed.
+    /// Whether `s ≥ 0` lies within the margin band of a boundary.
     fn near(&self, s: f32) -> bool {
-        let b = self.bounds();
+        let b = self.boundaries();
         let i = b.partition_point(|&x| x <= s);
         let close = |x: Option<&f32>| x.is_some_and(|&x| (s - x).abs() <= self.margin * x);
         close(b.get(i)) || close(i.checked_sub(1).and_then(|j| b.get(j)))
@@ -219,6 +303,11 @@ impl Classifier {
         self.segment_regime(self.segment(s))
     }
 
+    /// The balancing position is stable in segment `i` (every regime but `Gathering`).
+    fn stable(&self, i: usize) -> bool {
+        !matches!(self.seg_regime.get(i), Some(Regime::Gathering) | None)
+    }
+
     /// What to do at `speed` rad/s (see [`Advice`]). NaN and ±∞ give no advice.
     pub fn advice(&self, speed: f32) -> Advice {
         let none = Advice {
@@ -229,33 +318,29 @@ impl Classifier {
             return none;
         }
         let s = speed.abs();
-        let bounds = self.bounds();
-        // Zone `i` is `[from(i), bounds[i])`; `s ≥ 0` lies in the zone after every boundary
-        // at or below it.
-        let from = |i: usize| match i.checked_sub(1) {
-            None => Some(0.0),
-            Some(b) => bounds.get(b).copied(),
-        };
-        let zi = bounds.partition_point(|&f| f <= s);
-        let kind = self.zone_kind.get(zi).copied();
-        let drop_below = match kind {
-            Some(ZoneKind::Balancing) => from(zi).map(|f| f * (1.0 - self.margin)),
-            _ => None,
-        };
-        // The highest gathering zone starting at or below s.
-        let gi = if kind == Some(ZoneKind::Gathering) {
-            Some(zi)
+        let i = self.segment(s);
+        // Where the balancing position is stable: the start of the stable run containing i.
+        let drop_below = if self.stable(i) {
+            let mut j = i;
+            while j > 0 && self.stable(j - 1) {
+                j -= 1;
+            }
+            self.seg_from
+                .get(j)
+                .copied()
+                .filter(|&f| f > 0.0)
+                .map(|f| f * (1.0 - self.margin))
         } else {
-            zi.checked_sub(1)
+            None
         };
-        let exciter_band = gi.and_then(|g| {
-            let from = from(g)?;
-            let to = bounds.get(g).copied()?;
+        // The highest segment where the loads gather, starting at or below s.
+        let exciter_band = (0..=i).rev().find(|&g| !self.stable(g)).and_then(|g| {
+            let (from, to) = self.segment_range(g);
             let band = SpeedBand {
                 from: from * (1.0 + self.margin),
                 to: to * (1.0 - self.margin),
             };
-            (band.from < band.to).then_some(band)
+            (to.is_finite() && band.from < band.to).then_some(band)
         });
         Advice {
             drop_below,

@@ -859,16 +859,18 @@ fn classifier_agrees_with_zone_table() {
         let cfg = random_machine(&mut rng, 1 + trial % 3, true);
         let m = analyse(cfg);
         let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-        assert_eq!(c.characteristic_speeds().len(), m.zones().len() - 1);
+        // Every zone boundary is a boundary of the table (the others end capture windows).
+        for z in m.zones().iter().skip(1) {
+            assert!(c.boundaries().contains(&(z.from as f32)), "{z:?}");
+        }
         let top = m.zones().last().unwrap().from.max(m.resonant_speeds()[0]);
         let mut capture_checks = 0;
         for _ in 0..200 {
             let w = rng.uniform() * 2.0 * top;
-            let near = m
-                .zones()
+            let near = c
+                .boundaries()
                 .iter()
-                .skip(1)
-                .any(|z| (w - z.from).abs() <= 0.0201 * z.from);
+                .any(|&b| (w - f64::from(b)).abs() <= 0.0201 * f64::from(b));
             let r = c.classify(w as f32);
             if near {
                 continue;
@@ -877,7 +879,7 @@ fn classifier_agrees_with_zone_table() {
             match r {
                 Regime::Gathering => assert_eq!(expect, ZoneKind::Gathering),
                 Regime::Balancing => assert_eq!(expect, ZoneKind::Balancing),
-                Regime::Bistable => {
+                Regime::Bistable(BistableReason::Capture) => {
                     assert_eq!(expect, ZoneKind::Balancing);
                     if capture_checks < 3 {
                         capture_checks += 1;
@@ -895,7 +897,8 @@ fn classifier_agrees_with_zone_table() {
 fn near_band_hysteresis_and_events() {
     let m = analyse(scene(2));
     let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-    let b = c.characteristic_speeds()[0];
+    let b = c.boundaries()[0];
+    assert_eq!(b, m.zones()[1].from as f32);
     assert_eq!(c.classify(b), Regime::NearCharacteristic);
     assert_eq!(c.classify(b * 1.019), Regime::NearCharacteristic);
     assert_eq!(c.classify(b * 0.97), Regime::Gathering);
@@ -945,10 +948,13 @@ fn bistable_segment_and_advice() {
     let win = m.capture_windows()[0];
     assert!(win.until > win.from * 1.03, "{win:?}");
     let inside = (0.5 * (win.from * 1.03 + win.until)) as f32;
-    assert_eq!(c.classify(inside), Regime::Bistable);
+    assert_eq!(
+        c.classify(inside),
+        Regime::Bistable(BistableReason::Capture)
+    );
     assert_eq!(c.classify((win.until * 1.05) as f32), Regime::Balancing);
     let a = c.advice(inside);
-    let b = c.characteristic_speeds()[0];
+    let b = c.boundaries()[0];
     assert_eq!(a.drop_below, Some(b * 0.98));
     assert_eq!(
         a.exciter_band,
@@ -962,7 +968,7 @@ fn bistable_segment_and_advice() {
     // Two platforms, in the second gathering zone: run there.
     let m = analyse(scene(2));
     let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-    let cs = c.characteristic_speeds();
+    let cs: Vec<f32> = m.zones().iter().skip(1).map(|z| z.from as f32).collect();
     let mid = 0.5 * (cs[1] + cs[2]);
     let a = c.advice(mid);
     assert_eq!(a.drop_below, None);
@@ -988,16 +994,20 @@ proptest::proptest! {
     #![proptest_config(proptest::test_runner::Config::with_cases(2000))]
     #[test]
     fn runtime_is_total_for_any_f32(bits in proptest::prelude::any::<u32>(), seq in proptest::collection::vec(proptest::prelude::any::<u32>(), 0..16)) {
-        static M: std::sync::OnceLock<(Classifier, Classifier)> = std::sync::OnceLock::new();
-        let (c2, c3) = M.get_or_init(|| {
+        static M: std::sync::OnceLock<(Classifier, Classifier, Classifier)> = std::sync::OnceLock::new();
+        let (c2, c3, ct) = M.get_or_init(|| {
             let m2 = analyse(scene(2));
             let p = [platform(100.0, 4e5, 200.0), platform(100.0, 4e5, 200.0), platform(150.0, 3e5, 200.0)];
             let cs = [coupling(1, 2, 1e5, 50.0), coupling(2, 3, 1e5, 50.0)];
             let m3 = analyse(MachineConfig::new(&p, &cs, balancer(2)).unwrap());
-            (Classifier::new(&m2, 0.03, 0.01).unwrap(), Classifier::new(&m3, 0.0, 0.0).unwrap())
+            (
+                Classifier::new(&m2, 0.03, 0.01).unwrap(),
+                Classifier::new(&m3, 0.0, 0.0).unwrap(),
+                Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap(),
+            )
         });
         let x = f32::from_bits(bits);
-        for c in [c2, c3] {
+        for c in [c2, c3, ct] {
             let r = c.classify(x);
             proptest::prop_assert_eq!(r == Regime::Unknown, !x.is_finite());
             proptest::prop_assert_eq!(c.classify(-x), r);
@@ -1150,4 +1160,180 @@ fn kappa_by_kind() {
     assert_eq!(z1, z2);
     assert_eq!(ZoneKind::Balancing.name(), "balancing");
     assert_eq!(ZoneKind::Gathering.name(), "gathering");
+}
+
+// ---------------------------------------------------------------------------------------
+// Regime tables
+
+const fn seg(from: f32, regime: Regime) -> RegimeSegment {
+    RegimeSegment { from, regime }
+}
+
+/// The seed machine's exact table in the seed's units (ω̃ = 1): balancing position unstable
+/// below 1.0016, stable to 1.0874 (inside the capture window), unstable to 1.4252, stable
+/// above, captured loads possible up to 1.9.
+const SEED_TABLE: RegimeTable<'static> = RegimeTable {
+    segments: &[
+        seg(0.0, Regime::Gathering),
+        seg(1.0016, Regime::Bistable(BistableReason::Capture)),
+        seg(1.0874, Regime::Gathering),
+        seg(1.4252, Regime::Bistable(BistableReason::Capture)),
+        seg(1.9, Regime::Balancing),
+    ],
+};
+
+#[test]
+fn table_classifier_reads_the_table() {
+    let c = Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap();
+    assert_eq!(c.boundaries(), &[1.0016, 1.0874, 1.4252, 1.9]);
+    let cases = [
+        (0.5, Regime::Gathering),
+        (0.995, Regime::NearCharacteristic),
+        (1.05, Regime::Bistable(BistableReason::Capture)),
+        (1.2, Regime::Gathering),
+        (1.43, Regime::NearCharacteristic),
+        (1.6, Regime::Bistable(BistableReason::Capture)),
+        (2.5, Regime::Balancing),
+        (-2.5, Regime::Balancing),
+        (f32::NAN, Regime::Unknown),
+    ];
+    for (w, want) in cases {
+        assert_eq!(c.classify(w), want, "{w}");
+    }
+    assert!(Regime::Balancing.committed() && Regime::Gathering.committed());
+    assert!(!Regime::Bistable(BistableReason::Coexisting).committed());
+    assert_eq!(
+        Regime::Bistable(BistableReason::Coexisting).reason(),
+        Some(BistableReason::Coexisting)
+    );
+    assert_eq!(Regime::Balancing.reason(), None);
+    // The table round-trips through the classifier.
+    let back: Vec<RegimeSegment> = c.segments().collect();
+    assert_eq!(back.as_slice(), SEED_TABLE.segments);
+    // Advice: above the instability band, the stable stretch starts at 1.4252; the exciter
+    // band is the unstable band shrunk by the margin.
+    let a = c.advice(1.6);
+    assert_eq!(a.drop_below, Some(1.4252 * 0.99));
+    assert_eq!(
+        a.exciter_band,
+        Some(SpeedBand {
+            from: 1.0874 * 1.01,
+            to: 1.4252 * 0.99
+        })
+    );
+    let a = c.advice(1.05);
+    assert_eq!(a.drop_below, Some(1.0016 * 0.99));
+    assert_eq!(
+        a.exciter_band,
+        Some(SpeedBand {
+            from: 0.0,
+            to: 1.0016 * 0.99
+        })
+    );
+    assert_eq!(c.advice(1.2).drop_below, None);
+}
+
+#[test]
+fn table_validation_names_what_is_wrong() {
+    let check = |segments: &[RegimeSegment], want: ConfigError| {
+        let t = RegimeTable { segments };
+        assert_eq!(t.validate(), Err(want), "{segments:?}");
+        assert_eq!(Classifier::from_table(&t, 0.01, 0.0), Err(want));
+    };
+    let g = Regime::Gathering;
+    let b = Regime::Balancing;
+    check(&[], ConfigError::Capacity("segments"));
+    check(
+        &[seg(0.0, g), seg(1.0, b)].repeat(9),
+        ConfigError::Capacity("segments"),
+    );
+    check(&[seg(0.5, g)], ConfigError::OutOfRange("segments.from"));
+    check(
+        &[seg(0.0, g), seg(f32::INFINITY, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(1e-40, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(f32::NAN, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(2.0, b), seg(1.0, g)],
+        ConfigError::Inconsistent("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(1.0, g)],
+        ConfigError::Inconsistent("segments.regime"),
+    );
+    check(
+        &[seg(0.0, g), seg(1.0, Regime::NearCharacteristic)],
+        ConfigError::OutOfRange("segments.regime"),
+    );
+    check(
+        &[seg(0.0, Regime::Unknown)],
+        ConfigError::OutOfRange("segments.regime"),
+    );
+    assert!(Classifier::from_table(&SEED_TABLE, 0.5, 0.0).is_err());
+    assert!(Classifier::from_table(&SEED_TABLE, 0.0, f32::NAN).is_err());
+    assert!(Classifier::from_table(
+        &RegimeTable {
+            segments: &[seg(0.0, b)]
+        },
+        0.0,
+        0.0
+    )
+    .is_ok());
+}
+
+#[test]
+fn f64_speeds_that_f32_cannot_hold_are_errors() {
+    use super::table::speed_f32;
+    assert_eq!(speed_f32("s", 0.0), Ok(0.0));
+    assert_eq!(speed_f32("s", 61.5), Ok(61.5));
+    assert_eq!(speed_f32("s", 1e39), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", 1e-50), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", 1e-40), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", -1.0), Err(ConfigError::Negative("s")));
+    assert_eq!(speed_f32("s", f64::NAN), Err(ConfigError::NonFinite("s")));
+    assert_eq!(
+        RegimeSegment::new("s", 1e300, Regime::Balancing),
+        Err(ConfigError::OutOfRange("s"))
+    );
+    // A machine whose characteristic speeds f64 holds but f32 does not: the criterion's
+    // classifier rejects it instead of placing a boundary at infinity or at 0.
+    for (mass, stiffness) in [(1.0, 1e90), (1e10, 1e-80)] {
+        let b = AutoBalancer {
+            load_mass: 0.5 * mass,
+            housing_mass: 0.0,
+            ..balancer(1)
+        };
+        let cfg = MachineConfig::new(&[platform(mass, stiffness, 0.0)], &[], b).unwrap();
+        let m = analyse(cfg);
+        let w = m.zones()[1].from;
+        assert!(w.is_finite() && w > 0.0, "{w}");
+        assert_eq!(
+            Classifier::new(&m, 0.01, 0.0),
+            Err(ConfigError::OutOfRange("zones.from")),
+            "{w}"
+        );
+    }
+}
+
+#[test]
+fn criterion_classifier_merges_empty_segments() {
+    // A capture window ending where the balancing zone ends (equal in f32) must not leave an
+    // empty segment or two neighbours of one regime.
+    let mut rng = Rng(5);
+    for trial in 0..30 {
+        let m = analyse(random_machine(&mut rng, 1 + trial % 3, true));
+        let c = Classifier::new(&m, 0.0, 0.0).unwrap();
+        let segs: Vec<RegimeSegment> = c.segments().collect();
+        assert!(
+            RegimeTable { segments: &segs }.validate().is_ok(),
+            "{segs:?}"
+        );
+    }
 }

@@ -19,11 +19,12 @@ use crate::engine::system::{
 };
 use crate::engine::vibration::{
     classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind, LoadPlacement,
-    PlatformParams, RegimeCriteria, RegimeReport, RegimeSample, VibrationMachine,
-    VibrationMachineParams,
+    PlatformParams, RegimeReport, RegimeSample, VibrationMachine, VibrationMachineParams,
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
-use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
+#[cfg(doc)]
+use drive_monitor::balancer::DEFAULT_MARGIN;
+use drive_monitor::balancer::{Classifier, Machine};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Framing};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
@@ -484,21 +485,18 @@ pub fn scene_stem(path: &Path) -> String {
         .to_string()
 }
 
-/// The core's regime classifier for `machine` with the scene's `[monitor] regime_margin`
-/// (default [`DEFAULT_MARGIN`]) and half of it as hysteresis, and that margin.
+/// The core's regime classifier for `machine`: from the exact table of the scene's machine
+/// when it has one ([`crate::app::regimes`]), else from the criterion; with the scene's
+/// `[monitor] regime_margin` (default [`DEFAULT_MARGIN`]) and half of it as hysteresis. Returns
+/// the classifier and that margin.
 pub fn regime_classifier(
     scene: &Scene,
     file: &Path,
     machine: &Machine,
 ) -> Result<(Classifier, f32), SceneError> {
-    let margin = scene
-        .monitor
-        .as_ref()
-        .and_then(|m| m.regime_margin)
-        .map_or(DEFAULT_MARGIN, |m| m as f32);
-    let classifier = Classifier::new(machine, margin, 0.5 * margin)
-        .map_err(|e| value_error(file, "monitor", e))?;
-    Ok((classifier, margin))
+    let design = crate::app::regimes::design(scene, file, machine)?;
+    let (c, margin, _) = crate::app::regimes::classifier(scene, file, machine, design.as_ref())?;
+    Ok((c, margin))
 }
 
 /// Simulates `scene` and reports.
@@ -669,16 +667,16 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         report.noise_floor = median(&mut counted.iter().map(|w| w.noise_floor).collect::<Vec<_>>());
         report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
     }
-    if let Some(machine) = predict::machine(scene, file)? {
+    if let (Some(machine), Some(w)) = (predict::machine(scene, file)?, report.speed_measured) {
         let (classifier, _) = regime_classifier(scene, file, &machine)?;
-        if let Some(w) = report.speed_measured {
+        {
             report.regime_class = Some(classifier.classify(w as f32).name());
             // The criterion's own zone at the measured speed (no margin, no capture check).
             report.regime_predicted = Some(machine.zone_kind_at(w).name());
         }
     }
     if let Some(vm) = &vib_machine {
-        let criteria = RegimeCriteria::new(vm.reference_unbalance());
+        let criteria = vm.regime_criteria();
         if let Some(r) = classify(&col.samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());
             report.residual_relative = Some(r.residual_relative);

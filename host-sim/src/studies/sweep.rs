@@ -228,7 +228,7 @@ pub fn sweep(
     bar.finish_and_clear();
     let points = points?;
     let boundaries: Vec<f64> = classifier
-        .characteristic_speeds()
+        .boundaries()
         .iter()
         .map(|&b| f64::from(b))
         .collect();
