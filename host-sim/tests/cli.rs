@@ -41,6 +41,8 @@ fn scenes_lists_every_bundled_scene() {
         "auger-overhung",
         "one-mass",
         "one-mass-runup",
+        "one-mass-motor-runup",
+        "one-mass-undersized",
         "two-mass",
         "three-mass",
     ] {
@@ -262,4 +264,43 @@ fn criterion_writes_its_page_and_json() {
             .starts_with("<svg"));
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn undersized_balancer_is_a_design_result() {
+    // Two loads of 0.5 kg on 0.1 m (N·m·R = 0.1 kg·m) against a rotor unbalance of 0.12 kg·m:
+    // no balancing position. predict reports the capacity and the residual with the loads at
+    // their limit; run simulates it (at 100 rad/s the loads settle opposite the unbalance,
+    // leaving that residual); sweep runs instead of stopping on a contradiction.
+    let p = &json(&["predict", "one-mass-undersized", "--json"])["autobalancer"];
+    assert!((p["capacity"].as_f64().unwrap() - 0.1).abs() < 1e-12, "{p}");
+    assert!(
+        (p["residual_floor"].as_f64().unwrap() - 0.02).abs() < 1e-12,
+        "{p}"
+    );
+    assert!(p["stability"].is_null());
+    assert_eq!(p["regime_table_source"], "criterion");
+    let (_, text, _) = drive_sim(&["predict", "one-mass-undersized"]);
+    assert!(text.contains("too small for its rotor"), "{text}");
+    let v = json(&["run", "one-mass-undersized", "--json"]);
+    assert_eq!(v["regime_simulated"], "saturated", "{v}");
+    let floor = v["residual_floor"].as_f64().unwrap();
+    let rel = v["residual_relative"].as_f64().unwrap();
+    // Within 1 % of D of the floor (0.02/0.12 = 0.1667 of D).
+    assert!((rel - floor / 0.12).abs() <= 0.01, "{rel} {floor}");
+    let s = json(&[
+        "sweep",
+        "one-mass-undersized",
+        "--from",
+        "40",
+        "--to",
+        "110",
+        "--steps",
+        "2",
+        "--json",
+    ]);
+    let points = s["points"].as_array().unwrap();
+    assert_eq!(points[0]["regime_simulated"], "gathering");
+    assert_eq!(points[1]["regime_simulated"], "saturated");
+    assert_eq!(s["exact"], false);
 }

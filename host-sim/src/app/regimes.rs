@@ -280,3 +280,150 @@ pub fn classifier(
         .map_err(|e| value_error(file, "monitor", e))?;
     Ok((c, margin, false))
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::app::predict;
+    use crate::app::scene::resolve;
+    use crate::engine::vibration::floquet::Boundary;
+
+    fn one_mass() -> (Scene, std::path::PathBuf, Machine) {
+        let (scene, path) = resolve("one-mass").unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        (scene, path, m)
+    }
+
+    fn map_with(stable_at_from: bool, speeds: &[f64]) -> StabilityMap {
+        let mut stable = stable_at_from;
+        StabilityMap {
+            options: ScanOptions::new(10.0, 400.0),
+            stable_at_from,
+            boundaries: speeds
+                .iter()
+                .map(|&w| {
+                    stable = !stable;
+                    Boundary {
+                        speed: w,
+                        bracket: [w, w],
+                        stable_above: stable,
+                        radius: [1.0, 1.0],
+                    }
+                })
+                .collect(),
+            evaluations: 0,
+            neutral_drift: 0.0,
+        }
+    }
+
+    #[test]
+    fn table_combines_stability_capture_and_criterion() {
+        let (_, _, m) = one_mass();
+        let b = m.zones()[1].from; // 61.43: the criterion's resonance
+        let until = m.capture_windows()[0].until; // 90.41
+        let capture = Regime::Bistable(BistableReason::Capture);
+        // Stable from 72, as the Floquet analysis finds for this machine.
+        let t = table(&map_with(false, &[72.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (72.0, capture),
+                (until, Regime::Balancing)
+            ]
+        );
+        // Stable already below the criterion's boundary: coexisting with gathered loads there.
+        let t = table(&map_with(false, &[55.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (55.0, Regime::Bistable(BistableReason::Coexisting)),
+                (b, capture),
+                (until, Regime::Balancing)
+            ]
+        );
+        // An unstable band inside the capture window and another above it.
+        let t = table(&map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (65.0, capture),
+                (70.0, Regime::Gathering),
+                (80.0, capture),
+                (until, Regime::Balancing),
+                (120.0, Regime::Gathering),
+                (130.0, Regime::Balancing)
+            ]
+        );
+        // Never stable: gathering everywhere.
+        assert_eq!(
+            table(&map_with(false, &[]), &m),
+            vec![(0.0, Regime::Gathering)]
+        );
+    }
+
+    #[test]
+    fn core_segments_merge_what_f32_cannot_separate() {
+        let t = [
+            (0.0, Regime::Gathering),
+            (61.43, Regime::Balancing),
+            (61.430_000_001, Regime::Gathering),
+            (70.0, Regime::Balancing),
+        ];
+        let s = core_segments(&t).unwrap();
+        // 61.43 and 61.430000001 are one f32: the later segment replaces the earlier, and
+        // then joins the gathering one before it.
+        assert_eq!(
+            s,
+            vec![
+                RegimeSegment {
+                    from: 0.0,
+                    regime: Regime::Gathering
+                },
+                RegimeSegment {
+                    from: 70.0,
+                    regime: Regime::Balancing
+                }
+            ]
+        );
+        assert!(core_segments(&[(0.0, Regime::Gathering), (1e300, Regime::Balancing)]).is_err());
+    }
+
+    #[test]
+    fn scenes_get_the_exact_classifier_and_its_margin() {
+        let (scene, path, m) = one_mass();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        assert_eq!(e.map.boundaries.len(), 1);
+        let w = e.map.boundaries[0].speed;
+        // The criterion says balancing above 61.43; the balancing position is unstable to 72.3.
+        assert!((72.2..72.5).contains(&w), "{w}");
+        assert_eq!(e.comparison[0].kind, "resonance");
+        assert!((e.comparison[0].difference.unwrap() - (w / 61.43 - 1.0)).abs() < 1e-3);
+        let (c, margin, exact) = classifier(&scene, &path, &m, Some(&d)).unwrap();
+        assert!(exact && margin == TABLE_MARGIN);
+        assert_eq!(c.classify(66.0), Regime::Gathering);
+        assert_eq!(c.classify(80.0), Regime::Bistable(BistableReason::Capture));
+        assert_eq!(c.classify(110.0), Regime::Balancing);
+        // The scene's margin overrides the default.
+        let mut s2 = scene.clone();
+        s2.monitor
+            .get_or_insert_with(Default::default)
+            .regime_margin = Some(0.03);
+        let (_, margin, _) = classifier(&s2, &path, &m, Some(&d)).unwrap();
+        assert_eq!(margin, 0.03);
+        // A balancer too small for its rotor has no exact table: the criterion's, with its
+        // own default margin.
+        let mut small = scene.clone();
+        small.autobalancer.as_mut().unwrap().rotor_unbalance = Some(0.12);
+        let d = design(&small, &path, &m).unwrap().unwrap();
+        assert!(d.exact.is_none());
+        assert!((d.residual_floor - 0.02).abs() < 1e-12 && (d.capacity - 0.1).abs() < 1e-12);
+        let (c, margin, exact) = classifier(&small, &path, &m, Some(&d)).unwrap();
+        assert!(!exact && margin == DEFAULT_MARGIN);
+        assert_eq!(c.classify(110.0), Regime::Balancing);
+    }
+}

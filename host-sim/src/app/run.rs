@@ -127,9 +127,21 @@ pub struct RunReport {
     /// The core's full class: "balancing" | "gathering" | "bistable" | "near-characteristic".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_class: Option<&'static str>,
-    /// What the loads did in the simulation: "balancing" | "gathering".
+    /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
+    /// for its rotor, settled on the least residual it can leave) | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_simulated: Option<&'static str>,
+    /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
+    /// The rotor unbalance `D` simulated, kg·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotor_unbalance: Option<f64>,
+    /// `max(0, D − N·m·R)`: the least residual unbalance the loads can leave, kg·m (non-zero
+    /// for a balancer too small for its rotor: every load at its limit, opposite the
+    /// unbalance).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_floor: Option<f64>,
     /// Residual unbalance at the end relative to the rotor unbalance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_relative: Option<f64>,
@@ -676,6 +688,9 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
         }
     }
     if let Some(vm) = &vib_machine {
+        report.capacity = Some(vm.capacity());
+        report.rotor_unbalance = Some(vm.rotor_unbalance());
+        report.residual_floor = Some(vm.residual_floor());
         let criteria = vm.regime_criteria();
         if let Some(r) = classify(&col.samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());

@@ -558,6 +558,14 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "one-mass-runup.toml",
         include_str!("../../scenes/one-mass-runup.toml"),
     ),
+    (
+        "one-mass-undersized.toml",
+        include_str!("../../scenes/one-mass-undersized.toml"),
+    ),
+    (
+        "one-mass-motor-runup.toml",
+        include_str!("../../scenes/one-mass-motor-runup.toml"),
+    ),
     ("two-mass.toml", include_str!("../../scenes/two-mass.toml")),
     (
         "three-mass.toml",

@@ -204,32 +204,33 @@ fn sweep_cmd(
         print_json(&s)?;
     } else {
         println!(
-            "{:>10}  {:<10} {:<20} {:<10} {:>10}",
+            "{:>10}  {:<10} {:<32} {:<10} {:>10}",
             "speed", "criterion", "core class", "simulated", "residual"
         );
         for p in &s.points {
-            let mark = if p.regime_predicted == p.regime_simulated {
-                ""
-            } else {
+            let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
+            let mark = if committed
+                && !host_sim::studies::sweep::agrees(p.regime_class, p.regime_simulated)
+            {
                 "  ≠"
+            } else {
+                ""
+            };
+            let class = match p.regime_reason {
+                Some(r) => format!("{} ({r})", p.regime_class),
+                None => p.regime_class.to_string(),
             };
             println!(
-                "{:>10.3}  {:<10} {:<20} {:<10} {:>10.2e}{mark}",
-                p.speed,
-                p.regime_predicted,
-                p.regime_class,
-                p.regime_simulated,
-                p.residual_relative
+                "{:>10.3}  {:<10} {:<32} {:<10} {:>10.2e}{mark}",
+                p.speed, p.regime_predicted, class, p.regime_simulated, p.residual_relative
             );
         }
-        let agree = s
-            .points
-            .iter()
-            .filter(|p| p.regime_predicted == p.regime_simulated)
-            .count();
         println!(
-            "agreement: {agree} of {} speeds; away from the characteristic speeds {} of {}",
+            "core ({} table) commits at {} of {} speeds, the simulation agrees at {}; the criterion alone agrees at {} of {} speeds away from its characteristic speeds",
+            if s.exact { "exact" } else { "criterion" },
+            s.committed,
             s.points.len(),
+            s.committed_agreeing,
             s.agreeing,
             s.away_from_characteristic
         );
