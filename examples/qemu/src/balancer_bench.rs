@@ -1,13 +1,14 @@
 //! The auto-balancer on the target: the three-mass machine's characteristic speeds computed at
 //! configuration time (f64, software-emulated on the M4), and the per-speed-update
-//! classification (f32, binary search over the zones).
+//! classification (f32, binary search over the segments) from the criterion's zones and from
+//! the exact regime table the host computes and ships as a `const`.
 
 use core::hint::black_box;
 
 use cortex_m_semihosting::hprintln;
 use drive_monitor::balancer::{
-    AutoBalancer, BalancerKind, Classifier, Coupling, Machine, MachineConfig, Platform, Regime,
-    RegimeTracker, SearchOptions,
+    AutoBalancer, BalancerKind, BistableReason, Classifier, Coupling, Machine, MachineConfig,
+    Platform, Regime, RegimeSegment, RegimeTable, RegimeTracker, SearchOptions, TABLE_MARGIN,
 };
 
 use crate::bench::{ensure, measure, measure_each};
@@ -43,6 +44,27 @@ fn config() -> MachineConfig {
         Err(e) => crate::bench::fail(format_args!("machine rejected: {}", e)),
     }
 }
+
+const fn seg(from: f32, regime: Regime) -> RegimeSegment {
+    RegimeSegment { from, regime }
+}
+
+/// The bundled `three-mass.toml` machine's exact regime table: `regime_table` of
+/// `drive-sim predict three-mass --json` (Floquet stability of the balancing position, the
+/// core's capture windows, the criterion), speeds rounded to f32.
+const EXACT: RegimeTable<'static> = RegimeTable {
+    segments: &[
+        seg(0.0, Regime::Gathering),
+        seg(50.324_696, Regime::Bistable(BistableReason::Capture)),
+        seg(50.954_55, Regime::Balancing),
+        seg(51.349_155, Regime::Bistable(BistableReason::Coexisting)),
+        seg(51.435_593, Regime::Gathering),
+        seg(70.139_68, Regime::Bistable(BistableReason::Capture)),
+        seg(70.938_67, Regime::Gathering),
+        seg(91.156_73, Regime::Bistable(BistableReason::Capture)),
+        seg(105.822_15, Regime::Balancing),
+    ],
+};
 
 pub fn run() {
     hprintln!("-- auto-balancer: three-mass machine");
@@ -88,6 +110,27 @@ pub fn run() {
         classifier.classify(30.0) == Regime::Gathering
             && classifier.classify(120.0) == Regime::Balancing,
         "classification"
+    );
+    let start = icount::instructions();
+    let exact = match Classifier::from_table(&EXACT, TABLE_MARGIN, 0.5 * TABLE_MARGIN) {
+        Ok(c) => c,
+        Err(e) => crate::bench::fail(format_args!("table rejected: {}", e)),
+    };
+    let table_cost = icount::instructions() - start;
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "balancer::Classifier::from_table",
+        table_cost
+    );
+    measure_each("balancer::classify (exact table)", &speeds, 100, |w| {
+        exact.classify(w)
+    });
+    ensure!(
+        exact.classify(30.0) == Regime::Gathering
+            && exact.classify(60.0) == Regime::Gathering
+            && exact.classify(100.0) == Regime::Bistable(BistableReason::Capture)
+            && exact.classify(120.0) == Regime::Balancing,
+        "exact classification"
     );
     let mut tracker = RegimeTracker::new();
     let mut i = 0usize;

@@ -105,8 +105,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
         let _ = writeln!(
             s,
-            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {:.2e} of the rotor's)",
+            "Regime at the measured speed: core class {}{}, criterion {p}, simulation {sim} (residual unbalance {:.2e} of the rotor's)",
             r.regime_class.unwrap_or("?"),
+            r.regime_reason.map_or(String::new(), |x| format!(" ({x})")),
             r.residual_relative.unwrap_or(f64::NAN)
         );
     }

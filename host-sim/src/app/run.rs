@@ -121,12 +121,16 @@ pub struct RunReport {
     pub rejected_edges: [u32; 3],
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
-    /// Regime the core predicts at the measured speed: "balancing" | "gathering".
+    /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_predicted: Option<&'static str>,
-    /// The core's full class: "balancing" | "gathering" | "bistable" | "near-characteristic".
+    /// The core's class from the machine's regime table (exact unless the balancer is too
+    /// small for its rotor): "balancing" | "gathering" | "bistable" | "near-characteristic".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_class: Option<&'static str>,
+    /// Why bistable: "capture" | "coexisting".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_reason: Option<&'static str>,
     /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
     /// for its rotor, settled on the least residual it can leave) | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -681,11 +685,11 @@ pub fn run(scene: &Scene, file: &Path, over: Overrides) -> Result<RunReport, Sce
     }
     if let (Some(machine), Some(w)) = (predict::machine(scene, file)?, report.speed_measured) {
         let (classifier, _) = regime_classifier(scene, file, &machine)?;
-        {
-            report.regime_class = Some(classifier.classify(w as f32).name());
-            // The criterion's own zone at the measured speed (no margin, no capture check).
-            report.regime_predicted = Some(machine.zone_kind_at(w).name());
-        }
+        let class = classifier.classify(w as f32);
+        report.regime_class = Some(class.name());
+        report.regime_reason = class.reason().map(|r| r.name());
+        // The criterion's own zone at the measured speed (no margin, no capture check).
+        report.regime_predicted = Some(machine.zone_kind_at(w).name());
     }
     if let Some(vm) = &vib_machine {
         report.capacity = Some(vm.capacity());

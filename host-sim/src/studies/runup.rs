@@ -355,9 +355,13 @@ pub fn markdown(
         let _ = write!(
             s,
             "\n## After the release\n\n\
-             At the end of the run (rotor at {:.2} rad/s) the core predicts {pred}; the \
-             simulation ends {sim}, residual unbalance {:.2} of the rotor's.",
+             At the end of the run (rotor at {:.2} rad/s) the core classes the speed {}{} \
+             (the criterion: {pred}); the simulation ends {sim}, residual unbalance {:.2} of the \
+             rotor's.",
             main.speed_measured.unwrap_or(f64::NAN),
+            main.regime_class.unwrap_or("?"),
+            main.regime_reason
+                .map_or(String::new(), |r| format!(" ({r})")),
             main.residual_relative.unwrap_or(f64::NAN)
         );
         if sim != pred && 1.0 - c.coherence_end < 1e-12 {

@@ -35,10 +35,12 @@
 //!   `ω̃·t = 300`, 10⁻¹² by 1000). Loads started exactly coincident never part: identical loads
 //!   obey identical equations.
 //! - Started at the balancing position with a small perturbation, the criterion's `q > 1` is
-//!   not sufficient: a Floquet analysis of eq. 4 linearised about the balancing position, and
-//!   the full simulation, find balancing unstable on about `1.087 < n < 1.425` (stable on
-//!   `1.002 < n < 1.087` and above `1.425`). The band depends on `h` and `β` (it vanishes for
-//!   `h = 0.2` or `β = 5`), which is what the criterion check of issue 9 has to size.
+//!   not sufficient: the Floquet analysis of the model linearised about the balancing position
+//!   ([`super::floquet`]), a hand reduction of eq. 4, and the full simulation find balancing
+//!   unstable on `1.0874 < n < 1.4252` (stable on `1.0016 < n < 1.0874` and above `1.4252`).
+//!   The band depends on `h` and `β` (it vanishes for `h = 0.2` or `β = 5`); the exact regime
+//!   table ([`crate::app::regimes`]) is built on these boundaries, and `docs/criterion.md`
+//!   measures them on random machines.
 
 use serde::Serialize;
 
