@@ -6,7 +6,7 @@
 //! rates from 4 to 1/32 rad/s²): released 3.83, 1.34, 0.74, 0.19 % above `until` at 4, 1,
 //! 1/4 and 1/32 rad/s²; the excess falls as rate^0.65 (a slow passage through a fold gives
 //! 2/3), a fit `release = a + b·rate^(2/3)` puts the quasi-static release at 90.42 rad/s
-//! (+0.02 %) with residuals within 0.23 %; the captured load speed, averaged over whole slip
+//! (+0.01 %) with residuals within 0.23 %; the captured load speed, averaged over whole slip
 //! turns, is within 0.2 % of `capture_speed(ω)` at 1 rad/s² and slower (0.52 % at 4 rad/s²).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
