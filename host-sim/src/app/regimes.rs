@@ -181,12 +181,21 @@ fn push(out: &mut Vec<(f64, Regime)>, from: f64, r: Regime) {
     }
 }
 
-/// The table in the core's f32 form, neighbours that become equal in f32 merged.
-pub fn core_segments(segments: &[(f64, Regime)]) -> Result<Vec<RegimeSegment>, SceneError> {
+/// The table in the core's f32 form, neighbours that become equal in f32 merged. A speed f32
+/// cannot hold is an error naming `file`'s auto-balancer.
+pub fn core_segments(
+    segments: &[(f64, Regime)],
+    file: &Path,
+) -> Result<Vec<RegimeSegment>, SceneError> {
     let mut out: Vec<RegimeSegment> = Vec::new();
     for &(from, regime) in segments {
-        let s = RegimeSegment::new("regime table", from, regime)
-            .map_err(|e| SceneError::value(Path::new("regime table"), "from", e.to_string()))?;
+        let s = RegimeSegment::new("regime table speed", from, regime).map_err(|e| {
+            SceneError::value(
+                file,
+                "autobalancer",
+                format!("{e}: {from:e} rad/s in the regime table"),
+            )
+        })?;
         if out.last().is_some_and(|l| l.from >= s.from) {
             out.pop();
         }
@@ -264,7 +273,7 @@ pub fn classifier(
         .map(|m| m as f32);
     if let Some(exact) = design.and_then(|d| d.exact.as_ref()) {
         let margin = given.unwrap_or(TABLE_MARGIN);
-        let segments = core_segments(&exact.segments)?;
+        let segments = core_segments(&exact.segments, file)?;
         let c = Classifier::from_table(
             &RegimeTable {
                 segments: &segments,
@@ -373,7 +382,7 @@ mod tests {
             (61.430_000_001, Regime::Gathering),
             (70.0, Regime::Balancing),
         ];
-        let s = core_segments(&t).unwrap();
+        let s = core_segments(&t, Path::new("t.toml")).unwrap();
         // 61.43 and 61.430000001 are one f32: the later segment replaces the earlier, and
         // then joins the gathering one before it.
         assert_eq!(
@@ -389,7 +398,13 @@ mod tests {
                 }
             ]
         );
-        assert!(core_segments(&[(0.0, Regime::Gathering), (1e300, Regime::Balancing)]).is_err());
+        let e = core_segments(
+            &[(0.0, Regime::Gathering), (1e300, Regime::Balancing)],
+            Path::new("t.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("t.toml") && e.contains("1e300"), "{e}");
     }
 
     #[test]

@@ -483,7 +483,7 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
             "no balancing position to analyse",
         ));
     };
-    let segments = regimes::core_segments(&exact.segments)?;
+    let segments = regimes::core_segments(&exact.segments, &file)?;
     let table = RegimeTable {
         segments: &segments,
     };
