@@ -2143,6 +2143,58 @@ proptest! {
         }
     }
 
+    /// `Classifier::from_table` on arbitrary tables (any f32 speeds, any regimes, any length)
+    /// and settings: a typed error or a classifier that is total on any f32 speed, `Unknown`
+    /// exactly for non-finite speeds, bands with from < to; a table that validates gives a
+    /// classifier returning its segments unchanged.
+    #[test]
+    fn regime_table_classification_is_total(
+        segs in proptest::collection::vec((any::<u32>(), 0u8..6), 0..20),
+        sorted in any::<bool>(),
+        margin in prop_oneof![any::<f32>(), 0.0f32..0.4],
+        hysteresis in prop_oneof![any::<f32>(), 0.0f32..0.4],
+        speeds in proptest::collection::vec(any::<u32>(), 1..24),
+    ) {
+        use drive_monitor::balancer::{BistableReason, RegimeSegment, RegimeTable};
+        let mut segments: Vec<RegimeSegment> = segs
+            .iter()
+            .map(|&(bits, r)| RegimeSegment {
+                from: if sorted { f32::from_bits(bits).abs() } else { f32::from_bits(bits) },
+                regime: match r {
+                    0 => Regime::Balancing,
+                    1 => Regime::Gathering,
+                    2 => Regime::Bistable(BistableReason::Capture),
+                    3 => Regime::Bistable(BistableReason::Coexisting),
+                    4 => Regime::NearCharacteristic,
+                    _ => Regime::Unknown,
+                },
+            })
+            .collect();
+        if sorted {
+            segments.sort_by(|a, b| a.from.total_cmp(&b.from));
+            if let Some(f) = segments.first_mut() {
+                f.from = 0.0;
+            }
+        }
+        let table = RegimeTable { segments: &segments };
+        let Ok(c) = Classifier::from_table(&table, margin, hysteresis) else { return Ok(()); };
+        prop_assert!(table.validate().is_ok());
+        let back: Vec<RegimeSegment> = c.segments().collect();
+        prop_assert_eq!(&back, &segments);
+        let mut t = RegimeTracker::new();
+        for bits in speeds {
+            let x = f32::from_bits(bits);
+            let r = c.classify(x);
+            prop_assert_eq!(r == Regime::Unknown, !x.is_finite());
+            prop_assert_eq!(c.classify(-x), r);
+            if let Some(band) = c.advice(x).exciter_band {
+                prop_assert!(band.from < band.to);
+            }
+            let st = t.update(&c, x);
+            prop_assert_eq!(st.regime == Regime::Unknown, !x.is_finite());
+        }
+    }
+
     /// `SupportMonitor::update` and `set_unbalance` (both math backends), and the rotor's
     /// queries, on arbitrary rotors and limits (every f64 nasty) and arbitrary f32 speeds:
     /// typed errors or results; `speed_valid` exactly when the speed is not NaN; for a finite

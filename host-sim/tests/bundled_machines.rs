@@ -28,6 +28,13 @@ fn every_bundled_machine_matches_the_scan() {
     }
     assert_eq!(
         compared,
-        ["one-mass", "one-mass-runup", "two-mass", "three-mass"]
+        [
+            "one-mass",
+            "one-mass-runup",
+            "one-mass-undersized",
+            "one-mass-motor-runup",
+            "two-mass",
+            "three-mass"
+        ]
     );
 }

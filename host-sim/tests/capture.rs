@@ -6,7 +6,7 @@
 //! rates from 4 to 1/32 rad/s²): released 3.83, 1.34, 0.74, 0.19 % above `until` at 4, 1,
 //! 1/4 and 1/32 rad/s²; the excess falls as rate^0.65 (a slow passage through a fold gives
 //! 2/3), a fit `release = a + b·rate^(2/3)` puts the quasi-static release at 90.42 rad/s
-//! (+0.02 %) with residuals within 0.23 %; the captured load speed, averaged over whole slip
+//! (+0.01 %) with residuals within 0.23 %; the captured load speed, averaged over whole slip
 //! turns, is within 0.2 % of `capture_speed(ω)` at 1 rad/s² and slower (0.52 % at 4 rad/s²).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -173,4 +173,40 @@ fn release_converges_on_until_and_captured_speed_matches_the_core() {
         "{page}"
     );
     assert!(page.contains(&format!("a = {a:.2} rad/s")), "{page}");
+}
+
+/// The bundled `one-mass-motor-runup` scene: the same machine run up from rest by a Kloss
+/// motor (breakdown torque 12 N·m, shaft 4 kg·m², 1 N·m friction) instead of a prescribed
+/// ramp. Measured (`drive-sim run one-mass-motor-runup --out docs`): the rotor accelerates at
+/// 1.27 rad/s² while the loads are captured, from 61.61 rad/s, and they are released at 91.57
+/// rad/s, 1.29 % above the core's `until` (the ramp scene at 1 rad/s²: 1.34 %); the captured
+/// load speed is within 0.21 % of `capture_speed(ω)`. With the shaft's inertia doubled the
+/// run-up halves its rate and releases closer to `until`.
+#[test]
+fn motor_driven_runup_is_captured_then_released() {
+    let (scene, path) = resolve("one-mass-motor-runup").unwrap();
+    let mut s = scene.clone();
+    s.encoder = None;
+    let r = run(&s, &path, Overrides::default()).unwrap();
+    assert!(r.effects.contains(&"motor") && r.effects.contains(&"load"));
+    let c = r.capture.unwrap();
+    let b = released(&c);
+    let a = c.captured_from.unwrap()[1];
+    assert!(a > c.predicted_from && a < 1.01 * c.predicted_from, "{a}");
+    assert!(b > c.predicted_until && b < 1.02 * c.predicted_until, "{b}");
+    // The motor, not a law, set the rate: between 1 and 1.5 rad/s² while captured.
+    let rate = c.ramp_rate.unwrap();
+    assert!((1.0..1.5).contains(&rate), "{rate}");
+    for k in &c.checks {
+        assert!(k.relative_error.unwrap().abs() < 0.004, "{k:?}");
+    }
+    // Twice the inertia: about half the rate, released closer to `until`.
+    let runs = runup::ramp_rates(&scene, &path, &[2.0]).unwrap();
+    let slow = runs[0].capture.as_ref().unwrap();
+    assert!((runs[0].rate / rate - 0.5).abs() < 0.05, "{}", runs[0].rate);
+    let b2 = released(slow);
+    assert!(b2 > c.predicted_until && b2 < b, "{b2} vs {b}");
+    // A prescribed ramp's scene cannot be slowed by inertia, nor the motor's by stretching.
+    assert!(runup::with_inertia_scaled(&scene, &path, 0.0).is_err());
+    assert!(runup::with_ramp_stretched(&scene, &path, 2.0).is_err());
 }

@@ -41,6 +41,8 @@ fn scenes_lists_every_bundled_scene() {
         "auger-overhung",
         "one-mass",
         "one-mass-runup",
+        "one-mass-motor-runup",
+        "one-mass-undersized",
         "two-mass",
         "three-mass",
     ] {
@@ -224,8 +226,9 @@ fn bad_scenes_name_the_file_and_key_and_fail() {
 
 #[test]
 fn criterion_writes_its_page_and_json() {
-    // One machine (a single platform, so one boundary): the page names the command that
-    // regenerates it, and the JSON carries the machine, its grid and its boundary.
+    // One machine (a single platform, so one criterion boundary): the page names the command
+    // that regenerates it, and the JSON carries the machine, its grid, its exact boundaries
+    // with their checks and the criterion's boundary beside them.
     let dir = std::env::temp_dir().join(format!("drive-sim-criterion-{}", std::process::id()));
     let (ok, out, err) = drive_sim(&[
         "criterion",
@@ -242,7 +245,20 @@ fn criterion_writes_its_page_and_json() {
     let m = &v["machines"][0];
     assert_eq!(m["sample"]["platforms"], 1);
     assert_eq!(m["points"].as_array().unwrap().len(), 40);
-    assert_eq!(m["boundaries"][0]["kind"], "resonance");
+    assert_eq!(m["shifts"][0]["kind"], "resonance");
+    let checks = m["checks"].as_array().unwrap();
+    assert!(!checks.is_empty());
+    assert_eq!(checks[0]["stable_above"], true);
+    assert!(
+        m["design"]["exact"]["map"]["boundaries"]
+            .as_array()
+            .unwrap()
+            .len()
+            == checks.len()
+    );
+    for p in m["points"].as_array().unwrap() {
+        assert!(["balancing", "gathering", "bistable"].contains(&p["class"].as_str().unwrap()));
+    }
     let md = std::fs::read_to_string(dir.join("criterion.md")).unwrap();
     assert!(md.contains("criterion --machines 1 --seed 3 --out"), "{md}");
     for f in ["criterion-resonance.svg", "criterion-additional.svg"] {
@@ -404,4 +420,42 @@ fn sweep_steps_and_criterion_machines_are_bounded() {
         assert!(!ok, "{args:?}");
         assert!(err.contains("allowed"), "{args:?}: {err}");
     }
+}
+#[test]
+fn undersized_balancer_is_a_design_result() {
+    // Two loads of 0.5 kg on 0.1 m (N·m·R = 0.1 kg·m) against a rotor unbalance of 0.12 kg·m:
+    // no balancing position. predict reports the capacity and the residual with the loads at
+    // their limit; run simulates it (at 100 rad/s the loads settle opposite the unbalance,
+    // leaving that residual); sweep runs instead of stopping on a contradiction.
+    let p = &json(&["predict", "one-mass-undersized", "--json"])["autobalancer"];
+    assert!((p["capacity"].as_f64().unwrap() - 0.1).abs() < 1e-12, "{p}");
+    assert!(
+        (p["residual_floor"].as_f64().unwrap() - 0.02).abs() < 1e-12,
+        "{p}"
+    );
+    assert!(p["stability"].is_null());
+    assert_eq!(p["regime_table_source"], "criterion");
+    let (_, text, _) = drive_sim(&["predict", "one-mass-undersized"]);
+    assert!(text.contains("too small for its rotor"), "{text}");
+    let v = json(&["run", "one-mass-undersized", "--json"]);
+    assert_eq!(v["regime_simulated"], "saturated", "{v}");
+    let floor = v["residual_floor"].as_f64().unwrap();
+    let rel = v["residual_relative"].as_f64().unwrap();
+    // Within 1 % of D of the floor (0.02/0.12 = 0.1667 of D).
+    assert!((rel - floor / 0.12).abs() <= 0.01, "{rel} {floor}");
+    let s = json(&[
+        "sweep",
+        "one-mass-undersized",
+        "--from",
+        "40",
+        "--to",
+        "110",
+        "--steps",
+        "2",
+        "--json",
+    ]);
+    let points = s["points"].as_array().unwrap();
+    assert_eq!(points[0]["regime_simulated"], "gathering");
+    assert_eq!(points[1]["regime_simulated"], "saturated");
+    assert_eq!(s["exact"], false);
 }

@@ -13,7 +13,10 @@
 //!    [`Machine::additional_speeds`]);
 //! 3. finds, with the damping, the zones where balancing is stable ([`Machine::zones`]) and
 //!    the Sommerfeld capture windows ([`Machine::capture_windows`]);
-//! 4. classifies a measured speed at run time in f32 ([`Classifier`], [`RegimeTracker`]).
+//! 4. classifies a measured speed at run time in f32 ([`Classifier`], [`RegimeTracker`]),
+//!    from the criterion's zones ([`Classifier::new`]) or from an exact [`RegimeTable`]
+//!    computed on the host and shipped as data ([`Classifier::from_table`], module
+//!    [`table`]).
 //!
 //! Steps 1–3 run once at configuration time in f64; step 4 is the per-update path.
 //!
@@ -55,12 +58,15 @@ mod modal;
 mod poly;
 mod runtime;
 mod scanned;
+pub mod table;
 #[cfg(test)]
 mod tests;
 
 pub use runtime::{
-    Advice, Classifier, Regime, RegimeEvent, RegimeStatus, RegimeTracker, SpeedBand, DEFAULT_MARGIN,
+    Advice, Classifier, Regime, RegimeEvent, RegimeStatus, RegimeTracker, SpeedBand,
+    DEFAULT_MARGIN, TABLE_MARGIN,
 };
+pub use table::{BistableReason, RegimeSegment, RegimeTable};
 
 use crate::error::{finite, non_negative, positive, ConfigError};
 

@@ -1,29 +1,29 @@
-//! Run-time classification of a measured speed (f32, O(log zones), total).
+//! Run-time classification of a measured speed (f32, a binary search over at most
+//! [`MAX_SEGMENTS`] table entries, total).
 
-use super::{Machine, MachineTable, ZoneKind, MAX_PLATFORMS, MAX_ZONES};
+use super::table::{same_regime, speed_f32, MAX_SEGMENTS};
+use super::{
+    BistableReason, Machine, MachineTable, RegimeSegment, RegimeTable, ZoneKind, MAX_PLATFORMS,
+    MAX_ZONES,
+};
 use crate::error::ConfigError;
-
-/// Segments: the zones, with balancing zones split where a capture window ends.
-const MAX_SEGMENTS: usize = MAX_ZONES + MAX_PLATFORMS;
-/// Characteristic speeds (zone boundaries).
-const MAX_BOUNDS: usize = MAX_ZONES - 1;
 
 /// The regime expected at a speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Regime {
-    /// The auto-balancing position is stable and loads gathered below cannot stay captured.
+    /// The loads balance the rotor: the auto-balancing position is stable and no other state
+    /// is known to persist here.
     Balancing,
-    /// The loads gather: the machine works as a vibration exciter.
+    /// The loads do not balance (they gather: the machine works as a vibration exciter). In an
+    /// exact table ([`Classifier::from_table`]) the balancing position is unstable here; in the
+    /// criterion's ([`Classifier::new`]) the criterion says the loads gather.
     Gathering,
-    /// The criterion says balancing, but it is not assured: gathered loads can stay captured
-    /// near the resonance below (Sommerfeld effect), and direct simulation finds the
-    /// balancing position itself unstable just above the resonance (on random machines
-    /// balancing set in a median 17 % above it, `docs/criterion.md`). Which regime sets in
-    /// depends on the machine and its history.
-    Bistable,
-    /// Within the margin band around a damped characteristic speed, where the criterion is
-    /// not to be relied on.
+    /// The balancing position is stable, but another state can persist too ([`BistableReason`]):
+    /// which regime sets in depends on the machine's history.
+    Bistable(BistableReason),
+    /// Within the margin band about a boundary of the table, where the class is not to be
+    /// relied on.
     NearCharacteristic,
     /// The speed is not a number or infinite.
     Unknown,
@@ -36,10 +36,23 @@ impl Regime {
         match self {
             Regime::Balancing => "balancing",
             Regime::Gathering => "gathering",
-            Regime::Bistable => "bistable",
+            Regime::Bistable(_) => "bistable",
             Regime::NearCharacteristic => "near-characteristic",
             Regime::Unknown => "unknown",
         }
+    }
+
+    /// Why the regime is bistable (`None` for the others).
+    pub fn reason(self) -> Option<BistableReason> {
+        match self {
+            Regime::Bistable(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The classifier commits to this regime (`Balancing` or `Gathering`).
+    pub fn committed(self) -> bool {
+        matches!(self, Regime::Balancing | Regime::Gathering)
     }
 }
 
@@ -57,46 +70,57 @@ pub struct SpeedBand {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Advice {
-    /// When balancing (or bistable) at this speed: to get the loads to gather again (re-enter
-    /// the exciter mode), drop the speed below this, rad/s; the speed can be raised again
-    /// once the loads are stuck. `None` when the loads already tend to gather here.
+    /// When the balancing position is stable at this speed (`Balancing` or `Bistable`): to
+    /// get the loads to gather again (re-enter the exciter mode), drop the speed below this,
+    /// the start of the stable stretch shrunk by the margin, rad/s; the speed can be raised
+    /// again once the loads are stuck. `None` when the loads already gather here, or the
+    /// balancing position is stable down to standstill.
     pub drop_below: Option<f32>,
-    /// The gathering zone to run a vibration exciter in: the highest gathering zone starting
-    /// at or below this speed, shrunk by the margin at both finite edges. `None` if the
-    /// margins leave nothing.
+    /// Where to run a vibration exciter: the highest `Gathering` segment starting at or below
+    /// this speed, shrunk by the margin at both edges. `None` if the margins leave nothing or
+    /// that segment is open-ended.
     pub exciter_band: Option<SpeedBand>,
 }
 
-/// Run-time zone table in f32, built once from a [`Machine`].
+/// Run-time regime table in f32, built once from a [`RegimeTable`] (or, for the seed's
+/// criterion, from a [`Machine`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Classifier {
     seg_from: [f32; MAX_SEGMENTS],
     seg_regime: [Regime; MAX_SEGMENTS],
     n_seg: u8,
-    /// Kind of each zone; zone `i > 0` starts at `bounds[i − 1]`, zone 0 at 0.
-    zone_kind: [ZoneKind; MAX_ZONES],
-    bounds: [f32; MAX_BOUNDS],
-    n_bounds: u8,
     margin: f32,
     hysteresis: f32,
 }
 
-/// Default margin band about each damped characteristic speed: 5 %.
+/// Default margin band about each boundary of the seed criterion's table
+/// ([`Classifier::new`]): 5 %.
 ///
-/// Sized from simulation (`drive-sim criterion`, `docs/criterion.md`): on 120 random machines
-/// with `ε` in [0.005, 0.1], `h` in [0.01, 0.2] and `β` in [1, 50], the band an additional
-/// speed's boundary (balancing below, gathering above) needs for the classifier to match the
-/// simulation on both sides was 0.3 % at the median and 2.0 % at the 90th percentile; 5 %
-/// covers 69 of the 71 boundaries (in the other two the gathering zone above the additional
-/// speed shrinks or vanishes in simulation). The needed band did not change measurably with
-/// `ε` (medians and maxima flat across the range; a power-law fit gives `ε^−0.01`), so it is
-/// one constant, not a function of `ε`. The boundaries at the resonances move further, upwards, and are covered by the
-/// capture band ([`Regime::Bistable`]), not by this margin.
+/// Sized from simulation and from the exact boundaries (`drive-sim criterion`,
+/// `docs/criterion.md`, 120 random machines): at the additional speeds the balancing position
+/// stops being stable within 1.3 % of the criterion's boundary at the 90th percentile (−5.7 %
+/// to +0.9 %), and with this band the criterion's classifier agrees with the simulation at
+/// 98.6 % of the speeds it commits at. At the resonances the criterion's boundary is far off
+/// (the balancing position is stable for good a median 17 % higher): its capture band
+/// (`Bistable`) covers most of that, not this margin. An exact table ([`TABLE_MARGIN`]) needs
+/// no such allowance.
 pub const DEFAULT_MARGIN: f32 = 0.05;
 
-/// A relative band in `[0, 0.5)`: the checks of `non_negative_f32` (non-finite, negative, an
-/// f32 subnormal) then the upper limit, in a form a `const fn` can call.
+/// Default margin band about each boundary of an exact table ([`Classifier::from_table`]):
+/// 1 %.
+///
+/// The exact boundaries are placed to 1e-6; the band covers the speeds where a perturbation
+/// grows or decays so slowly that the regime takes very long to show, and errors in the
+/// machine's parameters. Sized from simulation (`drive-sim criterion`, `docs/criterion.md`,
+/// 120 random machines, 4800 speeds): the committed classes agree with the simulation at every
+/// speed more than 0.5 % from a boundary of the table (one miss closer), and each 1 % of
+/// margin costs about 1.7 % of the speeds committed (79.7 % committed without a band, 77.9 %
+/// with 1 %, 71.0 % with 5 %); 1 % leaves room for parameter errors the study cannot see.
+pub const TABLE_MARGIN: f32 = 0.01;
+
+/// A relative band in `[0, 0.5)`: non-finite, negative or f32-subnormal values rejected as
+/// `non_negative_f32` does, then the upper limit, in a form a `const fn` can call.
 const fn fraction(name: &'static str, x: f32) -> Result<f32, ConfigError> {
     if x.is_nan() || x.is_infinite() {
         Err(ConfigError::NonFinite(name))
@@ -113,7 +137,7 @@ const fn fraction(name: &'static str, x: f32) -> Result<f32, ConfigError> {
 /// first gathering from 0, finite and strictly ascending, each ending where the next starts
 /// (`Inconsistent("zones")` otherwise), kinds alternating, the last open; at most
 /// [`MAX_PLATFORMS`] capture windows; every speed finite (`NonFinite`, naming the field).
-const fn check_table(t: &MachineTable) -> Result<(), ConfigError> {
+const fn check_machine_table(t: &MachineTable) -> Result<(), ConfigError> {
     let zones = t.zones;
     if zones.is_empty() {
         return Err(ConfigError::Inconsistent("zones"));
@@ -175,62 +199,82 @@ const fn check_table(t: &MachineTable) -> Result<(), ConfigError> {
 }
 
 impl Classifier {
-    /// Builds the table. `margin`: relative half-width of the band around each damped
-    /// characteristic speed reported as [`Regime::NearCharacteristic`] (e.g. 0.03);
-    /// `hysteresis`: relative distance past a boundary the speed must go before
-    /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`.
+    /// Builds the classifier of a validated [`RegimeTable`] (the exact table a host computed,
+    /// see the module docs of [`super::table`]). `margin`: relative half-width of the band
+    /// about each boundary of the table reported as [`Regime::NearCharacteristic`] (e.g.
+    /// 0.02); `hysteresis`: relative distance past a boundary the speed must go before
+    /// [`RegimeTracker`] leaves a segment (e.g. 0.01). Both in `[0, 0.5)`. Errors: those of
+    /// [`RegimeTable::validate`], and `OutOfRange("margin")`/`OutOfRange("hysteresis")`.
+    pub const fn from_table(
+        table: &RegimeTable<'_>,
+        margin: f32,
+        hysteresis: f32,
+    ) -> Result<Self, ConfigError> {
+        if let Err(e) = table.validate() {
+            return Err(e);
+        }
+        let mut c = match Self::empty(margin, hysteresis) {
+            Ok(c) => c,
+            Err(e) => return Err(e),
+        };
+        let mut i = 0;
+        while i < table.segments.len() {
+            c = match c.push_segment(table.segments[i]) {
+                Ok(c) => c,
+                Err(e) => return Err(e),
+            };
+            i += 1;
+        }
+        Ok(c)
+    }
+
+    /// Builds the seed criterion's classifier of `machine`: its damped zones
+    /// ([`Machine::zones`]), with each balancing zone `Bistable(Capture)` up to where the
+    /// capture windows below it end ([`Machine::capture_windows`]). The criterion is
+    /// approximate (`docs/criterion.md`); a host's exact table ([`Classifier::from_table`])
+    /// is not. `margin` and `hysteresis` as for [`Classifier::from_table`]. A zone or window
+    /// speed f32 cannot hold (rounding to infinity, zero or a subnormal) gives
+    /// `OutOfRange("zones.from")` or `OutOfRange("capture_windows.until")`.
     pub fn new(machine: &Machine, margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
-        Self::from_table(&machine.table(), margin, hysteresis)
+        Self::from_machine_table(&machine.table(), margin, hysteresis)
     }
 
     /// [`Classifier::new`] from a machine's analysis as plain data, as a `const fn`: firmware
     /// that includes the table `drive-sim predict SCENE --emit rust` writes can build its
-    /// classifier in a `const` item, so neither the analysis nor this runs on the target
-    /// (an invalid table or band is then a compile error). The same table gives the same
+    /// classifier in a `const` item, so neither the analysis nor this runs on the target (an
+    /// invalid table or band is then a compile error). The same table gives the same
     /// classifier as [`Classifier::new`] on the machine it came from.
     ///
-    /// Errors: those of [`Classifier::new`] for `margin` and `hysteresis`; for a table that is
-    /// not as [`Machine::table`] makes one, `Inconsistent("zones")` (no zone, a first zone not
-    /// gathering from 0, zones not ascending, not adjoining, not alternating, or a last one
-    /// not open), `Capacity("zones")` (more than [`MAX_ZONES`]), `Capacity("captures")` (more
-    /// than one window per platform) and `NonFinite` naming the field with a NaN or ±∞.
-    pub const fn from_table(
+    /// Errors: those of [`Classifier::new`]; for a table that is not as [`Machine::table`]
+    /// makes one, `Inconsistent("zones")` (no zone, a first zone not gathering from 0, zones
+    /// not ascending, not adjoining, not alternating, or a last one not open),
+    /// `Capacity("zones")` (more than [`MAX_ZONES`]), `Capacity("captures")` (more than one
+    /// window per platform) and `NonFinite` naming the field with a NaN or ±∞.
+    pub const fn from_machine_table(
         table: &MachineTable,
         margin: f32,
         hysteresis: f32,
     ) -> Result<Self, ConfigError> {
-        let margin = match fraction("margin", margin) {
-            Ok(x) => x,
+        let mut c = match Self::empty(margin, hysteresis) {
+            Ok(c) => c,
             Err(e) => return Err(e),
         };
-        let hysteresis = match fraction("hysteresis", hysteresis) {
-            Ok(x) => x,
-            Err(e) => return Err(e),
-        };
-        if let Err(e) = check_table(table) {
+        if let Err(e) = check_machine_table(table) {
             return Err(e);
         }
-        let mut c = Classifier {
-            seg_from: [0.0; MAX_SEGMENTS],
-            seg_regime: [Regime::Gathering; MAX_SEGMENTS],
-            n_seg: 0,
-            zone_kind: [ZoneKind::Gathering; MAX_ZONES],
-            bounds: [0.0; MAX_BOUNDS],
-            n_bounds: 0,
-            margin,
-            hysteresis,
-        };
         let zones = table.zones;
         let mut i = 0;
-        // check_table: 1 ≤ zones.len() ≤ MAX_ZONES (the bounds tests only spare the panic).
-        while i < zones.len() && i < MAX_ZONES {
+        while i < zones.len() {
             let z = zones[i];
-            c.zone_kind[i] = z.kind;
-            if i > 0 && i - 1 < MAX_BOUNDS {
-                c.bounds[i - 1] = z.from as f32;
-            }
+            let from = match speed_f32("zones.from", z.from) {
+                Ok(f) => f,
+                Err(e) => return Err(e),
+            };
             let pushed = match z.kind {
-                ZoneKind::Gathering => c.with_segment(z.from, Regime::Gathering),
+                ZoneKind::Gathering => c.push_segment(RegimeSegment {
+                    from,
+                    regime: Regime::Gathering,
+                }),
                 ZoneKind::Balancing => {
                     // Capture is possible up to the largest `until` of the windows below.
                     let mut until = 0.0f64;
@@ -247,48 +291,119 @@ impl Classifier {
                         None => f64::INFINITY,
                     };
                     if until > z.from {
-                        match c.with_segment(z.from, Regime::Bistable) {
-                            Ok(next) if until < to => next.with_segment(until, Regime::Balancing),
+                        match c.push_segment(RegimeSegment {
+                            from,
+                            regime: Regime::Bistable(BistableReason::Capture),
+                        }) {
+                            Ok(next) if until < to => {
+                                match speed_f32("capture_windows.until", until) {
+                                    Ok(from) => next.push_segment(RegimeSegment {
+                                        from,
+                                        regime: Regime::Balancing,
+                                    }),
+                                    Err(e) => Err(e),
+                                }
+                            }
                             other => other,
                         }
                     } else {
-                        c.with_segment(z.from, Regime::Balancing)
+                        c.push_segment(RegimeSegment {
+                            from,
+                            regime: Regime::Balancing,
+                        })
                     }
                 }
             };
             c = match pushed {
-                Ok(next) => next,
+                Ok(c) => c,
                 Err(e) => return Err(e),
             };
             i += 1;
         }
-        c.n_bounds = i as u8 - 1;
+        if let Err(e) = c.check_table() {
+            return Err(e);
+        }
         Ok(c)
     }
 
-    /// The classifier with a segment appended, starting at `from` rad/s.
-    const fn with_segment(mut self, from: f64, regime: Regime) -> Result<Self, ConfigError> {
-        let i = self.n_seg as usize;
-        if i >= MAX_SEGMENTS {
+    const fn empty(margin: f32, hysteresis: f32) -> Result<Self, ConfigError> {
+        let margin = match fraction("margin", margin) {
+            Ok(x) => x,
+            Err(e) => return Err(e),
+        };
+        let hysteresis = match fraction("hysteresis", hysteresis) {
+            Ok(x) => x,
+            Err(e) => return Err(e),
+        };
+        Ok(Classifier {
+            seg_from: [0.0; MAX_SEGMENTS],
+            seg_regime: [Regime::Gathering; MAX_SEGMENTS],
+            n_seg: 0,
+            margin,
+            hysteresis,
+        })
+    }
+
+    /// The classifier with a segment appended. A segment starting where the last one starts
+    /// (speeds equal once in f32) replaces it, and one of the last one's regime extends it, so
+    /// the table stays strictly ascending with neighbours that differ.
+    const fn push_segment(mut self, seg: RegimeSegment) -> Result<Self, ConfigError> {
+        let mut n = self.n_seg as usize;
+        if n > 0 && n <= MAX_SEGMENTS && seg.from <= self.seg_from[n - 1] {
+            // The last segment is empty: drop it.
+            n -= 1;
+        }
+        if n > 0 && n <= MAX_SEGMENTS && same_regime(self.seg_regime[n - 1], seg.regime) {
+            self.n_seg = n as u8;
+            return Ok(self);
+        }
+        if n >= MAX_SEGMENTS {
             return Err(ConfigError::Capacity("segments"));
         }
-        self.seg_from[i] = from as f32;
-        self.seg_regime[i] = regime;
-        self.n_seg += 1;
+        self.seg_from[n] = if n == 0 { 0.0 } else { seg.from };
+        self.seg_regime[n] = seg.regime;
+        self.n_seg = n as u8 + 1;
         Ok(self)
+    }
+
+    /// Re-validates the built table (a machine's zones are validated by construction; this
+    /// keeps the invariants `classify` relies on explicit).
+    const fn check_table(&self) -> Result<(), ConfigError> {
+        let mut segs = [RegimeSegment {
+            from: 0.0,
+            regime: Regime::Gathering,
+        }; MAX_SEGMENTS];
+        let n = self.n_seg as usize;
+        let mut i = 0;
+        while i < n && i < MAX_SEGMENTS {
+            segs[i] = RegimeSegment {
+                from: self.seg_from[i],
+                regime: self.seg_regime[i],
+            };
+            i += 1;
+        }
+        match segs.split_at_checked(n) {
+            Some((built, _)) => RegimeTable { segments: built }.validate(),
+            None => Err(ConfigError::Capacity("segments")),
+        }
+    }
+
+    /// The segments as a table (for printing it, or for shipping it to a target).
+    pub fn segments(&self) -> impl Iterator<Item = RegimeSegment> + '_ {
+        self.segs()
+            .iter()
+            .zip(&self.seg_regime)
+            .map(|(&from, &regime)| RegimeSegment { from, regime })
     }
 
     fn segs(&self) -> &[f32] {
         self.seg_from.get(..usize::from(self.n_seg)).unwrap_or(&[])
     }
 
-    fn bounds(&self) -> &[f32] {
-        self.bounds.get(..usize::from(self.n_bounds)).unwrap_or(&[])
-    }
-
-    /// The damped characteristic speeds (zone boundaries), ascending, rad/s.
-    pub fn characteristic_speeds(&self) -> &[f32] {
-        self.bounds()
+    /// The boundaries of the table (every segment's `from` but the first), ascending, rad/s:
+    /// the speeds the margin band is placed about.
+    pub fn boundaries(&self) -> &[f32] {
+        self.segs().get(1..).unwrap_or(&[])
     }
 
     /// Index of the segment containing `s ≥ 0` (binary search).
@@ -311,9 +426,9 @@ impl Classifier {
         (from, to)
     }
 
-    /// Whether `s ≥ 0` lies within the margin band of a characteristic speed.
+    /// Whether `s ≥ 0` lies within the margin band of a boundary.
     fn near(&self, s: f32) -> bool {
-        let b = self.bounds();
+        let b = self.boundaries();
         let i = b.partition_point(|&x| x <= s);
         let close = |x: Option<&f32>| x.is_some_and(|&x| (s - x).abs() <= self.margin * x);
         close(b.get(i)) || close(i.checked_sub(1).and_then(|j| b.get(j)))
@@ -332,6 +447,11 @@ impl Classifier {
         self.segment_regime(self.segment(s))
     }
 
+    /// The balancing position is stable in segment `i` (every regime but `Gathering`).
+    fn stable(&self, i: usize) -> bool {
+        !matches!(self.seg_regime.get(i), Some(Regime::Gathering) | None)
+    }
+
     /// What to do at `speed` rad/s (see [`Advice`]). NaN and ±∞ give no advice.
     pub fn advice(&self, speed: f32) -> Advice {
         let none = Advice {
@@ -342,33 +462,29 @@ impl Classifier {
             return none;
         }
         let s = speed.abs();
-        let bounds = self.bounds();
-        // Zone `i` is `[from(i), bounds[i])`; `s ≥ 0` lies in the zone after every boundary
-        // at or below it.
-        let from = |i: usize| match i.checked_sub(1) {
-            None => Some(0.0),
-            Some(b) => bounds.get(b).copied(),
-        };
-        let zi = bounds.partition_point(|&f| f <= s);
-        let kind = self.zone_kind.get(zi).copied();
-        let drop_below = match kind {
-            Some(ZoneKind::Balancing) => from(zi).map(|f| f * (1.0 - self.margin)),
-            _ => None,
-        };
-        // The highest gathering zone starting at or below s.
-        let gi = if kind == Some(ZoneKind::Gathering) {
-            Some(zi)
+        let i = self.segment(s);
+        // Where the balancing position is stable: the start of the stable run containing i.
+        let drop_below = if self.stable(i) {
+            let mut j = i;
+            while j > 0 && self.stable(j - 1) {
+                j -= 1;
+            }
+            self.seg_from
+                .get(j)
+                .copied()
+                .filter(|&f| f > 0.0)
+                .map(|f| f * (1.0 - self.margin))
         } else {
-            zi.checked_sub(1)
+            None
         };
-        let exciter_band = gi.and_then(|g| {
-            let from = from(g)?;
-            let to = bounds.get(g).copied()?;
+        // The highest segment where the loads gather, starting at or below s.
+        let exciter_band = (0..=i).rev().find(|&g| !self.stable(g)).and_then(|g| {
+            let (from, to) = self.segment_range(g);
             let band = SpeedBand {
                 from: from * (1.0 + self.margin),
                 to: to * (1.0 - self.margin),
             };
-            (band.from < band.to).then_some(band)
+            (to.is_finite() && band.from < band.to).then_some(band)
         });
         Advice {
             drop_below,
@@ -449,43 +565,5 @@ impl RegimeTracker {
             near_characteristic: c.near(s),
             event: (from != to).then_some(RegimeEvent { from, to, speed: s }),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::fraction;
-    use crate::error::{non_negative_f32, ConfigError};
-
-    /// The const band check gives exactly what `non_negative_f32` followed by the `< 0.5`
-    /// limit gave before, for every class of f32 (a sweep over bit patterns, both signs,
-    /// subnormals, infinities and NaNs included).
-    #[test]
-    fn const_band_check_matches_the_validators() {
-        let reference = |x: f32| -> Result<f32, ConfigError> {
-            let x = non_negative_f32("margin", x)?;
-            if x >= 0.5 {
-                return Err(ConfigError::OutOfRange("margin"));
-            }
-            Ok(x)
-        };
-        let mut bits = 0u32;
-        let mut checked = 0;
-        loop {
-            let x = f32::from_bits(bits);
-            match (reference(x), fraction("margin", x)) {
-                (Ok(a), Ok(b)) => assert_eq!(a.to_bits(), b.to_bits(), "{x:e}"),
-                (a, b) => assert_eq!(a.err(), b.err(), "{x:e}"),
-            }
-            checked += 1;
-            bits = match bits.checked_add(0x0000_7fff) {
-                Some(b) => b,
-                None => break,
-            };
-        }
-        for x in [0.0, -0.0, 0.5, f32::MIN_POSITIVE, 1e-40, -1e-40, 0.4999999] {
-            assert_eq!(reference(x).ok(), fraction("margin", x).ok(), "{x:e}");
-        }
-        assert!(checked > 100_000);
     }
 }

@@ -866,16 +866,18 @@ fn classifier_agrees_with_zone_table() {
         let cfg = random_machine(&mut rng, 1 + trial % 3, true);
         let m = analyse(cfg);
         let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-        assert_eq!(c.characteristic_speeds().len(), m.zones().len() - 1);
+        // Every zone boundary is a boundary of the table (the others end capture windows).
+        for z in m.zones().iter().skip(1) {
+            assert!(c.boundaries().contains(&(z.from as f32)), "{z:?}");
+        }
         let top = m.zones().last().unwrap().from.max(m.resonant_speeds()[0]);
         let mut capture_checks = 0;
         for _ in 0..200 {
             let w = rng.uniform() * 2.0 * top;
-            let near = m
-                .zones()
+            let near = c
+                .boundaries()
                 .iter()
-                .skip(1)
-                .any(|z| (w - z.from).abs() <= 0.0201 * z.from);
+                .any(|&b| (w - f64::from(b)).abs() <= 0.0201 * f64::from(b));
             let r = c.classify(w as f32);
             if near {
                 continue;
@@ -884,7 +886,7 @@ fn classifier_agrees_with_zone_table() {
             match r {
                 Regime::Gathering => assert_eq!(expect, ZoneKind::Gathering),
                 Regime::Balancing => assert_eq!(expect, ZoneKind::Balancing),
-                Regime::Bistable => {
+                Regime::Bistable(BistableReason::Capture) => {
                     assert_eq!(expect, ZoneKind::Balancing);
                     if capture_checks < 3 {
                         capture_checks += 1;
@@ -902,7 +904,8 @@ fn classifier_agrees_with_zone_table() {
 fn near_band_hysteresis_and_events() {
     let m = analyse(scene(2));
     let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-    let b = c.characteristic_speeds()[0];
+    let b = c.boundaries()[0];
+    assert_eq!(b, m.zones()[1].from as f32);
     assert_eq!(c.classify(b), Regime::NearCharacteristic);
     assert_eq!(c.classify(b * 1.019), Regime::NearCharacteristic);
     assert_eq!(c.classify(b * 0.97), Regime::Gathering);
@@ -952,10 +955,13 @@ fn bistable_segment_and_advice() {
     let win = m.capture_windows()[0];
     assert!(win.until > win.from * 1.03, "{win:?}");
     let inside = (0.5 * (win.from * 1.03 + win.until)) as f32;
-    assert_eq!(c.classify(inside), Regime::Bistable);
+    assert_eq!(
+        c.classify(inside),
+        Regime::Bistable(BistableReason::Capture)
+    );
     assert_eq!(c.classify((win.until * 1.05) as f32), Regime::Balancing);
     let a = c.advice(inside);
-    let b = c.characteristic_speeds()[0];
+    let b = c.boundaries()[0];
     assert_eq!(a.drop_below, Some(b * 0.98));
     assert_eq!(
         a.exciter_band,
@@ -969,7 +975,7 @@ fn bistable_segment_and_advice() {
     // Two platforms, in the second gathering zone: run there.
     let m = analyse(scene(2));
     let c = Classifier::new(&m, 0.02, 0.01).unwrap();
-    let cs = c.characteristic_speeds();
+    let cs: Vec<f32> = m.zones().iter().skip(1).map(|z| z.from as f32).collect();
     let mid = 0.5 * (cs[1] + cs[2]);
     let a = c.advice(mid);
     assert_eq!(a.drop_below, None);
@@ -995,16 +1001,20 @@ proptest::proptest! {
     #![proptest_config(proptest::test_runner::Config::with_cases(2000))]
     #[test]
     fn runtime_is_total_for_any_f32(bits in proptest::prelude::any::<u32>(), seq in proptest::collection::vec(proptest::prelude::any::<u32>(), 0..16)) {
-        static M: std::sync::OnceLock<(Classifier, Classifier)> = std::sync::OnceLock::new();
-        let (c2, c3) = M.get_or_init(|| {
+        static M: std::sync::OnceLock<(Classifier, Classifier, Classifier)> = std::sync::OnceLock::new();
+        let (c2, c3, ct) = M.get_or_init(|| {
             let m2 = analyse(scene(2));
             let p = [platform(100.0, 4e5, 200.0), platform(100.0, 4e5, 200.0), platform(150.0, 3e5, 200.0)];
             let cs = [coupling(1, 2, 1e5, 50.0), coupling(2, 3, 1e5, 50.0)];
             let m3 = analyse(MachineConfig::new(&p, &cs, balancer(2)).unwrap());
-            (Classifier::new(&m2, 0.03, 0.01).unwrap(), Classifier::new(&m3, 0.0, 0.0).unwrap())
+            (
+                Classifier::new(&m2, 0.03, 0.01).unwrap(),
+                Classifier::new(&m3, 0.0, 0.0).unwrap(),
+                Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap(),
+            )
         });
         let x = f32::from_bits(bits);
-        for c in [c2, c3] {
+        for c in [c2, c3, ct] {
             let r = c.classify(x);
             proptest::prop_assert_eq!(r == Regime::Unknown, !x.is_finite());
             proptest::prop_assert_eq!(c.classify(-x), r);
@@ -1425,7 +1435,8 @@ const LITERAL: MachineTable<'static> = MachineTable {
         at: 61.5,
     }],
 };
-const FROM_LITERAL: Result<Classifier, ConfigError> = Classifier::from_table(&LITERAL, 0.02, 0.01);
+const FROM_LITERAL: Result<Classifier, ConfigError> =
+    Classifier::from_machine_table(&LITERAL, 0.02, 0.01);
 
 #[test]
 fn classifier_from_the_table_equals_classifier_from_the_machine() {
@@ -1438,10 +1449,17 @@ fn classifier_from_the_table_equals_classifier_from_the_machine() {
             SearchOptions::default(),
         )
         .unwrap();
+        // The criterion's segments built here with iterators, as a plain regime table.
+        let segments = criterion_segments(&m);
+        let reference = RegimeTable {
+            segments: &segments,
+        };
         for (margin, hysteresis) in [(0.0, 0.0), (0.02, 0.01), (0.05, 0.02), (0.3, 0.4)] {
             let a = Classifier::new(&m, margin, hysteresis).unwrap();
-            let b = Classifier::from_table(&m.table(), margin, hysteresis).unwrap();
+            let b = Classifier::from_machine_table(&m.table(), margin, hysteresis).unwrap();
+            let c = Classifier::from_table(&reference, margin, hysteresis).unwrap();
             assert_eq!(a, b, "trial {trial}");
+            assert_eq!(a, c, "trial {trial}: {segments:?}");
         }
         let t = m.table();
         assert_eq!(t.resonant, m.resonant_speeds());
@@ -1452,11 +1470,51 @@ fn classifier_from_the_table_equals_classifier_from_the_machine() {
     // The literal: gathering below 61.5·(1 − 0.02), near the boundary, bistable up to the
     // capture limit 90, balancing above.
     let c = FROM_LITERAL.unwrap();
-    assert_eq!(c.characteristic_speeds(), &[61.5]);
+    assert_eq!(c.boundaries(), &[61.5, 90.0]);
     assert_eq!(c.classify(50.0), Regime::Gathering);
     assert_eq!(c.classify(61.0), Regime::NearCharacteristic);
-    assert_eq!(c.classify(70.0), Regime::Bistable);
+    assert_eq!(c.classify(70.0), Regime::Bistable(BistableReason::Capture));
     assert_eq!(c.classify(95.0), Regime::Balancing);
+}
+
+/// The seed criterion's regime segments of `m`, built independently of the classifier: each
+/// zone its regime, a balancing zone bistable (capture) up to where the capture windows below
+/// it end; a segment that starts where the last one starts (in f32) replaces it, and equal
+/// neighbours merge.
+fn criterion_segments(m: &Machine) -> Vec<RegimeSegment> {
+    let mut segs: Vec<RegimeSegment> = Vec::new();
+    let mut push = |from: f64, regime: Regime| {
+        let from = from as f32;
+        if segs.last().is_some_and(|l| from <= l.from) {
+            segs.pop();
+        }
+        if segs.last().is_some_and(|l| l.regime == regime) {
+            return;
+        }
+        let from = if segs.is_empty() { 0.0 } else { from };
+        segs.push(RegimeSegment { from, regime });
+    };
+    for z in m.zones() {
+        match z.kind {
+            ZoneKind::Gathering => push(z.from, Regime::Gathering),
+            ZoneKind::Balancing => {
+                let until = m
+                    .capture_windows()
+                    .iter()
+                    .filter(|w| w.from <= z.from)
+                    .fold(0.0f64, |u, w| u.max(w.until));
+                if until > z.from {
+                    push(z.from, Regime::Bistable(BistableReason::Capture));
+                    if until < z.to.unwrap_or(f64::INFINITY) {
+                        push(until, Regime::Balancing);
+                    }
+                } else {
+                    push(z.from, Regime::Balancing);
+                }
+            }
+        }
+    }
+    segs
 }
 
 #[test]
@@ -1474,7 +1532,7 @@ fn a_table_unlike_a_machines_is_rejected_by_name() {
         zones,
         captures,
     };
-    let build = |t: &MachineTable| Classifier::from_table(t, 0.02, 0.01);
+    let build = |t: &MachineTable| Classifier::from_machine_table(t, 0.02, 0.01);
     let ok: &'static [Zone] = std::vec![z(0.0, Some(10.0), g), z(10.0, None, b)].leak();
     assert!(build(&table(ok, std::vec![w].leak())).is_ok());
     let inconsistent: [&'static [Zone]; 7] = [
@@ -1530,4 +1588,179 @@ fn a_table_unlike_a_machines_is_rejected_by_name() {
     assert_eq!(build(&t), Err(ConfigError::NonFinite("additional")));
     t.resonant = &[f64::NEG_INFINITY];
     assert_eq!(build(&t), Err(ConfigError::NonFinite("resonant")));
+}
+// ---------------------------------------------------------------------------------------
+// Regime tables
+
+const fn seg(from: f32, regime: Regime) -> RegimeSegment {
+    RegimeSegment { from, regime }
+}
+
+/// The seed machine's exact table in the seed's units (ω̃ = 1): balancing position unstable
+/// below 1.0016, stable to 1.0874 (inside the capture window), unstable to 1.4252, stable
+/// above, captured loads possible up to 1.9.
+const SEED_TABLE: RegimeTable<'static> = RegimeTable {
+    segments: &[
+        seg(0.0, Regime::Gathering),
+        seg(1.0016, Regime::Bistable(BistableReason::Capture)),
+        seg(1.0874, Regime::Gathering),
+        seg(1.4252, Regime::Bistable(BistableReason::Capture)),
+        seg(1.9, Regime::Balancing),
+    ],
+};
+
+#[test]
+fn table_classifier_reads_the_table() {
+    let c = Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap();
+    assert_eq!(c.boundaries(), &[1.0016, 1.0874, 1.4252, 1.9]);
+    let cases = [
+        (0.5, Regime::Gathering),
+        (0.995, Regime::NearCharacteristic),
+        (1.05, Regime::Bistable(BistableReason::Capture)),
+        (1.2, Regime::Gathering),
+        (1.43, Regime::NearCharacteristic),
+        (1.6, Regime::Bistable(BistableReason::Capture)),
+        (2.5, Regime::Balancing),
+        (-2.5, Regime::Balancing),
+        (f32::NAN, Regime::Unknown),
+    ];
+    for (w, want) in cases {
+        assert_eq!(c.classify(w), want, "{w}");
+    }
+    assert!(Regime::Balancing.committed() && Regime::Gathering.committed());
+    assert!(!Regime::Bistable(BistableReason::Coexisting).committed());
+    assert_eq!(
+        Regime::Bistable(BistableReason::Coexisting).reason(),
+        Some(BistableReason::Coexisting)
+    );
+    assert_eq!(Regime::Balancing.reason(), None);
+    // The table round-trips through the classifier.
+    let back: Vec<RegimeSegment> = c.segments().collect();
+    assert_eq!(back.as_slice(), SEED_TABLE.segments);
+    // Advice: above the instability band, the stable stretch starts at 1.4252; the exciter
+    // band is the unstable band shrunk by the margin.
+    let a = c.advice(1.6);
+    assert_eq!(a.drop_below, Some(1.4252 * 0.99));
+    assert_eq!(
+        a.exciter_band,
+        Some(SpeedBand {
+            from: 1.0874 * 1.01,
+            to: 1.4252 * 0.99
+        })
+    );
+    let a = c.advice(1.05);
+    assert_eq!(a.drop_below, Some(1.0016 * 0.99));
+    assert_eq!(
+        a.exciter_band,
+        Some(SpeedBand {
+            from: 0.0,
+            to: 1.0016 * 0.99
+        })
+    );
+    assert_eq!(c.advice(1.2).drop_below, None);
+}
+
+#[test]
+fn table_validation_names_what_is_wrong() {
+    let check = |segments: &[RegimeSegment], want: ConfigError| {
+        let t = RegimeTable { segments };
+        assert_eq!(t.validate(), Err(want), "{segments:?}");
+        assert_eq!(Classifier::from_table(&t, 0.01, 0.0), Err(want));
+    };
+    let g = Regime::Gathering;
+    let b = Regime::Balancing;
+    check(&[], ConfigError::Capacity("segments"));
+    check(
+        &[seg(0.0, g), seg(1.0, b)].repeat(9),
+        ConfigError::Capacity("segments"),
+    );
+    check(&[seg(0.5, g)], ConfigError::OutOfRange("segments.from"));
+    check(
+        &[seg(0.0, g), seg(f32::INFINITY, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(1e-40, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(f32::NAN, b)],
+        ConfigError::OutOfRange("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(2.0, b), seg(1.0, g)],
+        ConfigError::Inconsistent("segments.from"),
+    );
+    check(
+        &[seg(0.0, g), seg(1.0, g)],
+        ConfigError::Inconsistent("segments.regime"),
+    );
+    check(
+        &[seg(0.0, g), seg(1.0, Regime::NearCharacteristic)],
+        ConfigError::OutOfRange("segments.regime"),
+    );
+    check(
+        &[seg(0.0, Regime::Unknown)],
+        ConfigError::OutOfRange("segments.regime"),
+    );
+    assert!(Classifier::from_table(&SEED_TABLE, 0.5, 0.0).is_err());
+    assert!(Classifier::from_table(&SEED_TABLE, 0.0, f32::NAN).is_err());
+    assert!(Classifier::from_table(
+        &RegimeTable {
+            segments: &[seg(0.0, b)]
+        },
+        0.0,
+        0.0
+    )
+    .is_ok());
+}
+
+#[test]
+fn f64_speeds_that_f32_cannot_hold_are_errors() {
+    use super::table::speed_f32;
+    assert_eq!(speed_f32("s", 0.0), Ok(0.0));
+    assert_eq!(speed_f32("s", 61.5), Ok(61.5));
+    assert_eq!(speed_f32("s", 1e39), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", 1e-50), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", 1e-40), Err(ConfigError::OutOfRange("s")));
+    assert_eq!(speed_f32("s", -1.0), Err(ConfigError::Negative("s")));
+    assert_eq!(speed_f32("s", f64::NAN), Err(ConfigError::NonFinite("s")));
+    assert_eq!(
+        RegimeSegment::new("s", 1e300, Regime::Balancing),
+        Err(ConfigError::OutOfRange("s"))
+    );
+    // A machine whose characteristic speeds f64 holds but f32 does not: the criterion's
+    // classifier rejects it instead of placing a boundary at infinity or at 0.
+    for (mass, stiffness) in [(1.0, 1e90), (1e10, 1e-80)] {
+        let b = AutoBalancer {
+            load_mass: 0.5 * mass,
+            housing_mass: 0.0,
+            ..balancer(1)
+        };
+        let cfg = MachineConfig::new(&[platform(mass, stiffness, 0.0)], &[], b).unwrap();
+        let m = analyse(cfg);
+        let w = m.zones()[1].from;
+        assert!(w.is_finite() && w > 0.0, "{w}");
+        assert_eq!(
+            Classifier::new(&m, 0.01, 0.0),
+            Err(ConfigError::OutOfRange("zones.from")),
+            "{w}"
+        );
+    }
+}
+
+#[test]
+fn criterion_classifier_merges_empty_segments() {
+    // A capture window ending where the balancing zone ends (equal in f32) must not leave an
+    // empty segment or two neighbours of one regime.
+    let mut rng = Rng(5);
+    for trial in 0..30 {
+        let m = analyse(random_machine(&mut rng, 1 + trial % 3, true));
+        let c = Classifier::new(&m, 0.0, 0.0).unwrap();
+        let segs: Vec<RegimeSegment> = c.segments().collect();
+        assert!(
+            RegimeTable { segments: &segs }.validate().is_ok(),
+            "{segs:?}"
+        );
+    }
 }

@@ -2,14 +2,14 @@
 //! configuration time (f64, software-emulated on the M4), the same analysis taken instead from
 //! the table `drive-sim predict three-mass --emit rust` wrote (`three_mass_table.rs`, a classifier
 //! built at compile time), and the per-speed-update classification (f32, binary search over the
-//! zones).
+//! segments) from the criterion's zones and from the exact regime table the host computes.
 
 use core::hint::black_box;
 
 use cortex_m_semihosting::hprintln;
 use drive_monitor::balancer::{
-    AutoBalancer, BalancerKind, Classifier, Coupling, Machine, MachineConfig, Platform, Regime,
-    RegimeTracker, SearchOptions,
+    AutoBalancer, BalancerKind, BistableReason, Classifier, Coupling, Machine, MachineConfig,
+    Platform, Regime, RegimeSegment, RegimeTable, RegimeTracker, SearchOptions, TABLE_MARGIN,
 };
 
 use crate::bench::{ensure, measure, measure_each};
@@ -22,7 +22,7 @@ const HYSTERESIS: f32 = 0.01;
 
 /// The classifier of the emitted table, built by the compiler: no analysis on the target.
 const FROM_TABLE: Classifier =
-    match Classifier::from_table(&three_mass_table::MACHINE, MARGIN, HYSTERESIS) {
+    match Classifier::from_machine_table(&three_mass_table::MACHINE, MARGIN, HYSTERESIS) {
         Ok(c) => c,
         Err(_) => panic!("three_mass_table.rs: not a valid machine table"),
     };
@@ -57,6 +57,27 @@ fn config() -> MachineConfig {
         Err(e) => crate::bench::fail(format_args!("machine rejected: {}", e)),
     }
 }
+
+const fn seg(from: f32, regime: Regime) -> RegimeSegment {
+    RegimeSegment { from, regime }
+}
+
+/// The bundled `three-mass.toml` machine's exact regime table: `regime_table` of
+/// `drive-sim predict three-mass --json` (Floquet stability of the balancing position, the
+/// core's capture windows, the criterion), speeds rounded to f32.
+const EXACT: RegimeTable<'static> = RegimeTable {
+    segments: &[
+        seg(0.0, Regime::Gathering),
+        seg(50.324_696, Regime::Bistable(BistableReason::Capture)),
+        seg(50.954_55, Regime::Balancing),
+        seg(51.349_155, Regime::Bistable(BistableReason::Coexisting)),
+        seg(51.435_593, Regime::Gathering),
+        seg(70.139_68, Regime::Bistable(BistableReason::Capture)),
+        seg(70.938_67, Regime::Gathering),
+        seg(91.156_73, Regime::Bistable(BistableReason::Capture)),
+        seg(105.822_15, Regime::Balancing),
+    ],
+};
 
 pub fn run() {
     hprintln!("-- auto-balancer: three-mass machine");
@@ -103,6 +124,27 @@ pub fn run() {
         classifier.classify(30.0) == Regime::Gathering
             && classifier.classify(120.0) == Regime::Balancing,
         "classification"
+    );
+    let start = icount::instructions();
+    let exact = match Classifier::from_table(&EXACT, TABLE_MARGIN, 0.5 * TABLE_MARGIN) {
+        Ok(c) => c,
+        Err(e) => crate::bench::fail(format_args!("table rejected: {}", e)),
+    };
+    let table_cost = icount::instructions() - start;
+    hprintln!(
+        "bench {:<28} {:>7}",
+        "balancer::Classifier::from_table",
+        table_cost
+    );
+    measure_each("balancer::classify (exact table)", &speeds, 100, |w| {
+        exact.classify(w)
+    });
+    ensure!(
+        exact.classify(30.0) == Regime::Gathering
+            && exact.classify(60.0) == Regime::Gathering
+            && exact.classify(100.0) == Regime::Bistable(BistableReason::Capture)
+            && exact.classify(120.0) == Regime::Balancing,
+        "exact classification"
     );
     let mut tracker = RegimeTracker::new();
     let mut i = 0usize;

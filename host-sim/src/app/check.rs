@@ -657,12 +657,13 @@ fn autobalancer(ab: &AutobalancerSpec, platforms: u64, c: &Checker) -> Result<()
         "N·s/m",
     )?;
     if let Some(d) = ab.rotor_unbalance {
-        let capacity = f64::from(ab.loads) * ab.load_mass * ab.radius;
+        // More than the loads can balance (loads × load_mass × radius) is a machine to
+        // simulate too: the loads then settle at their limit (judged `saturated`).
         c.non_negative(
             "autobalancer.rotor_unbalance",
             d,
-            capacity,
-            "kg·m (loads × load_mass × radius)",
+            MAX_MASS * MAX_LENGTH,
+            "kg·m",
         )?;
     }
     Ok(())

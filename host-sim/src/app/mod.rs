@@ -1,7 +1,8 @@
 //! The `drive-sim` application: scene files ([`scene`]), a run through the engine and the core
-//! ([`run`]), design-time results ([`predict`]) and their Rust table for firmware ([`emit`]),
-//! the run-up's capture analysis ([`capture`]), and the report with its plots ([`report`],
-//! [`plot`]), progress bars ([`progress`]).
+//! ([`run`]), design-time results ([`predict`], the exact regime table [`regimes`]) and their
+//! Rust table for firmware ([`emit`]), the run-up's capture analysis ([`capture`]), scene
+//! checks ([`check`]), and the report with its plots ([`report`], [`plot`]), progress bars
+//! ([`progress`]).
 
 pub mod capture;
 pub mod check;
@@ -9,6 +10,7 @@ pub mod emit;
 pub mod plot;
 pub mod predict;
 pub mod progress;
+pub mod regimes;
 pub mod report;
 pub mod run;
 pub mod scene;

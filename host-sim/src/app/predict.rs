@@ -203,9 +203,61 @@ pub struct CaptureOut {
     pub at: f64,
 }
 
+/// A change of stability of the balancing position (Floquet).
+#[derive(Debug, Clone, Serialize)]
+pub struct StabilityBoundaryOut {
+    /// Speed, rad/s (placed to 1e-7 relative).
+    pub speed: f64,
+    /// Stable above, unstable below.
+    pub stable_above: bool,
+}
+
+/// `autobalancer.stability` of `predict --json`: where the balancing position is stable.
+#[derive(Debug, Clone, Serialize)]
+pub struct StabilityOut {
+    /// Speeds scanned, rad/s (the classes at the ends extend beyond).
+    pub scanned: [f64; 2],
+    /// Stable at the lowest speed scanned.
+    pub stable_at_start: bool,
+    /// Changes of stability, ascending.
+    pub boundaries: Vec<StabilityBoundaryOut>,
+    /// Each criterion boundary beside the nearest exact boundary of its kind.
+    pub criterion: Vec<crate::app::regimes::Comparison>,
+    /// Monodromy matrices integrated.
+    pub evaluations: usize,
+}
+
+/// One segment of the regime table.
+#[derive(Debug, Clone, Serialize)]
+pub struct SegmentOut {
+    /// Lower edge, rad/s (the segment runs to the next one's).
+    pub from: f64,
+    /// "balancing", "gathering" or "bistable".
+    pub regime: &'static str,
+    /// Why bistable: "capture" or "coexisting".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<&'static str>,
+}
+
 /// `autobalancer` member of `predict --json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct AutobalancerOut {
+    /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
+    pub capacity: f64,
+    /// The rotor unbalance the loads are to balance (`[autobalancer] rotor_unbalance`, default
+    /// half the capacity), kg·m.
+    pub rotor_unbalance: f64,
+    /// `max(0, D − N·m·R)`: the least residual unbalance the loads can leave, kg·m (non-zero:
+    /// the balancer is too small for its rotor; the loads at their limit, all opposite the
+    /// unbalance, leave this much).
+    pub residual_floor: f64,
+    /// Exact stability of the balancing position (absent without one: a balancer too small).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stability: Option<StabilityOut>,
+    /// The regime table the run-time classifier is built from (margin not applied).
+    pub regime_table: Vec<SegmentOut>,
+    /// "exact" (from the stability above) or "criterion" (without a balancing position).
+    pub regime_table_source: &'static str,
     /// Undamped resonant speeds, ascending, rad/s.
     pub resonant_speeds: Vec<f64>,
     /// Undamped additional speeds, ascending, rad/s.
@@ -311,7 +363,48 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         });
     }
     if let Some(m) = machine(scene, file)? {
+        let Some(design) = crate::app::regimes::design(scene, file, &m)? else {
+            return Err(SceneError::value(file, "autobalancer", "missing"));
+        };
+        let stability = design.exact.as_ref().map(|e| StabilityOut {
+            scanned: [e.map.options.from, e.map.options.to],
+            stable_at_start: e.map.stable_at_from,
+            boundaries: e
+                .map
+                .boundaries
+                .iter()
+                .map(|b| StabilityBoundaryOut {
+                    speed: b.speed,
+                    stable_above: b.stable_above,
+                })
+                .collect(),
+            criterion: e.comparison.clone(),
+            evaluations: e.map.evaluations,
+        });
+        let segment = |from: f64, r: drive_monitor::balancer::Regime| SegmentOut {
+            from,
+            regime: r.name(),
+            reason: r.reason().map(|x| x.name()),
+        };
+        let regime_table: Vec<SegmentOut> = match &design.exact {
+            Some(e) => e.segments.iter().map(|&(f, r)| segment(f, r)).collect(),
+            None => drive_monitor::balancer::Classifier::new(&m, 0.0, 0.0)
+                .map_err(|e| value_error(file, "autobalancer", e))?
+                .segments()
+                .map(|s| segment(f64::from(s.from), s.regime))
+                .collect(),
+        };
         p.autobalancer = Some(AutobalancerOut {
+            capacity: design.capacity,
+            rotor_unbalance: design.rotor_unbalance,
+            residual_floor: design.residual_floor,
+            stability,
+            regime_table,
+            regime_table_source: if design.exact.is_some() {
+                "exact"
+            } else {
+                "criterion"
+            },
             resonant_speeds: m.resonant_speeds().to_vec(),
             additional_speeds: m.additional_speeds().to_vec(),
             zones: m

@@ -94,11 +94,25 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             }
         }
     }
+    if let (Some(cap), Some(d), Some(floor)) = (r.capacity, r.rotor_unbalance, r.residual_floor) {
+        if floor > 0.0 {
+            let _ = writeln!(
+                s,
+                "Auto-balancer too small for its rotor: capacity N·m·R = {cap:.4e} kg·m < rotor \
+                 unbalance D = {d:.4e} kg·m; with every load at its limit the residual unbalance \
+                 is {floor:.4e} kg·m ({:.1} % of D); simulated: {}, residual {:.2e} of D",
+                100.0 * floor / d,
+                r.regime_simulated.unwrap_or("?"),
+                r.residual_relative.unwrap_or(f64::NAN)
+            );
+        }
+    }
     if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
         let _ = writeln!(
             s,
-            "Regime at the measured speed: core predicts {p} ({}), simulation {sim} (residual unbalance {} of the rotor's)",
+            "Regime at the measured speed: core class {}{}, criterion {p}, simulation {sim} (residual unbalance {} of the rotor's)",
             r.regime_class.unwrap_or("?"),
+            r.regime_reason.map_or(String::new(), |x| format!(" ({x})")),
             r.residual_relative
                 .map_or("–".to_string(), |x| format!("{x:.2e}"))
         );
@@ -465,6 +479,73 @@ pub fn prediction_text(p: &Prediction) -> String {
                 s,
                 "  capture possible from {:.3} up to {:.3} rad/s (loads held near {:.3} rad/s)",
                 c.from, c.until, c.at
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  capacity N·m·R = {:.4e} kg·m, rotor unbalance D = {:.4e} kg·m",
+            a.capacity, a.rotor_unbalance
+        );
+        if a.residual_floor > 0.0 {
+            let _ = writeln!(
+                s,
+                "  the balancer is too small for its rotor: no balancing position; with every \
+                 load at its limit, opposite the unbalance, the residual unbalance is {:.4e} \
+                 kg·m ({:.1} % of D)",
+                a.residual_floor,
+                100.0 * a.residual_floor / a.rotor_unbalance
+            );
+            let _ = writeln!(
+                s,
+                "  (the table below is the criterion's: its `balancing` means the loads at their \
+                 limit, the machine saturated)"
+            );
+        }
+        if let Some(st) = &a.stability {
+            let _ =
+                writeln!(
+                s,
+                "  exact stability of the balancing position (Floquet, {} monodromy matrices over \
+                 {:.2}–{:.2} rad/s): {} at the lowest speed",
+                st.evaluations,
+                st.scanned[0],
+                st.scanned[1],
+                if st.stable_at_start { "stable" } else { "unstable" }
+            );
+            for b in &st.boundaries {
+                let _ = writeln!(
+                    s,
+                    "    {:>10.4} rad/s  becomes {}",
+                    b.speed,
+                    if b.stable_above { "stable" } else { "unstable" }
+                );
+            }
+            for c in &st.criterion {
+                let _ = writeln!(
+                    s,
+                    "  criterion boundary {:.3} rad/s ({}): nearest exact {}",
+                    c.criterion,
+                    c.kind,
+                    match (c.exact, c.difference) {
+                        (Some(e), Some(d)) => format!("{e:.3} rad/s ({:+.2} %)", 100.0 * d),
+                        _ => "none".to_string(),
+                    }
+                );
+            }
+        }
+        let _ = writeln!(s, "  regime table ({}):", a.regime_table_source);
+        for (k, seg) in a.regime_table.iter().enumerate() {
+            let to = a
+                .regime_table
+                .get(k + 1)
+                .map_or("∞".to_string(), |n| format!("{:.3}", n.from));
+            let _ = writeln!(
+                s,
+                "    {:>9.3} – {:<9} rad/s  {}{}",
+                seg.from,
+                to,
+                seg.regime,
+                seg.reason.map_or(String::new(), |r| format!(" ({r})"))
             );
         }
     }

@@ -23,7 +23,9 @@ use crate::engine::vibration::{
     VibrationMachineParams,
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
-use drive_monitor::balancer::{Classifier, Machine, DEFAULT_MARGIN};
+#[cfg(doc)]
+use drive_monitor::balancer::DEFAULT_MARGIN;
+use drive_monitor::balancer::{Classifier, Machine};
 use drive_monitor::drive::DriveModel;
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
@@ -129,15 +131,31 @@ pub struct RunReport {
     /// Why the core measured nothing, when it has an encoder and no valid window.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_measurement: Option<String>,
-    /// Regime the core predicts at the measured speed: "balancing" | "gathering".
+    /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_predicted: Option<&'static str>,
-    /// The core's full class: "balancing" | "gathering" | "bistable" | "near-characteristic".
+    /// The core's class from the machine's regime table (exact unless the balancer is too
+    /// small for its rotor): "balancing" | "gathering" | "bistable" | "near-characteristic".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_class: Option<&'static str>,
-    /// What the loads did in the simulation: "balancing" | "gathering".
+    /// Why bistable: "capture" | "coexisting".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_reason: Option<&'static str>,
+    /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
+    /// for its rotor, settled on the least residual it can leave) | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_simulated: Option<&'static str>,
+    /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capacity: Option<f64>,
+    /// The rotor unbalance `D` simulated, kg·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotor_unbalance: Option<f64>,
+    /// `max(0, D − N·m·R)`: the least residual unbalance the loads can leave, kg·m (non-zero
+    /// for a balancer too small for its rotor: every load at its limit, opposite the
+    /// unbalance).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_floor: Option<f64>,
     /// Residual unbalance at the end relative to the rotor unbalance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_relative: Option<f64>,
@@ -446,6 +464,7 @@ struct RegimeStream {
     sure_from: f64,
     sure_first: Option<RegimeSample>,
     residual_max: f64,
+    residual_min: f64,
     coherence_min: f64,
     /// Earliest time that may lie in the judged part.
     maybe_from: f64,
@@ -465,6 +484,7 @@ impl RegimeStream {
             sure_from: keep * duration,
             sure_first: None,
             residual_max: 0.0,
+            residual_min: f64::INFINITY,
             coherence_min: 1.0,
             maybe_from: keep * (duration - 2.0 * every),
         }
@@ -479,6 +499,7 @@ impl RegimeStream {
                 self.sure_first = Some(s);
             }
             self.residual_max = self.residual_max.max(s.residual);
+            self.residual_min = self.residual_min.min(s.residual);
             self.coherence_min = self.coherence_min.min(s.coherence);
         } else if s.t >= self.maybe_from {
             self.undecided.push(s);
@@ -487,9 +508,9 @@ impl RegimeStream {
     }
 
     /// The samples `classify` needs, in time order: the first (the initial residual), every
-    /// sample that may begin the judged part, a stand-in for the part certainly judged (its
-    /// first sample, with that part's largest residual and smallest coherence: `classify`
-    /// only folds those) and the last.
+    /// sample that may begin the judged part, two stand-ins for the part certainly judged (its
+    /// first sample, with that part's largest and with its smallest residual, and its smallest
+    /// coherence: `classify` only folds those) and the last.
     fn samples(&self) -> Vec<RegimeSample> {
         let (Some(first), Some(last)) = (self.first, self.last) else {
             return Vec::new();
@@ -497,11 +518,13 @@ impl RegimeStream {
         let mut out = vec![first];
         out.extend(self.undecided.iter().copied().filter(|s| s.t > first.t));
         if let Some(s) = self.sure_first.filter(|s| s.t > first.t) {
-            out.push(RegimeSample {
-                residual: self.residual_max,
-                coherence: self.coherence_min,
-                ..s
-            });
+            for residual in [self.residual_max, self.residual_min] {
+                out.push(RegimeSample {
+                    residual,
+                    coherence: self.coherence_min,
+                    ..s
+                });
+            }
         }
         if out.last().is_some_and(|s| last.t > s.t) {
             out.push(last);
@@ -715,21 +738,18 @@ pub fn scene_stem(path: &Path) -> String {
         .to_string()
 }
 
-/// The core's regime classifier for `machine` with the scene's `[monitor] regime_margin`
-/// (default [`DEFAULT_MARGIN`]) and half of it as hysteresis, and that margin.
+/// The core's regime classifier for `machine`: from the exact table of the scene's machine
+/// when it has one ([`crate::app::regimes`]), else from the criterion; with the scene's
+/// `[monitor] regime_margin` (default [`DEFAULT_MARGIN`]) and half of it as hysteresis. Returns
+/// the classifier and that margin.
 pub fn regime_classifier(
     scene: &Scene,
     file: &Path,
     machine: &Machine,
 ) -> Result<(Classifier, f32), SceneError> {
-    let margin = scene
-        .monitor
-        .as_ref()
-        .and_then(|m| m.regime_margin)
-        .map_or(DEFAULT_MARGIN, |m| m as f32);
-    let classifier = Classifier::new(machine, margin, 0.5 * margin)
-        .map_err(|e| core_error(scene, file, "monitor", e))?;
-    Ok((classifier, margin))
+    let design = crate::app::regimes::design(scene, file, machine)?;
+    let (c, margin, _) = crate::app::regimes::classifier(scene, file, machine, design.as_ref())?;
+    Ok((c, margin))
 }
 
 /// The machine a run simulates: the system and what the report needs to know of it.
@@ -1170,16 +1190,19 @@ fn regime(
     vib_machine: Option<&VibrationMachine>,
     samples: &[RegimeSample],
 ) -> Result<(), SceneError> {
-    if let Some(machine) = predict::machine(scene, file)? {
+    if let (Some(machine), Some(w)) = (predict::machine(scene, file)?, report.speed_measured) {
         let (classifier, _) = regime_classifier(scene, file, &machine)?;
-        if let Some(w) = report.speed_measured {
-            report.regime_class = Some(classifier.classify(w as f32).name());
-            // The criterion's own zone at the measured speed (no margin, no capture check).
-            report.regime_predicted = Some(machine.zone_kind_at(w).name());
-        }
+        let class = classifier.classify(w as f32);
+        report.regime_class = Some(class.name());
+        report.regime_reason = class.reason().map(|r| r.name());
+        // The criterion's own zone at the measured speed (no margin, no capture check).
+        report.regime_predicted = Some(machine.zone_kind_at(w).name());
     }
     if let Some(vm) = vib_machine {
-        let criteria = RegimeCriteria::new(vm.reference_unbalance());
+        report.capacity = Some(vm.capacity());
+        report.rotor_unbalance = Some(vm.rotor_unbalance());
+        report.residual_floor = Some(vm.residual_floor());
+        let criteria = vm.regime_criteria();
         if let Some(r) = classify(samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());
             report.residual_relative = Some(r.residual_relative);

@@ -439,8 +439,10 @@ pub struct MonitorSpec {
     pub min_speed: Option<f64>,
     /// Steady-speed tolerance between windows (fraction).
     pub steady_tolerance: Option<f64>,
-    /// Relative margin band around each characteristic speed of the auto-balancer (default
-    /// `drive_monitor::balancer::DEFAULT_MARGIN`, 5 %, sized in `docs/criterion.md`).
+    /// Relative margin band about each boundary of the auto-balancer's regime table (default
+    /// `drive_monitor::balancer::TABLE_MARGIN`, 1 %, for the exact table; for a balancer too
+    /// small for its rotor, which has the criterion's table,
+    /// `drive_monitor::balancer::DEFAULT_MARGIN`, 5 %; both sized in `docs/criterion.md`).
     pub regime_margin: Option<f64>,
     /// Warning band of the support limits, as a fraction of each limit.
     pub warning_fraction: Option<f64>,
@@ -644,6 +646,14 @@ pub const BUNDLED: &[(&str, &str)] = &[
     (
         "one-mass-runup.toml",
         include_str!("../../scenes/one-mass-runup.toml"),
+    ),
+    (
+        "one-mass-undersized.toml",
+        include_str!("../../scenes/one-mass-undersized.toml"),
+    ),
+    (
+        "one-mass-motor-runup.toml",
+        include_str!("../../scenes/one-mass-motor-runup.toml"),
     ),
     ("two-mass.toml", include_str!("../../scenes/two-mass.toml")),
     (

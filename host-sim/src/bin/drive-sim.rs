@@ -301,32 +301,39 @@ fn sweep_cmd(
         text.push_str(&to_json(&s)?);
     } else {
         text.push_str(&format!(
-            "{:>10}  {:<10} {:<20} {:<10} {:>10}\n",
+            "{:>10}  {:<10} {:<32} {:<10} {:>10}\n",
             "speed", "criterion", "core class", "simulated", "residual"
         ));
         for p in &s.points {
-            let mark = if p.regime_predicted == p.regime_simulated {
-                ""
-            } else {
+            let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
+            let mark = if committed
+                && !host_sim::studies::sweep::agrees(p.regime_class, p.regime_simulated)
+            {
                 "  ≠"
+            } else {
+                ""
+            };
+            let class = match p.regime_reason {
+                Some(r) => format!("{} ({r})", p.regime_class),
+                None => p.regime_class.to_string(),
+            };
+            // No settled regime in the simulation: no residual to show.
+            let residual = if p.residual_relative.is_finite() {
+                format!("{:.2e}", p.residual_relative)
+            } else {
+                "–".to_string()
             };
             text.push_str(&format!(
-                "{:>10.3}  {:<10} {:<20} {:<10} {:>10.2e}{mark}\n",
-                p.speed,
-                p.regime_predicted,
-                p.regime_class,
-                p.regime_simulated,
-                p.residual_relative
+                "{:>10.3}  {:<10} {:<32} {:<10} {:>10}{mark}\n",
+                p.speed, p.regime_predicted, class, p.regime_simulated, residual
             ));
         }
-        let agree = s
-            .points
-            .iter()
-            .filter(|p| p.regime_predicted == p.regime_simulated)
-            .count();
         text.push_str(&format!(
-            "agreement: {agree} of {} speeds; away from the characteristic speeds {} of {}\n",
+            "core ({} table) commits at {} of {} speeds, the simulation agrees at {}; the criterion alone agrees at {} of {} speeds away from its characteristic speeds\n",
+            if s.exact { "exact" } else { "criterion" },
+            s.committed,
             s.points.len(),
+            s.committed_agreeing,
             s.agreeing,
             s.away_from_characteristic
         ));

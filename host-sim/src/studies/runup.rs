@@ -1,6 +1,9 @@
-//! The run-up capture page: a ramp scene whose loads start together, repeated at other ramp
-//! rates, so the page shows the release speed converging on the core's quasi-static
-//! [`CaptureWindow::until`] as the ramp slows.
+//! The run-up capture page: a run-up scene whose loads start together, repeated at slower and
+//! faster run-ups, so the page shows the release speed converging on the core's quasi-static
+//! [`CaptureWindow::until`] as the run-up slows. The rotor is either prescribed (a ramp,
+//! repeated at other ramp rates) or driven by the scene's motor (a Kloss or parabola
+//! characteristic against the load and the machine's own reaction torque, seed 000; repeated
+//! with the shaft's inertia scaled, which scales the run-up rate inversely).
 //!
 //! A finite-rate ramp releases late: the captured state disappears at the fold of the averaged
 //! balance (at `until`, or just past it when the fold lies beyond the gathering zone, see
@@ -51,36 +54,92 @@ pub fn with_ramp_stretched(scene: &Scene, file: &Path, factor: f64) -> Result<Sc
     Ok(s)
 }
 
-/// The ramp scene repeated with its ramp time scaled by each of `factors`, in parallel and
-/// without the encoder (only the loads are judged). Sorted by descending ramp rate.
+/// `scene` with a motor-driven run-up `factor` times slower: the shaft's inertia and
+/// flywheel, and the simulated time, scaled by `factor` (the acceleration under a given torque
+/// falls as the inertia rises). Errors unless the scene's shaft is motor-driven (`[shaft]`
+/// and a Kloss or parabola `[motor]`) and `factor` is positive and finite.
+pub fn with_inertia_scaled(scene: &Scene, file: &Path, factor: f64) -> Result<Scene, SceneError> {
+    if !(factor.is_finite() && factor > 0.0) {
+        return Err(SceneError::value(
+            file,
+            "shaft.inertia",
+            format!("inertia factor must be positive and finite, got {factor}"),
+        ));
+    }
+    let mut s = scene.clone();
+    if !matches!(
+        s.motor,
+        Some(MotorSpec::Kloss { .. } | MotorSpec::Parabola { .. })
+    ) {
+        return Err(SceneError::value(
+            file,
+            "motor",
+            "a motor-driven run-up needs a Kloss or parabola motor",
+        ));
+    }
+    let Some(shaft) = &mut s.shaft else {
+        return Err(SceneError::value(
+            file,
+            "shaft",
+            "missing: a motor-driven run-up needs [shaft]",
+        ));
+    };
+    shaft.inertia *= factor;
+    shaft.flywheel *= factor;
+    s.simulation.duration *= factor;
+    Ok(s)
+}
+
+/// The run-up scene repeated `factor` times slower for each of `factors` (a prescribed ramp
+/// stretched, [`with_ramp_stretched`], or a motor-driven shaft's inertia scaled,
+/// [`with_inertia_scaled`]), in parallel and without the encoder (only the loads are judged).
+/// The rate of a ramp is its own; of a motor-driven run-up, the rotor's mean acceleration
+/// while the loads were captured (NaN if they were not). In the order of `factors`.
 pub fn ramp_rates(scene: &Scene, file: &Path, factors: &[f64]) -> Result<Vec<RampRun>, SceneError> {
     use rayon::prelude::*;
-    let mut runs: Vec<RampRun> = factors
+    let motor_driven = !matches!(scene.motor, Some(MotorSpec::Ramp { .. }));
+    factors
         .par_iter()
         .map(|&f| {
-            let mut s = with_ramp_stretched(scene, file, f)?;
+            let mut s = if motor_driven {
+                with_inertia_scaled(scene, file, f)?
+            } else {
+                with_ramp_stretched(scene, file, f)?
+            };
             s.encoder = None;
+            let r = run(&s, file, Overrides::default())?;
             let rate = match &s.motor {
                 Some(MotorSpec::Ramp { from, to, duration }) => (to - from) / duration,
-                _ => f64::NAN,
+                _ => r
+                    .capture
+                    .as_ref()
+                    .and_then(|c| c.ramp_rate)
+                    .unwrap_or(f64::NAN),
             };
-            let r = run(&s, file, Overrides::default())?;
             Ok(RampRun {
                 rate,
                 capture: r.capture,
             })
         })
-        .collect::<Result<_, SceneError>>()?;
-    runs.sort_by(|a, b| b.rate.total_cmp(&a.rate));
-    Ok(runs)
+        .collect::<Result<_, SceneError>>()
 }
 
-/// The ramp scene run at its final speed from the start, loads together at rest, without the
-/// encoder: the contrast to the run-up's end state.
+/// The speed a run-up ends at: a ramp's final speed, or the steady mean speed the drive model
+/// predicts for a motor-driven shaft (`None` otherwise).
+pub fn final_speed(scene: &Scene, file: &Path) -> Result<Option<f64>, SceneError> {
+    if let Some(MotorSpec::Ramp { to, .. }) = &scene.motor {
+        return Ok(Some(*to));
+    }
+    Ok(crate::app::predict::drive_model(scene, file)?.map(|m| m.u_mean().max(0.0).sqrt()))
+}
+
+/// The run-up scene run at its final speed ([`final_speed`]) from the start, prescribed, loads
+/// together at rest, without the encoder: the contrast to the run-up's end state.
 pub fn held_run(scene: &Scene, file: &Path) -> Result<Option<RunReport>, SceneError> {
-    let Some(MotorSpec::Ramp { to, .. }) = &scene.motor else {
+    let Some(to) = final_speed(scene, file)? else {
         return Ok(None);
     };
+    let to = &to;
     let mut s = scene.clone();
     s.encoder = None;
     run(
@@ -184,10 +243,17 @@ pub fn markdown(
         s.push_str("The run has no capture analysis (the loads did not start together).\n");
         return s;
     };
+    let drive = if c.ramp_rate.is_some() && main.effects.contains(&"motor") {
+        "the rotor is driven from rest by the scene's motor (its torque characteristic against \
+         the load and the machine's own reaction torque, seed 000), through the first \
+         resonance to its steady speed"
+    } else {
+        "the rotor's speed is prescribed, ramped through the first resonance and then held"
+    };
     let _ = writeln!(
         s,
-        "The loads start together at rest; the rotor's speed is prescribed, ramped through the \
-         first resonance and then held. The core predicts that gathered loads can stay captured \
+        "The loads start together at rest; {drive}. The core predicts that gathered loads can \
+         stay captured \
          near the resonance (turning at Ω < ω) for rotor speeds from {:.2} up to {:.2} rad/s \
          (`Machine::capture_windows`), turning at `Machine::capture_speed(ω)`. The simulation \
          counts the loads captured while the rotor is above {:.2} rad/s and the loads lag it by \
@@ -214,11 +280,13 @@ pub fn markdown(
          balance describes the mean.\n\n",
     );
     s.push_str(
-        "## Release speed against the ramp rate\n\n\
-         A finite-rate ramp releases late: the captured state ceases to exist at the fold of \
+        "## Release speed against the run-up rate\n\n\
+         A finite-rate run-up releases late: the captured state ceases to exist at the fold of \
          the averaged balance, but the loads need time to fall off it. The release speed \
-         approaches the quasi-static value as the ramp slows.\n\n\
-         | ramp, rad/s² | captured from, rad/s | released at, rad/s | core `until`, rad/s | difference | captured Ω (median), rad/s | largest Ω difference from `capture_speed` |\n\
+         approaches the quasi-static value as the run-up slows (a ramp's rate is its own; a \
+         motor-driven run-up, repeated with the shaft's inertia scaled, is given the rotor's \
+         mean acceleration while the loads were captured).\n\n\
+         | run-up, rad/s² | captured from, rad/s | released at, rad/s | core `until`, rad/s | difference | captured Ω (median), rad/s | largest Ω difference from `capture_speed` |\n\
          |---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in runs {
@@ -287,9 +355,13 @@ pub fn markdown(
         let _ = write!(
             s,
             "\n## After the release\n\n\
-             At the end of the run (rotor at {:.2} rad/s) the core predicts {pred}; the \
-             simulation ends {sim}, residual unbalance {:.2} of the rotor's.",
+             At the end of the run (rotor at {:.2} rad/s) the core classes the speed {}{} \
+             (the criterion: {pred}); the simulation ends {sim}, residual unbalance {:.2} of the \
+             rotor's.",
             main.speed_measured.unwrap_or(f64::NAN),
+            main.regime_class.unwrap_or("?"),
+            main.regime_reason
+                .map_or(String::new(), |r| format!(" ({r})")),
             main.residual_relative.unwrap_or(f64::NAN)
         );
         if sim != pred && 1.0 - c.coherence_end < 1e-12 {
@@ -319,8 +391,9 @@ pub fn markdown(
     s
 }
 
-/// Ramp times of the capture page, relative to the scene's (slower ramps for the convergence
-/// of the release speed, two faster ones for contrast).
+/// Run-up slowdowns of the capture page, relative to the scene's (ramp time or shaft inertia;
+/// slower run-ups for the convergence of the release speed, two faster ones for contrast),
+/// ascending: the runs come out fastest first.
 const RAMP_FACTORS: [f64; 8] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 
 /// Writes the capture page of a run-up (`run SCENE --out DIR`): the Markdown page, the
@@ -356,7 +429,7 @@ pub fn publish(
         .filter_map(|r| {
             r.capture
                 .as_ref()
-                .map(|c| (format!("simulated, ramp {} rad/s²", rate_text(r.rate)), c))
+                .map(|c| (format!("simulated, run-up {} rad/s²", rate_text(r.rate)), c))
         })
         .collect();
     write_capture_svg(&dir.join(&speeds), &title, &shown, &machine)?;

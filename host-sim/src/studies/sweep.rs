@@ -1,10 +1,13 @@
 //! `drive-sim sweep`: a vibration-machine scene at a series of prescribed rotor speeds, in
-//! parallel, comparing the criterion's zone with what the loads did in the simulation.
+//! parallel, comparing the core's classification (from the machine's exact regime table,
+//! [`crate::app::regimes`]) and the seed criterion's zone with what the loads did in the
+//! simulation.
 
 use crate::app::predict;
 use crate::app::progress::progress_bar;
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{Scene, SceneError};
+use drive_monitor::balancer::{RegimeSegment, DEFAULT_MARGIN};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -14,17 +17,27 @@ use std::path::{Path, PathBuf};
 pub struct SweepPoint {
     /// Prescribed rotor speed, rad/s.
     pub speed: f64,
-    /// The criterion's zone at this speed (the core's zones, damping included):
+    /// The seed criterion's zone at this speed (the core's zones, damping included):
     /// "balancing" | "gathering".
     pub regime_predicted: &'static str,
-    /// The core's classification with its margin band and capture check:
-    /// "balancing" | "gathering" | "bistable" | "near-characteristic".
+    /// The core's classification with its margin band, from the exact regime table (or the
+    /// criterion's, for a balancer too small for its rotor): "balancing" | "gathering" |
+    /// "bistable" | "near-characteristic".
     pub regime_class: &'static str,
+    /// Why bistable: "capture" | "coexisting".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_reason: Option<&'static str>,
     /// What the loads did, started near the balancing position with a small perturbation
-    /// (or together at rest with `--together`): "balancing" | "gathering".
+    /// (or together at rest with `--together`): "balancing" | "saturated" | "gathering".
     pub regime_simulated: &'static str,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
+}
+
+/// Whether a simulated outcome is the predicted regime: "balancing" is met by "balancing",
+/// and, for a balancer too small for its rotor, by "saturated" (as balanced as it can be).
+pub fn agrees(predicted: &str, simulated: &str) -> bool {
+    predicted == simulated || (predicted == "balancing" && simulated == "saturated")
 }
 
 /// What to sweep: `steps` speeds from `from` to `to` rad/s (inclusive), the loads started
@@ -46,14 +59,21 @@ pub struct SweepRequest {
 pub struct Sweep {
     /// The points, by ascending speed.
     pub points: Vec<SweepPoint>,
-    /// Points outside the margin band around every damped characteristic speed.
+    /// Points outside the margin band around every damped characteristic speed (the
+    /// criterion's boundaries).
     pub away_from_characteristic: usize,
     /// Of those, the points where the criterion and the simulation agree.
     pub agreeing: usize,
-    /// The damped characteristic speeds (zone boundaries), rad/s.
+    /// Points where the core's classifier commits ("balancing" or "gathering").
+    pub committed: usize,
+    /// Of those, the points where the simulation agrees.
+    pub committed_agreeing: usize,
+    /// The classifier is built from the exact table (else from the criterion's).
+    pub exact: bool,
+    /// The damped characteristic speeds (the criterion's zone boundaries), rad/s.
     #[serde(skip)]
     pub boundaries: Vec<f64>,
-    /// The zones (from, to, regime) for plotting.
+    /// The classifier's table (from, to, regime name) for plotting.
     #[serde(skip)]
     pub zones: Vec<(f64, Option<f64>, &'static str)>,
     /// What was swept.
@@ -79,7 +99,7 @@ impl Sweep {
         } else {
             "near the balancing position"
         };
-        let title = format!("{stem}: criterion zones and simulated outcome (start {start})");
+        let title = format!("{stem}: regimes and simulated outcome (start {start})");
         let svg = dir.join(format!("regimes-{stem}.svg"));
         self.write_svg(&svg, &title)?;
         let md = dir.join(format!("regimes-{stem}.md"));
@@ -93,7 +113,7 @@ impl Sweep {
         Ok(vec![md, svg])
     }
 
-    /// The regime map as a Markdown table, with the agreement line.
+    /// The regime map as a Markdown table, with the agreement lines.
     pub fn markdown(&self) -> String {
         use std::fmt::Write;
         let mut s = String::from(
@@ -101,25 +121,34 @@ impl Sweep {
              |---:|---|---|---|---:|\n",
         );
         for p in &self.points {
+            let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
             let _ = writeln!(
                 s,
-                "| {:.2} | {} | {} | {}{} | {:.2e} |",
+                "| {:.2} | {} | {}{} | {}{} | {:.2e} |",
                 p.speed,
                 p.regime_predicted,
                 p.regime_class,
+                p.regime_reason.map_or(String::new(), |r| format!(" ({r})")),
                 p.regime_simulated,
-                if p.regime_predicted == p.regime_simulated {
-                    ""
-                } else {
+                if committed && !agrees(p.regime_class, p.regime_simulated) {
                     " ≠"
+                } else {
+                    ""
                 },
                 p.residual_relative
             );
         }
         let _ = writeln!(
             s,
-            "\nAway from the characteristic speeds (outside the margin band): {} of {} speeds agree.",
-            self.agreeing, self.away_from_characteristic
+            "\nThe core's classifier ({} table) commits at {} of {} speeds; the simulation \
+             agrees at {} of them (≠ marks the others). The seed's criterion alone, away from \
+             its characteristic speeds (outside the margin band): {} of {} speeds agree.",
+            if self.exact { "exact" } else { "criterion" },
+            self.committed,
+            self.points.len(),
+            self.committed_agreeing,
+            self.agreeing,
+            self.away_from_characteristic
         );
         s
     }
@@ -132,15 +161,21 @@ impl Sweep {
         let mut marks: Vec<Mark> = self
             .zones
             .iter()
+            .filter(|(_, _, regime)| *regime != "bistable")
             .map(|&(from, to, regime)| {
                 Mark::Band(
-                    format!("criterion: {regime}"),
+                    format!("core: {regime}"),
                     from,
                     to.unwrap_or(top * 2.0),
                     regime == "gathering",
                 )
             })
             .collect();
+        marks.extend(
+            self.boundaries
+                .iter()
+                .map(|&b| Mark::VLine("criterion boundary".into(), b)),
+        );
         marks.push(Mark::HLine("simulated balancing".into(), 1.0));
         let outcome = |p: &SweepPoint| {
             if p.regime_simulated == "balancing" {
@@ -198,7 +233,9 @@ pub fn sweep(
             format!("need at least 2 steps, got {steps}"),
         ));
     }
-    let (classifier, margin) = crate::app::run::regime_classifier(scene, file, &machine)?;
+    let design = crate::app::regimes::design(scene, file, &machine)?;
+    let (classifier, _, exact) =
+        crate::app::regimes::classifier(scene, file, &machine, design.as_ref())?;
     // The sweep judges the loads, not δ: no encoder, so no edges to generate.
     let mut quiet = scene.clone();
     quiet.encoder = None;
@@ -216,10 +253,12 @@ pub fn sweep(
                 },
             )?;
             bar.inc(1);
+            let class = classifier.classify(speed as f32);
             Ok(SweepPoint {
                 speed,
                 regime_predicted: machine.zone_kind_at(speed).name(),
-                regime_class: classifier.classify(speed as f32).name(),
+                regime_class: class.name(),
+                regime_reason: class.reason().map(|r| r.name()),
                 regime_simulated: r.regime_simulated.unwrap_or("unknown"),
                 residual_relative: r.residual_relative.unwrap_or(f64::NAN),
             })
@@ -227,28 +266,42 @@ pub fn sweep(
         .collect();
     bar.finish_and_clear();
     let points = points?;
-    let boundaries: Vec<f64> = classifier
-        .characteristic_speeds()
-        .iter()
-        .map(|&b| f64::from(b))
-        .collect();
-    let margin = f64::from(margin);
+    let boundaries: Vec<f64> = machine.zones().iter().skip(1).map(|z| z.from).collect();
+    let band = f64::from(DEFAULT_MARGIN);
     let away: Vec<&SweepPoint> = points
         .iter()
-        .filter(|p| boundaries.iter().all(|&b| (p.speed - b).abs() > margin * b))
+        .filter(|p| boundaries.iter().all(|&b| (p.speed - b).abs() > band * b))
+        .collect();
+    let committed: Vec<&SweepPoint> = points
+        .iter()
+        .filter(|p| p.regime_class == "balancing" || p.regime_class == "gathering")
+        .collect();
+    let segments: Vec<RegimeSegment> = classifier.segments().collect();
+    let zones = segments
+        .iter()
+        .enumerate()
+        .map(|(k, seg)| {
+            (
+                f64::from(seg.from),
+                segments.get(k + 1).map(|n| f64::from(n.from)),
+                seg.regime.name(),
+            )
+        })
         .collect();
     Ok(Sweep {
         away_from_characteristic: away.len(),
         agreeing: away
             .iter()
-            .filter(|p| p.regime_predicted == p.regime_simulated)
+            .filter(|p| agrees(p.regime_predicted, p.regime_simulated))
             .count(),
-        boundaries,
-        zones: machine
-            .zones()
+        committed: committed.len(),
+        committed_agreeing: committed
             .iter()
-            .map(|z| (z.from, z.to, z.kind.name()))
-            .collect(),
+            .filter(|p| agrees(p.regime_class, p.regime_simulated))
+            .count(),
+        exact,
+        boundaries,
+        zones,
         points,
         request: *request,
     })

@@ -95,6 +95,7 @@
 //! [`regime`] holds the observable (the residual unbalance `D·e^{i(φ+θ)} + m·R·Σ e^{iφ_j}`,
 //! kg·m), the analytic auto-balancing positions and the classification of a completed run.
 
+pub mod floquet;
 pub mod regime;
 
 use crate::engine::model::{Effect, Shaft};
@@ -209,7 +210,9 @@ pub enum LoadPlacement {
         spread: f64,
     },
     /// The auto-balancing position ([`balancing_fan`]) for the initial rotor angle, with load 1
-    /// turned forward by `perturbation` rad. Needs `N ≠ 1` (nothing to place for `N = 0`).
+    /// turned forward by `perturbation` rad. Needs `N ≠ 1` (nothing to place for `N = 0`). When
+    /// the loads cannot balance the rotor (`D > N·m·R`) they start at their limit instead:
+    /// all together opposite the unbalance, the residual `D − N·m·R`.
     Balanced {
         /// Forward offset of load 1 from the balancing position, rad.
         perturbation: f64,
@@ -391,8 +394,9 @@ impl VibrationMachine {
     ///
     /// Errors name the offending key: counts beyond [`MAX_PLATFORMS`]/[`MAX_LOADS`]
     /// (`Capacity`), non-finite, negative or zero masses, radius and `J_c`, couplings of a
-    /// platform to itself or to a missing one, a rotor unbalance the loads cannot balance when
-    /// the balanced start is asked for, or explicit angles whose count is not `N`.
+    /// platform to itself or to a missing one, or explicit angles whose count is not `N`. A
+    /// rotor unbalance larger than the loads can balance is not an error: it is a design
+    /// result ([`VibrationMachine::residual_floor`]).
     pub fn new(p: &VibrationMachineParams) -> Result<Self, ConfigError> {
         let np = p.platforms.len();
         if np == 0 {
@@ -494,13 +498,12 @@ impl VibrationMachine {
                     return Err(ConfigError::Inconsistent("initial.loads"));
                 }
                 if n > 1 {
-                    let fan = balancing_fan(
-                        n,
-                        self.load_mass * self.radius,
-                        self.rotor_unbalance,
-                        rotor + self.rotor_unbalance_angle,
-                    )
-                    .ok_or(ConfigError::Inconsistent("balancer.rotor_unbalance"))?;
+                    let towards = rotor + self.rotor_unbalance_angle;
+                    // A balancer too small for the rotor starts at its limit: every load
+                    // opposite the unbalance ([`VibrationMachine::residual_floor`]).
+                    let fan =
+                        balancing_fan(n, self.load_unbalance(), self.rotor_unbalance, towards)
+                            .unwrap_or([towards + core::f64::consts::PI; MAX_LOADS]);
                     angles.copy_from_slice(&fan[..n]);
                     angles[0] += dp;
                 }
@@ -625,6 +628,26 @@ impl VibrationMachine {
             coherence: cx.hypot(sy) / nf,
             mean_load_angle: mean / nf,
             rotor_angle: shaft.phi,
+        }
+    }
+
+    /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
+    pub fn capacity(&self) -> f64 {
+        self.loads as f64 * self.load_unbalance()
+    }
+
+    /// The least residual unbalance the loads can leave, `max(0, D − N·m·R)` kg·m: zero when
+    /// they can balance the rotor, else what remains with every load opposite the unbalance.
+    pub fn residual_floor(&self) -> f64 {
+        (self.rotor_unbalance - self.capacity()).max(0.0)
+    }
+
+    /// The thresholds a run of this machine is judged by: [`RegimeCriteria::new`] with
+    /// [`VibrationMachine::reference_unbalance`] and [`VibrationMachine::residual_floor`].
+    pub fn regime_criteria(&self) -> RegimeCriteria {
+        RegimeCriteria {
+            floor: self.residual_floor(),
+            ..RegimeCriteria::new(self.reference_unbalance())
         }
     }
 

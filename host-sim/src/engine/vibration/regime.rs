@@ -7,7 +7,10 @@
 //!
 //! - **balancing** when `max |U|` over the final window is at most
 //!   `residual_fraction · reference` (default 1 % of `D`, or of `N·m·R` when `D = 0`);
-//!   otherwise **gathering**;
+//!   for a balancer too small for its rotor (`D > N·m·R`, so `|U| ≥ floor = D − N·m·R`)
+//!   **saturated** when `max |U|` stays within `residual_fraction · reference` of that floor
+//!   (the loads together opposite the unbalance, as balanced as they can be); otherwise
+//!   **gathering**;
 //! - **gathered** when the loads' coherence `|Σ_j e^{iφ_j}|/N` (the seed's `s`, eq. 10) stays
 //!   at least `gathered_coherence` (default 0.95, two loads within ±18°) over the window;
 //! - the loads' mean angular speed `Ω` and the rotor's `ω` over the window, from the unwrapped
@@ -32,10 +35,12 @@
 //!   `ω̃·t = 300`, 10⁻¹² by 1000). Loads started exactly coincident never part: identical loads
 //!   obey identical equations.
 //! - Started at the balancing position with a small perturbation, the criterion's `q > 1` is
-//!   not sufficient: a Floquet analysis of eq. 4 linearised about the balancing position, and
-//!   the full simulation, find balancing unstable on about `1.087 < n < 1.425` (stable on
-//!   `1.002 < n < 1.087` and above `1.425`). The band depends on `h` and `β` (it vanishes for
-//!   `h = 0.2` or `β = 5`), which is what the criterion check of issue 9 has to size.
+//!   not sufficient: the Floquet analysis of the model linearised about the balancing position
+//!   ([`super::floquet`]), a hand reduction of eq. 4, and the full simulation find balancing
+//!   unstable on `1.0874 < n < 1.4252` (stable on `1.0016 < n < 1.0874` and above `1.4252`).
+//!   The band depends on `h` and `β` (it vanishes for `h = 0.2` or `β = 5`); the exact regime
+//!   table ([`crate::app::regimes`]) is built on these boundaries, and `docs/criterion.md`
+//!   measures them on random machines.
 
 use serde::Serialize;
 
@@ -45,15 +50,19 @@ use serde::Serialize;
 pub enum Regime {
     /// The residual unbalance decayed below the threshold.
     Balancing,
+    /// The balancer is too small for the rotor, and the residual settled on the least it can
+    /// leave (`D − N·m·R`, every load opposite the unbalance).
+    Saturated,
     /// It did not (loads gathered, stuck or still wandering).
     Gathering,
 }
 
 impl Regime {
-    /// `"balancing"` or `"gathering"`, as in the simulator's JSON.
+    /// `"balancing"`, `"saturated"` or `"gathering"`, as in the simulator's JSON.
     pub fn as_str(&self) -> &'static str {
         match self {
             Regime::Balancing => "balancing",
+            Regime::Saturated => "saturated",
             Regime::Gathering => "gathering",
         }
     }
@@ -80,6 +89,9 @@ pub struct RegimeCriteria {
     /// Unbalance the residual is measured against, kg·m
     /// ([`super::VibrationMachine::reference_unbalance`]).
     pub reference: f64,
+    /// The least residual the loads can leave, kg·m
+    /// ([`super::VibrationMachine::residual_floor`]; 0 when they can balance the rotor).
+    pub floor: f64,
     /// Final part of the run judged, as a fraction of its duration (default 0.25).
     pub window_fraction: f64,
     /// Balancing when the residual stays at most this fraction of `reference` (default 0.01).
@@ -91,10 +103,12 @@ pub struct RegimeCriteria {
 }
 
 impl RegimeCriteria {
-    /// The default thresholds for a reference unbalance `reference` (kg·m).
+    /// The default thresholds for a reference unbalance `reference` (kg·m), loads able to
+    /// balance it (floor 0).
     pub fn new(reference: f64) -> Self {
         RegimeCriteria {
             reference,
+            floor: 0.0,
             window_fraction: 0.25,
             residual_fraction: 0.01,
             gathered_coherence: 0.95,
@@ -106,12 +120,14 @@ impl RegimeCriteria {
 /// The classification of a completed run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RegimeReport {
-    /// Balancing or gathering.
+    /// Balancing, saturated or gathering.
     pub regime: Regime,
     /// Largest residual unbalance over the final window, kg·m.
     pub residual_max: f64,
     /// `residual_max / reference`.
     pub residual_relative: f64,
+    /// Smallest residual unbalance over the final window, relative to the reference.
+    pub residual_min_relative: f64,
     /// Residual unbalance at the first sample, kg·m.
     pub residual_initial: f64,
     /// `residual_initial` relative to the reference.
@@ -142,18 +158,20 @@ pub fn classify(samples: &[RegimeSample], c: &RegimeCriteria) -> Option<RegimeRe
         return None;
     }
     let residual_max = win.iter().map(|s| s.residual).fold(0.0, f64::max);
+    let residual_min = win.iter().map(|s| s.residual).fold(f64::INFINITY, f64::min);
     let coherence_min = win.iter().map(|s| s.coherence).fold(1.0, f64::min);
     let load_speed = (last.mean_load_angle - w0.mean_load_angle) / dt;
     let rotor_speed = (last.rotor_angle - w0.rotor_angle) / dt;
-    let balancing = residual_max <= c.residual_fraction * c.reference;
+    let settled = residual_max <= c.floor + c.residual_fraction * c.reference;
     Some(RegimeReport {
-        regime: if balancing {
-            Regime::Balancing
-        } else {
-            Regime::Gathering
+        regime: match (settled, c.floor > 0.0) {
+            (true, false) => Regime::Balancing,
+            (true, true) => Regime::Saturated,
+            (false, _) => Regime::Gathering,
         },
         residual_max,
         residual_relative: residual_max / c.reference,
+        residual_min_relative: residual_min / c.reference,
         residual_initial: first.residual,
         residual_initial_relative: first.residual / c.reference,
         coherence_min,
@@ -305,5 +323,18 @@ mod tests {
         assert!(r.gathered && r.lagging);
         assert!((r.load_speed - 8.5).abs() < 1e-12 && (r.rotor_speed - 10.0).abs() < 1e-12);
         assert!(classify(&s[..1], &RegimeCriteria::new(1.0)).is_none());
+        // A balancer too small for its rotor: residual settled at the floor 0.4 (within 1 % of
+        // the reference 2): saturated; 3 % above it: gathering.
+        let c = RegimeCriteria {
+            floor: 0.4,
+            ..RegimeCriteria::new(2.0)
+        };
+        let at = |r: f64| -> Vec<RegimeSample> {
+            (0..=100)
+                .map(|i| mk(i as f64 * 0.1, r, 0.99, 10.0, 10.0))
+                .collect()
+        };
+        assert_eq!(classify(&at(0.415), &c).unwrap().regime, Regime::Saturated);
+        assert_eq!(classify(&at(0.46), &c).unwrap().regime, Regime::Gathering);
     }
 }

@@ -1,0 +1,444 @@
+//! The exact regime table of a scene's vibration machine, computed at design time on the host
+//! and shipped to the target as data ([`drive_monitor::balancer::RegimeTable`]).
+//!
+//! Three things decide the regime at a rotor speed `ω`:
+//!
+//! 1. **Is the balancing position stable?** From the Floquet multipliers of the model
+//!    linearised about the balanced motion ([`crate::engine::vibration::floquet`]), scanned and
+//!    bisected to 1e-7 relative by [`stability_map`]. Exact for the model; it depends on the
+//!    rotor unbalance `D`, which fixes the loads' balancing angles.
+//! 2. **Can gathered loads stay captured below the rotor?** The core's capture windows
+//!    ([`Machine::capture_windows`]): `ω` in `[from, until)` of a window below.
+//! 3. **Does the criterion say gathered loads hold together?** The seed's criterion
+//!    ([`Machine::zones`]): `Re H(ω) > 0`.
+//!
+//! The table ([`table`]) commits to `Gathering` where the balancing position is unstable (the
+//! loads cannot balance, whatever their history: for two loads the balancing position is
+//! unique; for more, see the limits below), to `Balancing` where it is stable and neither (2)
+//! nor (3) holds, and says `Bistable(Capture)` where it is stable and (2) holds,
+//! `Bistable(Coexisting)` where it is stable and only (3) holds. Below the scanned range the
+//! class at its lowest speed is kept, above it the class at its highest (the scan reaches
+//! past every characteristic speed and capture window, and is extended until the balancing
+//! position is stable at its top).
+//!
+//! Limits: for `N ≥ 3` loads the balancing positions form a family and the analysis is of the
+//! equally spaced fan; a balancer too small for its rotor (`D > N·m·R`) has no balancing
+//! position, so it has no exact table ([`Design::exact`] is `None`) and the criterion's table
+//! is used, its `Balancing` meaning the loads sit at their limit opposite the unbalance
+//! ([`Design::residual_floor`]).
+
+use crate::app::predict::value_error;
+use crate::app::run::vibration_params;
+use crate::app::scene::{Scene, SceneError};
+use crate::engine::vibration::floquet::{Floquet, ScanOptions, StabilityMap};
+use crate::engine::vibration::VibrationMachine;
+use drive_monitor::balancer::{
+    BistableReason, Classifier, Machine, Regime, RegimeSegment, RegimeTable, ZoneKind,
+    DEFAULT_MARGIN, TABLE_MARGIN,
+};
+use serde::Serialize;
+use std::path::Path;
+
+/// What the design-time analysis of a scene's auto-balancer found.
+#[derive(Debug, Clone, Serialize)]
+pub struct Design {
+    /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
+    pub capacity: f64,
+    /// The rotor's unbalance `D` the loads are to balance, kg·m.
+    pub rotor_unbalance: f64,
+    /// The least residual unbalance the loads can leave, `max(0, D − N·m·R)`, kg·m: 0 when
+    /// they can balance the rotor; else with every load at its limit opposite the unbalance.
+    pub residual_floor: f64,
+    /// The exact stability and regime table (`None` without a balancing position: fewer than
+    /// two loads, or `D > N·m·R`).
+    pub exact: Option<Exact>,
+}
+
+/// The exact stability of the balancing position and the regime table built on it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Exact {
+    /// Where the balancing position is stable (Floquet).
+    pub map: StabilityMap,
+    /// The regime table, segments `(from rad/s, regime)` ascending from 0.
+    #[serde(skip)]
+    pub segments: Vec<(f64, Regime)>,
+    /// The criterion's boundaries beside the exact ones.
+    pub comparison: Vec<Comparison>,
+}
+
+/// A boundary of the seed criterion's zones and the exact boundary of the same kind nearest
+/// to it.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Comparison {
+    /// The criterion's boundary (a damped characteristic speed), rad/s.
+    pub criterion: f64,
+    /// "resonance" (gathering below, balancing above) or "additional" (the reverse).
+    pub kind: &'static str,
+    /// The nearest exact boundary where the balancing position becomes stable (resonance) or
+    /// unstable (additional), rad/s; `None` if there is none.
+    pub exact: Option<f64>,
+    /// `exact/criterion − 1`.
+    pub difference: Option<f64>,
+}
+
+/// The scene's vibration machine as the simulator builds it (the loads at the balancing
+/// position; `None` without an auto-balancer).
+pub fn vibration_machine(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<VibrationMachine>, SceneError> {
+    let Some(p) = vibration_params(scene, false, 0.0) else {
+        return Ok(None);
+    };
+    VibrationMachine::new(&p)
+        .map(Some)
+        .map_err(|e| value_error(file, "autobalancer", e))
+}
+
+/// The speeds scanned for `machine`: from a quarter of its lowest resonance to four times its
+/// highest characteristic speed, and at least 1.5 times past every capture window.
+pub fn scan_options(machine: &Machine) -> ScanOptions {
+    let first = machine
+        .resonant_speeds()
+        .first()
+        .copied()
+        .unwrap_or(machine.config().dimensionless().omega_ref);
+    let last = machine.zones().last().map_or(first, |z| z.from).max(first);
+    let until = machine
+        .capture_windows()
+        .iter()
+        .fold(0.0f64, |u, w| u.max(w.until));
+    ScanOptions::new(0.25 * first, (4.0 * last).max(1.5 * until))
+}
+
+/// The stability map of `floquet` over [`scan_options`], its top extended (doubled, up to
+/// four times) while the balancing position is still unstable there.
+pub fn stability_map(
+    floquet: &Floquet,
+    machine: &Machine,
+    file: &Path,
+) -> Result<StabilityMap, SceneError> {
+    let err = |e: crate::engine::vibration::floquet::StabilityError| {
+        SceneError::value(file, "autobalancer", e.to_string())
+    };
+    let mut opts = scan_options(machine);
+    let mut map = floquet.map(&opts).map_err(err)?;
+    for _ in 0..4 {
+        if map.stable_at(opts.to) {
+            break;
+        }
+        opts.to *= 2.0;
+        map = floquet.map(&opts).map_err(err)?;
+    }
+    Ok(map)
+}
+
+/// The regime table from the exact stability map and the machine's criterion and capture
+/// windows (module docs), as `(from rad/s, regime)` ascending from 0, neighbours different.
+pub fn table(map: &StabilityMap, machine: &Machine) -> Vec<(f64, Regime)> {
+    let captured = |w: f64| {
+        machine
+            .capture_windows()
+            .iter()
+            .any(|c| c.from <= w && w < c.until)
+    };
+    let regime = |w: f64| {
+        if !map.stable_at(w) {
+            Regime::Gathering
+        } else if captured(w) {
+            Regime::Bistable(BistableReason::Capture)
+        } else if machine.zone_kind_at(w) == ZoneKind::Gathering {
+            Regime::Bistable(BistableReason::Coexisting)
+        } else {
+            Regime::Balancing
+        }
+    };
+    let mut cuts: Vec<f64> = map.boundaries.iter().map(|b| b.speed).collect();
+    cuts.extend(machine.zones().iter().skip(1).map(|z| z.from));
+    for c in machine.capture_windows() {
+        cuts.push(c.from);
+        cuts.push(c.until);
+    }
+    cuts.retain(|c| c.is_finite() && *c > 0.0);
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let mut out: Vec<(f64, Regime)> = Vec::new();
+    let mut lo = 0.0;
+    for (k, &c) in cuts.iter().enumerate() {
+        // The regime on [lo, c): evaluated inside, at the geometric midpoint (half of c for
+        // the first interval).
+        let probe = if k == 0 { 0.5 * c } else { (lo * c).sqrt() };
+        push(&mut out, lo, regime(probe));
+        lo = c;
+    }
+    push(&mut out, lo, regime(2.0 * lo.max(1e-300)));
+    out
+}
+
+fn push(out: &mut Vec<(f64, Regime)>, from: f64, r: Regime) {
+    if out.last().map(|l| l.1) != Some(r) {
+        out.push((from, r));
+    }
+}
+
+/// The table in the core's f32 form, neighbours that become equal in f32 merged. A speed f32
+/// cannot hold is an error naming `file`'s auto-balancer.
+pub fn core_segments(
+    segments: &[(f64, Regime)],
+    file: &Path,
+) -> Result<Vec<RegimeSegment>, SceneError> {
+    let mut out: Vec<RegimeSegment> = Vec::new();
+    for &(from, regime) in segments {
+        let s = RegimeSegment::new("regime table speed", from, regime).map_err(|e| {
+            SceneError::value(
+                file,
+                "autobalancer",
+                format!("{e}: {from:e} rad/s in the regime table"),
+            )
+        })?;
+        if out.last().is_some_and(|l| l.from >= s.from) {
+            out.pop();
+        }
+        if out.last().map(|l| l.regime) != Some(s.regime) {
+            out.push(s);
+        }
+    }
+    Ok(out)
+}
+
+/// Each criterion boundary with the nearest exact boundary of its kind.
+pub fn compare(map: &StabilityMap, machine: &Machine) -> Vec<Comparison> {
+    machine
+        .zones()
+        .iter()
+        .skip(1)
+        .map(|z| {
+            let resonance = z.kind == ZoneKind::Balancing;
+            let exact = map
+                .boundaries
+                .iter()
+                .filter(|b| b.stable_above == resonance)
+                .map(|b| b.speed)
+                .min_by(|a, b| (a / z.from).ln().abs().total_cmp(&(b / z.from).ln().abs()));
+            Comparison {
+                criterion: z.from,
+                kind: if resonance { "resonance" } else { "additional" },
+                exact,
+                difference: exact.map(|e| e / z.from - 1.0),
+            }
+        })
+        .collect()
+}
+
+/// The design-time analysis of the scene's auto-balancer (`None` without one).
+pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<Design>, SceneError> {
+    let Some(vm) = vibration_machine(scene, file)? else {
+        return Ok(None);
+    };
+    let exact = match Floquet::new(&vm) {
+        Ok(f) => {
+            let map = stability_map(&f, machine, file)?;
+            let segments = table(&map, machine);
+            let comparison = compare(&map, machine);
+            Some(Exact {
+                map,
+                segments,
+                comparison,
+            })
+        }
+        Err(_) => None,
+    };
+    Ok(Some(Design {
+        capacity: vm.capacity(),
+        rotor_unbalance: vm.rotor_unbalance(),
+        residual_floor: vm.residual_floor(),
+        exact,
+    }))
+}
+
+/// The run-time classifier of a scene's machine: from the exact table when there is one
+/// (margin: the scene's `[monitor] regime_margin`, default [`TABLE_MARGIN`]), else from the
+/// criterion (default margin [`DEFAULT_MARGIN`]); half the margin as hysteresis. Returns the
+/// classifier, its margin and whether it is the exact one.
+pub fn classifier(
+    scene: &Scene,
+    file: &Path,
+    machine: &Machine,
+    design: Option<&Design>,
+) -> Result<(Classifier, f32, bool), SceneError> {
+    let given = scene
+        .monitor
+        .as_ref()
+        .and_then(|m| m.regime_margin)
+        .map(|m| m as f32);
+    if let Some(exact) = design.and_then(|d| d.exact.as_ref()) {
+        let margin = given.unwrap_or(TABLE_MARGIN);
+        let segments = core_segments(&exact.segments, file)?;
+        let c = Classifier::from_table(
+            &RegimeTable {
+                segments: &segments,
+            },
+            margin,
+            0.5 * margin,
+        )
+        .map_err(|e| value_error(file, "monitor", e))?;
+        return Ok((c, margin, true));
+    }
+    let margin = given.unwrap_or(DEFAULT_MARGIN);
+    let c = Classifier::new(machine, margin, 0.5 * margin)
+        .map_err(|e| value_error(file, "monitor", e))?;
+    Ok((c, margin, false))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::app::predict;
+    use crate::app::scene::resolve;
+    use crate::engine::vibration::floquet::Boundary;
+
+    fn one_mass() -> (Scene, std::path::PathBuf, Machine) {
+        let (scene, path) = resolve("one-mass").unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        (scene, path, m)
+    }
+
+    fn map_with(stable_at_from: bool, speeds: &[f64]) -> StabilityMap {
+        let mut stable = stable_at_from;
+        StabilityMap {
+            options: ScanOptions::new(10.0, 400.0),
+            stable_at_from,
+            boundaries: speeds
+                .iter()
+                .map(|&w| {
+                    stable = !stable;
+                    Boundary {
+                        speed: w,
+                        bracket: [w, w],
+                        stable_above: stable,
+                        radius: [1.0, 1.0],
+                    }
+                })
+                .collect(),
+            evaluations: 0,
+            neutral_drift: 0.0,
+        }
+    }
+
+    #[test]
+    fn table_combines_stability_capture_and_criterion() {
+        let (_, _, m) = one_mass();
+        let b = m.zones()[1].from; // 61.43: the criterion's resonance
+        let until = m.capture_windows()[0].until; // 90.41
+        let capture = Regime::Bistable(BistableReason::Capture);
+        // Stable from 72, as the Floquet analysis finds for this machine.
+        let t = table(&map_with(false, &[72.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (72.0, capture),
+                (until, Regime::Balancing)
+            ]
+        );
+        // Stable already below the criterion's boundary: coexisting with gathered loads there.
+        let t = table(&map_with(false, &[55.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (55.0, Regime::Bistable(BistableReason::Coexisting)),
+                (b, capture),
+                (until, Regime::Balancing)
+            ]
+        );
+        // An unstable band inside the capture window and another above it.
+        let t = table(&map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]), &m);
+        assert_eq!(
+            t,
+            vec![
+                (0.0, Regime::Gathering),
+                (65.0, capture),
+                (70.0, Regime::Gathering),
+                (80.0, capture),
+                (until, Regime::Balancing),
+                (120.0, Regime::Gathering),
+                (130.0, Regime::Balancing)
+            ]
+        );
+        // Never stable: gathering everywhere.
+        assert_eq!(
+            table(&map_with(false, &[]), &m),
+            vec![(0.0, Regime::Gathering)]
+        );
+    }
+
+    #[test]
+    fn core_segments_merge_what_f32_cannot_separate() {
+        let t = [
+            (0.0, Regime::Gathering),
+            (61.43, Regime::Balancing),
+            (61.430_000_001, Regime::Gathering),
+            (70.0, Regime::Balancing),
+        ];
+        let s = core_segments(&t, Path::new("t.toml")).unwrap();
+        // 61.43 and 61.430000001 are one f32: the later segment replaces the earlier, and
+        // then joins the gathering one before it.
+        assert_eq!(
+            s,
+            vec![
+                RegimeSegment {
+                    from: 0.0,
+                    regime: Regime::Gathering
+                },
+                RegimeSegment {
+                    from: 70.0,
+                    regime: Regime::Balancing
+                }
+            ]
+        );
+        let e = core_segments(
+            &[(0.0, Regime::Gathering), (1e300, Regime::Balancing)],
+            Path::new("t.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("t.toml") && e.contains("1e300"), "{e}");
+    }
+
+    #[test]
+    fn scenes_get_the_exact_classifier_and_its_margin() {
+        let (scene, path, m) = one_mass();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        assert_eq!(e.map.boundaries.len(), 1);
+        let w = e.map.boundaries[0].speed;
+        // The criterion says balancing above 61.43; the balancing position is unstable to 72.3.
+        assert!((72.2..72.5).contains(&w), "{w}");
+        assert_eq!(e.comparison[0].kind, "resonance");
+        assert!((e.comparison[0].difference.unwrap() - (w / 61.43 - 1.0)).abs() < 1e-3);
+        let (c, margin, exact) = classifier(&scene, &path, &m, Some(&d)).unwrap();
+        assert!(exact && margin == TABLE_MARGIN);
+        assert_eq!(c.classify(66.0), Regime::Gathering);
+        assert_eq!(c.classify(80.0), Regime::Bistable(BistableReason::Capture));
+        assert_eq!(c.classify(110.0), Regime::Balancing);
+        // The scene's margin overrides the default.
+        let mut s2 = scene.clone();
+        s2.monitor
+            .get_or_insert_with(Default::default)
+            .regime_margin = Some(0.03);
+        let (_, margin, _) = classifier(&s2, &path, &m, Some(&d)).unwrap();
+        assert_eq!(margin, 0.03);
+        // A balancer too small for its rotor has no exact table: the criterion's, with its
+        // own default margin.
+        let mut small = scene.clone();
+        small.autobalancer.as_mut().unwrap().rotor_unbalance = Some(0.12);
+        let d = design(&small, &path, &m).unwrap().unwrap();
+        assert!(d.exact.is_none());
+        assert!((d.residual_floor - 0.02).abs() < 1e-12 && (d.capacity - 0.1).abs() < 1e-12);
+        let (c, margin, exact) = classifier(&small, &path, &m, Some(&d)).unwrap();
+        assert!(!exact && margin == DEFAULT_MARGIN);
+        assert_eq!(c.classify(110.0), Regime::Balancing);
+    }
+}

@@ -1,0 +1,930 @@
+//! Exact local stability of the auto-balancing motion: the model linearised about it, its
+//! monodromy matrix over one revolution, and the Floquet multipliers.
+//!
+//! # The balanced motion
+//!
+//! At a prescribed rotor speed `ω` (shaft angle `ωt`), the platforms at rest (`Y_i = 0`) and the
+//! loads turning with the rotor at the balancing angles (`φ_j = ωt + α_j`, with
+//! `m·R·Σ_j e^{iα_j} + D·e^{iθ} = 0`, [`super::balancing_fan`]) is an exact solution of the
+//! model's equations ([`super`]): the loads' drag vanishes (`φ̇_j = ω`), their accelerations
+//! vanish, and the exciter platform's forcing `m·R·ω²·Σ sin φ_j + D·ω²·sin(ωt + θ)` is the
+//! imaginary part of `ω²·e^{iωt}·(m·R·Σ e^{iα_j} + D·e^{iθ}) = 0`. The solution is periodic with
+//! the period of one revolution, `T = 2π/ω`; the residual unbalance is zero on it.
+//!
+//! # Linearisation
+//!
+//! With `c_j = cos(ωt + α_j)`, `s_j = sin(ωt + α_j)` and the perturbations `δY_i`, `δẎ_i`,
+//! `δφ_j`, `δφ̇_j`, the model's explicit form (module docs of [`super`]) linearises exactly to
+//!
+//! ```text
+//! δA = [δF_e + Σ_j ((b_w·R/κ)·c_j·δφ̇_j + m·R·(ω²·c_j·δφ_j + 2ω·s_j·δφ̇_j))] / den(t)
+//! den(t) = M_e + M_c + (m/κ)·Σ_j ((κ − 1) + s_j²)
+//! δŸ_e = δA,   δŸ_i = δF_i/M_i (i ≠ e),   δφ̈_j = −(b_w/(κ·m))·δφ̇_j − δA·c_j/(κ·R)
+//! ```
+//!
+//! (`δF_i` the support and coupling forces of the perturbation). No other terms survive: the
+//! exciter's acceleration `A` and the loads' slips are zero on the balanced motion, so the
+//! derivatives of the bracket `den` and of `cos φ_j` multiply zero. The coefficients are
+//! periodic in `t` with period `T` — the platforms move along one direction `Y` only, so no
+//! rotating frame makes them constant. The equations are integrated in scaled variables
+//! (`s = ωt`, `y = δY/R`, `v = δẎ/(R·ω)`, `u = δφ̇/ω`), which leaves the multipliers unchanged
+//! and puts every component on the same scale for the integrator's tolerance.
+//!
+//! # Neutral directions
+//!
+//! Turning the loads by constant angles `δφ_j = v_j` with `Σ_j v_j·e^{iα_j} = 0` keeps the
+//! residual unbalance zero to first order: each such `v` is another balancing position, so the
+//! linearised equations keep it for ever and the monodromy matrix `Φ(T)` has it as an
+//! eigenvector with multiplier exactly 1. These directions span the null space `V` of the
+//! `2 × N` matrix `[cos α_j; sin α_j]`: `N − 2` directions in general, `N − 1` when the loads
+//! are collinear (`D = 0` with `N = 2`, where it is the rotation of the whole pair, or
+//! `D = N·m·R`). They are not perturbations of the balance but moves along the family of
+//! balancing positions, so they are removed exactly rather than judged: with `W` an orthonormal
+//! basis of the complement of `V` (every non-angle coordinate, plus the row space of
+//! `[cos α; sin α]` in the angles), `Φ(T)·V = V` makes `[V W]ᵀ·Φ(T)·[V W]` block upper
+//! triangular with the identity on `V`, so the remaining multipliers are exactly the
+//! eigenvalues of `Wᵀ·Φ(T)·W`. The balancing position is **stable** when all of them lie
+//! strictly inside the unit circle, **unstable** when one lies outside. [`Multipliers`] reports
+//! how far `Φ(T)·V` is from `V` (integration error) as a check.
+//!
+//! For `N ≥ 3` the balancing positions form a family and the analysis is of one member: the
+//! equally spaced fan the simulator starts near ([`super::balancing_fan`]), or the angles given
+//! to [`Floquet::with_angles`].
+//!
+//! # Monodromy, multipliers, boundaries
+//!
+//! `Φ(T)` is integrated column by column (all columns as one system) with the adaptive
+//! DOP853 of [`crate::engine::ode`] (tolerance [`ScanOptions::rtol`]); the multipliers are the eigenvalues of the reduced matrix
+//! (real Schur form, nalgebra). [`Floquet::map`] scans speeds on a logarithmic grid, refines
+//! every local extremum of the spectral radius lying near 1 (so a narrow band of instability
+//! between grid speeds is found), and bisects every change of stability to a relative bracket
+//! of [`ScanOptions::rel_tol`].
+
+use super::{balancing_fan, VibrationMachine, MAX_LOADS, MAX_PLATFORMS};
+use crate::engine::ode::{Integrator, OdeSystem, Solver};
+use nalgebra::{Complex, DMatrix};
+use serde::Serialize;
+use std::f64::consts::TAU;
+
+/// Why the balanced motion cannot be analysed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StabilityError {
+    /// Fewer than two loads: there is no balancing position to analyse.
+    #[error("the auto-balancer needs at least two loads, it has {0}")]
+    TooFewLoads(usize),
+    /// The loads cannot balance the rotor: `D > N·m·R`.
+    #[error(
+        "the loads' capacity N·m·R = {capacity:e} kg·m is below the rotor unbalance D = \
+         {unbalance:e} kg·m: there is no balancing position"
+    )]
+    Undersized {
+        /// `N·m·R`, kg·m.
+        capacity: f64,
+        /// `D`, kg·m.
+        unbalance: f64,
+    },
+    /// Angles given that do not balance the rotor.
+    #[error("the given load angles leave a residual unbalance of {0:e} kg·m")]
+    NotBalanced(f64),
+    /// The speed or a scan setting is not usable.
+    #[error("{0}")]
+    Input(String),
+    /// The integration of the monodromy matrix or the eigenvalue iteration failed.
+    #[error("Floquet analysis at {speed} rad/s: {message}")]
+    Numerical {
+        /// Rotor speed, rad/s.
+        speed: f64,
+        /// What failed.
+        message: String,
+    },
+}
+
+/// The Floquet multipliers of the balanced motion at one speed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Multipliers {
+    /// Rotor speed, rad/s.
+    pub speed: f64,
+    /// The multipliers once the neutral directions are removed, as `[re, im]`, by descending
+    /// modulus.
+    pub values: Vec<[f64; 2]>,
+    /// Largest modulus among them (the spectral radius); `< 1`: stable.
+    pub radius: f64,
+    /// Number of neutral directions removed (multipliers exactly 1: moves along the family of
+    /// balancing positions).
+    pub neutral: usize,
+    /// `max |Φ(T)·v − v|` over an orthonormal basis `v` of the neutral directions: zero in exact
+    /// arithmetic, the integration error otherwise.
+    pub neutral_drift: f64,
+}
+
+impl Multipliers {
+    /// The balancing position is locally stable (every multiplier strictly inside the unit
+    /// circle).
+    pub fn stable(&self) -> bool {
+        self.radius < 1.0
+    }
+
+    /// `ln(radius)/T`: the growth rate of the least stable perturbation, 1/s (negative when
+    /// stable).
+    pub fn growth_rate(&self) -> f64 {
+        self.radius.ln() * self.speed / TAU
+    }
+}
+
+/// Settings of a stability scan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ScanOptions {
+    /// Lowest speed scanned, rad/s.
+    pub from: f64,
+    /// Highest speed scanned, rad/s.
+    pub to: f64,
+    /// Grid speeds per octave (log-spaced).
+    pub per_octave: usize,
+    /// Relative bracket width to which each boundary is bisected.
+    pub rel_tol: f64,
+    /// Relative (and absolute, in the scaled variables) tolerance of the monodromy integration.
+    pub rtol: f64,
+    /// Local extrema of `ln(radius)` within this distance of 0 are searched for a crossing.
+    pub extremum_window: f64,
+}
+
+impl ScanOptions {
+    /// The default scan of `[from, to]` rad/s: 48 speeds per octave (1.4 % apart), boundaries
+    /// to a relative bracket of 1e-7 (so each is placed to better than 1e-6), monodromy to
+    /// 1e-10 (the spectral radius to about 1e-10: its sign against 1 is decided far inside
+    /// the bracket), extrema of `ln(radius)` within 0.2 of zero searched (so a band of
+    /// instability narrower than the grid is not stepped over).
+    pub fn new(from: f64, to: f64) -> Self {
+        ScanOptions {
+            from,
+            to,
+            per_octave: 48,
+            rel_tol: 1e-7,
+            rtol: 1e-10,
+            extremum_window: 0.2,
+        }
+    }
+}
+
+/// A speed at which the stability of the balancing position changes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Boundary {
+    /// The boundary (midpoint of the final bracket), rad/s.
+    pub speed: f64,
+    /// The final bracket `[below, above]`, rad/s (relative width at most the scan's `rel_tol`).
+    pub bracket: [f64; 2],
+    /// Stable above the boundary (and unstable below it).
+    pub stable_above: bool,
+    /// Spectral radius at the bracket's ends.
+    pub radius: [f64; 2],
+}
+
+/// The stability of the balancing position over a range of speeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilityMap {
+    /// The scan's settings.
+    pub options: ScanOptions,
+    /// Stable at the scan's lowest speed.
+    pub stable_at_from: bool,
+    /// Boundaries, ascending; stability alternates across them.
+    pub boundaries: Vec<Boundary>,
+    /// Monodromy matrices integrated.
+    pub evaluations: usize,
+    /// Largest neutral drift met (see [`Multipliers::neutral_drift`]).
+    pub neutral_drift: f64,
+}
+
+impl StabilityMap {
+    /// Whether the balancing position is stable at `speed` rad/s according to the map
+    /// (outside the scanned range, the class at the nearer end).
+    pub fn stable_at(&self, speed: f64) -> bool {
+        let crossed = self.boundaries.iter().filter(|b| b.speed <= speed).count();
+        self.stable_at_from ^ (crossed % 2 == 1)
+    }
+
+    /// The stable intervals `[from, to)` in rad/s (`to = None`: up to the end of the scan and,
+    /// by the class there, beyond).
+    pub fn stable_intervals(&self) -> Vec<(f64, Option<f64>)> {
+        let mut out = Vec::new();
+        let mut start = self.stable_at_from.then_some(0.0);
+        for b in &self.boundaries {
+            if b.stable_above {
+                start = Some(b.speed);
+            } else if let Some(s) = start.take() {
+                out.push((s, Some(b.speed)));
+            }
+        }
+        if let Some(s) = start {
+            out.push((s, None));
+        }
+        out
+    }
+}
+
+/// The balanced motion of a machine, ready for Floquet analysis.
+#[derive(Debug, Clone)]
+pub struct Floquet {
+    machine: VibrationMachine,
+    alpha: Vec<f64>,
+    /// Orthonormal basis (1 or 2 vectors of length `N`) of the span of `cos α` and `sin α`.
+    rows: Vec<Vec<f64>>,
+    /// Orthonormal basis of the neutral directions (the null space of `[cos α; sin α]`).
+    neutral: Vec<Vec<f64>>,
+}
+
+/// Largest component below which a Gram–Schmidt remainder counts as zero (the loads'
+/// directions are unit vectors, so this is an absolute tolerance on angles' cosines).
+const RANK_TOL: f64 = 1e-9;
+
+/// Gram–Schmidt: `v` minus its projections on `basis`, normalised; `None` if nothing is left.
+fn orthonormal_remainder(basis: &[Vec<f64>], v: &[f64]) -> Option<Vec<f64>> {
+    let mut r = v.to_vec();
+    // Twice, for orthogonality to rounding (classical Gram–Schmidt loses it in one pass).
+    for _ in 0..2 {
+        for b in basis {
+            let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
+            r.iter_mut().zip(b).for_each(|(x, y)| *x -= d * y);
+        }
+    }
+    let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+    (norm > RANK_TOL).then(|| r.iter().map(|x| x / norm).collect())
+}
+
+impl Floquet {
+    /// The balanced motion with the loads at the equally spaced fan
+    /// ([`super::balancing_fan`]) for a shaft at angle `ωt`.
+    pub fn new(machine: &VibrationMachine) -> Result<Self, StabilityError> {
+        let n = machine.loads;
+        if n < 2 {
+            return Err(StabilityError::TooFewLoads(n));
+        }
+        let capacity = n as f64 * machine.load_unbalance();
+        if machine.rotor_unbalance > capacity {
+            return Err(StabilityError::Undersized {
+                capacity,
+                unbalance: machine.rotor_unbalance,
+            });
+        }
+        let fan = balancing_fan(
+            n,
+            machine.load_unbalance(),
+            machine.rotor_unbalance,
+            machine.rotor_unbalance_angle,
+        )
+        .ok_or(StabilityError::Undersized {
+            capacity,
+            unbalance: machine.rotor_unbalance,
+        })?;
+        Self::with_angles(machine, &fan[..n])
+    }
+
+    /// The balanced motion with the loads at the given angles `α_j` (rad, relative to the
+    /// shaft angle), which must balance the rotor to `1e-9·N·m·R`.
+    pub fn with_angles(machine: &VibrationMachine, angles: &[f64]) -> Result<Self, StabilityError> {
+        let n = machine.loads;
+        if n < 2 {
+            return Err(StabilityError::TooFewLoads(n));
+        }
+        if angles.len() != n || angles.iter().any(|a| !a.is_finite()) {
+            return Err(StabilityError::Input(format!(
+                "need {n} finite load angles, got {angles:?}"
+            )));
+        }
+        let mut state = vec![0.0; machine.load_offset() + 2 * n];
+        state[machine.load_offset()..machine.load_offset() + n].copy_from_slice(angles);
+        let u = machine.residual_unbalance(0.0, &state);
+        let residual = u[0].hypot(u[1]);
+        if residual > 1e-9 * n as f64 * machine.load_unbalance() {
+            return Err(StabilityError::NotBalanced(residual));
+        }
+        let cos: Vec<f64> = angles.iter().map(|a| a.cos()).collect();
+        let sin: Vec<f64> = angles.iter().map(|a| a.sin()).collect();
+        let mut rows = Vec::new();
+        for v in [&cos, &sin] {
+            if let Some(r) = orthonormal_remainder(&rows, v) {
+                rows.push(r);
+            }
+        }
+        let mut neutral: Vec<Vec<f64>> = Vec::new();
+        for k in 0..n {
+            let mut e = vec![0.0; n];
+            e[k] = 1.0;
+            let basis: Vec<Vec<f64>> = rows.iter().chain(&neutral).cloned().collect();
+            if let Some(r) = orthonormal_remainder(&basis, &e) {
+                neutral.push(r);
+            }
+        }
+        Ok(Floquet {
+            machine: machine.clone(),
+            alpha: angles.to_vec(),
+            rows,
+            neutral,
+        })
+    }
+
+    /// The load angles `α_j` of the balanced motion, rad.
+    pub fn angles(&self) -> &[f64] {
+        &self.alpha
+    }
+
+    /// Number of neutral directions (moves along the family of balancing positions).
+    pub fn neutral_count(&self) -> usize {
+        self.neutral.len()
+    }
+
+    /// Dimension of the linearised system (`2·P + 2·N`).
+    pub fn dim(&self) -> usize {
+        2 * self.machine.platforms + 2 * self.machine.loads
+    }
+
+    /// The coefficients of the scaled linear system at speed `omega`.
+    fn coefficients(&self, omega: f64) -> Linear {
+        let m = &self.machine;
+        let np = m.platforms;
+        let w2 = omega * omega;
+        let mut c = Linear {
+            np,
+            n: m.loads,
+            e: m.exciter,
+            k: [0.0; MAX_PLATFORMS],
+            b: [0.0; MAX_PLATFORMS],
+            kc: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+            bc: [[0.0; MAX_PLATFORMS]; MAX_PLATFORMS],
+            mass: [0.0; MAX_PLATFORMS],
+            base: m.exciter_base_mass,
+            load_mass: m.load_mass,
+            kappa: m.kappa,
+            drag_platform: m.load_viscosity / (m.kappa * omega),
+            drag_load: m.load_viscosity / (m.kappa * m.load_mass * omega),
+            alpha: [0.0; MAX_LOADS],
+        };
+        for i in 0..np {
+            c.k[i] = m.stiffness[i] / w2;
+            c.b[i] = m.damping[i] / omega;
+            c.mass[i] = m.mass[i];
+            for l in 0..np {
+                c.kc[i][l] = m.coupling_stiffness[i][l] / w2;
+                c.bc[i][l] = m.coupling_damping[i][l] / omega;
+            }
+        }
+        c.alpha[..m.loads].copy_from_slice(&self.alpha);
+        c
+    }
+
+    /// The monodromy matrix `Φ(T)` at speed `omega` rad/s in the scaled variables
+    /// (`[δY/R, δẎ/(Rω), δφ, δφ̇/ω]`), integrated with DOP853 at relative and absolute
+    /// tolerance `rtol`.
+    pub fn monodromy(&self, omega: f64, rtol: f64) -> Result<DMatrix<f64>, StabilityError> {
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(StabilityError::Input(format!(
+                "the rotor speed must be positive and finite, got {omega}"
+            )));
+        }
+        let n = self.dim();
+        let mut sys = Variational {
+            lin: self.coefficients(omega),
+            cols: n,
+        };
+        let integ = Integrator::Dop853 {
+            rtol,
+            atol: rtol,
+            max_step: Some(TAU / 16.0),
+        };
+        integ.validate().map_err(|e| StabilityError::Numerical {
+            speed: omega,
+            message: e.to_string(),
+        })?;
+        let mut y0 = vec![0.0; n * n];
+        for k in 0..n {
+            y0[k * n + k] = 1.0;
+        }
+        let mut solver = Solver::new(&integ, n * n);
+        solver.reset(0.0, &y0);
+        while solver.t() < TAU {
+            solver
+                .step(&mut sys, TAU)
+                .map_err(|e| StabilityError::Numerical {
+                    speed: omega,
+                    message: e.to_string(),
+                })?;
+            if solver.stats().accepted_steps > 1_000_000 {
+                return Err(StabilityError::Numerical {
+                    speed: omega,
+                    message: "more than a million steps for one period".into(),
+                });
+            }
+        }
+        // Column k of Φ(T) is the state at T started from the k-th unit vector.
+        Ok(DMatrix::from_fn(n, n, |i, k| solver.y()[k * n + i]))
+    }
+
+    /// `Wᵀ·Φ·W`: the monodromy matrix with the neutral directions removed (see the module
+    /// docs), and the neutral drift `max |Φ·v − v|`.
+    pub fn reduce(&self, phi: &DMatrix<f64>) -> (DMatrix<f64>, f64) {
+        let n = self.dim();
+        let off = 2 * self.machine.platforms;
+        let nl = self.machine.loads;
+        // W: every non-angle coordinate, then the angle block's row-space vectors.
+        let mut w: Vec<Vec<f64>> = Vec::new();
+        for k in (0..n).filter(|k| !(off..off + nl).contains(k)) {
+            let mut e = vec![0.0; n];
+            e[k] = 1.0;
+            w.push(e);
+        }
+        for r in &self.rows {
+            let mut e = vec![0.0; n];
+            e[off..off + nl].copy_from_slice(r);
+            w.push(e);
+        }
+        let wm = DMatrix::from_fn(n, w.len(), |i, k| w[k][i]);
+        let reduced = wm.transpose() * phi * &wm;
+        let mut drift = 0.0f64;
+        for v in &self.neutral {
+            let mut e = vec![0.0; n];
+            e[off..off + nl].copy_from_slice(v);
+            let ev = nalgebra::DVector::from_vec(e);
+            let d = phi * &ev - &ev;
+            drift = drift.max(d.amax());
+        }
+        (reduced, drift)
+    }
+
+    /// The Floquet multipliers at speed `omega` rad/s, the monodromy integrated to `rtol`.
+    pub fn multipliers(&self, omega: f64, rtol: f64) -> Result<Multipliers, StabilityError> {
+        let phi = self.monodromy(omega, rtol)?;
+        let (reduced, neutral_drift) = self.reduce(&phi);
+        let schur = nalgebra::Schur::try_new(reduced, f64::EPSILON, 100_000).ok_or_else(|| {
+            StabilityError::Numerical {
+                speed: omega,
+                message: "the Schur iteration did not converge".into(),
+            }
+        })?;
+        let mut values: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
+        values.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+        let radius = values.first().map_or(0.0, |z| z.norm());
+        Ok(Multipliers {
+            speed: omega,
+            values: values.iter().map(|z| [z.re, z.im]).collect(),
+            radius,
+            neutral: self.neutral.len(),
+            neutral_drift,
+        })
+    }
+
+    /// Scans `[opts.from, opts.to]` for changes of stability and bisects each.
+    pub fn map(&self, opts: &ScanOptions) -> Result<StabilityMap, StabilityError> {
+        let ScanOptions {
+            from,
+            to,
+            per_octave,
+            rel_tol,
+            rtol,
+            extremum_window,
+        } = *opts;
+        if !(from.is_finite() && to.is_finite() && from > 0.0 && to > from) {
+            return Err(StabilityError::Input(format!(
+                "need 0 < from < to, got {from} and {to}"
+            )));
+        }
+        if per_octave < 2 || !(1e-12..=1e-2).contains(&rel_tol) {
+            return Err(StabilityError::Input(format!(
+                "need at least 2 speeds per octave and rel_tol in [1e-12, 1e-2], got {per_octave} \
+                 and {rel_tol}"
+            )));
+        }
+        let mut evaluations = 0usize;
+        let mut drift = 0.0f64;
+        let mut eval = |w: f64| -> Result<f64, StabilityError> {
+            let m = self.multipliers(w, rtol)?;
+            evaluations += 1;
+            drift = drift.max(m.neutral_drift);
+            Ok(m.radius.ln())
+        };
+        let count = ((to / from).log2() * per_octave as f64).ceil().max(2.0) as usize;
+        let mut pts: Vec<(f64, f64)> = Vec::with_capacity(count + 1);
+        for i in 0..=count {
+            let w = from * (to / from).powf(i as f64 / count as f64);
+            pts.push((w, eval(w)?));
+        }
+        // Local extrema of ln ρ close to 0 between grid speeds: search them for a crossing.
+        let mut extra = Vec::new();
+        for k in 1..pts.len() - 1 {
+            let (g0, g1, g2) = (pts[k - 1].1, pts[k].1, pts[k + 1].1);
+            let same_sign = (g0 < 0.0) == (g1 < 0.0) && (g1 < 0.0) == (g2 < 0.0);
+            let max = g1 >= g0 && g1 >= g2 && g1 < 0.0;
+            let min = g1 <= g0 && g1 <= g2 && g1 >= 0.0;
+            if same_sign && (max || min) && g1.abs() < extremum_window {
+                let sign = if max { 1.0 } else { -1.0 };
+                let (w, g) = golden(pts[k - 1].0, pts[k + 1].0, 40, |w| {
+                    eval(w).map(|g| sign * g)
+                })?;
+                extra.push((w, sign * g));
+            }
+        }
+        pts.extend(extra);
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut boundaries = Vec::new();
+        for pair in pts.windows(2) {
+            let ((mut a, ga), (mut b, gb)) = (pair[0], pair[1]);
+            let stable_a = ga < 0.0;
+            if stable_a == (gb < 0.0) {
+                continue;
+            }
+            let (mut ra, mut rb) = (ga.exp(), gb.exp());
+            while b - a > rel_tol * a {
+                let mid = (a * b).sqrt();
+                let g = eval(mid)?;
+                if (g < 0.0) == stable_a {
+                    a = mid;
+                    ra = g.exp();
+                } else {
+                    b = mid;
+                    rb = g.exp();
+                }
+            }
+            boundaries.push(Boundary {
+                speed: 0.5 * (a + b),
+                bracket: [a, b],
+                stable_above: !stable_a,
+                radius: [ra, rb],
+            });
+        }
+        Ok(StabilityMap {
+            options: *opts,
+            stable_at_from: pts[0].1 < 0.0,
+            boundaries,
+            evaluations,
+            neutral_drift: drift,
+        })
+    }
+}
+
+/// Golden-section search for the maximum of `f` on `[a, b]` (in log-speed), `iters` steps:
+/// `(argmax, max)` over every point evaluated.
+fn golden(
+    a: f64,
+    b: f64,
+    iters: usize,
+    mut f: impl FnMut(f64) -> Result<f64, StabilityError>,
+) -> Result<(f64, f64), StabilityError> {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut lo, mut hi) = (a.ln(), b.ln());
+    let mut x1 = hi - r * (hi - lo);
+    let mut x2 = lo + r * (hi - lo);
+    let (mut f1, mut f2) = (f(x1.exp())?, f(x2.exp())?);
+    let mut best = if f1 >= f2 { (x1, f1) } else { (x2, f2) };
+    for _ in 0..iters {
+        if f1 >= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - r * (hi - lo);
+            f1 = f(x1.exp())?;
+            if f1 > best.1 {
+                best = (x1, f1);
+            }
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + r * (hi - lo);
+            f2 = f(x2.exp())?;
+            if f2 > best.1 {
+                best = (x2, f2);
+            }
+        }
+    }
+    Ok((best.0.exp(), best.1))
+}
+
+/// Coefficients of the scaled linearised equations at one speed (see the module docs): forces
+/// over `ω²` (stiffness) and `ω` (damping), so that `δF/(R·ω²)` is a combination of the scaled
+/// states.
+#[derive(Debug, Clone, Copy)]
+struct Linear {
+    np: usize,
+    n: usize,
+    e: usize,
+    k: [f64; MAX_PLATFORMS],
+    b: [f64; MAX_PLATFORMS],
+    kc: [[f64; MAX_PLATFORMS]; MAX_PLATFORMS],
+    bc: [[f64; MAX_PLATFORMS]; MAX_PLATFORMS],
+    /// `M_i` (the exciter's is not used: its bracket `den` replaces it).
+    mass: [f64; MAX_PLATFORMS],
+    /// `M_e + M_c`.
+    base: f64,
+    load_mass: f64,
+    kappa: f64,
+    /// `b_w/(κ·ω)`, kg.
+    drag_platform: f64,
+    /// `b_w/(κ·m·ω)`.
+    drag_load: f64,
+    alpha: [f64; MAX_LOADS],
+}
+
+impl Linear {
+    /// `(cos, sin)` of `s + α_j` for every load, and the exciter's bracket `den` at phase `s`.
+    fn phase(&self, s: f64) -> ([(f64, f64); MAX_LOADS], f64) {
+        let mut cs = [(0.0, 0.0); MAX_LOADS];
+        let mut spread = 0.0;
+        for (c, a) in cs.iter_mut().zip(&self.alpha).take(self.n) {
+            let (sn, cn) = (s + a).sin_cos();
+            *c = (cn, sn);
+            // κ − cos² as (κ − 1) + sin², as in the model's own right-hand side.
+            spread += (self.kappa - 1.0) + sn * sn;
+        }
+        (cs, self.base + self.load_mass / self.kappa * spread)
+    }
+
+    /// `dx/ds` for one scaled state `x` at phase `s = ωt`, given `cos`/`sin` of `s + α_j` and
+    /// the exciter's bracket `den`.
+    fn apply(&self, cs: &[(f64, f64); MAX_LOADS], den: f64, x: &[f64], dx: &mut [f64]) {
+        let (np, n) = (self.np, self.n);
+        let (y, rest) = x.split_at(np);
+        let (v, rest) = rest.split_at(np);
+        let (p, u) = rest.split_at(n);
+        let mut force = [0.0; MAX_PLATFORMS];
+        for i in 0..np {
+            let mut f = -self.k[i] * y[i] - self.b[i] * v[i];
+            for l in 0..np {
+                f -= self.kc[i][l] * (y[i] - y[l]) + self.bc[i][l] * (v[i] - v[l]);
+            }
+            force[i] = f;
+        }
+        let mut num = force[self.e];
+        for j in 0..n {
+            let (c, s) = cs[j];
+            num += self.drag_platform * c * u[j] + self.load_mass * (c * p[j] + 2.0 * s * u[j]);
+        }
+        let a = num / den;
+        for i in 0..np {
+            dx[i] = v[i];
+            dx[np + i] = if i == self.e {
+                a
+            } else {
+                force[i] / self.mass[i]
+            };
+        }
+        for j in 0..n {
+            dx[2 * np + j] = u[j];
+            dx[2 * np + n + j] = -self.drag_load * u[j] - a * cs[j].0 / self.kappa;
+        }
+    }
+}
+
+/// The variational equations `dΦ/ds = J(s)·Φ`, all columns of `Φ` in one state vector.
+struct Variational {
+    lin: Linear,
+    cols: usize,
+}
+
+impl OdeSystem for Variational {
+    fn dim(&self) -> usize {
+        self.cols * (2 * self.lin.np + 2 * self.lin.n)
+    }
+
+    fn rhs(&mut self, s: f64, y: &[f64], dy: &mut [f64]) {
+        let l = &self.lin;
+        let (cs, den) = l.phase(s);
+        let n = 2 * l.np + 2 * l.n;
+        for (x, dx) in y.chunks_exact(n).zip(dy.chunks_exact_mut(n)) {
+            l.apply(&cs, den, x, dx);
+        }
+    }
+}
+
+/// Spectral radius of `m` as `lim ‖mᵏ‖^{1/k}`, by 40 squarings with renormalisation: a second
+/// method for the radius, independent of the eigenvalue iteration.
+pub fn radius_by_powers(m: &DMatrix<f64>) -> f64 {
+    let mut p = m.clone();
+    let (mut log_norm, mut k) = (0.0f64, 1.0f64);
+    for _ in 0..40 {
+        p = &p * &p;
+        let norm = p.amax();
+        if norm == 0.0 {
+            return 0.0;
+        }
+        p /= norm;
+        log_norm = 2.0 * log_norm + norm.ln();
+        k *= 2.0;
+    }
+    // ‖m^k‖ ≈ exp(log_norm)·‖p‖ with ‖p‖ = 1 after the last renormalisation.
+    (log_norm / k).exp()
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::engine::model::{Effect, Shaft};
+    use crate::engine::vibration::{
+        CouplingParams, InitialParams, LoadKind, PlatformParams, SeedSingleMass,
+        VibrationMachineParams,
+    };
+
+    /// The seed's single-mass machine (h = 0.1, ε = 0.05, β = 2, ω̃ = 30 rad/s) with `loads`
+    /// balls and rotor unbalance `d` kg·m.
+    fn seed(loads: usize, d: f64) -> VibrationMachine {
+        let g = SeedSingleMass {
+            h: 0.1,
+            epsilon: 0.05,
+            beta: 2.0,
+            loads,
+            kind: LoadKind::Ball,
+            omega_scale: 30.0,
+            load_mass: 0.5,
+            radius: 0.1,
+            housing_mass: 3.0,
+            rotor_unbalance: d,
+        };
+        let p =
+            VibrationMachineParams::from_seed_single_mass(&g, InitialParams::default()).unwrap();
+        VibrationMachine::new(&p).unwrap()
+    }
+
+    /// A two-platform machine with a roller balancer on platform 2 and rotor unbalance.
+    fn two_mass() -> VibrationMachine {
+        let mut p = VibrationMachineParams {
+            platforms: vec![
+                PlatformParams {
+                    mass: 100.0,
+                    stiffness: 4e5,
+                    damping: 200.0,
+                },
+                PlatformParams {
+                    mass: 80.0,
+                    stiffness: 3e5,
+                    damping: 150.0,
+                },
+            ],
+            couplings: vec![CouplingParams {
+                between: [0, 1],
+                stiffness: 1e5,
+                damping: 50.0,
+            }],
+            ..seed_params()
+        };
+        p.balancer.platform = Some(1);
+        p.balancer.kind = LoadKind::Roller;
+        p.balancer.rotor_unbalance = 0.06;
+        p.balancer.rotor_unbalance_angle = 0.4;
+        VibrationMachine::new(&p).unwrap()
+    }
+
+    fn seed_params() -> VibrationMachineParams {
+        VibrationMachineParams::from_seed_single_mass(
+            &SeedSingleMass {
+                h: 0.1,
+                epsilon: 0.05,
+                beta: 2.0,
+                loads: 2,
+                kind: LoadKind::Ball,
+                omega_scale: 30.0,
+                load_mass: 0.5,
+                radius: 0.1,
+                housing_mass: 3.0,
+                rotor_unbalance: 0.0,
+            },
+            InitialParams::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn linearisation_matches_the_models_own_right_hand_side() {
+        // Central differences of VibrationMachine::eval about the balanced motion, scaled as the
+        // variational equations are, against Linear::apply: the linearisation is of the model
+        // the simulator integrates, term by term. Step 1e-6 in scaled units: truncation error
+        // O(h²) ≈ 1e-12, rounding ≈ 1e-16/1e-6 = 1e-10 of the terms; tolerance 1e-7 of the
+        // largest entry.
+        for (m, omega) in [
+            (seed(2, 0.03), 41.0),
+            (seed(3, 0.02), 55.0),
+            (two_mass(), 47.0),
+        ] {
+            let f = Floquet::new(&m).unwrap();
+            let lin = f.coefficients(omega);
+            let (np, nl) = (m.platforms, m.loads);
+            let n = f.dim();
+            let r = m.radius;
+            for &t in &[0.0, 0.013, 0.05, 0.11] {
+                let s = omega * t;
+                let shaft = Shaft { phi: s, omega };
+                let mut x0 = vec![0.0; n];
+                for j in 0..nl {
+                    x0[2 * np + j] = s + f.alpha[j];
+                    x0[2 * np + nl + j] = omega;
+                }
+                // Scale of each coordinate: Y/R, Ẏ/(Rω), φ, φ̇/ω.
+                let scale: Vec<f64> = (0..n)
+                    .map(|k| {
+                        if k < np {
+                            r
+                        } else if k < 2 * np {
+                            r * omega
+                        } else if k < 2 * np + nl {
+                            1.0
+                        } else {
+                            omega
+                        }
+                    })
+                    .collect();
+                let (cs, den) = lin.phase(s);
+                let mut d0 = vec![0.0; n];
+                m.eval(t, shaft, &x0, &mut d0);
+                // On the balanced motion the state's derivative is (0, 0, ω, 0).
+                for (k, d) in d0.iter().enumerate() {
+                    let want = if (2 * np..2 * np + nl).contains(&k) {
+                        omega
+                    } else {
+                        0.0
+                    };
+                    assert!((d - want).abs() < 1e-9 * omega, "k={k} d={d}");
+                }
+                let h = 1e-6;
+                for col in 0..n {
+                    let mut e = vec![0.0; n];
+                    e[col] = 1.0;
+                    let mut want = vec![0.0; n];
+                    lin.apply(&cs, den, &e, &mut want);
+                    let (mut xp, mut xm) = (x0.clone(), x0.clone());
+                    xp[col] += h * scale[col];
+                    xm[col] -= h * scale[col];
+                    let (mut dp, mut dm) = (vec![0.0; n], vec![0.0; n]);
+                    m.eval(t, shaft, &xp, &mut dp);
+                    m.eval(t, shaft, &xm, &mut dm);
+                    // d(x_k/scale_k)/ds = (dx_k/dt)/(ω·scale_k).
+                    let got: Vec<f64> = (0..n)
+                        .map(|k| (dp[k] - dm[k]) / (2.0 * h) / (omega * scale[k]))
+                        .collect();
+                    let big = want.iter().chain(&got).fold(1.0f64, |a, x| a.max(x.abs()));
+                    for k in 0..n {
+                        assert!(
+                            (got[k] - want[k]).abs() < 1e-7 * big,
+                            "t={t} col={col} row={k}: {} vs {}",
+                            got[k],
+                            want[k]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn neutral_directions_are_the_family_of_balancing_positions() {
+        // D = 0, N = 2: the pair's rotation; D > 0, N = 2: none; N = 3: one; N = 4: two.
+        for (loads, d, want) in [
+            (2, 0.0, 1),
+            (2, 0.03, 0),
+            (3, 0.02, 1),
+            (4, 0.0, 2),
+            (4, 0.05, 2),
+        ] {
+            let f = Floquet::new(&seed(loads, d)).unwrap();
+            assert_eq!(f.neutral_count(), want, "N={loads} D={d}");
+            let m = f.multipliers(40.0, 1e-12).unwrap();
+            assert_eq!(m.values.len(), f.dim() - want);
+            assert!(m.neutral_drift < 1e-10, "{m:?}");
+        }
+    }
+
+    #[test]
+    fn radius_by_two_methods_and_two_tolerances() {
+        // The eigenvalue radius against repeated squaring (a second method) and against a 100×
+        // tighter integration; both to 1e-9 relative.
+        let f = Floquet::new(&two_mass()).unwrap();
+        for omega in [30.0, 52.0, 75.0, 140.0] {
+            let phi = f.monodromy(omega, 1e-12).unwrap();
+            let (reduced, _) = f.reduce(&phi);
+            let m = f.multipliers(omega, 1e-12).unwrap();
+            let by_powers = radius_by_powers(&reduced);
+            assert!(
+                (by_powers / m.radius - 1.0).abs() < 1e-9,
+                "{by_powers} {m:?}"
+            );
+            let tight = f.multipliers(omega, 1e-14).unwrap();
+            assert!(
+                (tight.radius / m.radius - 1.0).abs() < 1e-9,
+                "{tight:?} {m:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn undersized_and_unbalanced_inputs_are_errors() {
+        let m = seed(2, 0.11); // capacity 2·0.5·0.1 = 0.1
+        assert!(matches!(
+            Floquet::new(&m),
+            Err(StabilityError::Undersized { .. })
+        ));
+        let m = seed(2, 0.0);
+        assert!(matches!(
+            Floquet::with_angles(&m, &[0.0, 0.5]),
+            Err(StabilityError::NotBalanced(_))
+        ));
+        let f = Floquet::new(&m).unwrap();
+        assert!(f.multipliers(f64::NAN, 1e-12).is_err());
+        assert!(f.map(&ScanOptions::new(10.0, 5.0)).is_err());
+    }
+}
