@@ -7,6 +7,14 @@
 //! last `m` counted windows exceed the limit, and clears when at least `n` of the last `m` are
 //! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::error::{non_negative_f32, positive_f32, ConfigError};
 use crate::irregularity::WindowReport;
 use embedded_hal::digital::OutputPin;
@@ -139,7 +147,7 @@ impl DeltaAlarm {
             return (v, None);
         };
         let m = self.config.of_last as u32;
-        let mask = if m >= 32 { u32::MAX } else { (1u32 << m) - 1 };
+        let mask = 1u32.checked_shl(m).map_or(u32::MAX, |b| b.wrapping_sub(1));
         let below = r.delta < self.config.limit * (1.0 - self.config.hysteresis);
         self.over = ((self.over << 1) | (v == Verdict::Over) as u32) & mask;
         self.under = ((self.under << 1) | below as u32) & mask;

@@ -23,7 +23,16 @@
 //! gap of a missing-tooth wheel, the extra tooth of a `12+1` wheel). `pitch(k)` is the angle
 //! from edge k−1 to edge k; on a 60-2 wheel `pitch(0)` spans the gap (three positions).
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::error::{positive, ConfigError};
+use core::num::{NonZeroU16, NonZeroU32, NonZeroUsize};
 
 /// Largest number of lines (grid positions) per revolution: a turn is at most 2^30 units.
 pub const MAX_LINES: u16 = 16_384;
@@ -69,7 +78,7 @@ impl Pattern {
         let present = if teeth >= 128 {
             u128::MAX
         } else {
-            (1u128 << teeth) - 1
+            (1u128 << teeth).wrapping_sub(1)
         };
         Pattern { positions, present }
     }
@@ -82,11 +91,15 @@ impl Pattern {
         let all = mask_of(positions);
         let mut present = all;
         for &(start, count) in gaps {
-            if start >= positions || count == 0 || u16::from(start) + u16::from(count) > 255 {
+            // Two u8 in a u16: the sum does not wrap (and within a u8 past this check).
+            if start >= positions
+                || count == 0
+                || u16::from(start).wrapping_add(u16::from(count)) > 255
+            {
                 return Err(ConfigError::OutOfRange("pattern.gaps"));
             }
-            for p in start..start + count {
-                present &= !(1u128 << (p % positions));
+            for p in start..start.wrapping_add(count) {
+                present &= !(1u128 << p.checked_rem(positions).unwrap_or(0));
             }
         }
         Ok(Pattern { positions, present })
@@ -128,7 +141,7 @@ const fn mask_of(n: u8) -> u128 {
     if n >= 128 {
         u128::MAX
     } else {
-        (1u128 << n) - 1
+        (1u128 << n).wrapping_sub(1)
     }
 }
 
@@ -372,21 +385,16 @@ impl Encoder {
                 if !(2..=MAX_LINES).contains(&lines) {
                     return Err(ConfigError::OutOfRange("lines"));
                 }
-                if lines % u16::from(prescaler) != 0 || lines / u16::from(prescaler) < 2 {
+                // 1, 2, 4 or 8.
+                let p = NonZeroU16::new(u16::from(prescaler)).unwrap_or(NonZeroU16::MIN);
+                if lines % p != 0 || lines / p < 2 {
                     return Err(ConfigError::Inconsistent("prescaler"));
                 }
                 let framing = match config.wheel {
                     Wheel::Indexed { .. } => Framing::Index,
                     _ => Framing::None,
                 };
-                (
-                    framing,
-                    lines,
-                    lines / u16::from(prescaler),
-                    prescaler,
-                    0,
-                    0,
-                )
+                (framing, lines, lines / p, prescaler, 0, 0)
             }
             Wheel::Pattern(p) => {
                 if prescaler != 1 {
@@ -413,7 +421,7 @@ impl Encoder {
         let mask = if config.counter_bits == 32 {
             u32::MAX
         } else {
-            (1u32 << config.counter_bits) - 1
+            (1u32 << config.counter_bits).wrapping_sub(1)
         };
         let min_speed = positive("min_speed", config.min_speed)?;
         let Estimator::Edges(k) = config.estimator;
@@ -478,7 +486,10 @@ impl Encoder {
             base,
             long,
             short,
-            uniform_span: u32::from(k) * u32::from(base) * PITCH_UNITS,
+            // At most 32 · 255 · 2^16 (< 2^30): no wrap.
+            uniform_span: u32::from(k)
+                .wrapping_mul(u32::from(base))
+                .wrapping_mul(PITCH_UNITS),
             uniform,
         })
     }
@@ -532,7 +543,8 @@ impl Encoder {
     /// Nominal pitch of `tooth` (the angle from the edge before it) in units; 0 beyond the
     /// wheel.
     pub fn nominal_pitch(&self, tooth: u16) -> u32 {
-        self.grid_pitch(tooth) * PITCH_UNITS
+        // A grid pitch is under 256 positions: no wrap.
+        self.grid_pitch(tooth).wrapping_mul(PITCH_UNITS)
     }
     /// Nominal pitch of `tooth` in grid positions (0 beyond the wheel).
     #[inline]
@@ -582,7 +594,7 @@ impl Encoder {
 /// `(x·f) >> 32`: the high word of the 64-bit product, one instruction on a Cortex-M4.
 #[inline(always)]
 fn mul_hi(x: u32, f: u32) -> u32 {
-    ((u64::from(x) * u64::from(f)) >> 32) as u32
+    (u64::from(x).wrapping_mul(u64::from(f)) >> 32) as u32
 }
 
 /// `x` (in `[0, 1)`) as a 0.32 fixed-point fraction.
@@ -614,17 +626,19 @@ fn pattern_table(
     table: &mut [u8; MAX_PATTERN_TEETH],
 ) -> Result<(u16, u8, u64, u64), ConfigError> {
     let n = p.positions;
-    if !(3..=MAX_PATTERN_POSITIONS).contains(&n) {
+    let Some(grid) =
+        NonZeroU16::new(u16::from(n)).filter(|_| (3..=MAX_PATTERN_POSITIONS).contains(&n))
+    else {
         return Err(ConfigError::OutOfRange("pattern.positions"));
-    }
+    };
     let present = p.present;
     if present & !mask_of(n) != 0 {
         return Err(ConfigError::OutOfRange("pattern.teeth"));
     }
     let teeth = present.count_ones() as usize;
-    if teeth < 3 {
+    let Some(wheel) = NonZeroUsize::new(teeth).filter(|_| teeth >= 3) else {
         return Err(ConfigError::OutOfRange("pattern.teeth"));
-    }
+    };
     if teeth > MAX_PATTERN_TEETH {
         return Err(ConfigError::Capacity("pattern.teeth"));
     }
@@ -637,13 +651,20 @@ fn pattern_table(
             if let Some(slot) = pos.get_mut(j) {
                 *slot = q;
             }
-            j += 1;
+            j = j.wrapping_add(1); // at most 128
         }
     }
     for i in 0..teeth {
         let here = pos.get(i).copied().unwrap_or(0);
-        let before = pos.get((i + teeth - 1) % teeth).copied().unwrap_or(0);
-        let d = (u16::from(here) + u16::from(n) - u16::from(before)) % u16::from(n);
+        // (`i` < `teeth` and `before` < `n`: no wrap.)
+        let before = pos
+            .get(i.wrapping_add(teeth).wrapping_sub(1) % wheel)
+            .copied()
+            .unwrap_or(0);
+        let d = u16::from(here)
+            .wrapping_add(u16::from(n))
+            .wrapping_sub(u16::from(before))
+            % grid;
         if let Some(slot) = pitch.get_mut(i) {
             *slot = if d == 0 { n } else { d as u8 };
         }
@@ -665,8 +686,10 @@ fn pattern_table(
     }
     // Special pitches must be told from the base at a glance: at least 1.5× or at most 0.75×.
     for &c in pitch.iter().take(teeth) {
+        // u8 values in u16: the products do not wrap.
         let (c, b) = (u16::from(c), u16::from(base));
-        if c != b && 4 * c > 3 * b && 2 * c < 3 * b {
+        if c != b && c.wrapping_mul(4) > b.wrapping_mul(3) && c.wrapping_mul(2) < b.wrapping_mul(3)
+        {
             return Err(ConfigError::Inconsistent(
                 "pattern (a pitch too close to the base)",
             ));
@@ -677,7 +700,13 @@ fn pattern_table(
     let distinct = |c: u8| -> u32 {
         let (c, b) = (u32::from(c), u32::from(base));
         // Compare max(c/b, b/c) without division: scale both ways by b·c.
-        if c >= b { c * c } else { b * b }.saturating_mul(1000) / (b * c).max(1)
+        // (u8 values in u32: the products do not wrap.)
+        let square = if c >= b {
+            c.wrapping_mul(c)
+        } else {
+            b.wrapping_mul(b)
+        };
+        square.saturating_mul(1000) / NonZeroU32::new(b.wrapping_mul(c)).unwrap_or(NonZeroU32::MIN)
     };
     let mut frame = 0usize;
     for i in 0..teeth {
@@ -689,7 +718,8 @@ fn pattern_table(
     }
     // A pattern that repeats after a fraction of a turn cannot frame a revolution.
     for shift in 1..teeth {
-        if teeth % shift == 0 && (0..teeth).all(|i| pitch.get(i) == pitch.get((i + shift) % teeth))
+        if teeth.checked_rem(shift) == Some(0)
+            && (0..teeth).all(|i| pitch.get(i) == pitch.get(i.wrapping_add(shift) % wheel))
         {
             return Err(ConfigError::Inconsistent(
                 "pattern (rotationally symmetric)",
@@ -698,7 +728,10 @@ fn pattern_table(
     }
     let (mut long, mut short) = (0u64, 0u64);
     for i in 0..teeth {
-        let c = pitch.get((frame + i) % teeth).copied().unwrap_or(base);
+        let c = pitch
+            .get(frame.wrapping_add(i) % wheel)
+            .copied()
+            .unwrap_or(base);
         if let Some(slot) = table.get_mut(i) {
             *slot = c;
         }

@@ -16,6 +16,14 @@
 //! and compared by 64-bit cross products, so the per-edge work is integer compares; δ is formed
 //! once per window from the exact products.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::error::{positive, positive_f32, ConfigError};
 use crate::speed::{Fault, Sample, Tooth};
 
@@ -246,15 +254,12 @@ impl WindowState {
             }
             return;
         }
-        // Cross products, exact in 64 bits (spans ≤ 2^30, ticks < 2^32).
-        if u64::from(s.span) * u64::from(self.max.ticks)
-            > u64::from(self.max.span) * u64::from(s.ticks)
-        {
+        // Cross products, exact in 64 bits (two u32 factors: no wrap).
+        let cross = |a: u32, b: u32| u64::from(a).wrapping_mul(u64::from(b));
+        if cross(s.span, self.max.ticks) > cross(self.max.span, s.ticks) {
             self.max = s;
         }
-        if u64::from(s.span) * u64::from(self.min.ticks)
-            < u64::from(self.min.span) * u64::from(s.ticks)
-        {
+        if cross(s.span, self.min.ticks) < cross(self.min.span, s.ticks) {
             self.min = s;
         }
     }
@@ -307,10 +312,11 @@ impl WindowState {
         let (a2, t2) = (u64::from(self.min.span), u64::from(self.min.ticks));
         // δ = 2(a1/t1 − a2/t2)/(a1/t1 + a2/t2) = 2(a1·t2 − a2·t1)/(a1·t2 + a2·t1), from the
         // exact integer products: never a difference of two rounded speeds.
-        let p1 = a1 * t2;
-        let p2 = a2 * t1;
+        // (Products of two u32: no wrap; with spans ≤ 2^30 their sum is below 2^63.)
+        let p1 = a1.wrapping_mul(t2);
+        let p2 = a2.wrapping_mul(t1);
         let num = p1.saturating_sub(p2);
-        let den = p1 + p2;
+        let den = p1.wrapping_add(p2);
         let delta = if den > 0 {
             2.0 * (u64_to_f32(num) / u64_to_f32(den))
         } else {

@@ -14,9 +14,18 @@
 //! fault) and steady (its period within the tolerance of the previous one's), every tooth's
 //! share of it is folded into that tooth's running mean, once per revolution and out of line.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::encoder::Encoder;
 use crate::error::{positive_f32, ConfigError};
-use crate::speed::{EdgeSink, Fault, Tooth};
+use crate::speed::{each_pair, EdgeSink, Fault, Tooth};
+use core::num::NonZeroUsize;
 
 /// Per-tooth running means of the revolution fraction. Memory: 8·N bytes and a few words.
 #[derive(Debug, Clone)]
@@ -40,6 +49,12 @@ pub struct ToothLearner<const N: usize> {
 }
 
 impl<const N: usize> ToothLearner<N> {
+    /// `N` as a divisor (1 for an empty learner).
+    const TEETH: NonZeroUsize = match NonZeroUsize::new(N) {
+        Some(n) => n,
+        None => NonZeroUsize::MIN,
+    };
+
     /// A learner for `encoder`'s wheel that accepts revolutions whose period is within
     /// `steady_tolerance` (a fraction, 0 to 0.5) of the previous one's.
     pub fn new(encoder: &Encoder, steady_tolerance: f32) -> Result<Self, ConfigError> {
@@ -114,7 +129,11 @@ impl<const N: usize> ToothLearner<N> {
             let t: u64 = if self.timed {
                 u64::from(since)
             } else {
-                self.staged.iter().take(edges).map(|&d| u64::from(d)).sum()
+                // At most 2^16 intervals of 32 bits: the sum does not wrap.
+                self.staged
+                    .iter()
+                    .take(edges)
+                    .fold(0u64, |s, &d| s.wrapping_add(u64::from(d)))
             };
             let prev = self.prev_period;
             self.prev_period = t;
@@ -124,9 +143,8 @@ impl<const N: usize> ToothLearner<N> {
                 // Running mean: no growing sum to lose digits over long learning runs.
                 let weight = 1.0 / (f32::from(self.folded) + 1.0);
                 let (keep, take) = (1.0 - weight, weight / t as f32);
-                for (m, &d) in self.mean.iter_mut().zip(self.staged.iter()).take(edges) {
-                    *m = keep * *m + take * d as f32;
-                }
+                let mean = self.mean.get_mut(..edges).unwrap_or_default();
+                each_pair(mean, &self.staged, |m, &d| *m = keep * *m + take * d as f32);
                 self.folded = self.folded.saturating_add(1);
             }
         }
@@ -143,7 +161,7 @@ impl<const N: usize> EdgeSink for ToothLearner<N> {
     fn tooth(&mut self, ev: &Tooth) {
         // `tooth` < edges ≤ N, so the remainder is the tooth itself; it spares a bounds
         // branch (an `and` when N is a power of two).
-        if let Some(s) = self.staged.get_mut(usize::from(ev.tooth) % N.max(1)) {
+        if let Some(s) = self.staged.get_mut(usize::from(ev.tooth) % Self::TEETH) {
             *s = ev.dt;
         }
         if ev.frame {

@@ -16,6 +16,14 @@
 //! built in place: [`DeltaMonitor::unconfigured`] is a `const` value for a `static`, and
 //! [`DeltaMonitor::configure`] fills it without large temporaries.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::alarm::{AlarmConfig, AlarmEvent, DeltaAlarm, Verdict};
 use crate::encoder::{Encoder, EncoderConfig};
 use crate::error::ConfigError;

@@ -8,6 +8,14 @@
 //! [`crate::encoder`]), at most ±50 % of a pitch; the deviations of a revolution sum to zero,
 //! so the corrected pitches close the turn exactly.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::encoder::{Encoder, PITCH_UNITS};
 use crate::error::{positive_f32, ConfigError};
 
@@ -114,15 +122,19 @@ pub fn deviations(encoder: &Encoder, pitches: &[f32], out: &mut [i16]) -> Result
         }
         exact += d;
         let target = libm::round(exact) as i64;
-        let step = target - given;
+        let step = target.checked_sub(given);
         given = target;
-        *slot = i16::try_from(step).map_err(|_| ConfigError::OutOfRange("pitches"))?;
+        *slot = step
+            .and_then(|d| i16::try_from(d).ok())
+            .ok_or(ConfigError::OutOfRange("pitches"))?;
     }
     // The last rounding may leave ±1 unit: fold it into the last tooth.
     if given != 0 {
-        if let Some(slot) = out.get_mut(edges - 1) {
-            let v = i64::from(*slot) - given;
-            *slot = i16::try_from(v).map_err(|_| ConfigError::OutOfRange("pitches"))?;
+        if let Some(slot) = edges.checked_sub(1).and_then(|last| out.get_mut(last)) {
+            *slot = i64::from(*slot)
+                .checked_sub(given)
+                .and_then(|v| i16::try_from(v).ok())
+                .ok_or(ConfigError::OutOfRange("pitches"))?;
         }
     }
     Ok(())

@@ -43,8 +43,17 @@
 //! creeping below the minimum speed stays at standstill instead of flipping state on every edge.
 //! Timeouts and reversals are counted on leaving [`ShaftState::Running`] only.
 
+// The per-edge path runs through this module: no integer operation here may overflow or
+// divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
+// examples/qemu checks the image).
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
+)]
+
 use crate::encoder::{Encoder, Framing, MAX_PATTERN_TEETH, MAX_SPAN, PITCH_UNITS};
 use crate::pitch::PitchTable;
+use core::num::NonZeroU32;
 
 /// Direction of rotation reported with an edge (e.g. from the quadrature B channel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -304,7 +313,7 @@ fn ln(x: f32) -> f32 {
         return 0.0;
     }
     let bits = x.to_bits();
-    let exp = ((bits >> 23) & 0xff) as i32 - 127;
+    let exp = (((bits >> 23) & 0xff) as i32).wrapping_sub(127); // in [−127, 128]
     let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000); // in [1, 2)
                                                                 // ln(m) = 2·atanh((m−1)/(m+1)), |s| ≤ 1/3: four terms give 1e-5.
     let s = (m - 1.0) / (m + 1.0);
@@ -476,7 +485,8 @@ impl SpeedTracker {
     #[inline(always)]
     fn pitch<P: PitchTable>(&self, enc: &Encoder, table: &P, tooth: u16) -> u32 {
         if !self.teeth_known(enc) {
-            return enc.base_pitch() * PITCH_UNITS;
+            // A base pitch is under 256 grid positions: the product fits.
+            return enc.base_pitch().wrapping_mul(PITCH_UNITS);
         }
         let nominal = enc.nominal_pitch(tooth);
         if P::NOMINAL {
@@ -496,12 +506,12 @@ impl SpeedTracker {
         if usize::from(self.nidx) >= INDEXES {
             // The oldest waiting index lost its edge: drop it.
             self.index.copy_within(1.., 0);
-            self.nidx -= 1;
+            self.nidx = self.nidx.wrapping_sub(1);
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
         }
         if let Some(slot) = self.index.get_mut(usize::from(self.nidx)) {
             *slot = (t, self.arrivals);
-            self.nidx += 1;
+            self.nidx = self.nidx.wrapping_add(1);
         }
         self.block_fast();
     }
@@ -758,7 +768,7 @@ impl SpeedTracker {
             if let Some(seq) = self.pending_seq.get_mut(usize::from(self.npend)) {
                 *seq = self.arrivals;
             }
-            self.npend += 1;
+            self.npend = self.npend.wrapping_add(1);
         }
         self.latest = t;
         self.resolve(enc, table, false, sink);
@@ -913,14 +923,14 @@ impl SpeedTracker {
                 terms[0] = (x / spans, first);
                 [d2, d3]
             };
-            len += 1;
+            len = len.wrapping_add(1);
             let mut tooth = first;
             for d in rest.iter().flatten() {
                 tooth = tooth_after(tooth, 1, edges);
                 if let Some(slot) = terms.get_mut(len) {
                     *slot = (*d as f32 / pitch(tooth), tooth);
                 }
-                len += 1;
+                len = len.wrapping_add(1);
             }
             let (mut prev, mut prev_tooth) = (r as f32, before);
             let mut cost = 0.0;
@@ -949,7 +959,7 @@ impl SpeedTracker {
                 spans += pitch(tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
                 consider(
-                    chain_cost(here, tooth, spans, false) + margin * f32::from(j - 1),
+                    chain_cost(here, tooth, spans, false) + margin * f32::from(j.wrapping_sub(1)),
                     Verdict::Missing(j),
                 );
             }
@@ -971,7 +981,11 @@ impl SpeedTracker {
     fn is_special(&self, enc: &Encoder, tooth: u16) -> bool {
         tooth == 0
             || (enc.framing() == Framing::Pattern
-                && ((enc.long_teeth() | enc.short_teeth()) >> tooth) & 1 == 1)
+                && (enc.long_teeth() | enc.short_teeth())
+                    .checked_shr(u32::from(tooth))
+                    .unwrap_or(0)
+                    & 1
+                    == 1)
     }
 
     /// Whether a waiting index reported before the edge at `t` (arrival `seq`) lies between
@@ -1005,7 +1019,7 @@ impl SpeedTracker {
                 if let Some(slot) = self.index.get_mut(keep) {
                     *slot = (x, q);
                 }
-                keep += 1;
+                keep = keep.wrapping_add(1);
             } else if since > 0 && since <= d {
                 framed = true;
             } else if self.sync == SyncState::Synced {
@@ -1036,7 +1050,7 @@ impl SpeedTracker {
                 if let Some(slot) = self.index.get_mut(keep) {
                     *slot = (x, q);
                 }
-                keep += 1;
+                keep = keep.wrapping_add(1);
             } else if before <= enc.timeout_ticks() {
                 framed = true;
             }
@@ -1197,10 +1211,14 @@ impl SpeedTracker {
         } else {
             enc.base_pitch()
         };
-        let per_base = if grid == enc.base_pitch() || grid == 0 {
+        // No pitch (grid 0): the interval as it is.
+        let per_base = if grid == enc.base_pitch() {
             dt
         } else {
-            (u64::from(dt) * u64::from(enc.base_pitch()) / u64::from(grid)) as u32
+            u64::from(dt)
+                .wrapping_mul(u64::from(enc.base_pitch()))
+                .checked_div(u64::from(grid))
+                .map_or(dt, |q| q as u32)
         };
         if known && clean && had_ref {
             self.record(enc, tooth, per_base);
@@ -1237,11 +1255,9 @@ impl SpeedTracker {
     /// alignment if unique, else a count).
     fn acquire(&mut self, enc: &Encoder, dt: u32) -> u16 {
         let edges = enc.edges();
-        let all = if edges >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << edges) - 1
-        };
+        let all = 1u64
+            .checked_shl(u32::from(edges))
+            .map_or(u64::MAX, |b| b.wrapping_sub(1));
         let [before, middle] = self.acq;
         self.acq = [middle, dt];
         if self.viable == 0 {
@@ -1323,12 +1339,12 @@ impl SpeedTracker {
                 let special = enc.long_teeth() | enc.short_teeth() | 1;
                 let mut k = tooth_after(tooth, 1, edges);
                 for _ in 0..edges {
-                    if (special >> k) & 1 == 1 {
+                    if special.checked_shr(u32::from(k)).unwrap_or(0) & 1 == 1 {
                         return tooth_back(k, 1, edges);
                     }
                     k = tooth_after(k, 1, edges);
                 }
-                edges - 1
+                edges.saturating_sub(1)
             }
         }
     }
@@ -1499,7 +1515,7 @@ impl SpeedTracker {
         if self.pos != m as u32 {
             self.linearize(m);
         }
-        let head = self.ring.get(m - k..m).unwrap_or(&[]);
+        let head = self.ring.get(m.wrapping_sub(k)..m).unwrap_or(&[]);
         let last0 = self.last;
         let mut run = Run {
             last: last0,
@@ -1510,35 +1526,38 @@ impl SpeedTracker {
         };
         let mut i = 0usize;
         // Captures up to and including the next one on a refresh tooth.
-        let mut refresh = usize::from(BAND_REFRESH - (self.tooth & (BAND_REFRESH - 1)));
+        let mut refresh = usize::from(BAND_REFRESH.wrapping_sub(self.tooth & (BAND_REFRESH - 1)));
         loop {
             let end = n.min(refresh);
             // Samples that start before the batch (at the ring's times), then the others (at
             // the batch's own captures, K back).
             let mid = end.min(k);
+            // (`i` counts captures taken, at most `n`: the sums below do not wrap; `i ≥ k` in
+            // the second run, since `mid < end` means `mid = k`.)
             if i < mid {
-                i += run.take(
+                i = i.wrapping_add(run.take(
                     caps.get(i..mid).unwrap_or(&[]),
                     head.get(i..).unwrap_or(&[]),
-                );
+                ));
             }
             if i >= mid && i < end {
                 let now = caps.get(i..end).unwrap_or(&[]);
-                i += run.take(now, caps.get(i - k..).unwrap_or(&[]));
+                i = i.wrapping_add(run.take(now, caps.get(i.wrapping_sub(k)..).unwrap_or(&[])));
             }
             if i != refresh {
                 break;
             }
-            // The fast path's refresh after this tooth: around the mean of the last K.
+            // The fast path's refresh after this tooth: around the mean of the last K (`i` =
+            // `refresh` ≥ 1).
             let from = if i > k {
-                caps.get(i - 1 - k)
+                caps.get(i.wrapping_sub(1).wrapping_sub(k))
             } else {
-                head.get(i - 1)
+                head.get(i.wrapping_sub(1))
             };
             (run.lo, run.width) = enc
                 .band(run.last.wrapping_sub(from.copied().unwrap_or(0)))
                 .unwrap_or((u32::MAX, 0));
-            refresh += usize::from(BAND_REFRESH);
+            refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
             if i >= n {
                 break;
             }
@@ -1547,28 +1566,26 @@ impl SpeedTracker {
             return (0, 0);
         }
         let from = if i > k {
-            caps.get(i - 1 - k)
+            caps.get(i.wrapping_sub(1).wrapping_sub(k))
         } else {
-            head.get(i - 1)
+            head.get(i.wrapping_sub(1))
         };
         let sum = run.last.wrapping_sub(from.copied().unwrap_or(0));
         // Leave what the fast path would have left, laid out from the ring's start: the last
         // `m` times.
         if let Some(tail) = i.checked_sub(m).and_then(|from| caps.get(from..i)) {
-            for (d, &c) in self.ring.iter_mut().zip(tail) {
-                *d = c;
-            }
+            each_pair(&mut self.ring, tail, |d, &c| *d = c);
         } else {
-            // A short batch: the older times move down, the batch's follow.
-            for j in 0..m - i {
-                let v = self.ring.get(j + i).copied().unwrap_or(0);
+            // A short batch (`i` < `m` ≤ 32): the older times move down, the batch's follow.
+            let keep = m.saturating_sub(i);
+            for j in 0..keep {
+                let v = self.ring.get(j.wrapping_add(i)).copied().unwrap_or(0);
                 if let Some(d) = self.ring.get_mut(j) {
                     *d = v;
                 }
             }
-            for (d, &c) in self.ring.iter_mut().skip(m - i).zip(caps) {
-                *d = c;
-            }
+            let rest = self.ring.get_mut(keep..).unwrap_or_default();
+            each_pair(rest, caps, |d, &c| *d = c);
         }
         self.pos = m as u32;
         self.tooth = self.tooth.wrapping_add(i as u16);
@@ -1655,12 +1672,9 @@ impl Run {
     #[inline(never)]
     fn take(&mut self, now: &[u32], start: &[u32]) -> usize {
         let n = now.len().min(start.len());
-        let (now, start) = (now.get(..n).unwrap_or(&[]), start.get(..n).unwrap_or(&[]));
+        let (mut now, mut start) = (now.get(..n).unwrap_or(&[]), start.get(..n).unwrap_or(&[]));
         let (lo, width) = (self.lo, self.width);
         let (mut last, mut slowest, mut fastest) = (self.last, self.slowest, self.fastest);
-        let (quads, start_quads) = (now.chunks_exact(4), start.chunks_exact(4));
-        let (now_rest, start_rest) = (quads.remainder(), start_quads.remainder());
-        let full = n - now_rest.len();
         let mut step = |c: u32, s: u32| {
             if c.wrapping_sub(last).wrapping_sub(lo) > width {
                 return false;
@@ -1671,19 +1685,33 @@ impl Run {
             last = c;
             true
         };
-        // How many were taken, from where the run stopped (no counter in the loop).
+        // How many were taken, from where the run stopped: `n` less the captures left (no
+        // counter in the loop). Slice patterns, not `chunks_exact` or `zip`: no library
+        // precondition to check, in a debug build either.
         let taken = 'run: {
-            for (q, (c4, s4)) in quads.zip(start_quads).enumerate() {
-                for (e, (&c, &s)) in c4.iter().zip(s4).enumerate() {
-                    if !step(c, s) {
-                        break 'run 4 * q + e;
-                    }
+            while let ([c0, c1, c2, c3, now_rest @ ..], [s0, s1, s2, s3, start_rest @ ..]) =
+                (now, start)
+            {
+                let here = n.wrapping_sub(now.len());
+                if !step(*c0, *s0) {
+                    break 'run here;
                 }
+                if !step(*c1, *s1) {
+                    break 'run here.wrapping_add(1);
+                }
+                if !step(*c2, *s2) {
+                    break 'run here.wrapping_add(2);
+                }
+                if !step(*c3, *s3) {
+                    break 'run here.wrapping_add(3);
+                }
+                (now, start) = (now_rest, start_rest);
             }
-            for (e, (&c, &s)) in now_rest.iter().zip(start_rest).enumerate() {
-                if !step(c, s) {
-                    break 'run full + e;
+            while let ([c, now_rest @ ..], [s, start_rest @ ..]) = (now, start) {
+                if !step(*c, *s) {
+                    break 'run n.wrapping_sub(now.len());
                 }
+                (now, start) = (now_rest, start_rest);
             }
             n
         };
@@ -1738,11 +1766,22 @@ fn exp(x: f32) -> f32 {
             scale *= 2.0;
         }
     } else {
-        for _ in 0..(-n).min(60) {
+        for _ in 0..n.unsigned_abs().min(60) {
             scale *= 0.5;
         }
     }
     sum * scale
+}
+
+/// Calls `f` on the pairs of `a` and `b` in turn, as far as the shorter goes: `zip` by slice
+/// patterns. (A `zip` of two slices checks a library precondition in a debug build, with a
+/// panic branch, when it is not inlined.)
+#[inline(always)]
+pub(crate) fn each_pair<A, B>(mut a: &mut [A], mut b: &[B], mut f: impl FnMut(&mut A, &B)) {
+    while let ([x, a_rest @ ..], [y, b_rest @ ..]) = (a, b) {
+        f(x, y);
+        (a, b) = (a_rest, b_rest);
+    }
 }
 
 /// Whether an index numbered `index_seq` (the arrivals before it) was reported before the
@@ -1752,28 +1791,38 @@ fn reported_before(index_seq: u32, edge_seq: u32) -> bool {
     (edge_seq.wrapping_sub(index_seq) as i32) > 0
 }
 
-/// `bits` rotated left by one within `n` bits.
+/// `bits` rotated left by one within `n` bits (nothing left of them for `n` = 0).
 fn rotate_left(bits: u64, n: u16) -> u64 {
     if n >= 64 {
         bits.rotate_left(1)
     } else {
-        let top = (bits >> (n - 1)) & 1;
-        ((bits << 1) | top) & ((1u64 << n) - 1)
+        let n = u32::from(n);
+        let top = bits.checked_shr(n.wrapping_sub(1)).unwrap_or(0) & 1;
+        ((bits << 1) | top) & 1u64.checked_shl(n).map_or(u64::MAX, |b| b.wrapping_sub(1))
     }
+}
+
+/// The teeth of a wheel of `edges` teeth as a divisor (one for a wheel without teeth).
+#[inline(always)]
+fn wheel(edges: u16) -> NonZeroU32 {
+    NonZeroU32::new(u32::from(edges)).unwrap_or(NonZeroU32::MIN)
 }
 
 /// The tooth `n` after `tooth` on a wheel of `edges` teeth.
 #[inline(always)]
 fn tooth_after(tooth: u16, n: u16, edges: u16) -> u16 {
-    let s = u32::from(tooth) + u32::from(n);
-    (s % u32::from(edges.max(1))) as u16
+    // Two u16 in a u32: the sum does not wrap.
+    let s = u32::from(tooth).wrapping_add(u32::from(n));
+    (s % wheel(edges)) as u16
 }
 
 /// The tooth `n` before `tooth` on a wheel of `edges` teeth.
 #[inline(always)]
 fn tooth_back(tooth: u16, n: u16, edges: u16) -> u16 {
-    let e = u32::from(edges.max(1));
-    ((u32::from(tooth) + e - u32::from(n) % e) % e) as u16
+    let e = wheel(edges);
+    // `n mod e` < e ≤ tooth + e: no wrap.
+    let s = (u32::from(tooth).wrapping_add(e.get())).wrapping_sub(u32::from(n) % e);
+    (s % e) as u16
 }
 
 #[cfg(test)]

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Checks the firmware (release build, or with `dev` the debug build, overflow checks on):
-# nothing the core's per-edge entry points (src/entry_points.rs) reach can panic. Walks the call graph of the disassembly (direct calls and jumps between
-# functions) from those functions and fails if it reaches a panic routine of `core` (a bounds
-# check, an unwrap, an overflow, a slice length check, `panic_fmt`) or an indirect call it
-# cannot follow. Builds the firmware first if it is not built.
+# Checks the firmware (release build, or with `dev` the debug build, overflow checks and
+# library precondition checks on): nothing the core's per-edge entry points
+# (src/entry_points.rs) reach can panic. Walks the call graph of the disassembly (direct calls
+# and jumps between functions, conditional ones included) from those functions and fails if it
+# reaches a panic routine of `core` (a bounds check, an unwrap, an overflow, a slice length
+# check, a failed precondition, `panic_fmt`) or an indirect call it cannot follow. Builds the
+# firmware first (nothing to do when it is up to date).
 #
 # Needs: the rustup component llvm-tools (rustup component add llvm-tools) for llvm-objdump.
 set -euo pipefail
@@ -12,7 +14,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 profile="${1:-release}"
 case "$profile" in
 release) elf=target/thumbv7em-none-eabihf/release/drive-monitor-firmware
-    [ -f "$elf" ] || cargo build --release --quiet ;;
+    cargo build --release --quiet ;;
 dev) elf=target/thumbv7em-none-eabihf/debug/drive-monitor-firmware
     cargo build --quiet ;;
 *) echo "usage: panic-free.sh [release|dev]" >&2; exit 2 ;;
@@ -30,8 +32,9 @@ fi
         names[cur] = 1
         next
     }
-    # A direct call or jump to another function: "bl 0x... <symbol+0x..>"
-    cur != "" && /\t(bl|blx|b|b\.w|bal|beq|bne|bhs|blo|bhi|bls|bge|blt|bgt|ble|bmi|bpl|bvs|bvc|bcs|bcc|cbz|cbnz)(\.w)?\t/ && /</ {
+    # A direct call or jump to another function: "bl 0x... <symbol+0x..>", conditional ones
+    # too (a branch, or a call inside an IT block: "blne").
+    cur != "" && /\t(b|bl|blx)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?(\.w|\.n)?\t|\t(cbz|cbnz)\t/ && /</ {
         t = $0
         sub(/^[^<]*</, "", t)
         sub(/>.*$/, "", t)
@@ -39,8 +42,10 @@ fi
         if (t != cur) edges[cur] = edges[cur] " " t
         next
     }
-    # An indirect call (a register holds the target): not followed, so not allowed.
-    cur != "" && /\tblx\tr[0-9]+/ { indirect[cur] = 1 }
+    # An indirect call or jump (a register holds the target; "bx lr" is a return): not
+    # followed, so not allowed.
+    cur != "" && /\t(blx|bx)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?\t(r[0-9]+|ip|sb|sl|fp)([^0-9a-z]|$)/ { indirect[cur] = 1 }
+    cur != "" && /\t(mov|ldr)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?(\.w)?\tpc,/ { indirect[cur] = 1 }
     END {
         n = 0
         for (f in names) if (f ~ /12entry_points/) { queue[n++] = f; seen[f] = "(entry)" }
