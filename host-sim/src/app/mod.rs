@@ -2,8 +2,10 @@
 //! ([`run`]), design-time results ([`predict`]), the run-up's capture analysis ([`capture`]), and
 //! the report with its plots ([`report`], [`plot`]), progress bars ([`progress`]).
 
+pub mod analyze;
 pub mod capture;
 pub mod check;
+pub mod logic;
 pub mod plot;
 pub mod predict;
 pub mod progress;
