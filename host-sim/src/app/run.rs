@@ -421,6 +421,8 @@ fn sim_encoder(scene: &Scene, file: &Path, capture: bool) -> Result<SimEncoder, 
         c.duty = Some(scene.capture.unwrap_or_default().duty);
     }
     c.seed = scene.simulation.seed;
+    // Dropped edges reach the collector as ground truth; it passes them on to nothing else.
+    c.emit_dropped = true;
     crate::engine::encoder::Encoder::new(c.clone())
         .map_err(|er| core_error(scene, file, "encoder", er))?;
     Ok(c)
