@@ -836,7 +836,7 @@ fn shaft_model(
     names: &mut Vec<&'static str>,
 ) -> Result<ShaftModel, SceneError> {
     if let Some(profile) = speed_profile(scene, over) {
-        names.push("cranking");
+        // A prescribed shaft, not an effect: `names` lists the effects only.
         return Ok(ShaftModel::Profile(profile));
     }
     let prescribed = over.speed.or(match &scene.motor {
@@ -901,7 +901,8 @@ fn shaft_model(
 /// "profile"`) or carries a cranking ripple (`[cranking]`); `None` otherwise.
 fn speed_profile(scene: &Scene, over: Overrides) -> Option<SpeedProfile> {
     let mean = match (over.speed, &scene.motor) {
-        (Some(w), _) => vec![(0.0, w)],
+        (Some(w), _) if scene.cranking.is_some() => vec![(0.0, w)],
+        (Some(_), _) => return None,
         (None, Some(MotorSpec::Profile { points })) => {
             points.iter().map(|p| (p[0], p[1])).collect()
         }
