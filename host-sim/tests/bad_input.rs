@@ -272,6 +272,7 @@ fn work_is_bounded_before_simulating() {
     let options = RunOptions {
         progress: false,
         keep_windows: false,
+        ..RunOptions::default()
     };
     let r = run_with(&s, Path::new("long.toml"), Overrides::default(), options).unwrap();
     assert!(r.window_list.is_empty());

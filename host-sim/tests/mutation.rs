@@ -152,6 +152,7 @@ fn one(case: &Case) -> Result<(), String> {
     let options = RunOptions {
         progress: false,
         keep_windows: false,
+        ..RunOptions::default()
     };
     match run_with(&short, Path::new(&path), Overrides::default(), options) {
         Ok(r) => {

@@ -9,7 +9,7 @@
 //! ranges (values that contradict each other) are turned into scene keys by [`core_keys`].
 
 use crate::app::scene::{
-    AutobalancerSpec, EncoderSpec, FramingSpec, Harmonic, MotorSpec, Scene, SceneError,
+    parse_wheel, AutobalancerSpec, EncoderSpec, FramingSpec, Harmonic, MotorSpec, Scene, SceneError,
 };
 use drive_monitor::ConfigError;
 use std::collections::BTreeMap;
@@ -234,7 +234,22 @@ impl<'a> Checker<'a> {
     /// The core's rejection of a configuration built from the scene's `section`, as an error
     /// naming the scene keys the core's parameter stands for, with their values as written.
     pub fn core(&self, scene: &Scene, section: &str, e: ConfigError) -> SceneError {
-        let keys = core_keys(section, e.parameter());
+        let listed = core_keys(section, e.parameter());
+        // Of the keys the parameter may stand for, the ones this file uses (or whose default
+        // it relies on): a wheel given as `wheel = "36-2"` is not blamed on `encoder.teeth`.
+        let used: Vec<String> = listed
+            .iter()
+            .filter(|k| {
+                self.written.get(k).is_some()
+                    || default_of(scene, k).is_some()
+                    || self.written.entries().any(|(w, _, _)| {
+                        w.strip_prefix(k.as_str())
+                            .is_some_and(|rest| rest.starts_with('[') || rest.starts_with('.'))
+                    })
+            })
+            .cloned()
+            .collect();
+        let keys = if used.is_empty() { listed } else { used };
         let mut quoted = String::new();
         for (i, k) in keys.iter().enumerate() {
             if i > 0 {
@@ -267,7 +282,11 @@ fn core_message(e: &ConfigError, several: bool) -> String {
         }
         ConfigError::OutOfRange(_) => "out of range".into(),
         ConfigError::Capacity(_) => "more than the fixed capacity holds".into(),
-        ConfigError::Inconsistent(_) => "contradict each other".into(),
+        // The core names what contradicts in parentheses: "pattern (rotationally symmetric)".
+        ConfigError::Inconsistent(p) => match p.split_once(" (") {
+            Some((_, why)) => format!("contradict each other ({}", why),
+            None => "contradict each other".into(),
+        },
     }
 }
 
@@ -278,13 +297,25 @@ fn core_message(e: &ConfigError, several: bool) -> String {
 pub fn core_keys(section: &str, parameter: &str) -> Vec<String> {
     let listed: &[&str] = match (section, parameter) {
         // drive_monitor::encoder::Encoder::new, from [encoder] and [monitor].
-        ("encoder", "lines") => &["encoder.lines"],
-        ("encoder", "pattern.positions" | "pattern.teeth") => {
-            &["encoder.lines", "encoder.missing", "encoder.framing"]
-        }
+        ("encoder", "lines") => &["encoder.lines", "encoder.wheel"],
+        // The wheel's pattern, however the scene gives it; the core's "pattern (...)" names
+        // say what contradicts (uniform, rotationally symmetric, a pitch too close).
+        ("encoder", p) if p.starts_with("pattern") => &[
+            "encoder.wheel",
+            "encoder.gaps",
+            "encoder.teeth",
+            "encoder.lines",
+            "encoder.missing",
+            "encoder.framing",
+        ],
+        ("encoder", "prescaler") => &["encoder.prescaler", "encoder.lines", "encoder.framing"],
+        ("encoder", "tolerances.accept") => &["encoder.tolerances.accept"],
+        ("encoder", "tolerances.glitch_fraction") => &["encoder.tolerances.glitch_fraction"],
+        ("encoder", "tolerances.fault_margin") => &["encoder.tolerances.fault_margin"],
         ("encoder", "estimator.edges") => &[
             "encoder.estimator_edges",
             "encoder.lines",
+            "encoder.wheel",
             "monitor.min_speed",
             "encoder.timer_hz",
         ],
@@ -293,10 +324,21 @@ pub fn core_keys(section: &str, parameter: &str) -> Vec<String> {
             "monitor.min_speed",
             "encoder.timer_hz",
             "encoder.lines",
+            "encoder.wheel",
             "encoder.missing",
+            "encoder.gaps",
+            "encoder.teeth",
             "encoder.counter_bits",
         ],
         ("encoder", "counter_bits") => &["encoder.counter_bits"],
+        // The simulator's encoder (host_sim::engine::encoder), from [encoder] and [capture].
+        ("encoder", "encoder.duty") => &["capture.duty", "encoder.teeth", "encoder.gaps"],
+        ("encoder", "encoder.pitch_errors") => &["encoder.pitch_error", "encoder.runout"],
+        // The speed profile of a cranking scene (host_sim::engine::cranking).
+        ("shaft", "profile.points" | "profile.time" | "profile.speed") => &["motor.points"],
+        ("shaft", "ripple.amplitude") => &["cranking.ripple"],
+        ("shaft", "ripple.strokes") => &["cranking.strokes"],
+        ("shaft", "ripple.phase") => &["cranking.phase"],
         // drive_monitor::irregularity::WindowConfig, from [monitor] and the load's orders.
         ("monitor", "window.revolutions") => &["monitor.window_revolutions"],
         ("monitor", "window.load_order") => &["load.harmonics", "monitor.window_revolutions"],
@@ -354,10 +396,14 @@ fn default_of(scene: &Scene, key: &str) -> Option<String> {
     let e = scene.encoder.as_ref();
     let m = scene.monitor.as_ref();
     match key {
-        "encoder.missing" => e.map(|e| e.missing.to_string()),
+        "encoder.missing" => e
+            .filter(|e| e.framing() == FramingSpec::MissingTooth && e.wheel.is_none())
+            .map(|e| e.missing.to_string()),
         "encoder.counter_bits" => e.map(|e| e.counter_bits.to_string()),
+        "encoder.prescaler" => e.map(|e| e.prescaler.to_string()),
         "encoder.estimator_edges" => e.map(|e| e.estimator_edges.to_string()),
-        "encoder.framing" => e.map(|e| format!("{:?}", e.framing)),
+        "encoder.framing" => e.map(|e| format!("\"{}\"", e.framing().name())),
+        "capture.duty" => Some(num(scene.capture.unwrap_or_default().duty)),
         "monitor.min_speed" => Some(num(m.and_then(|m| m.min_speed).unwrap_or(1.0))),
         "monitor.steady_tolerance" => Some(num(m.and_then(|m| m.steady_tolerance).unwrap_or(0.02))),
         _ => None,
@@ -371,6 +417,7 @@ pub fn check(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     if let Some(e) = &scene.encoder {
         encoder(e, c)?;
     }
+    cranking_and_capture(scene, c)?;
     monitor(scene, c)?;
     vibration(scene, c)?;
     rotor(scene, c)?;
@@ -486,6 +533,28 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
             c.magnitude("motor.to", *to, MAX_SPEED, "rad/s")?;
             c.positive("motor.duration", *duration, MAX_DURATION, "s")?;
         }
+        Some(MotorSpec::Profile { points }) => {
+            let most = crate::engine::cranking::MAX_PROFILE_POINTS as u64;
+            if points.is_empty() || points.len() as u64 > most {
+                return Err(c.bad(
+                    "motor.points",
+                    format!("{} points", points.len()),
+                    format!("1 to {most} points [t, ω]"),
+                ));
+            }
+            for (i, &[t, w]) in points.iter().enumerate() {
+                let k = format!("motor.points[{}]", i + 1);
+                c.magnitude(&format!("{k}[1]"), t, MAX_DURATION, "s")?;
+                c.non_negative(&format!("{k}[2]"), w, MAX_SPEED, "rad/s")?;
+                if i > 0 && t <= points[i - 1][0] {
+                    return Err(c.bad(
+                        &format!("{k}[1]"),
+                        t,
+                        "times must increase from point to point",
+                    ));
+                }
+            }
+        }
         None => {}
     }
     if let Some(l) = &scene.load {
@@ -495,38 +564,304 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn encoder(e: &EncoderSpec, c: &Checker) -> Result<(), SceneError> {
-    c.count("encoder.lines", e.lines.into(), 2, MAX_LINES.into())?;
-    c.range("encoder.timer_hz", e.timer_hz, 1.0, false, 1e10, "Hz")?;
-    c.count("encoder.counter_bits", e.counter_bits.into(), 16, 32)?;
-    match e.framing {
-        FramingSpec::MissingTooth => {
-            c.count("encoder.missing", e.missing.into(), 1, 3)?;
-            let room = 2 * u64::from(e.missing) + 2;
-            if u64::from(e.lines) < u64::from(e.missing) + room {
+/// The wheel an `[encoder]` table describes, resolved from whichever keys give it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WheelDesc {
+    /// Grid positions (lines) per revolution.
+    pub lines: u16,
+    /// How revolutions are framed.
+    pub framing: FramingSpec,
+    /// Grid positions carrying a tooth, ascending (every position on an index or unframed
+    /// disc).
+    pub teeth: Vec<u16>,
+}
+
+impl WheelDesc {
+    /// The core's wheel.
+    pub fn core(&self) -> Result<drive_monitor::encoder::Wheel, ConfigError> {
+        use drive_monitor::encoder::{Pattern, Wheel};
+        Ok(match self.framing {
+            FramingSpec::Index => Wheel::Indexed { lines: self.lines },
+            FramingSpec::None => Wheel::Unframed { lines: self.lines },
+            FramingSpec::MissingTooth | FramingSpec::Pattern => {
+                let positions = u8::try_from(self.lines)
+                    .map_err(|_| ConfigError::OutOfRange("pattern.positions"))?;
+                let teeth: Vec<u8> = self.teeth.iter().map(|&t| t as u8).collect();
+                Wheel::Pattern(Pattern::from_teeth(positions, &teeth)?)
+            }
+        })
+    }
+}
+
+/// Most grid positions of a pattern wheel ([`drive_monitor::encoder::MAX_PATTERN_POSITIONS`]).
+pub const MAX_PATTERN_LINES: u16 = drive_monitor::encoder::MAX_PATTERN_POSITIONS as u16;
+
+/// Resolves the wheel of `e`: `wheel = "N-M"`, `lines` with `missing` (framing
+/// `"missing-tooth"`), `lines` with `gaps` or `teeth` (a pattern), or `lines` alone (an index
+/// or unframed disc). Keys that contradict each other are errors naming both.
+pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
+    let framing = e.framing();
+    let both = |a: &str, b: &str, why: &str| {
+        c.bad(
+            b,
+            c.shown(b, "?"),
+            format!("not together with `{a} = {}`: {why}", c.shown(a, "?")),
+        )
+    };
+    let wheel = match &e.wheel {
+        Some(w) => {
+            let (n, m) = parse_wheel(w).map_err(|why| c.bad("encoder.wheel", w, why))?;
+            for key in ["encoder.gaps", "encoder.teeth"] {
+                if c.written.get(&format!("{key}[1][1]")).is_some()
+                    || c.written.get(&format!("{key}[1]")).is_some()
+                {
+                    return Err(both("encoder.wheel", key, "the wheel names its one gap"));
+                }
+            }
+            if e.gaps.is_some() || e.teeth.is_some() {
+                return Err(c.bad(
+                    "encoder.wheel",
+                    w,
+                    "not together with gaps or teeth: the wheel names its one gap",
+                ));
+            }
+            if e.missing != 0 {
+                return Err(both(
+                    "encoder.wheel",
+                    "encoder.missing",
+                    "the wheel names its gap",
+                ));
+            }
+            if let Some(l) = e.lines.filter(|&l| l != n) {
                 return Err(c.bad(
                     "encoder.lines",
-                    e.lines,
+                    l,
                     format!(
-                        "too few for missing = {}: at least {} lines",
-                        c.shown("encoder.missing", e.missing),
-                        u64::from(e.missing) + room
+                        "contradicts wheel = {} ({n} positions)",
+                        c.shown("encoder.wheel", w)
                     ),
                 ));
             }
+            if framing != FramingSpec::MissingTooth {
+                return Err(both(
+                    "encoder.wheel",
+                    "encoder.framing",
+                    "a wheel \"N-M\" is framed by its gap (framing = \"missing-tooth\")",
+                ));
+            }
+            Some((n, m))
         }
-        FramingSpec::Index | FramingSpec::None if e.missing != 0 => {
-            return Err(c.bad(
-                "encoder.missing",
-                e.missing,
-                "only with framing = \"missing-tooth\" (this encoder has no gap)",
-            ));
+        None => None,
+    };
+    let lines = match (wheel, e.lines) {
+        (Some((n, _)), _) => n,
+        (None, Some(l)) => l,
+        (None, None) => {
+            return Err(SceneError::Rule {
+                file: c.file.to_path_buf(),
+                key: "encoder.lines".into(),
+                value: "(missing)".into(),
+                rule: "the encoder needs lines (or a wheel such as wheel = \"36-2\")".into(),
+            })
         }
-        _ => {}
+    };
+    let grid_max = match framing {
+        FramingSpec::MissingTooth | FramingSpec::Pattern => MAX_PATTERN_LINES,
+        FramingSpec::Index | FramingSpec::None => MAX_LINES,
+    };
+    let lines_key = if wheel.is_some() {
+        "encoder.wheel"
+    } else {
+        "encoder.lines"
+    };
+    if !(2..=grid_max).contains(&lines) {
+        let shown = c.shown(lines_key, lines);
+        let rule = if grid_max == MAX_LINES {
+            format!("allowed 2 to {MAX_LINES}")
+        } else {
+            format!(
+                "a wheel framed by its pattern has 3 to {MAX_PATTERN_LINES} grid positions (framing = \"{}\")",
+                framing.name()
+            )
+        };
+        return Err(c.bad(lines_key, shown, rule));
     }
-    let edges = u64::from(e.lines) - u64::from(e.missing);
-    let span = (drive_monitor::encoder::MAX_SPAN as u64).min(edges);
+    let all: Vec<u16> = (0..lines).collect();
+    let teeth =
+        match framing {
+            FramingSpec::Index | FramingSpec::None => {
+                if e.missing != 0 {
+                    return Err(c.bad(
+                        "encoder.missing",
+                        e.missing,
+                        "only with framing = \"missing-tooth\" (this encoder has no gap)",
+                    ));
+                }
+                for key in ["encoder.gaps", "encoder.teeth"] {
+                    let given = if key == "encoder.gaps" {
+                        e.gaps.is_some()
+                    } else {
+                        e.teeth.is_some()
+                    };
+                    if given {
+                        return Err(c.bad(
+                            key,
+                            "[...]",
+                            format!(
+                                "only for a pattern wheel (framing = {} has no pattern)",
+                                c.shown("encoder.framing", format!("\"{}\"", framing.name()))
+                            ),
+                        ));
+                    }
+                }
+                all
+            }
+            FramingSpec::MissingTooth => {
+                let (m, key) = match wheel {
+                    Some((_, m)) => (m, "encoder.wheel"),
+                    None => (e.missing, "encoder.missing"),
+                };
+                if e.gaps.is_some() || e.teeth.is_some() {
+                    return Err(c.bad(
+                        "encoder.framing",
+                        "\"missing-tooth\"",
+                        "gaps and teeth describe a pattern wheel: framing = \"pattern\"",
+                    ));
+                }
+                if m == 0 || u16::from(m) + 3 > lines {
+                    return Err(c.bad(
+                        key,
+                        c.shown(key, m),
+                        format!(
+                            "missing teeth: 1 to {} on {lines} positions (3 teeth at least)",
+                            lines.saturating_sub(3)
+                        ),
+                    ));
+                }
+                // The core numbers the gap at the end of the grid: the last M positions are absent.
+                all[..usize::from(lines - u16::from(m))].to_vec()
+            }
+            FramingSpec::Pattern => {
+                if e.missing != 0 {
+                    return Err(both(
+                        "encoder.framing",
+                        "encoder.missing",
+                        "a pattern wheel is given by gaps or teeth",
+                    ));
+                }
+                match (&e.gaps, &e.teeth) {
+                    (Some(_), Some(_)) => {
+                        return Err(c.bad(
+                            "encoder.teeth",
+                            "[...]",
+                            "not together with gaps: one description of the wheel",
+                        ))
+                    }
+                    (Some(gaps), None) => {
+                        let mut present = vec![true; usize::from(lines)];
+                        for (i, &[start, count]) in gaps.iter().enumerate() {
+                            let k = format!("encoder.gaps[{}]", i + 1);
+                            if start >= lines {
+                                return Err(c.bad(
+                                    &format!("{k}[1]"),
+                                    start,
+                                    format!("a gap starts at a grid position, 0 to {}", lines - 1),
+                                ));
+                            }
+                            if count == 0 || count >= lines {
+                                return Err(c.bad(
+                                    &format!("{k}[2]"),
+                                    count,
+                                    format!("missing positions, 1 to {}", lines - 1),
+                                ));
+                            }
+                            for p in start..start + count {
+                                present[usize::from(p % lines)] = false;
+                            }
+                        }
+                        all.into_iter()
+                            .filter(|&p| present[usize::from(p)])
+                            .collect()
+                    }
+                    (None, Some(teeth)) => {
+                        let mut sorted = Vec::with_capacity(teeth.len());
+                        for (i, &t) in teeth.iter().enumerate() {
+                            let k = format!("encoder.teeth[{}]", i + 1);
+                            if t >= lines {
+                                return Err(c.bad(
+                                    &k,
+                                    t,
+                                    format!("a grid position, 0 to {}", lines - 1),
+                                ));
+                            }
+                            if sorted.contains(&t) {
+                                return Err(c.bad(&k, t, "listed twice"));
+                            }
+                            sorted.push(t);
+                        }
+                        sorted.sort_unstable();
+                        sorted
+                    }
+                    (None, None) => return Err(c.bad(
+                        "encoder.framing",
+                        "\"pattern\"",
+                        "a pattern wheel needs its gaps = [[start, count], ...] or teeth = [...]",
+                    )),
+                }
+            }
+        };
+    let most = drive_monitor::encoder::MAX_PATTERN_TEETH;
+    if matches!(framing, FramingSpec::Pattern) && (teeth.len() < 3 || teeth.len() > most) {
+        let key = if e.gaps.is_some() {
+            "encoder.gaps"
+        } else {
+            "encoder.teeth"
+        };
+        return Err(c.bad(
+            key,
+            format!("{} teeth", teeth.len()),
+            format!("a pattern wheel has 3 to {most} teeth"),
+        ));
+    }
+    if matches!(framing, FramingSpec::MissingTooth) && teeth.len() > most {
+        return Err(c.bad(
+            lines_key,
+            c.shown(lines_key, lines),
+            format!("a missing-tooth wheel has at most {most} teeth"),
+        ));
+    }
+    Ok(WheelDesc {
+        lines,
+        framing,
+        teeth,
+    })
+}
+
+fn encoder(e: &EncoderSpec, c: &Checker) -> Result<(), SceneError> {
+    let w = wheel(e, c)?;
+    c.range("encoder.timer_hz", e.timer_hz, 1.0, false, 1e10, "Hz")?;
+    c.count("encoder.counter_bits", e.counter_bits.into(), 16, 32)?;
+    if ![1, 2, 4, 8].contains(&e.prescaler) {
+        return Err(c.bad("encoder.prescaler", e.prescaler, "allowed 1, 2, 4 or 8"));
+    }
+    let edges = w.teeth.len() as u64 / u64::from(e.prescaler).max(1);
+    let span = (drive_monitor::encoder::MAX_SPAN as u64).min(edges.max(1));
     c.count("encoder.estimator_edges", e.estimator_edges.into(), 1, span)?;
+    let t = &e.tolerances;
+    for (key, x, lo, hi) in [
+        ("encoder.tolerances.accept", t.accept, 1.05, 2.0),
+        (
+            "encoder.tolerances.glitch_fraction",
+            t.glitch_fraction,
+            0.05,
+            0.6,
+        ),
+        ("encoder.tolerances.fault_margin", t.fault_margin, 0.05, 2.0),
+    ] {
+        if let Some(x) = x {
+            c.range(key, x, lo, false, hi, "")?;
+        }
+    }
     c.non_negative("encoder.jitter", e.jitter, MAX_JITTER, "s")?;
     c.range("encoder.runout", e.runout, 0.0, false, 0.5, "(e/r)")?;
     c.magnitude("encoder.runout_phase", e.runout_phase, MAX_ANGLE, "rad")?;
@@ -536,6 +871,70 @@ fn encoder(e: &EncoderSpec, c: &Checker) -> Result<(), SceneError> {
         ("encoder.glitch_probability", e.glitch_probability),
     ] {
         c.non_negative(key, p, MAX_FAULT_PROBABILITY, "")?;
+    }
+    if let Some([a, b]) = e.glitch_window {
+        c.range(
+            "encoder.glitch_window[1]",
+            a,
+            0.0,
+            false,
+            1.0,
+            "of a tooth interval",
+        )?;
+        c.range(
+            "encoder.glitch_window[2]",
+            b,
+            0.0,
+            false,
+            1.0,
+            "of a tooth interval",
+        )?;
+        if b < a {
+            return Err(c.bad(
+                "encoder.glitch_window[2]",
+                b,
+                format!(
+                    "must not be below glitch_window[1] = {}",
+                    c.shown("encoder.glitch_window[1]", a)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `[cranking]` and `[capture]`.
+fn cranking_and_capture(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
+    if let Some(k) = &scene.cranking {
+        c.range("cranking.ripple", k.ripple, 0.0, false, 0.9, "(relative)")?;
+        c.range(
+            "cranking.strokes",
+            k.strokes,
+            0.0,
+            true,
+            MAX_ORDER,
+            "per revolution",
+        )?;
+        c.magnitude("cranking.phase", k.phase, MAX_ANGLE, "rad")?;
+        if !matches!(
+            scene.motor,
+            Some(MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } | MotorSpec::Profile { .. })
+        ) {
+            return Err(SceneError::Rule {
+                file: c.file.to_path_buf(),
+                key: "cranking".into(),
+                value: "(table)".into(),
+                rule: "a cranking ripple modulates a prescribed speed: [motor] model = \"speed\", \"ramp\" or \"profile\"".into(),
+            });
+        }
+    }
+    if let Some(k) = &scene.capture {
+        c.range("capture.sample_rate", k.sample_rate, 1.0, false, 1e10, "Hz")?;
+        if k.sample_rate.fract() != 0.0 {
+            return Err(c.bad("capture.sample_rate", k.sample_rate, "a whole number of Hz"));
+        }
+        c.range("capture.duty", k.duty, 0.0, true, 0.99, "of a grid pitch")?;
+        c.range("capture.noise_width", k.noise_width, 1e-12, false, 1.0, "s")?;
     }
     Ok(())
 }

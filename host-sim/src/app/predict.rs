@@ -52,7 +52,9 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
             Motor::kloss(k, KlossFit::SynchronousTangent)
                 .map_err(|e| core_error(scene, file, "motor", e))?
         }
-        MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } => return Ok(None),
+        MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } | MotorSpec::Profile { .. } => {
+            return Ok(None)
+        }
     };
     let mut harmonics = Vec::with_capacity(load.harmonics.len());
     for h in &load.harmonics {

@@ -6,10 +6,12 @@
 //! core's classifiers judge the measured speed. The report puts the core's measurements next
 //! to the design-time prediction and to what the simulation itself did.
 
+use crate::app::logic::{CaptureFormat, CaptureSettings, CaptureWriter};
 use crate::app::predict::{self, core_error};
 use crate::app::scene::{
     BalancerKindSpec, FramingSpec, IntegratorKind, MotorSpec, Scene, SceneError,
 };
+use crate::engine::cranking::{Ripple, SpeedProfile};
 use crate::engine::encoder::{EncoderConfig as SimEncoder, Reference, Runout};
 use crate::engine::model::Effect;
 use crate::engine::ode::Integrator;
@@ -27,7 +29,7 @@ use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
 use drive_monitor::balancer::DEFAULT_MARGIN;
 use drive_monitor::balancer::{Classifier, Machine};
 use drive_monitor::drive::DriveModel;
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Tolerances, Wheel};
 use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
 use drive_monitor::supports::Level;
@@ -175,6 +177,15 @@ pub struct RunReport {
     /// Speed the core measured against time, decimated (for plots).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
+    /// The capture file written (`--capture`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture_file: Option<String>,
+    /// Rows written to it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture_rows: Option<u64>,
+    /// Every edge the encoder produced ([`RunOptions::keep_edges`]).
+    #[serde(skip)]
+    pub edge_list: Vec<crate::engine::encoder::Edge>,
     /// Settling time, s.
     #[serde(skip)]
     pub settle: f64,
@@ -315,34 +326,47 @@ fn rotor_loads(scene: &Scene, file: &Path) -> Result<Option<RotorLoads>, SceneEr
         .map_err(|e| core_error(scene, file, "rotor", e))
 }
 
-/// The core's monitor for the scene's encoder.
-fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LINES>>, SceneError> {
+/// The core's encoder configuration for the scene's `[encoder]` (and `[monitor] min_speed`),
+/// validated by the core: the wheel however the scene gives it, the timer, the prescaler, the
+/// estimator and the tolerances. `None` without an `[encoder]`.
+pub fn core_encoder(scene: &Scene, file: &Path) -> Result<Option<Encoder>, SceneError> {
     let Some(e) = &scene.encoder else {
         return Ok(None);
     };
-    let mut c = match e.framing {
-        FramingSpec::Index => EncoderConfig::indexed(e.lines, e.timer_hz),
-        FramingSpec::MissingTooth => {
-            let positions = u8::try_from(e.lines).map_err(|_| {
-                SceneError::value(
-                    file,
-                    "encoder.lines",
-                    format!(
-                        "a missing-tooth wheel has at most {} positions, got {}",
-                        drive_monitor::encoder::MAX_PATTERN_POSITIONS,
-                        e.lines
-                    ),
-                )
-            })?;
-            EncoderConfig::missing_teeth(positions, e.missing, e.timer_hz)
-        }
-        FramingSpec::None => EncoderConfig::unframed(e.lines, e.timer_hz),
+    let c = scene.checker(file);
+    let w = crate::app::check::wheel(e, &c)?;
+    let wheel = w
+        .core()
+        .map_err(|er| core_error(scene, file, "encoder", er))?;
+    let mut cfg = match wheel {
+        Wheel::Indexed { lines } => EncoderConfig::indexed(lines, e.timer_hz),
+        Wheel::Unframed { lines } => EncoderConfig::unframed(lines, e.timer_hz),
+        Wheel::Pattern(p) => EncoderConfig::pattern(p, e.timer_hz),
     };
-    c.counter_bits = e.counter_bits;
-    c.estimator = Estimator::Edges(e.estimator_edges);
+    cfg.counter_bits = e.counter_bits;
+    cfg.prescaler = e.prescaler;
+    cfg.estimator = Estimator::Edges(e.estimator_edges);
+    let t = e.tolerances;
+    let d = Tolerances::default();
+    cfg.tolerances = Tolerances {
+        accept: t.accept.map_or(d.accept, |x| x as f32),
+        glitch_fraction: t.glitch_fraction.map_or(d.glitch_fraction, |x| x as f32),
+        fault_margin: t.fault_margin.map_or(d.fault_margin, |x| x as f32),
+    };
+    cfg.min_speed = scene
+        .monitor
+        .as_ref()
+        .and_then(|m| m.min_speed)
+        .unwrap_or(1.0);
+    Encoder::new(cfg)
+        .map(Some)
+        .map_err(|er| core_error(scene, file, "encoder", er))
+}
+
+/// The δ window of a scene: `[monitor] window_revolutions`, else one load cycle (the lowest
+/// order of the load's harmonics), else one revolution.
+pub fn window_config(scene: &Scene) -> WindowConfig {
     let m = scene.monitor.clone().unwrap_or_default();
-    c.min_speed = m.min_speed.unwrap_or(1.0);
-    let enc = Encoder::new(c).map_err(|er| core_error(scene, file, "encoder", er))?;
     let revs = match m.window_revolutions {
         Some(n) => WindowLength::Revolutions(n),
         None => {
@@ -360,30 +384,42 @@ fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LI
             }
         }
     };
-    let window = WindowConfig {
+    WindowConfig {
         length: revs,
         steady_tolerance: m.steady_tolerance.unwrap_or(0.02) as f32,
+    }
+}
+
+/// The core's monitor for the scene's encoder.
+fn core_monitor(scene: &Scene, file: &Path) -> Result<Option<DeltaMonitor<MAX_LINES>>, SceneError> {
+    let Some(enc) = core_encoder(scene, file)? else {
+        return Ok(None);
     };
+    let m = scene.monitor.clone().unwrap_or_default();
     let alarm = m.delta_limit.map(|l| AlarmConfig::new(l as f32));
-    DeltaMonitor::new(enc, window, alarm)
+    DeltaMonitor::new(enc, window_config(scene), alarm)
         .map(Some)
         .map_err(|er| core_error(scene, file, "monitor", er))
 }
 
-fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
+/// The simulator's encoder for the scene: the same wheel as the core's (one description, the
+/// teeth of [`crate::app::check::wheel`]), the index channel of an index disc, the scene's
+/// errors and faults, and with `capture` the falling edges of every pulse.
+fn sim_encoder(scene: &Scene, file: &Path, capture: bool) -> Result<SimEncoder, SceneError> {
     let Some(e) = &scene.encoder else {
         // Without an encoder table the simulation still needs one to advance; use a coarse one
         // whose edges are ignored.
         return Ok(SimEncoder::ideal(4, 1e6));
     };
-    let mut c = SimEncoder::ideal(e.lines as u32, e.timer_hz);
-    c.reference = match e.framing {
-        FramingSpec::Index => Reference::Index,
-        FramingSpec::MissingTooth => Reference::MissingTeeth {
-            count: e.missing as u32,
-        },
-        FramingSpec::None => Reference::None,
-    };
+    let w = crate::app::check::wheel(e, &scene.checker(file))?;
+    let mut c = SimEncoder::ideal(u32::from(w.lines), e.timer_hz);
+    match w.framing {
+        FramingSpec::Index => c.reference = Reference::Index,
+        FramingSpec::None => {}
+        FramingSpec::MissingTooth | FramingSpec::Pattern => {
+            c.teeth = Some(w.teeth.iter().map(|&t| u32::from(t)).collect());
+        }
+    }
     c.counter_bits = e.counter_bits as u32;
     c.jitter = e.jitter;
     c.pitch_error_std = e.pitch_error;
@@ -396,7 +432,15 @@ fn sim_encoder(scene: &Scene, file: &Path) -> Result<SimEncoder, SceneError> {
     }
     c.drop_probability = e.drop_probability;
     c.glitch_probability = e.glitch_probability;
+    if let Some(g) = e.glitch_window {
+        c.glitch_window = g;
+    }
+    if capture {
+        c.duty = Some(scene.capture.unwrap_or_default().duty);
+    }
     c.seed = scene.simulation.seed;
+    // Dropped edges reach the collector as ground truth; it passes them on to nothing else.
+    c.emit_dropped = true;
     crate::engine::encoder::Encoder::new(c.clone())
         .map_err(|er| core_error(scene, file, "encoder", er))?;
     Ok(c)
@@ -424,8 +468,17 @@ pub const MAX_EDGES: f64 = 2e8;
 /// Most integrator steps one run may take.
 pub const MAX_STEPS: u64 = 50_000_000;
 
+/// Where `drive-sim run --capture` writes the encoder signal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureTarget {
+    /// The capture file.
+    pub path: std::path::PathBuf,
+    /// Its format.
+    pub format: CaptureFormat,
+}
+
 /// How a run is carried out (not what it simulates).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct RunOptions {
     /// Show a progress bar on stderr once the run has taken a second (never when stderr is
     /// not a terminal).
@@ -433,6 +486,13 @@ pub struct RunOptions {
     /// Keep every δ window ([`RunReport::window_list`], for plots). Without it a run keeps only
     /// δ and the noise floor of the counted windows (for their medians), 8 bytes per window.
     pub keep_windows: bool,
+    /// Write the encoder signal as a logic analyzer records it ([`crate::app::logic`]): the
+    /// scene's `[capture]` settings, every edge (both of every pulse, noise pulses; not the
+    /// dropped ones), the index on a second channel.
+    pub capture: Option<CaptureTarget>,
+    /// Keep every edge the encoder produced, dropped ones included, in
+    /// [`RunReport::edge_list`] (the ground truth of a test; memory grows with the run).
+    pub keep_edges: bool,
 }
 
 impl Default for RunOptions {
@@ -440,6 +500,8 @@ impl Default for RunOptions {
         RunOptions {
             progress: false,
             keep_windows: true,
+            capture: None,
+            keep_edges: false,
         }
     }
 }
@@ -449,6 +511,7 @@ impl Default for RunOptions {
 enum Stop {
     Edges,
     Steps,
+    Capture,
 }
 
 /// The regime classification's reductions over the run, kept as the samples arrive so that
@@ -543,6 +606,9 @@ enum Samples {
 
 struct Collector<'a> {
     monitor: Option<DeltaMonitor<MAX_LINES>>,
+    capture: Option<CaptureWriter<std::io::BufWriter<std::fs::File>>>,
+    capture_error: Option<std::io::Error>,
+    edge_list: Option<Vec<crate::engine::encoder::Edge>>,
     keep_windows: bool,
     windows: Vec<WindowOut>,
     /// δ and noise floor of the counted windows (valid, steady, after `settle`).
@@ -646,7 +712,23 @@ impl Collector<'_> {
 
 impl Observer for Collector<'_> {
     fn edge(&mut self, edge: &crate::engine::encoder::Edge) {
+        if let Some(list) = &mut self.edge_list {
+            list.push(*edge);
+        }
+        if edge.dropped {
+            return;
+        }
+        if let Some(w) = &mut self.capture {
+            if let Err(e) = w.edge(edge) {
+                self.capture_error = Some(e);
+                self.capture = None;
+            }
+        }
         self.all_edges += 1;
+        // The capture unit is set to the rising edges.
+        if !edge.rising {
+            return;
+        }
         let Some(m) = self.monitor.as_mut() else {
             return;
         };
@@ -701,7 +783,9 @@ impl Observer for Collector<'_> {
                 }
             }
         }
-        if self.all_edges as f64 > MAX_EDGES {
+        if self.capture_error.is_some() {
+            self.stop = Some(Stop::Capture);
+        } else if self.all_edges as f64 > MAX_EDGES {
             self.stop = Some(Stop::Edges);
         } else if self.steps > MAX_STEPS {
             self.stop = Some(Stop::Steps);
@@ -771,6 +855,10 @@ fn shaft_model(
     effects: &mut Vec<Box<dyn Effect>>,
     names: &mut Vec<&'static str>,
 ) -> Result<ShaftModel, SceneError> {
+    if let Some(profile) = speed_profile(scene, over) {
+        // A prescribed shaft, not an effect: `names` lists the effects only.
+        return Ok(ShaftModel::Profile(profile));
+    }
     let prescribed = over.speed.or(match &scene.motor {
         Some(MotorSpec::Speed { speed }) => Some(*speed),
         _ => None,
@@ -829,6 +917,33 @@ fn shaft_model(
     }
 }
 
+/// The speed profile of a scene whose prescribed speed is a profile (`[motor] model =
+/// "profile"`) or carries a cranking ripple (`[cranking]`); `None` otherwise.
+fn speed_profile(scene: &Scene, over: Overrides) -> Option<SpeedProfile> {
+    let mean = match (over.speed, &scene.motor) {
+        (Some(w), _) if scene.cranking.is_some() => vec![(0.0, w)],
+        (Some(_), _) => return None,
+        (None, Some(MotorSpec::Profile { points })) => {
+            points.iter().map(|p| (p[0], p[1])).collect()
+        }
+        (None, Some(MotorSpec::Speed { speed })) if scene.cranking.is_some() => {
+            vec![(0.0, *speed)]
+        }
+        (None, Some(MotorSpec::Ramp { from, to, duration })) if scene.cranking.is_some() => {
+            vec![(0.0, *from), (*duration, *to)]
+        }
+        _ => return None,
+    };
+    Some(SpeedProfile {
+        mean,
+        ripple: scene.cranking.map(|c| Ripple {
+            amplitude: c.ripple,
+            strokes: c.strokes,
+            phase: c.phase,
+        }),
+    })
+}
+
 /// The system of `scene`: its shaft and the effects it calls for, in assembly order (motor,
 /// load, vibration machine, rotor loads).
 fn assemble(
@@ -847,6 +962,7 @@ fn assemble(
     let rotor_speed0 = match &shaft {
         ShaftModel::Prescribed(law) => law.shaft(0.0).omega,
         ShaftModel::Dynamic(d) => d.omega0,
+        ShaftModel::Profile(p) => p.omega(0.0, 0.0),
     };
     let vib_params = vibration_params(scene, over.loads_together, rotor_speed0);
     let vib_machine = match &vib_params {
@@ -888,13 +1004,17 @@ fn speed_bound(scene: &Scene, over: Overrides) -> f64 {
         _ if over.speed.is_some() => over.speed.unwrap_or(0.0).abs(),
         Some(MotorSpec::Speed { speed }) => speed.abs(),
         Some(MotorSpec::Ramp { from, to, .. }) => from.abs().max(to.abs()),
+        Some(MotorSpec::Profile { points }) => {
+            points.iter().map(|p| p[1].abs()).fold(0.0, f64::max)
+        }
         Some(MotorSpec::Parabola { no_load_speed, .. }) => 2.0 * no_load_speed,
         Some(MotorSpec::Kloss {
             synchronous_speed, ..
         }) => 2.0 * synchronous_speed,
         None => 0.0,
     };
-    motor.max(initial)
+    let ripple = scene.cranking.map_or(0.0, |c| c.ripple);
+    motor.max(initial) * (1.0 + ripple)
 }
 
 /// Refuses, before anything is simulated, a run that would produce more than [`MAX_EDGES`]
@@ -911,13 +1031,14 @@ fn check_work(
         (_, Some(_)) => "the sweep's speed",
         (Some(MotorSpec::Speed { .. }), _) => "motor.speed",
         (Some(MotorSpec::Ramp { .. }), _) => "motor.from/to",
+        (Some(MotorSpec::Profile { .. }), _) => "motor.points",
         (Some(MotorSpec::Parabola { .. }), _) => "motor.no_load_speed",
         (Some(MotorSpec::Kloss { .. }), _) => "motor.synchronous_speed",
         (None, _) => "motor",
     };
     if let Some(e) = &scene.encoder {
         let edges =
-            speed_bound(scene, over) * duration / std::f64::consts::TAU * f64::from(e.lines);
+            speed_bound(scene, over) * duration / std::f64::consts::TAU * f64::from(e.grid_lines());
         if edges > MAX_EDGES {
             return Err(c.bad(
                 "simulation.duration",
@@ -925,7 +1046,7 @@ fn check_work(
                 format!(
                     "with {speed_key} and encoder.lines = {} the run would produce about {edges:.2e} edges, \
                      more than the limit of {MAX_EDGES:.0e} (shorten the duration)",
-                    c.shown("encoder.lines", e.lines)
+                    c.shown("encoder.lines", e.grid_lines())
                 ),
             ));
         }
@@ -982,11 +1103,18 @@ pub fn run_with(
         .validate()
         .map_err(|e| core_error(scene, file, "simulation", e))?;
     check_work(scene, file, over, &integ)?;
-    let mut sim = Simulation::new(system, integ.clone(), sim_encoder(scene, file)?)
-        .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
+    let mut sim = Simulation::new(
+        system,
+        integ.clone(),
+        sim_encoder(scene, file, options.capture.is_some())?,
+    )
+    .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let duration = scene.simulation.duration;
     let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
-    let lines = scene.encoder.as_ref().map_or(1, |e| e.lines as u64);
+    let lines = scene
+        .encoder
+        .as_ref()
+        .map_or(1, |e| u64::from(e.grid_lines()));
     let expected_edges = model
         .as_ref()
         .map_or(1e3, |m| m.u_mean().max(1.0).sqrt())
@@ -999,8 +1127,15 @@ pub fn run_with(
     let together = vib_params
         .as_ref()
         .is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
+    let capture = match &options.capture {
+        Some(t) => Some(open_capture(scene, file, t)?),
+        None => None,
+    };
     let mut col = Collector {
         monitor: core_monitor(scene, file)?,
+        capture,
+        capture_error: None,
+        edge_list: options.keep_edges.then(Vec::new),
         keep_windows: options.keep_windows,
         windows: Vec::new(),
         counted: Vec::new(),
@@ -1042,8 +1177,33 @@ pub fn run_with(
         &mut col.progress,
         Progress::new(0.0, false),
     ));
+    if let Some(e) = col.capture_error.take() {
+        let t = options
+            .capture
+            .as_ref()
+            .map(|t| t.path.display().to_string());
+        return Err(SceneError::value(
+            file,
+            "capture",
+            format!("cannot write {}: {e}", t.unwrap_or_default()),
+        ));
+    }
     if let Some(stop) = col.stop {
         return Err(stopped(scene, file, stop, stats.time));
+    }
+    let mut capture_rows = None;
+    if let (Some(w), Some(t)) = (col.capture.take(), &options.capture) {
+        let rows = w.rows_written;
+        let written = w.finish(stats.time);
+        let total = written.as_ref().map(|_| ()).map_err(|e| {
+            SceneError::value(
+                file,
+                "capture",
+                format!("cannot write {}: {e}", t.path.display()),
+            )
+        });
+        total?;
+        capture_rows = Some(rows);
     }
     let mut report = RunReport {
         scene: file.display().to_string(),
@@ -1059,6 +1219,11 @@ pub fn run_with(
         steps: [stats.solver.accepted_steps, stats.solver.rejected_steps],
         edges: stats.encoder.edges,
         settle,
+        capture_file: options
+            .capture
+            .as_ref()
+            .map(|t| t.path.display().to_string()),
+        capture_rows,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         ..Default::default()
     };
@@ -1076,8 +1241,38 @@ pub fn run_with(
     report.alarms = col.alarms;
     report.window_list = col.windows;
     report.speed_trace = col.trace;
+    report.edge_list = col.edge_list.take().unwrap_or_default();
     report.wall_seconds = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// The capture writer of a run: the scene's `[capture]` settings (or their defaults).
+fn open_capture(
+    scene: &Scene,
+    file: &Path,
+    target: &CaptureTarget,
+) -> Result<CaptureWriter<std::io::BufWriter<std::fs::File>>, SceneError> {
+    let spec = scene.capture.unwrap_or_default();
+    let index = matches!(
+        scene.encoder.as_ref().map(|e| e.framing()),
+        Some(FramingSpec::Index)
+    );
+    let settings = CaptureSettings {
+        format: target.format,
+        sample_rate: spec.sample_rate,
+        noise_width: spec.noise_width,
+        dedup: spec.dedup,
+        index,
+    };
+    let fail = |e: std::io::Error| {
+        SceneError::value(
+            file,
+            "capture",
+            format!("cannot write {}: {e}", target.path.display()),
+        )
+    };
+    let f = std::fs::File::create(&target.path).map_err(fail)?;
+    CaptureWriter::new(std::io::BufWriter::new(f), settings).map_err(fail)
 }
 
 /// An integration failure, with the scene keys that set the integration up.
@@ -1108,6 +1303,7 @@ fn stopped(scene: &Scene, file: &Path, stop: Stop, t: f64) -> SceneError {
     let what = match stop {
         Stop::Edges => format!("more than {MAX_EDGES:.0e} encoder edges"),
         Stop::Steps => format!("more than {MAX_STEPS} integrator steps"),
+        Stop::Capture => "a capture file that could not be written".to_string(),
     };
     c.bad(
         "simulation.duration",

@@ -91,6 +91,10 @@ pub struct Scene {
     pub motor: Option<MotorSpec>,
     /// The load torque.
     pub load: Option<LoadSpec>,
+    /// Engine-like cranking: a compression ripple on the prescribed speed.
+    pub cranking: Option<CrankingSpec>,
+    /// How `drive-sim run --capture` writes the signal a logic analyzer records.
+    pub capture: Option<CaptureSpec>,
     /// The encoder and capture timer.
     pub encoder: Option<EncoderSpec>,
     /// Monitor settings.
@@ -249,6 +253,11 @@ pub enum MotorSpec {
         /// Ramp time, s.
         duration: f64,
     },
+    /// A prescribed piecewise-linear speed through `[t, ω]` points (held after the last).
+    Profile {
+        /// `[t, ω]` points, s and rad/s, in increasing time.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 /// `[motor] model`.
@@ -263,6 +272,8 @@ pub enum MotorModel {
     Speed,
     /// [`MotorSpec::Ramp`].
     Ramp,
+    /// [`MotorSpec::Profile`].
+    Profile,
 }
 
 /// `[motor]` as written: the model and every key any model has, each with its own type.
@@ -289,6 +300,8 @@ pub struct MotorTable {
     pub to: Option<f64>,
     /// Ramp: ramp time.
     pub duration: Option<f64>,
+    /// Profile: `[t, ω]` points.
+    pub points: Option<Vec<[f64; 2]>>,
 }
 
 impl TryFrom<MotorTable> for MotorSpec {
@@ -306,7 +319,14 @@ impl TryFrom<MotorTable> for MotorSpec {
             ),
             MotorModel::Speed => ("speed", &["speed"]),
             MotorModel::Ramp => ("ramp", &["from", "to", "duration"]),
+            MotorModel::Profile => ("profile", &["points"]),
         };
+        if t.points.is_some() && t.model != MotorModel::Profile {
+            return Err(format!(
+                "`motor.points` does not belong to model = \"{model}\" (its keys: {})",
+                keys.join(", ")
+            ));
+        }
         let given = [
             ("no_load_speed", t.no_load_speed),
             ("breakdown_speed", t.breakdown_speed),
@@ -352,6 +372,11 @@ impl TryFrom<MotorTable> for MotorSpec {
                 to: get("to")?,
                 duration: get("duration")?,
             },
+            MotorModel::Profile => MotorSpec::Profile {
+                points: t.points.ok_or_else(|| {
+                    "missing key `motor.points` (model = \"profile\")".to_string()
+                })?,
+            },
         })
     }
 }
@@ -374,32 +399,77 @@ pub enum FramingSpec {
     /// Index pulse once per revolution.
     #[default]
     Index,
-    /// Missing-tooth gap.
+    /// Missing-tooth gap (`missing` positions, or `wheel = "N-M"`).
     MissingTooth,
+    /// A general tooth pattern (`gaps` or `teeth`).
+    Pattern,
     /// No marker.
     None,
+}
+
+impl FramingSpec {
+    /// The value as written in a scene file.
+    pub fn name(self) -> &'static str {
+        match self {
+            FramingSpec::Index => "index",
+            FramingSpec::MissingTooth => "missing-tooth",
+            FramingSpec::Pattern => "pattern",
+            FramingSpec::None => "none",
+        }
+    }
+}
+
+/// `[encoder] tolerances`: the core's edge-check tolerances (`drive_monitor::encoder::Tolerances`;
+/// each defaults to the core's).
+#[derive(Debug, Clone, Copy, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct TolerancesSpec {
+    /// Swing taken at once (1.05 to 2).
+    pub accept: Option<f64>,
+    /// Fraction of the expected interval below which an edge is a glitch outright (0.05 to 0.6).
+    pub glitch_fraction: Option<f64>,
+    /// How much better a fault must explain the intervals than a clean tooth (0.05 to 2).
+    pub fault_margin: Option<f64>,
 }
 
 /// `[encoder]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EncoderSpec {
-    /// Tooth positions per revolution (lines).
-    pub lines: u16,
+    /// Tooth positions per revolution (lines; the grid of a pattern). Required unless `wheel`
+    /// gives it.
+    #[serde(default)]
+    pub lines: Option<u16>,
+    /// A missing-tooth wheel in the usual notation, `"N-M"`: N positions, M missing in one gap
+    /// (`"36-2"`, `"60-2"`, `"8-1"`).
+    #[serde(default)]
+    pub wheel: Option<String>,
+    /// Gaps of a pattern wheel on the grid of `lines`: `[first missing position, count]` each.
+    #[serde(default)]
+    pub gaps: Option<Vec<[u16; 2]>>,
+    /// Teeth of a pattern wheel: the grid positions (0 … lines−1) that carry a tooth.
+    #[serde(default)]
+    pub teeth: Option<Vec<u16>>,
     /// Capture timer clock, Hz.
     pub timer_hz: f64,
     /// Counter width, bits.
     #[serde(default = "default_bits")]
     pub counter_bits: u8,
-    /// Framing.
+    /// Input prescaler of the capture (1, 2, 4 or 8; uniform discs only).
+    #[serde(default = "default_prescaler")]
+    pub prescaler: u8,
+    /// Framing (default: `index`, or what `wheel`, `missing`, `gaps` or `teeth` imply).
     #[serde(default)]
-    pub framing: FramingSpec,
+    pub framing: Option<FramingSpec>,
     /// Missing positions (missing-tooth framing).
     #[serde(default)]
     pub missing: u8,
     /// Edges averaged per speed sample.
     #[serde(default = "default_estimator_edges")]
     pub estimator_edges: u16,
+    /// The core's edge-check tolerances.
+    #[serde(default)]
+    pub tolerances: TolerancesSpec,
     /// Edge jitter, standard deviation, s.
     #[serde(default)]
     pub jitter: f64,
@@ -412,12 +482,130 @@ pub struct EncoderSpec {
     /// Random pitch error per line, standard deviation, rad.
     #[serde(default)]
     pub pitch_error: f64,
-    /// Probability that an edge is lost.
+    /// Probability that a tooth's edge is lost.
     #[serde(default)]
     pub drop_probability: f64,
-    /// Probability per edge of a spurious extra edge.
+    /// Probability per edge of a spurious extra edge (a noise pulse).
     #[serde(default)]
     pub glitch_probability: f64,
+    /// Where a noise pulse falls between two teeth, as fractions of the tooth interval
+    /// `[from, to]` (default `[0, 1]`, anywhere).
+    #[serde(default)]
+    pub glitch_window: Option<[f64; 2]>,
+}
+
+impl EncoderSpec {
+    /// Grid positions per revolution: `lines`, or the N of `wheel = "N-M"` (0 when neither
+    /// reads: validation reports it).
+    pub fn grid_lines(&self) -> u16 {
+        self.lines
+            .or_else(|| {
+                self.wheel
+                    .as_deref()
+                    .and_then(|w| parse_wheel(w).ok())
+                    .map(|(n, _)| n)
+            })
+            .unwrap_or(0)
+    }
+
+    /// The framing the keys ask for: `framing` if given, else what the wheel keys imply.
+    pub fn framing(&self) -> FramingSpec {
+        match self.framing {
+            Some(f) => f,
+            None if self.wheel.is_some() => FramingSpec::MissingTooth,
+            None if self.gaps.is_some() || self.teeth.is_some() => FramingSpec::Pattern,
+            None => FramingSpec::Index,
+        }
+    }
+}
+
+/// `wheel = "N-M"` read as (N, M), or why not.
+pub fn parse_wheel(text: &str) -> Result<(u16, u8), String> {
+    let t = text.trim();
+    if t.contains('+') {
+        return Err(
+            "\"N+1\" is ambiguous (an index on its own channel, or an extra tooth on the wheel): \
+             write lines = N with framing = \"index\", or the teeth of the wheel with lines and teeth"
+                .to_string(),
+        );
+    }
+    let parts: Vec<&str> = t.split('-').collect();
+    let [n, m] = parts.as_slice() else {
+        return Err(
+            "expected \"N-M\" (N positions, M missing in one gap, e.g. \"36-2\"); a wheel with \
+             several gaps is described by lines and gaps"
+                .to_string(),
+        );
+    };
+    let n: u16 = n
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{n}` is not a number of positions"))?;
+    let m: u8 = m
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{m}` is not a number of missing teeth"))?;
+    Ok((n, m))
+}
+
+/// `[cranking]`: a compression ripple on the prescribed speed (`[motor]` model `speed`,
+/// `ramp` or `profile`): ω = ω̄(t)·(1 + ripple·sin(strokes·φ + phase)).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrankingSpec {
+    /// Relative ripple per stroke (0.4: ±40 %), 0 to 0.9.
+    pub ripple: f64,
+    /// Compression strokes per revolution (2 for four cylinders, four strokes).
+    pub strokes: f64,
+    /// Phase, rad.
+    #[serde(default)]
+    pub phase: f64,
+}
+
+/// Capture file formats (`drive-sim run --capture-format`, `drive-sim analyze --format`).
+pub use crate::app::logic::CaptureFormat;
+
+/// `[capture]`: the logic analyzer `drive-sim run --capture` emulates.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaptureSpec {
+    /// Sample rate, Hz (whole Hz): transitions are recorded at the first sample after them.
+    #[serde(default = "default_sample_rate")]
+    pub sample_rate: f64,
+    /// Width of a tooth's pulse (and of the index pulse), in grid pitches (0 < duty < 1).
+    #[serde(default = "default_duty")]
+    pub duty: f64,
+    /// Width of a noise pulse, s.
+    #[serde(default = "default_noise_width")]
+    pub noise_width: f64,
+    /// Write only the rows where a level changes in the sigrok format (its `dedup` option);
+    /// default: every sample, as sigrok writes by default.
+    #[serde(default)]
+    pub dedup: bool,
+}
+
+impl Default for CaptureSpec {
+    fn default() -> Self {
+        CaptureSpec {
+            sample_rate: default_sample_rate(),
+            duty: default_duty(),
+            noise_width: default_noise_width(),
+            dedup: false,
+        }
+    }
+}
+
+fn default_sample_rate() -> f64 {
+    50e6
+}
+fn default_duty() -> f64 {
+    0.5
+}
+fn default_noise_width() -> f64 {
+    2e-6
+}
+fn default_prescaler() -> u8 {
+    1
 }
 
 fn default_bits() -> u8 {

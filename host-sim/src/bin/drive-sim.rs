@@ -1,6 +1,8 @@
 //! `drive-sim`: run, predict and sweep scenes.
 
 use clap::{Parser, Subcommand};
+use host_sim::app::analyze::{Channel, FramingArg, Polarity};
+use host_sim::app::logic::CaptureFormat;
 use host_sim::app::predict::predict;
 use host_sim::app::scene::{resolve, BUNDLED, DEFAULT_SCENE};
 use std::io::Write;
@@ -34,6 +36,69 @@ enum Command {
         /// directory: Markdown and SVGs, the scene repeated at slower and faster ramps.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Write the encoder signal (and the index channel, if any) as a logic analyzer
+        /// records it: a CSV of levels over time (the scene's [capture] settings).
+        #[arg(long)]
+        capture: Option<PathBuf>,
+        /// Format of the capture file.
+        #[arg(long, value_enum, default_value = "saleae", requires = "capture")]
+        capture_format: CaptureFormat,
+    },
+    /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV):
+    /// windows, faults, sync, edges and revolutions counted.
+    Analyze {
+        /// The capture file.
+        capture: PathBuf,
+        /// Its format (default: told from its first lines).
+        #[arg(long, value_enum)]
+        format: Option<CaptureFormat>,
+        /// The encoder channel: its name in the header, or its number among the channels
+        /// (from 0).
+        #[arg(long, default_value = "0")]
+        channel: Channel,
+        /// The index channel of an index disc (default: channel 1).
+        #[arg(long)]
+        index_channel: Option<Channel>,
+        /// The edges the capture unit takes.
+        #[arg(long, value_enum, default_value = "rising")]
+        edge: Polarity,
+        /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
+        #[arg(long)]
+        wheel: Option<String>,
+        /// A uniform disc of N lines (with --framing).
+        #[arg(long)]
+        lines: Option<u16>,
+        /// How the uniform disc of --lines is framed.
+        #[arg(long, value_enum)]
+        framing: Option<FramingArg>,
+        /// Take the wheel, the timer, the tolerances and the window from a scene's [encoder]
+        /// and [monitor] (a bundled scene's name or a file).
+        #[arg(long)]
+        scene: Option<String>,
+        /// The emulated capture timer clock, Hz (default 1e6, or the scene's).
+        #[arg(long)]
+        timer_hz: Option<f64>,
+        /// The emulated counter width, bits (16 to 32; default 32, or the scene's).
+        #[arg(long)]
+        counter_bits: Option<u8>,
+        /// Slowest speed still running, rad/s (default 1, or the scene's).
+        #[arg(long)]
+        min_speed: Option<f64>,
+        /// Edges per speed sample (default 1, or the scene's).
+        #[arg(long)]
+        estimator_edges: Option<u16>,
+        /// Revolutions per δ window (default 1, or the scene's).
+        #[arg(long)]
+        window_revolutions: Option<u16>,
+        /// Samples per second of a sigrok file without a samplerate comment, Hz.
+        #[arg(long)]
+        sample_rate: Option<f64>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Write SVG plots (speed, δ per window) into this directory.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Design-time results only (no simulation): predicted δ, support limits, regime zones.
     Predict {
@@ -153,13 +218,67 @@ impl From<host_sim::app::scene::SceneError> for Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => run_cmd(DEFAULT_SCENE, false, None, None),
+        None => run_cmd(DEFAULT_SCENE, false, None, None, None),
         Some(Command::Run {
             scene,
             json,
             plot,
             out,
-        }) => run_cmd(&scene, json, plot.as_deref(), out.as_deref()),
+            capture,
+            capture_format,
+        }) => {
+            let capture = capture.map(|path| host_sim::app::run::CaptureTarget {
+                path,
+                format: capture_format,
+            });
+            run_cmd(&scene, json, plot.as_deref(), out.as_deref(), capture)
+        }
+        Some(Command::Analyze {
+            capture,
+            format,
+            channel,
+            index_channel,
+            edge,
+            wheel,
+            lines,
+            framing,
+            scene,
+            timer_hz,
+            counter_bits,
+            min_speed,
+            estimator_edges,
+            window_revolutions,
+            sample_rate,
+            json,
+            plot,
+        }) => (|| {
+            let scene = match scene {
+                Some(name) => Some(resolve(&name)?),
+                None => None,
+            };
+            let options = host_sim::app::analyze::AnalyzeOptions {
+                wheel,
+                lines,
+                framing,
+                scene,
+                timer_hz,
+                counter_bits,
+                min_speed,
+                estimator_edges,
+                window_revolutions,
+                channel: Some(channel),
+                index_channel,
+                edge: Some(edge),
+            };
+            analyze_cmd(
+                &capture,
+                format,
+                sample_rate,
+                &options,
+                json,
+                plot.as_deref(),
+            )
+        })(),
         Some(Command::Predict {
             scene,
             emit: Some(format),
@@ -234,7 +353,56 @@ fn writable_dir(option: &str, dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-fn run_cmd(name: &str, json: bool, plot: Option<&Path>, out: Option<&Path>) -> Result<(), Failure> {
+fn analyze_cmd(
+    capture: &Path,
+    format: Option<CaptureFormat>,
+    sample_rate: Option<f64>,
+    options: &host_sim::app::analyze::AnalyzeOptions,
+    json: bool,
+    plot: Option<&Path>,
+) -> Result<(), Failure> {
+    use host_sim::app::analyze;
+    if let Some(r) = sample_rate {
+        if !(r.is_finite() && (1.0..=1e12).contains(&r)) {
+            return Err(Failure::Message(format!(
+                "--sample-rate {r}: allowed 1 to 1e12 Hz"
+            )));
+        }
+    }
+    let cfg = analyze::configure(options)?;
+    if let Some(dir) = plot {
+        writable_dir("--plot", dir)?;
+    }
+    let mut reader = host_sim::app::logic::CaptureReader::open(capture, format, sample_rate)
+        .map_err(|e| e.to_string())?;
+    let mut report = analyze::analyze(&mut reader, &cfg, &mut |_| {}).map_err(|e| e.to_string())?;
+    report.file = capture.display().to_string();
+    let mut text = String::new();
+    if let Some(dir) = plot {
+        let stem = capture
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("capture");
+        let files = analyze::plots(&report, stem, dir)?;
+        if !json {
+            text.push_str(&list(&files, "plot:"));
+        }
+    }
+    if json {
+        text.push_str(&to_json(&report)?);
+    } else {
+        text.push_str(&analyze::text(&report));
+    }
+    write_out(&text)
+}
+
+fn run_cmd(
+    name: &str,
+    json: bool,
+    plot: Option<&Path>,
+    out: Option<&Path>,
+    capture: Option<host_sim::app::run::CaptureTarget>,
+) -> Result<(), Failure> {
     let (scene, path) = resolve(name)?;
     if let Some(dir) = plot {
         writable_dir("--plot", dir)?;
@@ -245,9 +413,14 @@ fn run_cmd(name: &str, json: bool, plot: Option<&Path>, out: Option<&Path>) -> R
     let options = host_sim::app::run::RunOptions {
         progress: !json,
         keep_windows: plot.is_some(),
+        capture,
+        keep_edges: false,
     };
     let report = host_sim::app::run::run_with(&scene, &path, Default::default(), options)?;
     let mut text = String::new();
+    if let (Some(f), Some(rows), false) = (&report.capture_file, report.capture_rows, json) {
+        text.push_str(&format!("capture: wrote {f} ({rows} rows)\n"));
+    }
     if let Some(dir) = out {
         let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
         if !json {

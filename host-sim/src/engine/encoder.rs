@@ -3,9 +3,16 @@
 //!
 //! The disc has `lines` positions; position k passes the sensor when the shaft angle reaches
 //! θ_k = 2π·k/lines + pitch error_k + (e/r)·sin(2π·k/lines + phase) (run-out e of the disc at
-//! radius r seen as an angular error), plus 2π per revolution. A reference mark either omits
-//! the first `count` positions of each revolution (missing-tooth gap) or adds an index pulse
-//! on its own channel half a pitch before position 0.
+//! radius r seen as an angular error), plus 2π per revolution. Which positions carry a tooth is
+//! the wheel's pattern: all of them, the ones listed in `teeth` (any pattern on the grid:
+//! 36-2-2-2 with uneven gaps, 12+1 on a half-pitch grid), or all but the first `count` (a
+//! missing-tooth gap, [`Reference::MissingTeeth`]). An index pulse on its own channel half a
+//! pitch before position 0 is added by [`Reference::Index`].
+//!
+//! A sensor's output is a pulse per tooth: the rising edge at the tooth's angle and, when
+//! `duty` is set, the falling edge `duty` grid pitches later ([`Edge::rising`] tells them
+//! apart; without `duty` only rising edges are produced, as a capture unit set to one polarity
+//! sees them). The index pulse has the same width.
 //!
 //! Edge times are located on the shaft angle's polynomial over each integration step (the
 //! integrator's dense output, or the exact law of a prescribed shaft): turning points of the
@@ -17,14 +24,19 @@
 //! [`Direction::Reverse`].
 //!
 //! Then, like a capture unit: optional Gaussian jitter (std `jitter` s), quantisation
-//! ticks = ⌊t·timer_hz⌋ + counter_start masked to `counter_bits`. Faults: each real edge is
-//! dropped with probability `drop_probability`; before each line edge a glitch edge is inserted
-//! with probability `glitch_probability`, at a uniformly random time since the previous line
-//! edge (glitches are quantised without jitter). Edges are delivered in true-time order; keep the
-//! jitter well below the edge spacing, or the captured ticks can run backwards. All randomness
-//! comes from `seed` through independent ChaCha8 streams (jitter, drops, glitches, pitch
-//! errors), so enabling one fault does not change the others' draws: the same seed gives
-//! identical ticks.
+//! ticks = ⌊t·timer_hz⌋ + counter_start masked to `counter_bits`. Faults: each real tooth (or
+//! index pulse) is dropped with probability `drop_probability` (its falling edge with it);
+//! before each rising line edge a glitch edge is inserted with probability
+//! `glitch_probability`, at a uniformly random fraction within `glitch_window` of the time
+//! since the previous rising line edge (glitches are quantised without jitter). Dropped edges
+//! are delivered too, marked [`Edge::dropped`], when `emit_dropped` is set (the ground truth of
+//! a test); a capture unit never sees them. Edges are delivered in the order their marks are
+//! crossed, which is true-time order except for a glitch, which comes just before the rising
+//! edge it precedes (a falling edge or an index edge between the two may be later than it);
+//! keep the jitter well below the edge spacing, or the captured ticks can run backwards. All
+//! randomness comes from `seed` through independent ChaCha8 streams (jitter, drops, glitches,
+//! pitch errors, falling-edge jitter), so enabling one fault or the falling edges does not
+//! change the others' draws: the same seed gives identical ticks.
 
 use core::f64::consts::TAU;
 
@@ -40,7 +52,7 @@ use crate::engine::ode::ComponentPoly;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Reference {
-    /// No reference: all positions present, no index.
+    /// No reference: the teeth alone (all positions, or the pattern of `teeth`), no index.
     #[default]
     None,
     /// An index pulse once per revolution, half a pitch before position 0, on its own channel.
@@ -105,9 +117,28 @@ pub struct EncoderConfig {
     /// Probability that a spurious edge precedes a line edge.
     #[serde(default)]
     pub glitch_probability: f64,
+    /// Where a glitch falls between the previous rising line edge and the one it precedes, as
+    /// fractions of that interval (drawn uniformly between them; default the whole interval).
+    #[serde(default = "default_glitch_window")]
+    pub glitch_window: [f64; 2],
+    /// Grid positions carrying a tooth, ascending (`None`: every position, or all but the
+    /// gap of [`Reference::MissingTeeth`]).
+    #[serde(default)]
+    pub teeth: Option<Vec<u32>>,
+    /// Width of a tooth (and of the index pulse) in grid pitches, 0 < duty < 1: when set, the
+    /// falling edge of every pulse is produced too.
+    #[serde(default)]
+    pub duty: Option<f64>,
+    /// Deliver dropped edges too, marked [`Edge::dropped`] (ground truth for tests).
+    #[serde(default)]
+    pub emit_dropped: bool,
     /// Seed of all random draws.
     #[serde(default)]
     pub seed: u64,
+}
+
+fn default_glitch_window() -> [f64; 2] {
+    [0.0, 1.0]
 }
 
 impl EncoderConfig {
@@ -126,6 +157,10 @@ impl EncoderConfig {
             runout: None,
             drop_probability: 0.0,
             glitch_probability: 0.0,
+            glitch_window: default_glitch_window(),
+            teeth: None,
+            duty: None,
+            emit_dropped: false,
             seed: 0,
         }
     }
@@ -147,11 +182,19 @@ pub struct Edge {
     pub glitch: bool,
     /// True time of the crossing, s (before jitter and quantisation).
     pub true_time: f64,
+    /// Time the sensor's output changes, s: the true time plus the jitter (what a logic
+    /// analyzer records, before its own sampling).
+    pub seen_time: f64,
     /// Disc position 0 … lines−1 (0 for the index; for a glitch, the position of the line
     /// edge it precedes).
     pub tooth: u32,
     /// Revolution number of the mark (ground truth).
     pub revolution: i64,
+    /// A rising edge (the leading edge of a tooth or index pulse, or a glitch); `false` for
+    /// the falling edge ending a pulse (only with `duty`).
+    pub rising: bool,
+    /// The edge was lost: the capture unit never saw it (only with `emit_dropped`).
+    pub dropped: bool,
 }
 
 /// One mark on the disc within a revolution.
@@ -163,13 +206,17 @@ pub struct Mark {
     pub tooth: u32,
     /// On the index channel.
     pub index: bool,
+    /// The leading edge of the pulse (`false`: its falling edge, with `duty`).
+    pub rising: bool,
 }
 
 /// Counters of the edges produced.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct EncoderStats {
-    /// Edges delivered (line, index and glitch).
+    /// Rising edges delivered (line, index and glitch).
     pub edges: u64,
+    /// Falling edges delivered (with `duty`).
+    pub falling: u64,
     /// Index pulses delivered.
     pub index_pulses: u64,
     /// Real edges dropped.
@@ -196,6 +243,10 @@ pub struct Encoder {
     rng_jitter: ChaCha8Rng,
     rng_drop: ChaCha8Rng,
     rng_glitch: ChaCha8Rng,
+    rng_falling: ChaCha8Rng,
+    /// The last rising edge of the line and of the index channel was dropped: so is the
+    /// falling edge that ends its pulse.
+    pulse_dropped: [bool; 2],
     /// Index j of the last mark at or below φ (global: revolution·marks + slot).
     pos: i64,
     started: bool,
@@ -210,7 +261,8 @@ fn gaussian(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
 }
 
-/// Stream `k` of `seed`: 0 jitter, 1 drops, 2 glitches, 3 pitch errors.
+/// Stream `k` of `seed`: 0 jitter, 1 drops, 2 glitches, 3 pitch errors, 4 falling-edge
+/// jitter.
 fn stream(seed: u64, k: u64) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(k);
@@ -262,49 +314,117 @@ impl Encoder {
                 if count == 0 || count >= lines {
                     return Err(ConfigError::OutOfRange("encoder.reference.count"));
                 }
+                if config.teeth.is_some() {
+                    // One description of the wheel: a gap, or the list of teeth.
+                    return Err(ConfigError::Inconsistent("encoder.teeth"));
+                }
                 count
             }
             _ => 0,
         };
+        let mut present = vec![true; lines as usize];
+        if let Some(teeth) = &config.teeth {
+            if teeth.is_empty() || teeth.windows(2).any(|w| w[0] >= w[1]) {
+                return Err(ConfigError::Inconsistent("encoder.teeth"));
+            }
+            if teeth.iter().any(|&k| k >= lines) {
+                return Err(ConfigError::OutOfRange("encoder.teeth"));
+            }
+            present.iter_mut().for_each(|p| *p = false);
+            for &k in teeth {
+                present[k as usize] = true;
+            }
+        }
+        for p in present.iter_mut().take(missing as usize) {
+            *p = false;
+        }
+        let [g0, g1] = config.glitch_window;
+        if !(g0.is_finite() && g1.is_finite() && 0.0 <= g0 && g0 <= g1 && g1 <= 1.0) {
+            return Err(ConfigError::OutOfRange("encoder.glitch_window"));
+        }
+        if let Some(d) = config.duty {
+            if !(d.is_finite() && d > 0.0 && d < 1.0) {
+                return Err(ConfigError::OutOfRange("encoder.duty"));
+            }
+        }
         let pitch = TAU / f64::from(lines);
         let runout = |theta: f64| match config.runout {
             Some(r) => r.eccentricity / r.radius * (theta + r.phase).sin(),
             None => 0.0,
         };
         let mut rng_pitch = stream(config.seed, 3);
-        let mut marks = Vec::with_capacity(lines as usize + 1);
+        // Rising marks of each channel (line, index), in angle order.
+        let mut rising: [Vec<Mark>; 2] = [Vec::with_capacity(lines as usize), Vec::new()];
         if config.reference == Reference::Index {
             let nominal = -0.5 * pitch;
-            marks.push(Mark {
+            rising[1].push(Mark {
                 angle: nominal + runout(nominal),
                 tooth: 0,
                 index: true,
+                rising: true,
             });
         }
         for k in 0..lines {
             let nominal = f64::from(k) * pitch;
             let mut err = config.pitch_errors.get(k as usize).copied().unwrap_or(0.0);
             if config.pitch_error_std > 0.0 {
+                // Drawn for every position, present or not: a pattern does not change the
+                // errors of the teeth it keeps.
                 err += config.pitch_error_std * gaussian(&mut rng_pitch);
             }
-            if k < missing {
+            if !present[k as usize] {
                 continue;
             }
-            marks.push(Mark {
+            rising[0].push(Mark {
                 angle: nominal + err + runout(nominal),
                 tooth: k,
                 index: false,
+                rising: true,
             });
         }
-        let ordered = marks.windows(2).all(|w| w[0].angle < w[1].angle);
-        let span_ok = match (marks.first(), marks.last()) {
-            (Some(a), Some(b)) => b.angle - a.angle < TAU,
-            _ => false,
-        };
-        if !ordered || !span_ok {
-            // Errors so large that marks swap places or reach into the next revolution.
-            return Err(ConfigError::Inconsistent("encoder.pitch_errors"));
+        let mut marks = Vec::with_capacity(2 * (lines as usize + 1));
+        for channel in &rising {
+            let ordered = channel.windows(2).all(|w| w[0].angle < w[1].angle);
+            let span_ok = match (channel.first(), channel.last()) {
+                (Some(a), Some(b)) => b.angle - a.angle < TAU,
+                _ => true,
+            };
+            if !ordered || !span_ok {
+                // Errors so large that marks swap places or reach into the next revolution.
+                return Err(ConfigError::Inconsistent("encoder.pitch_errors"));
+            }
+            for (i, m) in channel.iter().enumerate() {
+                marks.push(*m);
+                if let Some(d) = config.duty {
+                    let fall = m.angle + d * pitch;
+                    // The pulse must end before the next one of its channel starts.
+                    let next = channel
+                        .get(i + 1)
+                        .map_or(channel[0].angle + TAU, |n| n.angle);
+                    if fall >= next {
+                        return Err(ConfigError::Inconsistent("encoder.duty"));
+                    }
+                    marks.push(Mark {
+                        angle: fall,
+                        rising: false,
+                        ..*m
+                    });
+                }
+            }
         }
+        if rising[0].is_empty() {
+            return Err(ConfigError::Inconsistent("encoder.teeth"));
+        }
+        // One table for both channels, by angle; a revolution starts at the first mark.
+        marks.sort_by(|a, b| a.angle.total_cmp(&b.angle));
+        let first = marks[0].angle;
+        for m in &mut marks {
+            if m.angle - first >= TAU {
+                // A falling edge past the revolution's first mark belongs before it.
+                m.angle -= TAU;
+            }
+        }
+        marks.sort_by(|a, b| a.angle.total_cmp(&b.angle));
         // counter_bits ≤ 32 (checked above): the shift cannot overflow.
         let mask = (1u64 << config.counter_bits) - 1;
         let seed = config.seed;
@@ -315,6 +435,8 @@ impl Encoder {
             rng_jitter: stream(seed, 0),
             rng_drop: stream(seed, 1),
             rng_glitch: stream(seed, 2),
+            rng_falling: stream(seed, 4),
+            pulse_dropped: [false; 2],
             pos: 0,
             started: false,
             last_line_time: None,
@@ -434,7 +556,19 @@ impl Encoder {
         let m = self.marks.len() as i64;
         let mark = self.marks[j.rem_euclid(m) as usize];
         let revolution = j.div_euclid(m);
+        let channel = usize::from(mark.index);
         self.stats.crossings += 1;
+        if !mark.rising {
+            // The end of a pulse: its own jitter stream; lost with the pulse's rising edge.
+            let jitter = if self.config.jitter > 0.0 {
+                self.config.jitter * gaussian(&mut self.rng_falling)
+            } else {
+                0.0
+            };
+            let dropped = std::mem::take(&mut self.pulse_dropped[channel]);
+            self.deliver(t, jitter, direction, mark, revolution, dropped, emit);
+            return;
+        }
         let jitter = if self.config.jitter > 0.0 {
             self.config.jitter * gaussian(&mut self.rng_jitter)
         } else {
@@ -446,7 +580,8 @@ impl Encoder {
             if self.config.glitch_probability > 0.0
                 && self.rng_glitch.gen::<f64>() < self.config.glitch_probability
             {
-                let u = self.rng_glitch.gen::<f64>();
+                let [lo, hi] = self.config.glitch_window;
+                let u = lo + (hi - lo) * self.rng_glitch.gen::<f64>();
                 if let Some(tp) = self.last_line_time {
                     let tg = tp + u * (t - tp);
                     self.stats.glitches += 1;
@@ -457,20 +592,44 @@ impl Encoder {
                         index: false,
                         glitch: true,
                         true_time: tg,
+                        seen_time: tg,
                         tooth: mark.tooth,
                         revolution,
+                        rising: true,
+                        dropped: false,
                     });
                 }
             }
             self.last_line_time = Some(t);
         }
+        self.pulse_dropped[channel] = dropped;
+        self.deliver(t, jitter, direction, mark, revolution, dropped, emit);
+    }
+
+    /// Delivers the edge of `mark` crossed at `t` (or counts it as dropped).
+    #[allow(clippy::too_many_arguments)]
+    fn deliver<F: FnMut(&Edge)>(
+        &mut self,
+        t: f64,
+        jitter: f64,
+        direction: Direction,
+        mark: Mark,
+        revolution: i64,
+        dropped: bool,
+        emit: &mut F,
+    ) {
         if dropped {
             self.stats.dropped += 1;
-            return;
-        }
-        self.stats.edges += 1;
-        if mark.index {
-            self.stats.index_pulses += 1;
+            if !self.config.emit_dropped {
+                return;
+            }
+        } else if mark.rising {
+            self.stats.edges += 1;
+            if mark.index {
+                self.stats.index_pulses += 1;
+            }
+        } else {
+            self.stats.falling += 1;
         }
         emit(&Edge {
             ticks: self.quantize(t + jitter),
@@ -478,8 +637,11 @@ impl Encoder {
             index: mark.index,
             glitch: false,
             true_time: t,
+            seen_time: t + jitter,
             tooth: mark.tooth,
             revolution,
+            rising: mark.rising,
+            dropped,
         });
     }
 }
@@ -640,6 +802,97 @@ mod tests {
         );
         assert!((last.true_time - 1.5).abs() < 1e-12);
         assert_eq!(e.stats().crossings, 4);
+    }
+
+    #[test]
+    fn patterns_pulses_and_truth_leave_the_rising_edges_alone() {
+        // A 12+1 wheel on a 24-position grid, pulses half a grid pitch wide.
+        let mut c = EncoderConfig::ideal(24, 1e6);
+        let mut teeth: Vec<u32> = (0..12).map(|i| 2 * i).collect();
+        teeth.insert(4, 7);
+        c.teeth = Some(teeth.clone());
+        c.jitter = 1e-6;
+        c.drop_probability = 0.1;
+        c.glitch_probability = 0.1;
+        c.glitch_window = [0.3, 0.7];
+        c.seed = 9;
+        let edges = |c: &EncoderConfig| {
+            let mut e = Encoder::new(c.clone()).unwrap();
+            let mut out = Vec::new();
+            e.process(&line(0.0, 1.0, 0.1, 20.0 * TAU), &mut |ed| out.push(*ed));
+            out
+        };
+        let plain = edges(&c);
+        assert!(plain.iter().all(|e| e.rising && !e.dropped));
+        let positions: std::collections::BTreeSet<u32> = plain
+            .iter()
+            .filter(|e| !e.glitch)
+            .map(|e| e.tooth)
+            .collect();
+        assert_eq!(positions.into_iter().collect::<Vec<_>>(), {
+            let mut t = teeth.clone();
+            t.sort_unstable();
+            t
+        });
+        // Falling edges and the ground truth of dropped edges add edges, never change the
+        // rising ones (their draws come from streams of their own).
+        c.duty = Some(0.5);
+        c.emit_dropped = true;
+        let all = edges(&c);
+        let rising: Vec<Edge> = all
+            .iter()
+            .filter(|e| e.rising && !e.dropped)
+            .copied()
+            .collect();
+        // The same edges; the crossing solver starts from the previous crossing, so the last
+        // digit of a time may differ.
+        assert_eq!(rising.len(), plain.len());
+        for (a, b) in rising.iter().zip(&plain) {
+            assert!((a.true_time - b.true_time).abs() < 1e-12, "{a:?} {b:?}");
+            let same = Edge {
+                true_time: b.true_time,
+                seen_time: b.seen_time,
+                ..*a
+            };
+            assert_eq!(&same, b);
+        }
+        let pitch = TAU / 24.0;
+        for e in all.iter().filter(|e| !e.rising && !e.dropped) {
+            // Each pulse ends half a grid pitch after its tooth: 20 turns/s, 0.1 rad at t = 0.
+            let angle = 0.1 + 20.0 * TAU * e.true_time;
+            let off = (angle - f64::from(e.tooth) * pitch).rem_euclid(TAU);
+            assert!((off - 0.5 * pitch).abs() < 1e-9, "{off}");
+        }
+        // A dropped tooth loses both its edges.
+        let dropped: Vec<&Edge> = all.iter().filter(|e| e.dropped).collect();
+        assert!(
+            !dropped.is_empty() && dropped.len() % 2 == 0,
+            "{}",
+            dropped.len()
+        );
+        // Glitches fall within 30–70 % of the interval before the edge they precede.
+        let line_edges: Vec<&Edge> = all.iter().filter(|e| e.rising && !e.glitch).collect();
+        for g in all.iter().filter(|e| e.glitch) {
+            let k = line_edges.partition_point(|e| e.true_time < g.true_time);
+            if k == 0 || k >= line_edges.len() {
+                continue;
+            }
+            let (a, b) = (line_edges[k - 1].true_time, line_edges[k].true_time);
+            let u = (g.true_time - a) / (b - a);
+            assert!((0.3 - 1e-9..=0.7 + 1e-9).contains(&u), "{u}");
+        }
+        // A pulse as wide as a pitch, or two descriptions of one wheel, are refused.
+        c.duty = Some(1.0);
+        assert_eq!(
+            Encoder::new(c.clone()).err(),
+            Some(ConfigError::OutOfRange("encoder.duty"))
+        );
+        c.duty = None;
+        c.reference = Reference::MissingTeeth { count: 2 };
+        assert_eq!(
+            Encoder::new(c).err(),
+            Some(ConfigError::Inconsistent("encoder.teeth"))
+        );
     }
 
     #[test]

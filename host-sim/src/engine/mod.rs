@@ -2,6 +2,7 @@
 //! effects a scene calls for ([`model`], [`system`], [`effects`], [`vibration`],
 //! [`rotor_loads`]) and the encoder edges a capture timer would see ([`encoder`]).
 
+pub mod cranking;
 pub mod effects;
 pub mod encoder;
 pub mod model;

@@ -37,6 +37,7 @@ use serde::Deserialize;
 
 use drive_monitor::error::{finite, non_negative, positive, ConfigError};
 
+use crate::engine::cranking::SpeedProfile;
 use crate::engine::encoder::{Edge, Encoder, EncoderConfig, EncoderStats};
 use crate::engine::model::{Effect, Shaft};
 use crate::engine::ode::{
@@ -259,6 +260,10 @@ pub enum ShaftModel {
     Prescribed(SpeedLaw),
     /// Integrated from the torques of all effects.
     Dynamic(DynamicShaft),
+    /// A prescribed speed ω(φ, t) (cranking: a mean speed with a compression ripple); φ is
+    /// integrated from it (one state), the effects' torques do not move it.
+    #[serde(skip)]
+    Profile(SpeedProfile),
 }
 
 impl ShaftModel {
@@ -267,6 +272,16 @@ impl ShaftModel {
         match self {
             ShaftModel::Prescribed(l) => l.validate(),
             ShaftModel::Dynamic(d) => d.validate(),
+            ShaftModel::Profile(p) => p.validate(),
+        }
+    }
+
+    /// States the shaft itself owns: φ and ω when dynamic, φ for a profile.
+    fn dim(&self) -> usize {
+        match self {
+            ShaftModel::Prescribed(_) => 0,
+            ShaftModel::Dynamic(_) => 2,
+            ShaftModel::Profile(_) => 1,
         }
     }
 }
@@ -309,10 +324,7 @@ impl System {
     pub fn new(shaft: ShaftModel, effects: Vec<Box<dyn Effect>>) -> Result<Self, ConfigError> {
         shaft.validate()?;
         let mut offsets = Vec::with_capacity(effects.len() + 1);
-        let mut o = match shaft {
-            ShaftModel::Dynamic(_) => 2,
-            ShaftModel::Prescribed(_) => 0,
-        };
+        let mut o = shaft.dim();
         for e in &effects {
             offsets.push(o);
             o += e.dim();
@@ -343,6 +355,12 @@ impl System {
         matches!(self.shaft, ShaftModel::Dynamic(_))
     }
 
+    /// Whether φ is state variable 0 (a dynamic shaft or a speed profile): the encoder reads
+    /// it from the integrator's dense output.
+    pub fn integrates_angle(&self) -> bool {
+        self.shaft.dim() > 0
+    }
+
     /// Names of the effects, in state order.
     pub fn effect_names(&self) -> Vec<&'static str> {
         self.effects.iter().map(|e| e.name()).collect()
@@ -360,6 +378,7 @@ impl System {
             y[0] = d.phi0;
             y[1] = d.omega0;
         }
+        // A profile starts at φ = 0 (y is zeroed).
         for (k, e) in self.effects.iter().enumerate() {
             e.init(&mut y[self.offsets[k]..self.offsets[k + 1]]);
         }
@@ -374,6 +393,10 @@ impl System {
                 omega: y[1],
             },
             ShaftModel::Prescribed(l) => l.shaft(t),
+            ShaftModel::Profile(p) => Shaft {
+                phi: y[0],
+                omega: p.omega(y[0], t),
+            },
         }
     }
 
@@ -381,7 +404,7 @@ impl System {
     /// entry per effect in order.
     pub fn evaluations(&self) -> Vec<ComponentEvals> {
         let mut v = Vec::with_capacity(self.effects.len() + 1);
-        if self.is_dynamic() {
+        if self.integrates_angle() {
             v.push(ComponentEvals {
                 name: "shaft",
                 evals: self.shaft_evals,
@@ -410,17 +433,24 @@ impl OdeSystem for System {
             torque += e.eval(t, shaft, &y[a..b], &mut dy[a..b]);
             self.effect_evals[k] += 1;
         }
-        if let ShaftModel::Dynamic(d) = &self.shaft {
-            let (j, dj) = d.inertia_at(shaft.phi);
-            dy[0] = shaft.omega;
-            dy[1] = (torque - 0.5 * shaft.omega * shaft.omega * dj) / j;
-            self.shaft_evals += 1;
+        match &self.shaft {
+            ShaftModel::Dynamic(d) => {
+                let (j, dj) = d.inertia_at(shaft.phi);
+                dy[0] = shaft.omega;
+                dy[1] = (torque - 0.5 * shaft.omega * shaft.omega * dj) / j;
+                self.shaft_evals += 1;
+            }
+            ShaftModel::Profile(_) => {
+                dy[0] = shaft.omega;
+                self.shaft_evals += 1;
+            }
+            ShaftModel::Prescribed(_) => {}
         }
     }
 
     fn error_reference(&self, i: usize) -> Option<f64> {
         // φ grows without bound: measure its error against one revolution.
-        (i == 0 && self.is_dynamic()).then_some(TAU)
+        (i == 0 && self.integrates_angle()).then_some(TAU)
     }
 }
 
@@ -488,7 +518,14 @@ impl StepView<'_> {
                 omega: d.eval(1, t),
             },
             (ShaftModel::Prescribed(l), _) => l.shaft(t),
-            (ShaftModel::Dynamic(_), None) => Shaft {
+            (ShaftModel::Profile(p), Some(d)) => {
+                let phi = d.eval(0, t);
+                Shaft {
+                    phi,
+                    omega: p.omega(phi, t),
+                }
+            }
+            (ShaftModel::Dynamic(_) | ShaftModel::Profile(_), None) => Shaft {
                 phi: f64::NAN,
                 omega: f64::NAN,
             },
@@ -633,7 +670,13 @@ impl Simulation {
         let t_end = self.t + duration;
         while self.t < t_end {
             let (t0, t1) = if self.system.dim() > 0 {
-                self.solver.step(&mut self.system, t_end)?;
+                // A profile's corners are stepped onto, never across.
+                let corner = match &self.system.shaft {
+                    ShaftModel::Profile(p) => p.breakpoints().find(|&tb| tb > self.t),
+                    _ => None,
+                };
+                let limit = corner.map_or(t_end, |tb| tb.min(t_end));
+                self.solver.step(&mut self.system, limit)?;
                 let d = self.solver.dense();
                 (d.t0(), d.t1())
             } else {
@@ -641,7 +684,7 @@ impl Simulation {
             };
             let mut emit = |e: &Edge| observer.edge(e);
             match &self.system.shaft {
-                ShaftModel::Dynamic(_) => {
+                ShaftModel::Dynamic(_) | ShaftModel::Profile(_) => {
                     let seg = self.solver.dense().component(0);
                     self.encoder.process(&seg, &mut emit);
                 }

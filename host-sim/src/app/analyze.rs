@@ -1,0 +1,985 @@
+//! `drive-sim analyze`: the core on a recorded capture.
+//!
+//! A capture file ([`crate::app::logic`]) is read row by row; the edges of the chosen polarity
+//! on the encoder channel become capture timestamps as a real input-capture timer would latch
+//! them — `⌊t·timer_hz⌋` masked to the counter width — and go to the core's [`DeltaMonitor`]
+//! (the code that runs on the target), the edges of the index channel to its `on_index`.
+//! Between edges the analyzer polls the monitor as a firmware's periodic task would
+//! ([`poll_interval`]), and once at the end of the capture. An [`EdgeSink`] observer records
+//! every decision the core takes (a tooth and its number, a glitch, a missing edge...).
+//!
+//! The report: the windows (where they start and end, δ, validity and fault), the faults with
+//! their times, the sync state and when it was acquired or lost, the edges and revolutions
+//! counted, and a decimated speed trace for the plot. Memory stays bounded whatever the length
+//! of the capture: the speed trace is decimated to at most [`MAX_TRACE`] points, and at most
+//! [`MAX_LISTED`] windows and faults are listed (the counters count them all).
+
+use std::collections::VecDeque;
+use std::io::BufRead;
+
+use serde::Serialize;
+
+use drive_monitor::encoder::{Encoder, EncoderConfig};
+use drive_monitor::irregularity::{WindowConfig, WindowReport};
+use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
+use drive_monitor::speed::{EdgeSink, Fault, SyncState, Tooth};
+
+use crate::app::logic::{CaptureError, CaptureReader, Level};
+use crate::app::run::MAX_LINES;
+
+/// Most windows and faults listed in a report (the counters count them all).
+pub const MAX_LISTED: usize = 10_000;
+/// Most points of the decimated speed trace.
+pub const MAX_TRACE: usize = 20_000;
+/// Longest interval between two polls of the monitor, s (a firmware's periodic task; shorter
+/// when the counter wraps sooner, see [`poll_interval`]).
+pub const POLL_INTERVAL: f64 = 1e-3;
+
+/// Which edges of a channel are the capture unit's events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Polarity {
+    /// Low to high.
+    Rising,
+    /// High to low.
+    Falling,
+}
+
+/// A channel of the capture: by name as the header gives it, or by 0-based column among the
+/// channels.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Channel {
+    /// The n-th channel column (0 = the first after the time).
+    Column(usize),
+    /// The channel of this name.
+    Name(String),
+}
+
+impl std::str::FromStr for Channel {
+    type Err = std::convert::Infallible;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ok(match s.trim().parse::<usize>() {
+            Ok(n) => Channel::Column(n),
+            Err(_) => Channel::Name(s.trim().to_string()),
+        })
+    }
+}
+
+/// What to analyze and how.
+#[derive(Debug, Clone)]
+pub struct AnalyzeConfig {
+    /// The encoder as the firmware would configure it: wheel, timer clock, counter width,
+    /// tolerances, estimator, minimum speed.
+    pub encoder: EncoderConfig,
+    /// The δ window.
+    pub window: WindowConfig,
+    /// The encoder channel.
+    pub channel: Channel,
+    /// The index channel (index discs).
+    pub index_channel: Option<Channel>,
+    /// The edges taken.
+    pub edge: Polarity,
+}
+
+/// A decision of the core on one edge, with its capture time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decision {
+    /// Capture time, s.
+    pub time: f64,
+    /// What the core decided.
+    pub kind: DecisionKind,
+}
+
+/// What the core decided about an edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DecisionKind {
+    /// Accepted as a tooth.
+    Tooth {
+        /// Tooth number within the revolution (meaningful when `synced`).
+        tooth: u16,
+        /// The teeth were identified.
+        synced: bool,
+        /// Tooth 0 of a revolution counted in sync.
+        frame: bool,
+        /// The speed sample ending here, rad/s.
+        speed: Option<f64>,
+    },
+    /// A fault (a rejected glitch, a missing edge, a timeout...).
+    Fault(Fault),
+}
+
+/// One δ window.
+#[derive(Debug, Clone, Serialize)]
+pub struct WindowOut {
+    /// Capture time of its first edge, s.
+    pub start: f64,
+    /// Capture time of its last edge (or of the fault that ended it), s.
+    pub end: f64,
+    /// Accepted-edge numbers it spans.
+    pub start_edge: u32,
+    /// Last accepted edge in it.
+    pub end_edge: u32,
+    /// Whole revolutions covered.
+    pub revolutions: u16,
+    /// Complete and without fault.
+    pub valid: bool,
+    /// Why not, when invalid.
+    pub fault: Option<&'static str>,
+    /// δ (valid windows).
+    pub delta: Option<f64>,
+    /// Mean speed, rad/s.
+    pub omega_mean: Option<f64>,
+    /// Largest and smallest speed sample, rad/s.
+    pub omega_max: Option<f64>,
+    /// Smallest speed sample, rad/s.
+    pub omega_min: Option<f64>,
+    /// Bound on δ's error from timer quantization.
+    pub noise_floor: Option<f64>,
+}
+
+/// A fault with its time.
+#[derive(Debug, Clone, Serialize)]
+pub struct FaultOut {
+    /// Capture time, s.
+    pub time: f64,
+    /// What (`glitch`, `missing-edge`, `extra-edge`, `missing-frame`, `reversal`, `timeout`).
+    pub fault: &'static str,
+}
+
+/// A change of the sync state.
+#[derive(Debug, Clone, Serialize)]
+pub struct SyncOut {
+    /// Capture time of the edge after which the state changed, s.
+    pub time: f64,
+    /// The new state: `searching`, `confirming` or `synced`.
+    pub state: &'static str,
+}
+
+/// What the core found in a capture.
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct AnalyzeReport {
+    /// The capture file.
+    pub file: String,
+    /// Its format.
+    pub format: &'static str,
+    /// The channel analyzed and the index channel.
+    pub channel: String,
+    /// The index channel, if any.
+    pub index_channel: Option<String>,
+    /// The edges taken: `rising` or `falling`.
+    pub edge: &'static str,
+    /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
+    pub wheel: String,
+    /// Emulated capture timer clock, Hz.
+    pub timer_hz: f64,
+    /// Emulated counter width, bits.
+    pub counter_bits: u8,
+    /// Rows read.
+    pub rows: u64,
+    /// First and last time in the capture, s.
+    pub span: [f64; 2],
+    /// Edges of the chosen polarity on the encoder channel (fed to the core).
+    pub edges: u64,
+    /// Edges on the index channel (fed to the core).
+    pub index_pulses: u64,
+    /// Edges the core accepted as teeth.
+    pub accepted: u32,
+    /// Revolutions counted in sync.
+    pub revolutions: u32,
+    /// Faults by kind: glitches, missing edges, extra edges, missing frames, reversals,
+    /// timeouts.
+    pub glitches: u32,
+    /// Missing edges.
+    pub missing: u32,
+    /// Extra edges.
+    pub extra: u32,
+    /// Missing frames.
+    pub missing_frames: u32,
+    /// Reversals.
+    pub reversals: u32,
+    /// Timeouts.
+    pub timeouts: u32,
+    /// Times the frame was found and confirmed, and lost.
+    pub syncs: u32,
+    /// Times sync was lost.
+    pub sync_losses: u32,
+    /// When sync was first acquired, s.
+    pub sync_acquired: Option<f64>,
+    /// The sync state at the end.
+    pub sync_state: &'static str,
+    /// Every change of the sync state (at most [`MAX_LISTED`]).
+    pub sync: Vec<SyncOut>,
+    /// Valid and invalid windows.
+    pub valid_windows: u32,
+    /// Invalid windows.
+    pub invalid_windows: u32,
+    /// The windows (at most [`MAX_LISTED`]).
+    pub windows: Vec<WindowOut>,
+    /// The faults (at most [`MAX_LISTED`]).
+    pub faults: Vec<FaultOut>,
+    /// Edges pending judgement when the capture ended (the last edges, waiting for the two
+    /// that would confirm them).
+    pub unjudged_at_end: u64,
+    /// Edges accepted as teeth when a poll found the shaft stopped (the core's `poll` reports
+    /// them to no observer: their tooth numbers are not known here).
+    pub judged_at_poll: u64,
+    /// The speed samples against time, decimated (for the plot).
+    #[serde(skip)]
+    pub speed_trace: Vec<(f64, f64)>,
+}
+
+/// What the observer saw during one call to the monitor.
+#[derive(Default)]
+struct Seen {
+    events: Vec<(u32, Event)>,
+}
+
+#[derive(Clone, Copy)]
+enum Event {
+    Tooth(Tooth),
+    Fault(Fault),
+}
+
+impl EdgeSink for Seen {
+    fn tooth(&mut self, tooth: &Tooth) {
+        self.events.push((tooth.time, Event::Tooth(*tooth)));
+    }
+    fn fault(&mut self, fault: Fault, time: u32) {
+        self.events.push((time, Event::Fault(fault)));
+    }
+}
+
+/// The poll interval for a counter of `bits` at `timer_hz`: [`POLL_INTERVAL`], or a quarter of
+/// the counter's period when that is shorter (elapsed time is measured modulo the counter).
+pub fn poll_interval(timer_hz: f64, bits: u8) -> f64 {
+    let period = 2f64.powi(i32::from(bits)) / timer_hz;
+    POLL_INTERVAL.min(period / 4.0)
+}
+
+/// Converts capture times to ticks and back.
+struct Clock {
+    hz: f64,
+    mask: u64,
+    /// Recent raw events: (ticks, time), newest last.
+    recent: VecDeque<(u32, f64)>,
+    latest: (u32, f64),
+}
+
+impl Clock {
+    fn ticks(&self, t: f64) -> u32 {
+        // A real timer latches the count of whole ticks elapsed.
+        let n = (t * self.hz).floor() as i64;
+        (n as u64 & self.mask) as u32
+    }
+
+    fn note(&mut self, ticks: u32, t: f64) {
+        if self.recent.len() == 64 {
+            self.recent.pop_front();
+        }
+        self.recent.push_back((ticks, t));
+        self.latest = (ticks, t);
+    }
+
+    /// The capture time of `ticks`: the recent event latched at it, else counted back from
+    /// the latest event (the core reports times of recent edges and polls).
+    fn time(&self, ticks: u32) -> f64 {
+        if let Some(&(_, t)) = self.recent.iter().rev().find(|(k, _)| *k == ticks) {
+            return t;
+        }
+        let back = (u64::from(self.latest.0).wrapping_sub(u64::from(ticks))) & self.mask;
+        self.latest.1 - back as f64 / self.hz
+    }
+}
+
+fn sync_name(s: SyncState) -> &'static str {
+    match s {
+        SyncState::Searching => "searching",
+        SyncState::Confirming => "confirming",
+        SyncState::Synced => "synced",
+    }
+}
+
+/// The wheel as the core frames it, in words.
+pub fn wheel_text(e: &Encoder) -> String {
+    use drive_monitor::encoder::Wheel;
+    match e.config().wheel {
+        Wheel::Indexed { lines } => format!("{lines} lines with an index pulse"),
+        Wheel::Unframed { lines } => format!("{lines} lines, no frame marker"),
+        Wheel::Pattern(p) => format!(
+            "pattern of {} teeth on {} positions",
+            p.teeth(),
+            p.positions()
+        ),
+    }
+}
+
+fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, String> {
+    match c {
+        Channel::Column(n) if *n < channels.len() => Ok(*n),
+        Channel::Name(name) => channels.iter().position(|x| x == name).ok_or_else(|| {
+            format!(
+                "{option} {name}: no such channel (the capture has {})",
+                channels.join(", ")
+            )
+        }),
+        Channel::Column(n) => Err(format!(
+            "{option} {n}: the capture has {} channel{} ({}), numbered from 0",
+            channels.len(),
+            if channels.len() == 1 { "" } else { "s" },
+            channels.join(", ")
+        )),
+    }
+}
+
+/// Why an analysis failed: the file, or the options.
+#[derive(Debug)]
+pub enum AnalyzeError {
+    /// The capture file.
+    Capture(CaptureError),
+    /// An option that does not fit the capture or the core.
+    Option(String),
+}
+
+impl std::fmt::Display for AnalyzeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AnalyzeError::Capture(e) => write!(f, "{e}"),
+            AnalyzeError::Option(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl From<CaptureError> for AnalyzeError {
+    fn from(e: CaptureError) -> Self {
+        AnalyzeError::Capture(e)
+    }
+}
+
+/// Analyzes the capture `reader` with `cfg`; `on_decision` is told every decision of the
+/// core, in order.
+pub fn analyze<R: BufRead>(
+    reader: &mut CaptureReader<R>,
+    cfg: &AnalyzeConfig,
+    on_decision: &mut dyn FnMut(&Decision),
+) -> Result<AnalyzeReport, AnalyzeError> {
+    let enc = Encoder::new(cfg.encoder)
+        .map_err(|e| AnalyzeError::Option(format!("the encoder configuration: {e}")))?;
+    let mut monitor: DeltaMonitor<MAX_LINES> = DeltaMonitor::new(enc.clone(), cfg.window, None)
+        .map_err(|e| AnalyzeError::Option(format!("the monitor configuration: {e}")))?;
+    let channels = reader.channels().to_vec();
+    let ch = column(&channels, &cfg.channel, "--channel").map_err(AnalyzeError::Option)?;
+    let ich = match &cfg.index_channel {
+        Some(c) => Some(column(&channels, c, "--index-channel").map_err(AnalyzeError::Option)?),
+        None => None,
+    };
+    if ich == Some(ch) {
+        return Err(AnalyzeError::Option(
+            "--index-channel is the encoder channel itself".into(),
+        ));
+    }
+    let mut report = AnalyzeReport {
+        format: reader.format().name(),
+        channel: channels[ch].clone(),
+        index_channel: ich.map(|i| channels[i].clone()),
+        edge: match cfg.edge {
+            Polarity::Rising => "rising",
+            Polarity::Falling => "falling",
+        },
+        wheel: wheel_text(&enc),
+        timer_hz: cfg.encoder.timer_hz,
+        counter_bits: cfg.encoder.counter_bits,
+        sync_state: "searching",
+        ..Default::default()
+    };
+    let mut clock = Clock {
+        hz: cfg.encoder.timer_hz,
+        mask: u64::from(enc.mask()),
+        recent: VecDeque::new(),
+        latest: (0, 0.0),
+    };
+    let poll_every = poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits);
+    let timeout = f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz;
+    let mut st = State {
+        seen: Seen::default(),
+        frames: VecDeque::new(),
+        sync: SyncState::Searching,
+        stride: 1,
+        skipped: 0,
+        max_revs: usize::from(monitor.window_revolutions()),
+    };
+    let mut prev: Vec<Level> = Vec::new();
+    let mut last_event: Option<f64> = None;
+    let mut last_poll = f64::NEG_INFINITY;
+    let mut end = 0.0;
+    while let Some((t, levels)) = reader.next_row()? {
+        if report.rows == 0 {
+            report.span[0] = t;
+            prev = levels.to_vec();
+        }
+        report.rows += 1;
+        end = t;
+        let edge = |c: usize| -> Option<Polarity> {
+            match (prev[c], levels[c]) {
+                (Level::Low, Level::High) => Some(Polarity::Rising),
+                (Level::High, Level::Low) => Some(Polarity::Falling),
+                _ => None,
+            }
+        };
+        let index_edge = ich.and_then(edge) == Some(cfg.edge);
+        let encoder_edge = edge(ch) == Some(cfg.edge);
+        prev.copy_from_slice(levels);
+        if !index_edge && !encoder_edge {
+            continue;
+        }
+        // The periodic task between the last event and this one. A poll finds nothing until
+        // the timeout has passed: only the ones around it are made.
+        if let Some(t0) = last_event {
+            let mut p = last_poll.max(t0 + timeout - 2.0 * poll_every).max(t0) + poll_every;
+            while p < t && p <= t0 + timeout + 2.0 * poll_every {
+                let ticks = clock.ticks(p);
+                clock.note(ticks, p);
+                st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+                last_poll = p;
+                p += poll_every;
+            }
+        }
+        let ticks = clock.ticks(t);
+        clock.note(ticks, t);
+        last_event = Some(t);
+        if index_edge {
+            report.index_pulses += 1;
+            monitor.on_index(ticks);
+        }
+        if encoder_edge {
+            report.edges += 1;
+            let o = monitor.on_edge_observed(ticks, None, &mut st.seen);
+            st.after(&mut monitor, &clock, o, &mut report, on_decision);
+        }
+    }
+    report.span[1] = end;
+    // The end of the recording: a last poll there.
+    if last_event.is_some() {
+        let ticks = clock.ticks(end);
+        clock.note(ticks, end);
+        st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+    }
+    let d = monitor.diagnostics();
+    let e = d.edges;
+    report.accepted = e.accepted;
+    report.revolutions = e.revolutions;
+    report.glitches = e.glitches;
+    report.missing = e.missing;
+    report.extra = e.extra;
+    report.missing_frames = e.missing_frames;
+    report.reversals = e.reversals;
+    report.timeouts = e.timeouts;
+    report.syncs = e.syncs;
+    report.sync_losses = e.sync_losses;
+    report.valid_windows = d.valid_windows;
+    report.invalid_windows = d.invalid_windows;
+    report.sync_state = sync_name(monitor.sync_state());
+    // Edges fed but neither accepted nor rejected: still waiting for their lookahead.
+    report.unjudged_at_end = report
+        .edges
+        .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches));
+    report.speed_trace.shrink_to_fit();
+    Ok(report)
+}
+
+/// The analysis state between calls to the monitor.
+struct State {
+    seen: Seen,
+    /// Times of recent frame teeth by accepted-edge number (window starts).
+    frames: VecDeque<(u32, f64)>,
+    sync: SyncState,
+    /// Keep every `stride`-th speed sample; `skipped` since the last kept.
+    stride: u64,
+    skipped: u64,
+    max_revs: usize,
+}
+
+impl State {
+    /// Polls the monitor at `ticks`. The core's `poll` tells no observer what it decides (the
+    /// edges it judges when it finds the shaft stopped, the timeout): they are read from its
+    /// counters, the faults reported at the poll's time, the teeth counted in
+    /// [`AnalyzeReport::judged_at_poll`].
+    fn poll(
+        &mut self,
+        monitor: &mut DeltaMonitor<MAX_LINES>,
+        clock: &Clock,
+        ticks: u32,
+        report: &mut AnalyzeReport,
+        on_decision: &mut dyn FnMut(&Decision),
+    ) {
+        let before = monitor.diagnostics().edges;
+        let o = monitor.poll(ticks);
+        let after = monitor.diagnostics().edges;
+        let d = |a: u32, b: u32| a.wrapping_sub(b);
+        for (n, f) in [
+            (d(after.glitches, before.glitches), Fault::Glitch),
+            (d(after.missing, before.missing), Fault::MissingEdge),
+            (d(after.extra, before.extra), Fault::ExtraEdge),
+            (
+                d(after.missing_frames, before.missing_frames),
+                Fault::MissingFrame,
+            ),
+            (d(after.timeouts, before.timeouts), Fault::Timeout),
+        ] {
+            for _ in 0..n {
+                self.seen.events.push((ticks, Event::Fault(f)));
+            }
+        }
+        report.judged_at_poll += u64::from(d(after.accepted, before.accepted));
+        self.after(monitor, clock, o, report, on_decision);
+    }
+
+    /// Takes what the monitor reported during one call.
+    fn after(
+        &mut self,
+        monitor: &mut DeltaMonitor<MAX_LINES>,
+        clock: &Clock,
+        outcome: Option<WindowOutcome>,
+        report: &mut AnalyzeReport,
+        on_decision: &mut dyn FnMut(&Decision),
+    ) {
+        let unit = f64::from(monitor.encoder().unit_rad());
+        let hz = clock.hz;
+        for (ticks, ev) in self.seen.events.drain(..) {
+            let time = clock.time(ticks);
+            let kind = match ev {
+                Event::Tooth(t) => {
+                    let speed = t
+                        .sample
+                        .filter(|s| s.ticks > 0)
+                        .map(|s| f64::from(s.span) * unit * hz / f64::from(s.ticks));
+                    if t.frame {
+                        if self.frames.len() > self.max_revs + 4 {
+                            self.frames.pop_front();
+                        }
+                        self.frames.push_back((t.index, time));
+                    }
+                    if let Some(w) = speed.filter(|_| t.synced) {
+                        self.skipped += 1;
+                        if self.skipped >= self.stride {
+                            self.skipped = 0;
+                            report.speed_trace.push((time, w));
+                            if report.speed_trace.len() >= MAX_TRACE {
+                                // Halve the trace and keep every other sample from now on.
+                                let kept: Vec<(f64, f64)> =
+                                    report.speed_trace.iter().step_by(2).copied().collect();
+                                report.speed_trace = kept;
+                                self.stride *= 2;
+                            }
+                        }
+                    }
+                    if report.sync_acquired.is_none() && t.synced {
+                        report.sync_acquired = Some(time);
+                    }
+                    DecisionKind::Tooth {
+                        tooth: t.tooth,
+                        synced: t.synced,
+                        frame: t.frame,
+                        speed,
+                    }
+                }
+                Event::Fault(f) => {
+                    if report.faults.len() < MAX_LISTED {
+                        report.faults.push(FaultOut {
+                            time,
+                            fault: f.name(),
+                        });
+                    }
+                    DecisionKind::Fault(f)
+                }
+            };
+            on_decision(&Decision { time, kind });
+        }
+        let s = monitor.sync_state();
+        if s != self.sync {
+            self.sync = s;
+            if report.sync.len() < MAX_LISTED {
+                report.sync.push(SyncOut {
+                    time: clock.latest.1,
+                    state: sync_name(s),
+                });
+            }
+        }
+        if let Some(o) = outcome {
+            self.window(&o.report, clock, report);
+        }
+    }
+
+    fn window(&self, r: &WindowReport, clock: &Clock, report: &mut AnalyzeReport) {
+        if report.windows.len() >= MAX_LISTED {
+            return;
+        }
+        let at = |edge: u32, ticks: u32| {
+            self.frames
+                .iter()
+                .rev()
+                .find(|(i, _)| *i == edge)
+                .map_or_else(|| clock.time(ticks), |&(_, t)| t)
+        };
+        let m = r.measurement();
+        let f = |x: f32| Some(f64::from(x));
+        report.windows.push(WindowOut {
+            start: at(r.start_edge, r.start_ticks),
+            end: if r.valid() {
+                at(r.end_edge, r.end_ticks)
+            } else {
+                clock.time(r.end_ticks)
+            },
+            start_edge: r.start_edge,
+            end_edge: r.end_edge,
+            revolutions: r.revolutions,
+            valid: r.valid(),
+            fault: r.fault().map(Fault::name),
+            delta: m.and_then(|m| f(m.delta)),
+            omega_mean: m.and_then(|m| f(m.omega_mean)),
+            omega_max: m.and_then(|m| f(m.omega_max)),
+            omega_min: m.and_then(|m| f(m.omega_min)),
+            noise_floor: m.and_then(|m| f(m.noise_floor)),
+        });
+    }
+}
+
+/// The report as text.
+pub fn text(r: &AnalyzeReport) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "capture: {} ({} format, {} rows, {:.6} s to {:.6} s)",
+        r.file, r.format, r.rows, r.span[0], r.span[1]
+    );
+    let _ = writeln!(
+        s,
+        "channel: {} ({} edges){}",
+        r.channel,
+        r.edge,
+        r.index_channel
+            .as_ref()
+            .map_or(String::new(), |i| format!(", index channel {i}"))
+    );
+    let _ = writeln!(
+        s,
+        "wheel: {}; timer {} Hz, {}-bit counter",
+        r.wheel, r.timer_hz, r.counter_bits
+    );
+    let _ = writeln!(
+        s,
+        "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
+        r.edges,
+        r.accepted,
+        if r.index_pulses > 0 {
+            format!(", {} index pulses", r.index_pulses)
+        } else {
+            String::new()
+        },
+        r.revolutions
+    );
+    let _ = writeln!(
+        s,
+        "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts",
+        r.glitches, r.missing, r.extra, r.missing_frames, r.reversals, r.timeouts
+    );
+    match r.sync_acquired {
+        Some(t) => {
+            let _ = writeln!(
+                s,
+                "sync: acquired at {t:.6} s; {} times synced, {} times lost; {} at the end",
+                r.syncs, r.sync_losses, r.sync_state
+            );
+        }
+        None => {
+            let _ = writeln!(s, "sync: never acquired ({} at the end)", r.sync_state);
+        }
+    }
+    for e in r.sync.iter().take(20) {
+        let _ = writeln!(s, "  {:>12.6} s  {}", e.time, e.state);
+    }
+    if r.sync.len() > 20 {
+        let _ = writeln!(s, "  ... {} more changes (see --json)", r.sync.len() - 20);
+    }
+    if r.unjudged_at_end > 0 {
+        let _ = writeln!(
+            s,
+            "{} edge(s) at the end of the capture were still waiting to be judged",
+            r.unjudged_at_end
+        );
+    }
+    let _ = writeln!(
+        s,
+        "windows: {} valid, {} invalid",
+        r.valid_windows, r.invalid_windows
+    );
+    if !r.windows.is_empty() {
+        let _ = writeln!(
+            s,
+            "  {:>12} {:>12} {:>5}  {:>10} {:>10} {:>10}  result",
+            "start, s", "end, s", "revs", "δ", "ω mean", "floor"
+        );
+    }
+    for w in r.windows.iter().take(40) {
+        match (w.delta, w.omega_mean, w.noise_floor) {
+            (Some(d), Some(m), Some(f)) => {
+                let _ = writeln!(
+                    s,
+                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid",
+                    w.start, w.end, w.revolutions, d, m, f
+                );
+            }
+            _ => {
+                let _ = writeln!(
+                    s,
+                    "  {:>12.6} {:>12.6} {:>5}  {:>10} {:>10} {:>10}  invalid: {}",
+                    w.start,
+                    w.end,
+                    w.revolutions,
+                    "-",
+                    "-",
+                    "-",
+                    w.fault.unwrap_or("?")
+                );
+            }
+        }
+    }
+    if r.windows.len() > 40 {
+        let _ = writeln!(
+            s,
+            "  ... {} more windows (see --json)",
+            r.windows.len() - 40
+        );
+    }
+    if !r.faults.is_empty() {
+        let _ = writeln!(s, "fault list:");
+        for f in r.faults.iter().take(40) {
+            let _ = writeln!(s, "  {:>12.6} s  {}", f.time, f.fault);
+        }
+        if r.faults.len() > 40 {
+            let _ = writeln!(s, "  ... {} more faults (see --json)", r.faults.len() - 40);
+        }
+    }
+    s
+}
+
+/// The speed plot (and δ per window) into `dir`: returns the files written.
+pub fn plots(
+    r: &AnalyzeReport,
+    stem: &str,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>, String> {
+    use crate::app::plot::{write_svg, Chart, Series};
+    let mut files = Vec::new();
+    let speed_at = |t: f64| -> f64 {
+        let k = r.speed_trace.partition_point(|p| p.0 < t);
+        r.speed_trace
+            .get(k.min(r.speed_trace.len().saturating_sub(1)))
+            .map_or(0.0, |p| p.1)
+    };
+    let mut series = vec![Series {
+        label: "speed sample (synced teeth)".into(),
+        points: r.speed_trace.clone(),
+        markers: false,
+    }];
+    if !r.faults.is_empty() {
+        series.push(Series {
+            label: "fault".into(),
+            points: r
+                .faults
+                .iter()
+                .map(|f| (f.time, speed_at(f.time)))
+                .collect(),
+            markers: true,
+        });
+    }
+    let path = dir.join(format!("{stem}-speed.svg"));
+    write_svg(
+        &path,
+        &Chart {
+            title: "speed from the capture",
+            x_label: "capture time, s",
+            y_label: "ω, rad/s",
+            series,
+            marks: Vec::new(),
+        },
+    )?;
+    files.push(path);
+    let deltas: Vec<(f64, f64)> = r
+        .windows
+        .iter()
+        .filter_map(|w| w.delta.map(|d| (w.end, d)))
+        .collect();
+    let path = dir.join(format!("{stem}-delta.svg"));
+    write_svg(
+        &path,
+        &Chart {
+            title: "δ per valid window",
+            x_label: "capture time at the window's end, s",
+            y_label: "δ",
+            series: vec![Series {
+                label: "δ".into(),
+                points: deltas,
+                markers: true,
+            }],
+            marks: Vec::new(),
+        },
+    )?;
+    files.push(path);
+    Ok(files)
+}
+
+/// How an index or unframed disc is framed (`--framing`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FramingArg {
+    /// An index pulse on its own channel (`--index-channel`, default the second channel).
+    Index,
+    /// No frame marker.
+    None,
+}
+
+/// The command line's description of an analysis, before it is checked.
+#[derive(Debug, Clone, Default)]
+pub struct AnalyzeOptions {
+    /// `--wheel N-M`.
+    pub wheel: Option<String>,
+    /// `--lines N`.
+    pub lines: Option<u16>,
+    /// `--framing` (with `--lines`).
+    pub framing: Option<FramingArg>,
+    /// `--scene`: the scene and the path its errors name.
+    pub scene: Option<(crate::app::scene::Scene, std::path::PathBuf)>,
+    /// `--timer-hz`.
+    pub timer_hz: Option<f64>,
+    /// `--counter-bits`.
+    pub counter_bits: Option<u8>,
+    /// `--min-speed`.
+    pub min_speed: Option<f64>,
+    /// `--estimator-edges`.
+    pub estimator_edges: Option<u16>,
+    /// `--window-revolutions`.
+    pub window_revolutions: Option<u16>,
+    /// `--channel` (default the first).
+    pub channel: Option<Channel>,
+    /// `--index-channel`.
+    pub index_channel: Option<Channel>,
+    /// `--edge` (default rising).
+    pub edge: Option<Polarity>,
+}
+
+/// Default emulated timer clock without a scene, Hz.
+pub const DEFAULT_TIMER_HZ: f64 = 1e6;
+
+/// The command-line option a core parameter comes from.
+fn option_of(parameter: &str) -> &'static str {
+    match parameter {
+        "timer_hz" => "--timer-hz",
+        "min_speed" => "--min-speed",
+        "counter_bits" => "--counter-bits",
+        "estimator.edges" => "--estimator-edges",
+        "lines" => "--lines",
+        "window.revolutions" => "--window-revolutions",
+        p if p.starts_with("pattern") => "--wheel",
+        _ => "the scene's [encoder]",
+    }
+}
+
+/// Checks the options and builds the analysis they describe.
+pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
+    use drive_monitor::encoder::{Estimator, Pattern};
+    use drive_monitor::irregularity::WindowLength;
+    let given = [o.wheel.is_some(), o.lines.is_some(), o.scene.is_some()];
+    if given.iter().filter(|&&g| g).count() != 1 {
+        return Err(
+            "name the wheel once: --wheel N-M (a missing-tooth wheel), --lines N with --framing \
+             index|none, or --scene FILE (its [encoder])"
+                .into(),
+        );
+    }
+    if o.framing.is_some() && o.lines.is_none() {
+        return Err("--framing goes with --lines (a --wheel or a scene names its framing)".into());
+    }
+    let timer_hz = o.timer_hz.unwrap_or(DEFAULT_TIMER_HZ);
+    let (mut enc, mut window) = match (&o.wheel, o.lines, &o.scene) {
+        (Some(w), _, _) => {
+            let (n, m) =
+                crate::app::scene::parse_wheel(w).map_err(|e| format!("--wheel {w}: {e}"))?;
+            let n = u8::try_from(n).map_err(|_| {
+                format!(
+                    "--wheel {w}: at most {} positions",
+                    drive_monitor::encoder::MAX_PATTERN_POSITIONS
+                )
+            })?;
+            let mut c = EncoderConfig::pattern(Pattern::missing_teeth(n, m), timer_hz);
+            c.counter_bits = 32;
+            (c, None)
+        }
+        (None, Some(lines), _) => {
+            let c = match o.framing.unwrap_or(FramingArg::None) {
+                FramingArg::Index => EncoderConfig::indexed(lines, timer_hz),
+                FramingArg::None => EncoderConfig::unframed(lines, timer_hz),
+            };
+            (c, None)
+        }
+        (None, None, Some((scene, path))) => {
+            let e = crate::app::run::core_encoder(scene, path)
+                .map_err(|e| e.to_string())?
+                .ok_or_else(|| format!("{}: no [encoder] table", path.display()))?;
+            (*e.config(), Some(crate::app::run::window_config(scene)))
+        }
+        (None, None, None) => unreachable_wheel()?,
+    };
+    if o.scene.is_none() || o.timer_hz.is_some() {
+        enc.timer_hz = timer_hz;
+    }
+    if let Some(b) = o.counter_bits {
+        enc.counter_bits = b;
+    }
+    if let Some(w) = o.min_speed {
+        enc.min_speed = w;
+    }
+    if let Some(k) = o.estimator_edges {
+        enc.estimator = Estimator::Edges(k);
+    }
+    if let Some(n) = o.window_revolutions {
+        window = Some(WindowConfig {
+            length: WindowLength::Revolutions(n),
+            steady_tolerance: 0.02,
+        });
+    }
+    let window = window.unwrap_or(WindowConfig {
+        length: WindowLength::Revolutions(1),
+        steady_tolerance: 0.02,
+    });
+    Encoder::new(enc).map_err(|e| {
+        format!(
+            "{} does not fit: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",
+            option_of(e.parameter()),
+            enc.timer_hz,
+            enc.counter_bits,
+            enc.min_speed
+        )
+    })?;
+    window
+        .validate()
+        .map_err(|e| format!("{}: {e}", option_of(e.parameter())))?;
+    let index = matches!(enc.wheel, drive_monitor::encoder::Wheel::Indexed { .. });
+    if o.index_channel.is_some() && !index {
+        return Err("--index-channel goes with an index disc (--lines N --framing index, or a scene whose framing is \"index\")".into());
+    }
+    Ok(AnalyzeConfig {
+        encoder: enc,
+        window,
+        channel: o.channel.clone().unwrap_or(Channel::Column(0)),
+        index_channel: if index {
+            Some(o.index_channel.clone().unwrap_or(Channel::Column(1)))
+        } else {
+            None
+        },
+        edge: o.edge.unwrap_or(Polarity::Rising),
+    })
+}
+
+fn unreachable_wheel() -> Result<(EncoderConfig, Option<WindowConfig>), String> {
+    Err("name the wheel: --wheel, --lines or --scene".into())
+}

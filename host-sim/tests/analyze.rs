@@ -1,0 +1,612 @@
+//! Captures written by the simulator and read back by `drive-sim analyze`: the formats round
+//! trip, bad lines are named, and the core run on the captures of cranking engines is checked
+//! against the simulation's ground truth (every edge: tooth, glitch, dropped).
+
+use host_sim::app::analyze::{analyze, configure, AnalyzeOptions, AnalyzeReport, DecisionKind};
+use host_sim::app::logic::{CaptureFormat, CaptureReader, Level};
+use host_sim::app::run::{run_with, CaptureTarget, Overrides, RunOptions, RunReport};
+use host_sim::app::scene::Scene;
+use host_sim::engine::encoder::Edge;
+use std::path::{Path, PathBuf};
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("analyze-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Simulates `text` writing a capture in `format` to `file`; the report keeps every edge.
+fn simulate(text: &str, format: CaptureFormat, file: &Path) -> RunReport {
+    let scene = Scene::parse(text, Path::new("test.toml")).unwrap();
+    let options = RunOptions {
+        capture: Some(CaptureTarget {
+            path: file.to_path_buf(),
+            format,
+        }),
+        keep_edges: true,
+        ..RunOptions::default()
+    };
+    run_with(
+        &scene,
+        Path::new("test.toml"),
+        Overrides::default(),
+        options,
+    )
+    .unwrap()
+}
+
+/// A decision of the core, as the tests compare it.
+#[derive(Debug, Clone, Copy)]
+enum Seen {
+    Tooth { time: f64, tooth: u16, synced: bool },
+    Fault { time: f64, fault: &'static str },
+}
+
+fn run_analyze(file: &Path, options: AnalyzeOptions) -> (AnalyzeReport, Vec<Seen>) {
+    let cfg = configure(&options).unwrap();
+    let mut reader = CaptureReader::open(file, None, None).unwrap();
+    let mut seen = Vec::new();
+    let report = analyze(&mut reader, &cfg, &mut |d| {
+        seen.push(match d.kind {
+            DecisionKind::Tooth { tooth, synced, .. } => Seen::Tooth {
+                time: d.time,
+                tooth,
+                synced,
+            },
+            DecisionKind::Fault(f) => Seen::Fault {
+                time: d.time,
+                fault: f.name(),
+            },
+        })
+    })
+    .unwrap();
+    (report, seen)
+}
+
+fn wheel(w: &str) -> AnalyzeOptions {
+    AnalyzeOptions {
+        wheel: Some(w.into()),
+        ..AnalyzeOptions::default()
+    }
+}
+
+/// The real tooth edges the capture shows (rising, on the encoder channel, not dropped).
+fn teeth(edges: &[Edge]) -> Vec<Edge> {
+    edges
+        .iter()
+        .filter(|e| e.rising && !e.index && !e.glitch && !e.dropped)
+        .copied()
+        .collect()
+}
+
+/// The core's number of the tooth at grid position `pos` on an N-M wheel: teeth at positions
+/// 0 … N−M−1, tooth 0 the one after the gap (position 0).
+fn core_tooth(pos: u32) -> u16 {
+    pos as u16
+}
+
+/// The largest tooth-to-tooth ratio of the per-pitch intervals (either way), skipping the
+/// first `skip` intervals.
+fn worst_ratio(teeth: &[Edge], lines: u32, skip: usize) -> f64 {
+    let per_pitch: Vec<f64> = teeth
+        .windows(2)
+        .map(|w| {
+            let p = (w[1].tooth + lines - w[0].tooth) % lines;
+            (w[1].true_time - w[0].true_time) / f64::from(p.max(1))
+        })
+        .collect();
+    per_pitch
+        .windows(2)
+        .skip(skip)
+        .map(|r| (r[1] / r[0]).max(r[0] / r[1]))
+        .fold(1.0, f64::max)
+}
+
+/// Where a capture records an edge: at the first sample at or after it.
+fn sampled(t: f64, rate: f64) -> f64 {
+    (t * rate).ceil() / rate
+}
+
+/// Cranking from rest: the mean speed ramps from 0 to 25 rad/s in 0.5 s and holds; ±40 %
+/// ripple, two compression strokes per revolution.
+fn cranking(wheel: &str, capture: &str, duration: f64, extra: &str) -> String {
+    format!(
+        "[simulation]\nduration = {duration}\nseed = 3\n\
+         [motor]\nmodel = \"profile\"\npoints = [[0.0, 0.0], [0.5, 25.0]]\n\
+         [cranking]\nripple = 0.4\nstrokes = 2.0\nphase = 0.3\n\
+         [encoder]\nwheel = \"{wheel}\"\ntimer_hz = 1e6\nestimator_edges = 1\n{extra}\n\
+         [monitor]\nwindow_revolutions = 1\n\
+         [capture]\n{capture}\n"
+    )
+}
+
+/// The truth's δ over the edges of a window: per-tooth speed samples (angle over time, K = 1)
+/// from the true times, their extremes.
+fn truth_delta(teeth: &[Edge], lines: u32, start: f64, end: f64, rate: f64) -> f64 {
+    let pitch = std::f64::consts::TAU / f64::from(lines);
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for w in teeth.windows(2) {
+        let t1 = sampled(w[1].seen_time, rate);
+        if t1 <= start + 1e-12 || t1 > end + 1e-12 {
+            continue;
+        }
+        let p = f64::from((w[1].tooth + lines - w[0].tooth) % lines);
+        let omega = p * pitch / (w[1].true_time - w[0].true_time);
+        lo = lo.min(omega);
+        hi = hi.max(omega);
+    }
+    2.0 * (hi - lo) / (hi + lo)
+}
+
+/// The checks of a clean cranking capture of an N-M wheel: no fault, sync at the right teeth,
+/// every revolution after sync counted, δ within its noise floor of the truth.
+fn check_clean(run: &RunReport, report: &AnalyzeReport, seen: &[Seen], lines: u32, rate: f64) {
+    let truth = teeth(&run.edge_list);
+    // Clean: every tooth present, ratios within 0.45–2.2 (the first intervals of a start from
+    // rest are the core's time references, not judged).
+    let worst = worst_ratio(&truth, lines, 3);
+    assert!(worst < 2.2, "the signal is not clean: ratio {worst}");
+    let faults: Vec<&Seen> = seen
+        .iter()
+        .filter(|s| matches!(s, Seen::Fault { .. }))
+        .collect();
+    assert!(faults.is_empty(), "{faults:?}");
+    assert_eq!(
+        (
+            report.glitches,
+            report.missing,
+            report.extra,
+            report.missing_frames
+        ),
+        (0, 0, 0, 0)
+    );
+    // Every accepted tooth is a real edge, and once synced it carries the truth's number.
+    let mut first_synced = None;
+    let mut k = 0usize;
+    for s in seen {
+        let Seen::Tooth {
+            time,
+            tooth,
+            synced,
+        } = *s
+        else {
+            continue;
+        };
+        while k < truth.len() && sampled(truth[k].seen_time, rate) < time - 1e-9 {
+            k += 1;
+        }
+        let e = truth.get(k).unwrap_or_else(|| panic!("no edge at {time}"));
+        assert!((sampled(e.seen_time, rate) - time).abs() < 1e-9, "{time}");
+        if synced {
+            first_synced.get_or_insert(k);
+            assert_eq!(tooth, core_tooth(e.tooth), "tooth at {time}");
+        }
+    }
+    let first = first_synced.expect("sync acquired");
+    let teeth_per_rev = truth.iter().filter(|e| e.revolution == 2).count();
+    assert!(
+        first < truth.iter().position(|e| e.revolution >= 1).unwrap() + 2 * teeth_per_rev,
+        "sync acquired at edge {first}"
+    );
+    // Every revolution after the first synced edge is counted (up to the last edge judged: the
+    // last edges of a capture may still wait for the two that would confirm them).
+    let last = seen
+        .iter()
+        .filter_map(|s| match s {
+            Seen::Tooth { time, .. } => Some(*time),
+            Seen::Fault { .. } => None,
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    let frames = truth[first + 1..]
+        .iter()
+        .filter(|e| e.tooth == 0 && sampled(e.seen_time, rate) <= last + 1e-9)
+        .count();
+    assert_eq!(report.revolutions as usize, frames);
+    assert_eq!(report.invalid_windows, 0);
+    assert!(report.valid_windows as usize + 1 >= frames, "{report:?}");
+    for w in &report.windows {
+        let d = w.delta.unwrap();
+        let floor = w.noise_floor.unwrap();
+        let truth = truth_delta(&truth, lines, w.start, w.end, rate);
+        // The floor bounds the timer's quantization; the capture's sampling adds at most one
+        // sample period per timestamp (timer 1 MHz, sampling 50× faster: 2 % of the floor).
+        assert!(
+            (d - truth).abs() <= floor * 1.02,
+            "window {:.4}–{:.4}: δ {d} truth {truth} floor {floor}",
+            w.start,
+            w.end
+        );
+    }
+}
+
+#[test]
+fn clean_cranking_of_a_36_2_wheel_from_a_saleae_capture() {
+    let file = tmp("crank-36-2.csv");
+    let run = simulate(
+        &cranking("36-2", "sample_rate = 50e6", 2.0, ""),
+        CaptureFormat::Saleae,
+        &file,
+    );
+    let (report, seen) = run_analyze(&file, wheel("36-2"));
+    assert_eq!(report.format, "saleae");
+    assert!(report.revolutions >= 4, "{}", report.revolutions);
+    check_clean(&run, &report, &seen, 36, 50e6);
+}
+
+#[test]
+fn clean_cranking_of_an_8_1_wheel_from_a_sigrok_capture() {
+    let file = tmp("crank-8-1.csv");
+    let run = simulate(
+        &cranking("8-1", "sample_rate = 50e6\ndedup = true", 3.0, ""),
+        CaptureFormat::Sigrok,
+        &file,
+    );
+    let (report, seen) = run_analyze(&file, wheel("8-1"));
+    assert_eq!(report.format, "sigrok");
+    assert!(report.revolutions >= 6, "{}", report.revolutions);
+    check_clean(&run, &report, &seen, 8, 50e6);
+}
+
+#[test]
+fn clean_cranking_from_a_plain_capture_of_a_60_2_wheel() {
+    let file = tmp("crank-60-2.csv");
+    let run = simulate(
+        &cranking("60-2", "sample_rate = 50e6", 1.5, ""),
+        CaptureFormat::Plain,
+        &file,
+    );
+    let (report, seen) = run_analyze(&file, wheel("60-2"));
+    assert_eq!(report.format, "plain");
+    check_clean(&run, &report, &seen, 60, 50e6);
+}
+
+/// Start from rest, crank, stall: the only fault is the timeout once the shaft has stopped
+/// (the capture goes on for a second after it).
+#[test]
+#[ignore = "core defect: the stall's falling mean speed draws false missing/extra edges and a sync loss (speed.rs expects the previous revolution's absolute interval; see tests/framing_defects.rs)"]
+fn a_stall_after_cranking_is_one_timeout_and_nothing_else() {
+    let file = tmp("stall.csv");
+    let text = cranking("36-2", "sample_rate = 50e6", 3.5, "").replace(
+        "points = [[0.0, 0.0], [0.5, 25.0]]",
+        "points = [[0.0, 0.0], [0.5, 25.0], [1.8, 25.0], [2.4, 0.0]]",
+    );
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let truth = teeth(&run.edge_list);
+    assert!(worst_ratio(&truth, 36, 3) < 2.2);
+    let (report, seen) = run_analyze(&file, wheel("36-2"));
+    let faults: Vec<&Seen> = seen
+        .iter()
+        .filter(|s| matches!(s, Seen::Fault { .. }))
+        .collect();
+    assert_eq!(faults.len(), 1, "{faults:?}");
+    assert!(
+        matches!(faults[0], Seen::Fault { fault: "timeout", time } if *time > truth.last().unwrap().true_time)
+    );
+    assert_eq!(report.sync_losses, 1);
+}
+
+/// Noise pulses at 30–70 % of a tooth interval are glitches, each one, and no valid window
+/// spans one; the real teeth behind them keep their numbers.
+#[test]
+fn noise_pulses_are_counted_as_glitches() {
+    let file = tmp("noise.csv");
+    let text = cranking(
+        "36-2",
+        "sample_rate = 50e6\nnoise_width = 2e-6",
+        2.0,
+        "glitch_probability = 0.01\nglitch_window = [0.3, 0.7]",
+    );
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let glitches: Vec<f64> = run
+        .edge_list
+        .iter()
+        .filter(|e| e.glitch)
+        .map(|e| e.seen_time)
+        .collect();
+    assert!(glitches.len() >= 3, "{}", glitches.len());
+    let (report, seen) = run_analyze(&file, wheel("36-2"));
+    // Noise before the core runs (the first edges are time references) cannot be judged.
+    let judged: Vec<f64> = glitches
+        .iter()
+        .copied()
+        .filter(|&t| t > report.sync_acquired.unwrap_or(f64::INFINITY))
+        .collect();
+    let found: Vec<f64> = seen
+        .iter()
+        .filter_map(|s| match s {
+            Seen::Fault {
+                fault: "glitch",
+                time,
+            } => Some(*time),
+            _ => None,
+        })
+        .filter(|&t| t > report.sync_acquired.unwrap_or(f64::INFINITY))
+        .collect();
+    assert_eq!(
+        found.len(),
+        judged.len(),
+        "found {found:?}, truth {judged:?}"
+    );
+    for (f, g) in found.iter().zip(&judged) {
+        // The pulse's rising edge: at its start, or at its end when it is a dip on a tooth.
+        assert!((f - g).abs() < 3e-6, "{f} {g}");
+    }
+    assert_eq!((report.missing, report.extra), (0, 0), "{report:?}");
+    for w in report.windows.iter().filter(|w| w.valid) {
+        assert!(
+            !glitches.iter().any(|&g| g > w.start && g < w.end),
+            "valid window {}–{} spans a glitch",
+            w.start,
+            w.end
+        );
+    }
+}
+
+/// Dropped teeth are missing edges, each one.
+#[test]
+fn dropped_teeth_are_counted_as_missing() {
+    let file = tmp("dropped.csv");
+    let text = cranking("36-2", "sample_rate = 50e6", 3.0, "drop_probability = 0.02");
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let (report, seen) = run_analyze(&file, wheel("36-2"));
+    let after = report.sync_acquired.unwrap();
+    let dropped: Vec<&Edge> = run
+        .edge_list
+        .iter()
+        .filter(|e| e.dropped && e.rising && e.true_time > after)
+        .collect();
+    assert!(dropped.len() >= 2, "{}", dropped.len());
+    let missing: Vec<f64> = seen
+        .iter()
+        .filter_map(|s| match s {
+            Seen::Fault {
+                fault: "missing-edge",
+                time,
+            } => Some(*time),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(missing.len(), dropped.len(), "{missing:?} {dropped:?}");
+    assert_eq!((report.glitches, report.extra), (0, 0));
+}
+
+/// An index disc (24 lines and an index pulse on its own channel): synced by the index,
+/// every revolution counted, no fault.
+#[test]
+fn an_index_disc_from_two_channels() {
+    let file = tmp("index.csv");
+    let text = "[simulation]\nduration = 1.0\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+                [encoder]\nlines = 24\nframing = \"index\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
+                [capture]\nsample_rate = 10e6\n";
+    let run = simulate(text, CaptureFormat::Saleae, &file);
+    let options = AnalyzeOptions {
+        lines: Some(24),
+        framing: Some(host_sim::app::analyze::FramingArg::Index),
+        ..AnalyzeOptions::default()
+    };
+    let (report, seen) = run_analyze(&file, options);
+    assert_eq!(report.index_channel.as_deref(), Some("Channel 1"));
+    assert!(seen.iter().all(|s| matches!(s, Seen::Tooth { .. })));
+    let index = run.edge_list.iter().filter(|e| e.index && e.rising).count() as u64;
+    assert_eq!(report.index_pulses, index);
+    let synced = report.sync_acquired.unwrap();
+    let frames = teeth(&run.edge_list)
+        .iter()
+        .filter(|e| e.tooth == 0 && e.true_time > synced + 1e-9)
+        .count();
+    assert_eq!(report.revolutions as usize, frames);
+    assert!(frames >= 4);
+}
+
+/// Every format writes and reads back the same transitions, to its time resolution: the
+/// sample grid (sigrok, plain exactly; Saleae's nine decimals to half a nanosecond).
+#[test]
+fn captures_round_trip_in_every_format() {
+    let text = cranking("8-1", "sample_rate = 1e6", 0.7, "glitch_probability = 0.05")
+        .replace("[capture]\n", "[capture]\nnoise_width = 1e-3\n");
+    for format in [
+        CaptureFormat::Saleae,
+        CaptureFormat::Sigrok,
+        CaptureFormat::Plain,
+    ] {
+        let file = tmp(&format!("round-{}.csv", format.name()));
+        let run = simulate(&text, format, &file);
+        // The level the writer was given, sample by sample: the tooth signal (set by each
+        // pulse edge) exclusive-or the noise pulses; a transition where it changes.
+        let mut events: Vec<(f64, Option<bool>)> = Vec::new();
+        for e in run.edge_list.iter().filter(|e| !e.dropped && !e.index) {
+            if e.glitch {
+                events.push((e.seen_time, None));
+                events.push((e.seen_time + 1e-3, None));
+            } else {
+                events.push((e.seen_time, Some(e.rising)));
+            }
+        }
+        events.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (mut tooth, mut noise, mut out) = (false, false, false);
+        let mut exp: Vec<f64> = Vec::new();
+        let mut k = 0;
+        while k < events.len() {
+            let at = sampled(events[k].0, 1e6);
+            while k < events.len() && sampled(events[k].0, 1e6) == at {
+                match events[k].1 {
+                    Some(l) => tooth = l,
+                    None => noise = !noise,
+                }
+                k += 1;
+            }
+            if (tooth ^ noise) != out {
+                out = tooth ^ noise;
+                exp.push(at);
+            }
+        }
+        let mut reader = CaptureReader::open(&file, None, None).unwrap();
+        assert_eq!(reader.format(), format);
+        let mut got = Vec::new();
+        let mut prev = Level::Low;
+        while let Some((t, levels)) = reader.next_row().unwrap() {
+            if levels[0] != prev {
+                got.push(t);
+                prev = levels[0];
+            }
+        }
+        if got.len() != exp.len() {
+            for (i, (g, e)) in got.iter().zip(&exp).enumerate() {
+                if (g - e).abs() > 1e-9 {
+                    panic!(
+                        "{}: #{i}: {g} vs {e}\n{:?}\n{:?}",
+                        format.name(),
+                        &got[i.saturating_sub(3)..(i + 3).min(got.len())],
+                        &exp[i.saturating_sub(3)..(i + 3).min(exp.len())]
+                    );
+                }
+            }
+        }
+        assert_eq!(got.len(), exp.len(), "{}", format.name());
+        let tol = if format == CaptureFormat::Saleae {
+            5.1e-10
+        } else {
+            1e-12
+        };
+        for (g, e) in got.iter().zip(&exp) {
+            assert!((g - e).abs() <= tol, "{}: {g} vs {e}", format.name());
+        }
+    }
+}
+
+fn reader_error(text: &str) -> String {
+    match CaptureReader::new(
+        std::io::Cursor::new(text.to_string()),
+        Path::new("cap.csv"),
+        None,
+        None,
+    ) {
+        Err(e) => e.to_string(),
+        Ok(mut r) => loop {
+            match r.next_row() {
+                Ok(Some(_)) => continue,
+                Ok(None) => panic!("no error in {text}"),
+                Err(e) => break e.to_string(),
+            }
+        },
+    }
+}
+
+#[test]
+fn each_parser_names_the_bad_line() {
+    let e = reader_error("Time [s],Channel 0\n0.000000000,0\n0.001000000,1\n0.002,2\n");
+    assert!(
+        e.starts_with("cap.csv:4:") && e.contains("`2`") && e.contains("not a logic level"),
+        "{e}"
+    );
+    let e = reader_error("Time [s],Channel 0,Channel 1\n0.0,0,0\n0.1,1\n");
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("expected 3 fields"),
+        "{e}"
+    );
+    let e = reader_error("time_s,level\n0,0\nabc,1\n");
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("not a time in seconds"),
+        "{e}"
+    );
+    let e = reader_error("time_s,level\n0.5,0\n0.4,1\n");
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("before the previous row"),
+        "{e}"
+    );
+    let sigrok =
+        "; CSV generated by libsigrok 0.6.0\n; from Demo device on Thu Jan  1 00:00:00 1970\n\
+                  ; Channels (2/8): D0, D1\n; Samplerate: 1 MHz\nmicroseconds,logic,logic\n\
+                  1,0,0\n2,1,0\n3,1,x\n";
+    let e = reader_error(sigrok);
+    assert!(
+        e.starts_with("cap.csv:8:") && e.contains("channel `D1`"),
+        "{e}"
+    );
+    let e = reader_error("; CSV\nTime,D0\n1,0\n");
+    assert!(
+        e.contains("cap.csv:2:") && e.contains("--sample-rate"),
+        "{e}"
+    );
+    let e = reader_error("hello,world\n1,2\n");
+    assert!(e.starts_with("cap.csv:1:") && e.contains("--format"), "{e}");
+    let long = format!("time_s,level\n0,{}\n", "0".repeat(5000));
+    let e = reader_error(&long);
+    assert!(
+        e.starts_with("cap.csv:2:") && e.contains("longer than"),
+        "{e}"
+    );
+}
+
+#[test]
+fn sigrok_channel_names_and_sample_times_follow_libsigrok() {
+    let text = "; CSV generated by libsigrok 0.6.0\n; from Demo on Thu Jan  1 00:00:00 1970\n\
+                ; Channels (2/8): D0, D1\n; Samplerate: 3 MHz\nnanoseconds,logic,logic\n\
+                333,0,0\n666,1,0\n999,1,1\n";
+    let mut r = CaptureReader::new(
+        std::io::Cursor::new(text.to_string()),
+        Path::new("s.csv"),
+        None,
+        None,
+    )
+    .unwrap();
+    assert_eq!(r.channels(), ["D0", "D1"]);
+    // Sample i is written (i+1)·333 ns at 3 MHz (the period truncated): read back i/3e6.
+    let mut times = Vec::new();
+    while let Some((t, _)) = r.next_row().unwrap() {
+        times.push(t);
+    }
+    assert_eq!(times, vec![0.0, 1.0 / 3e6, 2.0 / 3e6]);
+}
+
+#[test]
+fn scene_wheel_keys_are_checked_by_name() {
+    let err = |enc: &str| {
+        let text =
+            format!("[motor]\nmodel = \"speed\"\nspeed = 10.0\n[encoder]\ntimer_hz = 1e6\n{enc}\n");
+        Scene::parse(&text, Path::new("w.toml"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    assert!(err("wheel = \"36-2\"").is_empty());
+    assert!(err("lines = 36\ngaps = [[0, 2], [12, 2], [27, 2]]").is_empty());
+    assert!(err(
+        "lines = 24\nteeth = [0, 2, 4, 6, 7, 8, 10, 12, 14, 16, 18, 20, 22]\nestimator_edges = 1"
+    )
+    .is_empty());
+    let e = err("wheel = \"24+1\"");
+    assert!(
+        e.contains("encoder.wheel") && e.contains("ambiguous"),
+        "{e}"
+    );
+    let e = err("wheel = \"36-2\"\nlines = 60");
+    assert!(
+        e.contains("`encoder.lines = 60`") && e.contains("36-2"),
+        "{e}"
+    );
+    let e = err("lines = 36\ngaps = [[40, 2]]");
+    assert!(e.contains("`encoder.gaps[1][1] = 40`"), "{e}");
+    let e = err("lines = 24\nteeth = [0, 2, 2]");
+    assert!(
+        e.contains("`encoder.teeth[3] = 2`") && e.contains("twice"),
+        "{e}"
+    );
+    let e = err("wheel = \"36-2\"\ntolerances = { accept = 3.0 }");
+    assert!(e.contains("`encoder.tolerances.accept = 3.0`"), "{e}");
+    let e = err("lines = 100\nprescaler = 3");
+    assert!(e.contains("`encoder.prescaler = 3`"), "{e}");
+    // A pattern the core cannot frame: named by its keys, with the core's reason.
+    let text = "[motor]\nmodel = \"speed\"\nspeed = 10.0\n[encoder]\ntimer_hz = 1e6\n\
+                lines = 36\ngaps = [[0, 2], [12, 2], [24, 2]]\n";
+    let scene = Scene::parse(text, Path::new("w.toml")).unwrap();
+    let e = host_sim::app::run::core_encoder(&scene, Path::new("w.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("encoder.gaps")
+            && e.contains("rotationally symmetric")
+            && !e.contains("encoder.teeth"),
+        "{e}"
+    );
+}

@@ -1,0 +1,91 @@
+//! Clean signals the core's framing misjudges (host-sim's `tests/analyze.rs` finds the same on
+//! simulated captures). `#[ignore]`d until the core is fixed: run them with
+//! `cargo test --test framing_defects -- --ignored`.
+
+use drive_monitor::encoder::{Encoder, EncoderConfig};
+use drive_monitor::irregularity::{WindowConfig, WindowLength};
+use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::speed::{EdgeSink, Fault, Tooth};
+use host_sim::engine::cranking::{Ripple, SpeedProfile};
+use host_sim::engine::encoder::EncoderConfig as SimEncoder;
+use host_sim::engine::ode::Integrator;
+use host_sim::engine::system::{ShaftModel, Simulation, System};
+
+/// What an observer is told: every fault with its time, and the largest tooth-to-tooth ratio
+/// of the per-pitch intervals of the accepted teeth (the signal's cleanliness).
+#[derive(Default)]
+struct Seen {
+    faults: Vec<(Fault, u32)>,
+}
+
+impl EdgeSink for Seen {
+    fn tooth(&mut self, _t: &Tooth) {}
+    fn fault(&mut self, f: Fault, time: u32) {
+        self.faults.push((f, time));
+    }
+}
+
+/// A cranking 36-2 wheel — ±40 % compression ripple, two strokes per revolution, 25 rad/s
+/// mean — that stalls: the mean speed falls linearly to 0 over 0.6 s after 1.6 s. Every tooth
+/// is there and the per-pitch intervals change by at most 1.4× from tooth to tooth (checked
+/// below), yet the tracker calls three faults after 1.8 s (missing and extra edges).
+///
+/// Cause (found by patching it out): the expected interval of the next tooth is meant to be
+/// this interval times the swing the same teeth had one revolution earlier, but
+/// `expected_after` and `recorded_swing` divide by `hist[tooth]` after the accept paths have
+/// overwritten it with this revolution's interval. The "swing" is then the previous
+/// revolution's absolute interval of the next tooth over this one's, and the expectation is
+/// the previous revolution's interval itself — wrong as soon as the mean speed changes much
+/// from one revolution to the next (here it halves within one). Keeping the overwritten value
+/// of the last tooth and dividing by it removes all three faults (the test then passes).
+#[test]
+#[ignore = "core defect: speed.rs divides by hist[tooth] after overwriting it with this revolution's interval, so the expected interval is the previous revolution's; a stalling 36-2 crank (clean, ratios ≤ 1.4) gets 3 false faults (missing, extra edges)"]
+fn a_stalling_crank_is_not_a_fault() {
+    let profile = SpeedProfile {
+        mean: vec![(0.0, 25.0), (1.6, 25.0), (2.2, 0.0)],
+        ripple: Some(Ripple {
+            amplitude: 0.4,
+            strokes: 2.0,
+            phase: 0.0,
+        }),
+    };
+    let system = System::new(ShaftModel::Profile(profile), Vec::new()).unwrap();
+    let integ = Integrator::Dopri5 {
+        rtol: 1e-9,
+        atol: 1e-9,
+        max_step: Some(0.01),
+    };
+    let mut sim_enc = SimEncoder::ideal(36, 1e6);
+    // The core's 36-2: positions 0..=33 carry teeth, 34 and 35 are the gap.
+    sim_enc.teeth = Some((0..34).collect());
+    let mut sim = Simulation::new(system, integ, sim_enc).unwrap();
+    let mut c = EncoderConfig::missing_teeth(36, 2, 1e6);
+    c.min_speed = 1.0;
+    let w = WindowConfig {
+        length: WindowLength::Revolutions(1),
+        steady_tolerance: 0.05,
+    };
+    let mut m = DeltaMonitor::<64>::new(Encoder::new(c).unwrap(), w, None).unwrap();
+    let mut seen = Seen::default();
+    let mut times = Vec::new();
+    sim.run(2.2, |e| {
+        times.push((e.true_time, e.tooth));
+        m.on_edge_observed(e.ticks, None, &mut seen);
+    })
+    .unwrap();
+    // The signal is clean: per-pitch tooth-to-tooth ratios within 0.45–2.2 (1.4 at most).
+    let per_pitch: Vec<f64> = times
+        .windows(2)
+        .map(|w| {
+            let pitches = (w[1].1 + 36 - w[0].1) % 36;
+            (w[1].0 - w[0].0) / f64::from(pitches)
+        })
+        .collect();
+    let worst = per_pitch
+        .windows(2)
+        .map(|r| (r[1] / r[0]).max(r[0] / r[1]))
+        .fold(1.0, f64::max);
+    assert!(worst < 2.2, "{worst}");
+    assert_eq!(seen.faults, Vec::new());
+    assert_eq!(m.diagnostics().edges.sync_losses, 0);
+}
