@@ -459,6 +459,16 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
 
     /// Checks for standstill at time `now` (ticks); returns the window cut short, if any.
     pub fn poll(&mut self, now: u32) -> Option<WindowOutcome> {
+        self.poll_observed(now, &mut ())
+    }
+
+    /// [`DeltaMonitor::poll`], telling `observer` what it decides: the edges still pending
+    /// that it judges once the shaft has stopped (teeth and faults) and the timeout.
+    pub fn poll_observed<O: EdgeSink>(
+        &mut self,
+        now: u32,
+        observer: &mut O,
+    ) -> Option<WindowOutcome> {
         let mut first = self.spill.take();
         let spill = &mut self.spill;
         let mut feed = Feed {
@@ -469,7 +479,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             state: &mut self.state,
             alarm: &mut self.alarm,
             diag: &mut self.diag,
-            observer: &mut (),
+            observer,
             out: |o| keep(&mut first, spill, o),
         };
         self.tracker

@@ -220,9 +220,6 @@ pub struct AnalyzeReport {
     /// Edges pending judgement when the capture ended (the last edges, waiting for the two
     /// that would confirm them).
     pub unjudged_at_end: u64,
-    /// Edges accepted as teeth when a poll found the shaft stopped (the core's `poll` reports
-    /// them to no observer: their tooth numbers are not known here).
-    pub judged_at_poll: u64,
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
@@ -499,10 +496,8 @@ struct State {
 }
 
 impl State {
-    /// Polls the monitor at `ticks`. The core's `poll` tells no observer what it decides (the
-    /// edges it judges when it finds the shaft stopped, the timeout): they are read from its
-    /// counters, the faults reported at the poll's time, the teeth counted in
-    /// [`AnalyzeReport::judged_at_poll`].
+    /// Polls the monitor at `ticks`, observing what the poll decides (the edges it judges
+    /// once the shaft has stopped, the timeout) like any edge.
     fn poll(
         &mut self,
         monitor: &mut DeltaMonitor<MAX_LINES>,
@@ -511,25 +506,7 @@ impl State {
         report: &mut AnalyzeReport,
         on_decision: &mut dyn FnMut(&Decision),
     ) {
-        let before = monitor.diagnostics().edges;
-        let o = monitor.poll(ticks);
-        let after = monitor.diagnostics().edges;
-        let d = |a: u32, b: u32| a.wrapping_sub(b);
-        for (n, f) in [
-            (d(after.glitches, before.glitches), Fault::Glitch),
-            (d(after.missing, before.missing), Fault::MissingEdge),
-            (d(after.extra, before.extra), Fault::ExtraEdge),
-            (
-                d(after.missing_frames, before.missing_frames),
-                Fault::MissingFrame,
-            ),
-            (d(after.timeouts, before.timeouts), Fault::Timeout),
-        ] {
-            for _ in 0..n {
-                self.seen.events.push((ticks, Event::Fault(f)));
-            }
-        }
-        report.judged_at_poll += u64::from(d(after.accepted, before.accepted));
+        let o = monitor.poll_observed(ticks, &mut self.seen);
         self.after(monitor, clock, o, report, on_decision);
     }
 
