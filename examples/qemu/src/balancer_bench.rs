@@ -9,7 +9,7 @@ use core::hint::black_box;
 use cortex_m_semihosting::hprintln;
 use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, BistableReason, Classifier, Coupling, Machine, MachineConfig,
-    Platform, Regime, RegimeSegment, RegimeTable, RegimeTracker, SearchOptions, TABLE_MARGIN,
+    Platform, Regime, RegimeTracker, SearchOptions, TABLE_MARGIN,
 };
 
 use crate::bench::{ensure, measure, measure_each};
@@ -25,6 +25,14 @@ const FROM_TABLE: Classifier =
     match Classifier::from_machine_table(&three_mass_table::MACHINE, MARGIN, HYSTERESIS) {
         Ok(c) => c,
         Err(_) => panic!("three_mass_table.rs: not a valid machine table"),
+    };
+
+/// The classifier of the emitted exact regime table (`REGIMES`: Floquet stability of the
+/// balancing position, the capture windows, the criterion), built by the compiler.
+const EXACT: Classifier =
+    match Classifier::from_table(&three_mass_table::REGIMES, TABLE_MARGIN, 0.5 * TABLE_MARGIN) {
+        Ok(c) => c,
+        Err(_) => panic!("three_mass_table.rs: not a valid regime table"),
     };
 
 /// The bundled `three-mass.toml` machine.
@@ -57,27 +65,6 @@ fn config() -> MachineConfig {
         Err(e) => crate::bench::fail(format_args!("machine rejected: {}", e)),
     }
 }
-
-const fn seg(from: f32, regime: Regime) -> RegimeSegment {
-    RegimeSegment { from, regime }
-}
-
-/// The bundled `three-mass.toml` machine's exact regime table: `regime_table` of
-/// `drive-sim predict three-mass --json` (Floquet stability of the balancing position, the
-/// core's capture windows, the criterion), speeds rounded to f32.
-const EXACT: RegimeTable<'static> = RegimeTable {
-    segments: &[
-        seg(0.0, Regime::Gathering),
-        seg(50.324_696, Regime::Bistable(BistableReason::Capture)),
-        seg(50.954_55, Regime::Balancing),
-        seg(51.349_155, Regime::Bistable(BistableReason::Coexisting)),
-        seg(51.435_593, Regime::Gathering),
-        seg(70.139_68, Regime::Bistable(BistableReason::Capture)),
-        seg(70.938_67, Regime::Gathering),
-        seg(91.156_73, Regime::Bistable(BistableReason::Capture)),
-        seg(105.822_15, Regime::Balancing),
-    ],
-};
 
 pub fn run() {
     hprintln!("-- auto-balancer: three-mass machine");
@@ -126,11 +113,19 @@ pub fn run() {
         "classification"
     );
     let start = icount::instructions();
-    let exact = match Classifier::from_table(&EXACT, TABLE_MARGIN, 0.5 * TABLE_MARGIN) {
+    let exact = match Classifier::from_table(
+        black_box(&three_mass_table::REGIMES),
+        TABLE_MARGIN,
+        0.5 * TABLE_MARGIN,
+    ) {
         Ok(c) => c,
         Err(e) => crate::bench::fail(format_args!("table rejected: {}", e)),
     };
     let table_cost = icount::instructions() - start;
+    ensure!(
+        exact == EXACT,
+        "the exact table's classifier differs built at run time and by the compiler"
+    );
     hprintln!(
         "bench {:<28} {:>7}",
         "balancer::Classifier::from_table",

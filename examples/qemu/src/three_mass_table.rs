@@ -6,7 +6,9 @@
 //! Speeds in rad/s. Each f64 is Rust's shortest round-trip form of the value
 //! `Machine::new` computed (default `SearchOptions`): it reads back as the same bits.
 
-use drive_monitor::balancer::{CaptureWindow, MachineTable, Zone, ZoneKind};
+use drive_monitor::balancer::{
+    BistableReason, CaptureWindow, MachineTable, Regime, RegimeSegment, RegimeTable, Zone, ZoneKind,
+};
 
 /// Characteristic speeds, zones and capture windows of the `three-mass` scene's machine
 /// ([`MachineTable`]).
@@ -26,5 +28,24 @@ pub const MACHINE: MachineTable<'static> = MachineTable {
         CaptureWindow { from: 49.74062014725808, until: 50.95455277616617, at: 49.74062014725808 },
         CaptureWindow { from: 66.6231498246738, until: 74.55178532208701, at: 66.53934341660285 },
         CaptureWindow { from: 80.33713623877476, until: 105.82215063858969, at: 80.33713623877476 },
+    ],
+};
+
+/// The exact regime table of the `three-mass` scene's machine (the balancing position's
+/// stability from the Floquet multipliers of the model, the capture windows, the
+/// criterion), speeds in the core's f32: build the classifier with
+/// `Classifier::from_table(&REGIMES, TABLE_MARGIN, TABLE_MARGIN / 2.0)`.
+#[rustfmt::skip]
+pub const REGIMES: RegimeTable<'static> = RegimeTable {
+    segments: &[
+        RegimeSegment { from: 0.0, regime: Regime::Gathering },
+        RegimeSegment { from: 50.324696, regime: Regime::Bistable(BistableReason::Capture) },
+        RegimeSegment { from: 50.95455, regime: Regime::Balancing },
+        RegimeSegment { from: 51.349155, regime: Regime::Bistable(BistableReason::Coexisting) },
+        RegimeSegment { from: 51.435593, regime: Regime::Gathering },
+        RegimeSegment { from: 70.13968, regime: Regime::Bistable(BistableReason::Capture) },
+        RegimeSegment { from: 70.93867, regime: Regime::Gathering },
+        RegimeSegment { from: 91.15673, regime: Regime::Bistable(BistableReason::Capture) },
+        RegimeSegment { from: 105.82215, regime: Regime::Balancing },
     ],
 };

@@ -1,27 +1,34 @@
 //! `drive-sim predict SCENE --emit rust [--out FILE]`: the scene's auto-balancer machine
-//! analysed on the host ([`Machine::new`]) and written as Rust source: one `const`
+//! analysed on the host and written as Rust source: a `const`
 //! [`MachineTable`](drive_monitor::balancer::MachineTable) holding its characteristic speeds,
-//! zones and capture windows. Firmware includes the file as a module and builds its
-//! classifier at compile time with the `const fn`
-//! [`Classifier::from_table`](drive_monitor::balancer::Classifier::from_table), so the target
-//! never analyses the machine (nor links the analysis).
+//! zones and capture windows ([`Machine::new`]), and, when the machine has a balancing
+//! position, a `const` [`RegimeTable`](drive_monitor::balancer::RegimeTable): the exact regime
+//! table ([`crate::app::regimes`]: the balancing position's stability from the Floquet
+//! multipliers, the capture windows, the criterion). Firmware includes the file as a module
+//! and builds its classifier at compile time with the `const fn`s
+//! [`Classifier::from_table`](drive_monitor::balancer::Classifier::from_table) (the exact
+//! table) or [`Classifier::from_machine_table`](drive_monitor::balancer::Classifier::from_machine_table)
+//! (the criterion's), so the target never analyses the machine (nor links the analysis).
 //!
 //! Every f64 is written in Rust's shortest round-trip form (`{:?}`: the fewest digits that
 //! read back as the same bits; `str::parse` and rustc's float literals both round correctly),
-//! so the constant holds exactly the values computed here. The firmware example
+//! so the constant holds exactly the values computed here; the regime table's speeds are the
+//! core's f32 (each f64 boundary rounded to nearest), written the same way. The firmware example
 //! (`examples/qemu`) compares its checked-in table with `Machine::new` run on the target, and
 //! a host test compares that file with what this writes now.
 
 use crate::app::predict::machine;
+use crate::app::regimes::{core_segments, design};
 use crate::app::scene::{resolve, SceneError};
-use drive_monitor::balancer::{Machine, ZoneKind};
+use drive_monitor::balancer::{BistableReason, Machine, Regime, RegimeSegment, ZoneKind};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// What `--emit` writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
-    /// Rust source: a `const MACHINE: MachineTable` for firmware.
+    /// Rust source: `const MACHINE: MachineTable` and `const REGIMES: RegimeTable` for
+    /// firmware.
     Rust,
 }
 
@@ -46,8 +53,13 @@ pub fn literal(x: f64) -> String {
 }
 
 /// The Rust source for the machine of the scene named `scene` (as given on the command line),
-/// with its one-line `description`.
-pub fn rust_table(scene: &str, description: Option<&str>, m: &Machine) -> String {
+/// with its one-line `description` and its exact regime table, if it has one.
+pub fn rust_table(
+    scene: &str,
+    description: Option<&str>,
+    m: &Machine,
+    regimes: Option<&[RegimeSegment]>,
+) -> String {
     let list = |v: &[f64]| v.iter().map(|&x| literal(x)).collect::<Vec<_>>().join(", ");
     let mut s = String::new();
     let _ = writeln!(
@@ -67,11 +79,32 @@ pub fn rust_table(scene: &str, description: Option<&str>, m: &Machine) -> String
     if !m.capture_windows().is_empty() {
         types.insert(0, "CaptureWindow");
     }
-    let _ = writeln!(
-        s,
-        "use drive_monitor::balancer::{{{}}};\n",
-        types.join(", ")
-    );
+    if let Some(r) = regimes {
+        types.extend(["Regime", "RegimeSegment", "RegimeTable"]);
+        if r.iter().any(|g| matches!(g.regime, Regime::Bistable(_))) {
+            types.insert(0, "BistableReason");
+        }
+        types.sort_unstable();
+    }
+    // As rustfmt lays it out (the checked-in file must pass `cargo fmt --check`): one line
+    // when it fits in 100 columns, else the names filling indented lines.
+    let one = format!("use drive_monitor::balancer::{{{}}};", types.join(", "));
+    if one.len() <= 100 {
+        let _ = writeln!(s, "{one}\n");
+    } else {
+        let _ = writeln!(s, "use drive_monitor::balancer::{{");
+        let mut line = String::from("   ");
+        for t in &types {
+            if line.len() + t.len() + 2 > 100 {
+                let _ = writeln!(s, "{line}");
+                line = String::from("   ");
+            }
+            line.push(' ');
+            line.push_str(t);
+            line.push(',');
+        }
+        let _ = writeln!(s, "{line}\n}};\n");
+    }
     let _ = writeln!(
         s,
         "/// Characteristic speeds, zones and capture windows of the `{scene}` scene's machine\n\
@@ -112,6 +145,46 @@ pub fn rust_table(scene: &str, description: Option<&str>, m: &Machine) -> String
         let _ = writeln!(s, "    ],");
     }
     let _ = writeln!(s, "}};");
+    match regimes {
+        Some(r) => {
+            let _ = writeln!(
+                s,
+                "\n/// The exact regime table of the `{scene}` scene's machine (the balancing position's\n\
+                 /// stability from the Floquet multipliers of the model, the capture windows, the\n\
+                 /// criterion), speeds in the core's f32: build the classifier with\n\
+                 /// `Classifier::from_table(&REGIMES, TABLE_MARGIN, TABLE_MARGIN / 2.0)`.\n\
+                 #[rustfmt::skip]\n\
+                 pub const REGIMES: RegimeTable<'static> = RegimeTable {{\n    segments: &["
+            );
+            for g in r {
+                let regime = match g.regime {
+                    Regime::Balancing => "Regime::Balancing",
+                    Regime::Gathering => "Regime::Gathering",
+                    Regime::Bistable(BistableReason::Capture) => {
+                        "Regime::Bistable(BistableReason::Capture)"
+                    }
+                    Regime::Bistable(BistableReason::Coexisting) => {
+                        "Regime::Bistable(BistableReason::Coexisting)"
+                    }
+                    // A validated table has neither.
+                    Regime::NearCharacteristic | Regime::Unknown => "Regime::Unknown",
+                };
+                let _ = writeln!(
+                    s,
+                    "        RegimeSegment {{ from: {:?}, regime: {regime} }},",
+                    g.from
+                );
+            }
+            let _ = writeln!(s, "    ],\n}};");
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "\n// No exact regime table: the machine has no balancing position (fewer than two\n\
+                 // loads, or a rotor unbalance larger than they can balance)."
+            );
+        }
+    }
     s
 }
 
@@ -122,8 +195,12 @@ pub fn emit_text(name: &str, format: Format) -> Result<String, EmitError> {
     let Some(m) = machine(&scene, &path)? else {
         return Err(EmitError::NoMachine { file: path });
     };
+    let regimes = match design(&scene, &path, &m)?.and_then(|d| d.exact) {
+        Some(exact) => Some(core_segments(&exact.segments, &path)?),
+        None => None,
+    };
     Ok(match format {
-        Format::Rust => rust_table(name, scene.description.as_deref(), &m),
+        Format::Rust => rust_table(name, scene.description.as_deref(), &m, regimes.as_deref()),
     })
 }
 
@@ -141,7 +218,7 @@ mod tests {
             let Some(m) = machine(&scene, &path).unwrap() else {
                 continue;
             };
-            let text = rust_table(file, scene.description.as_deref(), &m);
+            let text = rust_table(file, scene.description.as_deref(), &m, None);
             let mut values: Vec<f64> = m
                 .resonant_speeds()
                 .iter()
@@ -172,6 +249,32 @@ mod tests {
         ] {
             assert_eq!(literal(v).parse::<f64>().unwrap().to_bits(), v.to_bits());
         }
+    }
+
+    /// The exact regime table is written when the machine has one, each f32 speed in a form
+    /// that reads back as the same bits; a machine without a balancing position says so.
+    #[test]
+    fn the_exact_regime_table_is_emitted_when_there_is_one() {
+        let (scene, path) = resolve("three-mass").unwrap();
+        let m = machine(&scene, &path).unwrap().unwrap();
+        let exact = design(&scene, &path, &m).unwrap().unwrap().exact.unwrap();
+        let segments = core_segments(&exact.segments, &path).unwrap();
+        let text = emit_text("three-mass", Format::Rust).unwrap();
+        assert!(
+            text.contains("pub const REGIMES: RegimeTable<'static>"),
+            "{text}"
+        );
+        for g in &segments {
+            let l = format!("{:?}", g.from);
+            assert_eq!(l.parse::<f32>().unwrap().to_bits(), g.from.to_bits(), "{l}");
+            assert!(text.contains(&format!("from: {l}, ")), "{l} missing");
+        }
+        assert_eq!(text.matches("RegimeSegment {").count(), segments.len());
+        let text = emit_text("one-mass-undersized", Format::Rust).unwrap();
+        assert!(
+            !text.contains("REGIMES") && text.contains("No exact regime table"),
+            "{text}"
+        );
     }
 
     #[test]
