@@ -30,6 +30,12 @@ fi
     /^[0-9a-f]+ <[^>]+>:$/ {
         cur = substr($2, 2, length($2) - 3)
         names[cur] = 1
+        # A function runs up to the next one (its literal pool and padding included).
+        addr = 0
+        for (k = 1; k <= length($1); k++) addr = addr * 16 + index("0123456789abcdef", substr($1, k, 1)) - 1
+        if (prev != "") size[prev] = addr - start[prev]
+        start[cur] = addr
+        prev = cur
         next
     }
     # A direct call or jump to another function: "bl 0x... <symbol+0x..>", conditional ones
@@ -48,7 +54,7 @@ fi
     cur != "" && /\t(mov|ldr)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?(\.w)?\tpc,/ { indirect[cur] = 1 }
     END {
         n = 0
-        for (f in names) if (f ~ /12entry_points/) { queue[n++] = f; seen[f] = "(entry)" }
+        for (f in names) if (f ~ /12entry_points/ && f !~ /17configure_monitor/) { queue[n++] = f; seen[f] = "(entry)" }
         if (n == 0) { print "panic-free.sh: no entry points found in the image" > "/dev/stderr"; exit 1 }
         roots = n
         for (i = 0; i < n; i++) {
@@ -76,5 +82,17 @@ fi
         }
         if (bad > 0) exit 1
         printf "panic-free (%s): %d functions reached from %d per-edge entry points, none can panic\n", profile, n, roots
+        # The code of a DeltaMonitor<1024> in firmware: everything its configuration, on_edge,
+        # on_captures, on_index and poll reach (not the learner or the corrected table).
+        m = 0
+        for (f in names) if (f ~ /12entry_points(17configure_monitor|7on_edge17|11on_captures|8on_index|4poll)/) { q2[m++] = f; s2[f] = 1 }
+        for (i = 0; i < m; i++) {
+            split(edges[q2[i]], out, " ")
+            for (j in out) { g = out[j]; if (g != "" && !(g in s2)) { s2[g] = 1; q2[m++] = g } }
+        }
+        bytes = 0
+        for (i = 0; i < m; i++) bytes += size[q2[i]]
+        printf "monitor code (%s): %d bytes in %d functions (configure, on_edge, on_captures, on_index, poll of a DeltaMonitor<1024>)\n", profile, bytes, m
+        if (ENVIRON["PANIC_FREE_SIZES"] != "") for (i = 0; i < m; i++) printf "%8d %s\n", size[q2[i]], q2[i]
     }
 '

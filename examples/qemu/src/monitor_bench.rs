@@ -410,7 +410,18 @@ pub fn run() {
 /// The out-of-line entry points (which `panic-free.sh` checks) report the windows the inlined
 /// calls do: the last δ of each way of feeding the stream is `delta`, bit for bit.
 fn entry_points_agree(ticks: &Ticks, delta: f32) {
-    let mut each = monitor(16, 8);
+    let mut each = DeltaMonitor::unconfigured();
+    let configured = entry_points::configure_monitor(
+        &mut each,
+        encoder_config(16),
+        window(8),
+        Some(AlarmConfig::new(0.06)),
+    );
+    ensure!(
+        configured.is_ok(),
+        "configuration rejected: {:?}",
+        configured
+    );
     let mut batched = monitor(16, 8);
     let mut learning = monitor(16, 8);
     let Ok(mut learner) = ToothLearner::new(learning.encoder(), 0.01) else {
