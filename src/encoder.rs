@@ -571,6 +571,25 @@ impl Encoder {
     pub(crate) fn short_teeth(&self) -> u64 {
         self.short
     }
+    /// Teeth that end two short pitches which together span at most one base pitch: the
+    /// second half of a pitch split by an extra tooth (bit k = tooth k; pattern wheels).
+    pub(crate) fn pair_teeth(&self) -> u64 {
+        if self.short == 0 {
+            return 0;
+        }
+        let mut pairs = 0u64;
+        for t in 0..self.edges.min(64) {
+            let prev = if t == 0 { self.edges } else { t }.wrapping_sub(1);
+            let both = self.short.checked_shr(u32::from(t)).unwrap_or(0) & 1 == 1
+                && self.short.checked_shr(u32::from(prev)).unwrap_or(0) & 1 == 1;
+            if both
+                && self.grid_pitch(t).wrapping_add(self.grid_pitch(prev)) <= u32::from(self.base)
+            {
+                pairs |= 1u64.checked_shl(u32::from(t)).unwrap_or(0);
+            }
+        }
+        pairs
+    }
     /// Span of `samples_span()` teeth on a uniform disc, units.
     pub fn uniform_span(&self) -> u32 {
         self.uniform_span

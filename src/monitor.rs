@@ -766,6 +766,71 @@ mod tests {
     }
 
     #[test]
+    fn general_patterns_sync_through_cranking_and_measure_delta() {
+        // Several gaps, uneven gaps, an extra tooth: zero faults while cranking at ±40 %, every
+        // revolution after sync counted, and δ of a steady ripple within its floor.
+        let mut half = [0u8; 13];
+        for (i, t) in half.iter_mut().take(12).enumerate() {
+            *t = 2 * i as u8;
+        }
+        half[12] = 7;
+        let wheels = [
+            (
+                "36-2-2-2",
+                Pattern::with_gaps(36, &[(0, 2), (12, 2), (27, 2)]).unwrap(),
+            ),
+            (
+                "36-2-1",
+                Pattern::with_gaps(36, &[(10, 1), (30, 2)]).unwrap(),
+            ),
+            (
+                "44-2-2",
+                Pattern::with_gaps(44, &[(0, 2), (20, 2)]).unwrap(),
+            ),
+            ("12+1", Pattern::from_teeth(24, &half).unwrap()),
+        ];
+        for (name, p) in wheels {
+            let mut c = EncoderConfig::pattern(p, 1e6);
+            c.estimator = Estimator::Edges(1);
+            c.min_speed = 5.0;
+            // The stroke phase against the wheel: where the speed peaks and dips.
+            for phase in [0.0, 0.8, 1.6, 2.4] {
+                let crank = move |phi: f64| 25.0 * (1.0 + 0.4 * (2.0 * phi + phase).sin());
+                let mut m = monitor(c, 1);
+                let revs = 30;
+                let evs = stream(&pattern_angles(p), None, revs, 1e6, u32::MAX, &crank);
+                run(&mut m, &evs);
+                let d = m.diagnostics().edges;
+                assert_eq!(d.missing + d.glitches + d.extra, 0, "{name} {phase}: {d:?}");
+                assert_eq!((d.syncs, d.sync_losses), (1, 0), "{name} {phase}: {d:?}");
+                assert!(d.revolutions + 3 >= revs, "{name} {phase}: {d:?}");
+            }
+            // Steady running with the kneader's ripple: δ = 0.02 exactly.
+            let mut c = EncoderConfig::pattern(p, 10e6);
+            c.estimator = Estimator::Edges(2);
+            c.min_speed = 20.0;
+            let mut m = monitor(c, 8);
+            let evs = stream(
+                &pattern_angles(p),
+                None,
+                8 * 4 + 3,
+                10e6,
+                u32::MAX,
+                &kneader(0.01),
+            );
+            let out = run(&mut m, &evs);
+            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+            assert!(valid.len() >= 3, "{name}: {out:?}");
+            for r in valid {
+                assert!(
+                    (r.delta - 0.02).abs() < 2e-3 + r.noise_floor,
+                    "{name}: {r:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn a_noise_pulse_is_a_glitch_and_the_real_edge_is_kept() {
         for frac in [0.3, 0.45, 0.55, 0.7] {
             let mut evs = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));

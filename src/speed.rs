@@ -274,9 +274,9 @@ pub struct SpeedTracker {
     arrivals: u32,
     nidx: u8,
     /// Pattern acquisition: alignments still possible for the last accepted edge (bit k:
-    /// it is tooth k), the two previous unsynced intervals, and the confirmation countdown.
+    /// it is tooth k), the three previous unsynced intervals, and the confirmation countdown.
     viable: u64,
-    acq: [u32; 2],
+    acq: [u32; 3],
     confirm: u16,
     seen_special: bool,
     /// Edges accepted while searching (a missing frame is counted every two revolutions).
@@ -373,7 +373,7 @@ impl SpeedTracker {
             arrivals: 0,
             nidx: 0,
             viable: 0,
-            acq: [0; 2],
+            acq: [0; 3],
             confirm: 0,
             seen_special: false,
             searched: 0,
@@ -1258,8 +1258,8 @@ impl SpeedTracker {
         let all = 1u64
             .checked_shl(u32::from(edges))
             .map_or(u64::MAX, |b| b.wrapping_sub(1));
-        let [before, middle] = self.acq;
-        self.acq = [middle, dt];
+        let [first, before, middle] = self.acq;
+        self.acq = [before, middle, dt];
         if self.viable == 0 {
             self.viable = all;
         }
@@ -1281,6 +1281,22 @@ impl SpeedTracker {
             }
             if enc.short_teeth() != 0 && m <= short_thr * hi as f32 {
                 allowed &= enc.short_teeth();
+            }
+            let pairs = enc.pair_teeth();
+            if pairs != 0 && first > 0 {
+                // An extra tooth splits a pitch in two: `before` and `middle` together span one
+                // base pitch. Their sum over the geometric mean of the intervals either side
+                // (which cancels a steady speed trend) is about 1 for a split pitch and about 2
+                // for two ordinary ones; cranking at ±40 % on 12 teeth moves these to at most
+                // 1.33 and at least 1.71, inside the thresholds √2 and 2^0.75.
+                // Compared squared: (b + c)² against the thresholds² times a·d, no root.
+                let sum = before as f32 + m;
+                let (sq, around) = (sum * sum, first as f32 * dt as f32);
+                if sq <= 2.0 * around {
+                    allowed &= pairs;
+                } else if sq >= NOT_A_PAIR_SQ * around {
+                    allowed &= !pairs;
+                }
             }
             // `viable` refers to the edge ending `middle` (the previous edge).
             let special = allowed != all;
@@ -1397,7 +1413,7 @@ impl SpeedTracker {
         self.npend = 0;
         self.out_of_band = false;
         self.block_fast();
-        self.acq = [0; 2];
+        self.acq = [0; 3];
         self.forget_history();
         self.reset_ring();
     }
@@ -1721,6 +1737,10 @@ impl Run {
         taken
     }
 }
+
+/// Two intervals at least 2^0.75 times the intervals either side are two ordinary pitches, not
+/// one split by an extra tooth; squared, 2^1.5.
+const NOT_A_PAIR_SQ: f32 = 2.828_427;
 
 /// Evidence thresholds of pattern acquisition, from the wheel's pitches: an interval at least
 /// `long`× both neighbours is a long pitch, at most `not_long`× both is not one, at most
