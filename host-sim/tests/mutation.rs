@@ -180,8 +180,9 @@ fn every_numeric_key_of_every_bundled_scene_mutated() {
         .iter()
         .flat_map(|(file, text)| cases(file, text))
         .collect();
-    // Seven scenes of 8 to 40 numeric keys each, nine mutations per key.
+    // Nine scenes of 8 to 40 numeric keys each, nine mutations per key.
     assert!(all.len() > 700, "{} cases", all.len());
+    println!("{} mutated scenes", all.len());
     let failures: Vec<String> = all
         .into_par_iter()
         .filter_map(|case| {
