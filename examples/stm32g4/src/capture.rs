@@ -2,7 +2,7 @@
 //!
 //! Channel A's rising edge latches TIM2's free-running 32-bit counter into TIM2_CCR1; the
 //! capture raises TIM2's CC1 DMA request, which DMAMUX1 channel 0 routes to DMA1 channel 1;
-//! the DMA copies CCR1 into the next slot of [`RING`] and wraps (circular mode). Its
+//! the DMA copies CCR1 into the next slot of a ring of [`RING`] and wraps (circular mode). Its
 //! half-transfer and transfer-complete interrupts say that one half of the ring has just
 //! filled; `main`'s DMA1_CHANNEL1 handler hands that half to the monitor. The index pulse is
 //! captured on channel 2 (TIM2_CCR2) with an interrupt: once per revolution, no DMA needed.
@@ -33,16 +33,7 @@ use embassy_stm32::timer::{Ch1, Ch2};
 use embassy_stm32::Peri;
 
 use crate::config::{EDGES_PER_CAPTURE, USE_INDEX};
-
-/// Captures in the DMA ring. Each half (64 captures: 1/16 revolution of a 1024-line disc) is
-/// one block for the monitor.
-pub const RING: usize = 128;
-/// Captures in one half of the ring.
-pub const HALF: usize = RING / 2;
-const _: () = assert!(
-    RING % 2 == 0 && RING <= u16::MAX as usize,
-    "DMA_CNDTR is 16-bit"
-);
+use crate::ring::{HALF, RING};
 
 /// TIM2's capture/compare channel index (0-based) of encoder A and of the index pulse.
 const CH_A: usize = 0;

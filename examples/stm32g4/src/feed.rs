@@ -1,27 +1,24 @@
 //! Where the captures meet the core: the blocks of the DMA ring and the index timestamps in,
 //! δ windows, the alarm pin and the log out.
 //!
-//! [`Feeder::feed`] is the one place the monitor is given captures. Three paths lead to it,
-//! all in interrupt handlers serialized by one critical section (`main`):
+//! [`Feeder::feed`] is the one place the monitor is given captures. Two paths lead to it, both
+//! in interrupt handlers serialized by one critical section (`main`):
 //! - DMA1 channel 1's half-transfer / transfer-complete interrupt: the half of the ring that
 //!   has just filled ([`Feeder::on_dma`]);
 //! - the periodic poll (SysTick): the part of the current half filled so far, so that edges
-//!   waiting for their half to fill are not mistaken for a stopped shaft ([`Feeder::on_poll`]);
-//! - neither feeds the same slot twice: `consumed` is the next slot not yet fed.
+//!   waiting for their half to fill are not mistaken for a stopped shaft ([`Feeder::on_poll`]).
+//!
+//! Which slots each feeds is decided by [`crate::ring::Cursor`], so that every slot is fed once
+//! and in order; the index pulses wait in [`crate::ring::IndexQueue`].
 
 use drive_monitor::alarm::{AlarmEvent, AlarmOutput};
 use drive_monitor::monitor::{fault_name, WindowOutcome};
 use drive_monitor::speed::Direction;
 use embassy_stm32::gpio::Output;
-use heapless::Deque;
 
-use crate::capture::{self, DmaEvents, TimerEvents, CAPTURES, HALF, RING};
+use crate::capture::{self, DmaEvents, TimerEvents, CAPTURES};
 use crate::config::Monitor;
-
-/// Index timestamps waiting for the edge that follows them. One index per revolution, taken
-/// at least at every half of the ring: more than one is pending only on a disc with fewer
-/// lines than a half holds.
-const INDEX_QUEUE: usize = 4;
+use crate::ring::{Cursor, IndexQueue, Step, HALF};
 
 /// What the capture path counted.
 #[derive(Clone, Copy, Debug, Default, defmt::Format)]
@@ -46,9 +43,8 @@ pub struct Stats {
 pub struct Feeder {
     monitor: &'static mut Monitor,
     alarm: AlarmOutput<Output<'static>>,
-    index: Deque<u32, INDEX_QUEUE>,
-    /// The next ring slot not yet fed, `0..RING`.
-    consumed: usize,
+    index: IndexQueue,
+    cursor: Cursor,
     /// Ticks by which a capture is surely in the ring: the DMA copies CCR1 within a few bus
     /// cycles, this allows 10 µs.
     settle_ticks: u32,
@@ -65,8 +61,8 @@ impl Feeder {
         Feeder {
             monitor,
             alarm,
-            index: Deque::new(),
-            consumed: 0,
+            index: IndexQueue::new(),
+            cursor: Cursor::new(),
             settle_ticks: counter_hz / 100_000,
             stats: Stats::default(),
         }
@@ -87,7 +83,7 @@ impl Feeder {
     pub fn on_timer_events(&mut self, events: TimerEvents) {
         if let Some(ticks) = events.index {
             self.stats.indices = self.stats.indices.wrapping_add(1);
-            if self.index.push_back(ticks).is_err() {
+            if !self.index.push(ticks) {
                 self.stats.lost_indices = self.stats.lost_indices.wrapping_add(1);
             }
         }
@@ -105,27 +101,15 @@ impl Feeder {
             self.stats.transfer_errors = self.stats.transfer_errors.wrapping_add(1);
             defmt::error!("DMA transfer error: capture stopped");
         }
-        if !(events.half || events.complete) {
-            return;
-        }
-        // The half that has just filled, and whether the DMA is still writing the other one:
-        // if it has come round into this half, or both flags are up, the handler ran a half
-        // late and the slots are being overwritten.
         let write = capture::write_position();
-        let (end, in_time) = match (events.half, events.complete) {
-            (true, false) => (HALF, write >= HALF),
-            (false, true) => (RING, write < HALF),
-            _ => (RING, false),
-        };
-        if !in_time || !(end - HALF..=end).contains(&self.consumed) {
-            // Skip to the half being written; the monitor sees the gap as missing edges and
-            // invalidates the window.
-            self.stats.overruns = self.stats.overruns.wrapping_add(1);
-            self.consumed = if write >= HALF { HALF } else { 0 };
-            return;
+        match self.cursor.on_dma(events.half, events.complete, write) {
+            Step::Feed { start, end } => {
+                self.on_timer_events(capture::take_timer_events());
+                self.feed_slots(start, end);
+            }
+            Step::Overrun => self.stats.overruns = self.stats.overruns.wrapping_add(1),
+            Step::Idle => {}
         }
-        self.on_timer_events(capture::take_timer_events());
-        self.drain_to(end);
     }
 
     /// The periodic poll: feeds what the current half holds so far, delivers index pulses no
@@ -139,12 +123,10 @@ impl Feeder {
             // DMA1_CHANNEL1's handler is about to feed a block: edges are arriving.
             return;
         }
-        let start = if write >= HALF { HALF } else { 0 };
-        if !(start..=write).contains(&self.consumed) {
-            return;
-        }
         self.on_timer_events(capture::take_timer_events());
-        self.drain_to(write);
+        if let Step::Feed { start, end } = self.cursor.on_poll(write) {
+            self.feed_slots(start, end);
+        }
 
         if let Some(outcome) = self.monitor.poll(now) {
             self.report(&outcome);
@@ -155,23 +137,16 @@ impl Feeder {
         // forgets a pending index when it declares standstill: the next edge after a restart
         // is still tooth 0).
         let settled = now.wrapping_sub(self.settle_ticks);
-        while let Some(&ticks) = self.index.front() {
-            if (settled.wrapping_sub(ticks) as i32) < 0 {
-                break;
-            }
-            self.index.pop_front();
+        while self.index.due(settled) {
             self.monitor.on_index();
         }
     }
 
-    /// Feeds ring slots `consumed..end` (`end` in the half `consumed` is in, or its end).
-    fn drain_to(&mut self, end: usize) {
-        if end > self.consumed {
-            let mut block = [0u32; HALF];
-            let captures = CAPTURES.copy_block(self.consumed, end, &mut block);
-            self.feed(captures);
-        }
-        self.consumed = if end >= RING { 0 } else { end };
+    /// Feeds ring slots `start..end` (within one half).
+    fn feed_slots(&mut self, start: usize, end: usize) {
+        let mut block = [0u32; HALF];
+        let captures = CAPTURES.copy_block(start, end, &mut block);
+        self.feed(captures);
     }
 
     /// The one place the monitor takes captures: a block of consecutive channel-A timestamps
@@ -188,13 +163,7 @@ impl Feeder {
         self.stats.blocks = self.stats.blocks.wrapping_add(1);
         self.stats.captures = self.stats.captures.wrapping_add(captures.len() as u32);
         for &ticks in captures {
-            // Timestamps compare by their wrapped difference, valid while the index waits less
-            // than 2^31 ticks (12.6 s at 170 MHz); `on_poll` delivers it within a poll period.
-            while let Some(&index) = self.index.front() {
-                if (ticks.wrapping_sub(index) as i32) < 0 {
-                    break;
-                }
-                self.index.pop_front();
+            while self.index.due(ticks) {
                 self.monitor.on_index();
             }
             if let Some(outcome) = self.monitor.on_edge(ticks, Some(Direction::Forward)) {
