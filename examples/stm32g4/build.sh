@@ -6,7 +6,7 @@
 #
 # Flashing needs the board and probe-rs: `cargo run --release` in this folder (README).
 # Needs: the thumbv7em-none-eabihf target (rustup target add thumbv7em-none-eabihf) and GNU
-# size (Debian: binutils). Installs nothing itself.
+# size and nm (Debian: binutils). Installs nothing itself.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 
@@ -25,10 +25,12 @@ g474 | g431)
 esac
 
 missing=0
-if ! command -v size >/dev/null 2>&1; then
-    echo "build.sh: 'size' not found; install it with: apt-get install -y binutils" >&2
-    missing=1
-fi
+for tool in size nm; do
+    if ! command -v "$tool" >/dev/null 2>&1; then
+        echo "build.sh: '$tool' not found; install it with: apt-get install -y binutils" >&2
+        missing=1
+    fi
+done
 if command -v rustup >/dev/null 2>&1 &&
     ! rustup target list --installed | grep -qx thumbv7em-none-eabihf; then
     echo "build.sh: target thumbv7em-none-eabihf missing; run: rustup target add thumbv7em-none-eabihf" >&2
@@ -51,3 +53,18 @@ size "$elf"
 # data and bss statically, plus the stack, which takes the rest of the chip's SRAM.
 size "$elf" | awk 'NR == 2 {
     printf "footprint: flash %d bytes, static RAM %d bytes\n", $1 + $2, $2 + $3 }'
+# The two large statics, from the symbol table: the monitor (a `DeltaMonitor<1024>` built by
+# the compiler as `unconfigured()` and configured in place, in its `ConstStaticCell` with the
+# cell's taken flag) and the DMA ring of captures.
+static_size() {
+    local hex
+    hex="$(nm --print-size --demangle "$elf" | awk -v name="$1" '$NF ~ ("::" name "$") { print $2; exit }')"
+    if [ -z "$hex" ]; then
+        echo "build.sh: symbol $1 not found in the image" >&2
+        return 1
+    fi
+    echo $((16#$hex))
+}
+monitor="$(static_size MONITOR)"
+ring="$(static_size CAPTURES)"
+echo "footprint: monitor static $monitor bytes, DMA ring $ring bytes"

@@ -9,16 +9,18 @@
 //!   waiting for their half to fill are not mistaken for a stopped shaft ([`Feeder::on_poll`]).
 //!
 //! Which slots each feeds is decided by [`crate::ring::Cursor`], so that every slot is fed once
-//! and in order; the index pulses wait in [`crate::ring::IndexQueue`].
+//! and in order; the index pulses wait in [`crate::ring::IndexQueue`] until the block with the
+//! edge after them is fed ([`crate::ring::feed_block`]) or a poll finds no edge after them yet
+//! ([`crate::ring::release_indices`]). Those three are the hardware-free part, tested on the
+//! host (`host-test/`).
 
 use drive_monitor::alarm::{AlarmEvent, AlarmOutput};
 use drive_monitor::monitor::{fault_name, WindowOutcome};
-use drive_monitor::speed::Direction;
 use embassy_stm32::gpio::Output;
 
 use crate::capture::{self, DmaEvents, TimerEvents, CAPTURES};
 use crate::config::Monitor;
-use crate::ring::{Cursor, IndexQueue, Step, HALF};
+use crate::ring::{self, Cursor, IndexQueue, Step, HALF};
 
 /// What the capture path counted.
 #[derive(Clone, Copy, Debug, Default, defmt::Format)]
@@ -129,17 +131,14 @@ impl Feeder {
         }
 
         if let Some(outcome) = self.monitor.poll(now) {
-            self.report(&outcome);
+            report(&mut self.alarm, &outcome);
         }
         // Every capture taken before `settled` was in the ring when `write` was read and has
-        // been fed. An index queued before `settled` therefore has no edge after it yet: all
-        // that follow are still to come, so it can be delivered now (after `poll`, which
-        // forgets a pending index when it declares standstill: the next edge after a restart
-        // is still tooth 0).
+        // been fed. An index queued at or before `settled` therefore has no edge after it yet:
+        // all that follow are still to come, so it can be handed over now, as it would be
+        // just before its edge.
         let settled = now.wrapping_sub(self.settle_ticks);
-        while self.index.due(settled) {
-            self.monitor.on_index();
-        }
+        ring::release_indices(self.monitor, &mut self.index, settled);
     }
 
     /// Feeds ring slots `start..end` (within one half).
@@ -150,59 +149,57 @@ impl Feeder {
     }
 
     /// The one place the monitor takes captures: a block of consecutive channel-A timestamps
-    /// (raw TIM2 counts, wrapping modulo 2^32), usually the half of the ring that has just
-    /// filled. Index pulses queued before a capture are delivered just before it.
-    ///
-    /// With today's API this is one `on_edge` per capture, each preceded by `on_index` for an
-    /// index at or before it (an edge at the very tick of the index counts as after it, so it
-    /// is tooth 0). It becomes one call of the batch entry point: queued index timestamps
-    /// handed over with `on_index(ticks)`, then `on_captures(captures, ..)` with the timer's
-    /// input prescaler (`config::EDGES_PER_CAPTURE`), its finished windows passed to
-    /// `report`.
+    /// (raw TIM2 counts, wrapping modulo 2^32; one every `config::EDGES_PER_CAPTURE` edges),
+    /// usually the half of the ring that has just filled. It goes to the core's batch entry
+    /// point `on_captures` in one call, split only where a queued index pulse falls: that goes
+    /// in by `on_index(ticks)` just before the first capture at or after it
+    /// ([`ring::feed_block`]). Each window that ends is logged and shown on the alarm pin as it
+    /// ends.
     fn feed(&mut self, captures: &[u32]) {
         self.stats.blocks = self.stats.blocks.wrapping_add(1);
         self.stats.captures = self.stats.captures.wrapping_add(captures.len() as u32);
-        for &ticks in captures {
-            while self.index.due(ticks) {
-                self.monitor.on_index();
-            }
-            if let Some(outcome) = self.monitor.on_edge(ticks, Some(Direction::Forward)) {
-                self.report(&outcome);
-            }
-        }
+        let alarm = &mut self.alarm;
+        ring::feed_block(self.monitor, &mut self.index, captures, |outcome| {
+            report(alarm, &outcome)
+        });
     }
+}
 
-    /// Logs a finished window and sets the alarm pin.
-    fn report(&mut self, outcome: &WindowOutcome) {
-        let r = &outcome.report;
-        match r.fault {
-            None => defmt::info!(
-                "δ {=f32} | ω mean {=f32} rad/s, min {=f32}, max {=f32} | floor {=f32} | steady {=bool} | {=u16} rev, {=u32} samples | {}",
-                r.delta,
-                r.omega_mean,
-                r.omega_min,
-                r.omega_max,
-                r.noise_floor,
-                r.steady,
-                r.revolutions,
-                r.samples,
-                outcome.verdict
-            ),
-            Some(fault) => defmt::warn!(
-                "window invalid: {=str} after {=u16} rev",
-                fault_name(fault),
-                r.revolutions
-            ),
+/// Logs a finished window and shows an alarm transition on the pin.
+fn report(alarm: &mut AlarmOutput<Output<'static>>, outcome: &WindowOutcome) {
+    let r = &outcome.report;
+    match &r.result {
+        Ok(m) => defmt::info!(
+            "δ {=f32} | ω mean {=f32} rad/s, min {=f32}, max {=f32} | floor {=f32} | steady {=bool} | {=u16} rev, {=u32} samples | {}",
+            m.delta,
+            m.omega_mean,
+            m.omega_min,
+            m.omega_max,
+            m.noise_floor,
+            m.steady,
+            r.revolutions,
+            m.samples,
+            outcome.verdict
+        ),
+        Err(fault) => defmt::warn!(
+            "window invalid: {=str} after {=u16} rev",
+            fault_name(*fault),
+            r.revolutions
+        ),
+    }
+    let active = match outcome.event {
+        Some(AlarmEvent::Raised) => {
+            defmt::warn!("δ alarm raised");
+            true
         }
-        match outcome.event {
-            Some(AlarmEvent::Raised) => defmt::warn!("δ alarm raised"),
-            Some(AlarmEvent::Cleared) => defmt::info!("δ alarm cleared"),
-            None => {}
+        Some(AlarmEvent::Cleared) => {
+            defmt::info!("δ alarm cleared");
+            false
         }
-        let active = self.monitor.alarm_active();
-        match self.alarm.show(active) {
-            Ok(()) => {}
-            Err(never) => match never {},
-        }
+        None => return,
+    };
+    match alarm.show(active) {
+        Ok(()) => {}
+        Err(never) => match never {},
     }
 }

@@ -6,7 +6,8 @@
 //!   [`ring::RING`] timestamps ([`capture`]).
 //! - The DMA's half-transfer and transfer-complete interrupt hands the half that has just
 //!   filled to the monitor ([`feed::Feeder::feed`], the one place the core takes captures).
-//! - The index pulse is captured on TIM2_CH2, with an interrupt.
+//! - The index pulse is captured on TIM2_CH2, with an interrupt; its timestamp goes to the
+//!   monitor just before the first capture after it.
 //! - SysTick polls at [`POLL_HZ`]: the part of a half filled so far is fed, and the monitor
 //!   checks for a stopped shaft.
 //! - Each δ window is logged over defmt-rtt; the δ alarm drives a GPIO through the core's
@@ -35,7 +36,7 @@ use drive_monitor::alarm::AlarmOutput;
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use panic_probe as _;
-use static_cell::StaticCell;
+use static_cell::ConstStaticCell;
 
 use crate::config::Monitor;
 use crate::feed::Feeder;
@@ -53,10 +54,9 @@ const DIAGNOSTICS_EVERY_S: u32 = 10;
 const INDEX_PRIORITY: Priority = Priority::P1;
 const FEED_PRIORITY: Priority = Priority::P2;
 
-/// The monitor (a `DeltaMonitor<1024>`: 18 984 bytes today) lives in a static, not on the
-/// stack. Today's `DeltaMonitor::new` returns it by value, so it passes through the stack once,
-/// at start-up.
-static MONITOR: StaticCell<Monitor> = StaticCell::new();
+/// The monitor lives in a static, built by the compiler as `DeltaMonitor::unconfigured()` and
+/// configured in place at start-up (`config::configure`): it never passes through the stack.
+static MONITOR: ConstStaticCell<Monitor> = ConstStaticCell::new(Monitor::unconfigured());
 
 /// The feeder, shared by the three interrupt handlers.
 static FEEDER: Mutex<RefCell<Option<Feeder>>> = Mutex::new(RefCell::new(None));
@@ -73,19 +73,29 @@ fn main() -> ! {
     let capture = capture::Capture::configure(board.tim2, board.dma, board.encoder_a, board.index);
     let counter_hz = capture.counter_hz();
     defmt::info!(
-        "drive-monitor on STM32G4: HCLK {=u32} Hz; TIM2 counts at {=u32} Hz, {=u8}-bit; {=u16}-line disc, {} framing; DMA ring of {=usize} captures",
+        "drive-monitor on STM32G4: HCLK {=u32} Hz; TIM2 counts at {=u32} Hz, {=u8}-bit; {=u16}-line disc, index {=bool}, {=u8} edges per capture; DMA ring of {=usize} captures",
         hclk.0,
         counter_hz,
         config::COUNTER_BITS,
         config::LINES,
-        config::FRAMING,
+        config::USE_INDEX,
+        config::EDGES_PER_CAPTURE,
         ring::RING
     );
 
-    let monitor = match config::monitor(f64::from(counter_hz)) {
-        Ok(m) => MONITOR.init(m),
-        Err(e) => defmt::panic!("configuration rejected: {}", e),
+    let Some(monitor) = MONITOR.try_take() else {
+        defmt::panic!("monitor already taken");
     };
+    if let Err(e) = config::configure(monitor, f64::from(counter_hz)) {
+        defmt::panic!("configuration rejected: {}", e);
+    }
+    defmt::info!(
+        "monitor: {=usize} bytes in a static, {=u16} captures per revolution, {} framing, δ windows of {=u16} rev",
+        core::mem::size_of::<Monitor>(),
+        monitor.encoder().edges(),
+        monitor.encoder().framing(),
+        monitor.window_revolutions()
+    );
     let alarm = AlarmOutput::new(board.alarm, true);
     critical_section::with(|cs| {
         FEEDER
@@ -124,12 +134,20 @@ fn main() -> ! {
     }
 }
 
+/// The feeder, in a critical section: `None` until `main` has built it. Every handler borrows
+/// it only inside its own critical section, so it is never already borrowed; `try_borrow_mut`
+/// says so without a panic branch on the interrupt path.
+fn feeder(cs: critical_section::CriticalSection<'_>) -> Option<core::cell::RefMut<'_, Feeder>> {
+    let cell = FEEDER.borrow(cs).try_borrow_mut().ok()?;
+    core::cell::RefMut::filter_map(cell, Option::as_mut).ok()
+}
+
 /// DMA1 channel 1: half transfer or transfer complete, a block of captures to feed.
 #[interrupt]
 fn DMA1_CHANNEL1() {
     critical_section::with(|cs| {
         let events = capture::take_dma_events();
-        if let Some(feeder) = FEEDER.borrow_ref_mut(cs).as_mut() {
+        if let Some(mut feeder) = feeder(cs) {
             feeder.on_dma(events);
         }
     });
@@ -140,7 +158,7 @@ fn DMA1_CHANNEL1() {
 fn TIM2() {
     critical_section::with(|cs| {
         let events = capture::take_timer_events();
-        if let Some(feeder) = FEEDER.borrow_ref_mut(cs).as_mut() {
+        if let Some(mut feeder) = feeder(cs) {
             feeder.on_timer_events(events);
         }
     });
@@ -154,13 +172,14 @@ fn SysTick() {
     *TICKS = TICKS.wrapping_add(1);
     let log = *TICKS % (POLL_HZ * DIAGNOSTICS_EVERY_S) == 0;
     critical_section::with(|cs| {
-        if let Some(feeder) = FEEDER.borrow_ref_mut(cs).as_mut() {
+        if let Some(mut feeder) = feeder(cs) {
             feeder.on_poll();
             if log {
                 let monitor = feeder.monitor();
                 defmt::info!(
-                    "shaft {} at {=f32} rad/s, alarm {=bool} | {} | {}",
+                    "shaft {} ({}) at {=f32} rad/s, alarm {=bool} | {} | {}",
                     monitor.shaft_state(),
+                    monitor.sync_state(),
                     monitor.speed(),
                     monitor.alarm_active(),
                     monitor.diagnostics(),

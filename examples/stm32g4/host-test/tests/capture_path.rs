@@ -4,12 +4,17 @@
 //! half-transfer flag when it fills slot `HALF - 1` and the transfer-complete flag when it
 //! fills the last slot and wraps, like DMA1 in circular mode. The CPU model takes the flags
 //! and reads the write position the way the firmware's handlers do (`feed.rs`), with the DMA
-//! allowed to move on between those reads.
+//! allowed to move on between those reads, and hands the blocks to the core with the
+//! firmware's own `ring::feed_block` (the batch entry point `on_captures`, split at index
+//! pulses) and `ring::release_indices`.
 
-use drive_monitor::monitor::WindowOutcome;
+use drive_monitor::encoder::EncoderConfig;
+use drive_monitor::monitor::{DeltaMonitor, Diagnostics, WindowOutcome};
 use drive_monitor::speed::Direction;
-use drive_monitor_stm32g4_host_test::config;
-use drive_monitor_stm32g4_host_test::ring::{Cursor, IndexQueue, Step, HALF, RING};
+use drive_monitor_stm32g4_host_test::config::{self, Monitor};
+use drive_monitor_stm32g4_host_test::ring::{
+    feed_block, release_indices, Cursor, IndexQueue, Step, HALF, RING,
+};
 
 /// xorshift64*: a fixed, seedable sequence.
 struct Rng(u64);
@@ -189,27 +194,39 @@ fn a_late_handler_is_an_overrun_and_nothing_stale_is_fed() {
 fn an_index_is_due_at_or_before_its_edge_across_the_wrap() {
     let mut q = IndexQueue::new();
     assert!(q.push(u32::MAX - 5));
-    assert!(!q.due(u32::MAX - 6), "an edge before the index");
-    assert!(
+    assert_eq!(q.due(u32::MAX - 6), None, "an edge before the index");
+    assert_eq!(
         q.due(u32::MAX - 5),
+        Some(u32::MAX - 5),
         "an edge at the index's tick is after it"
     );
-    assert!(!q.due(u32::MAX - 5), "delivered once");
+    assert_eq!(q.due(u32::MAX - 5), None, "delivered once");
+    assert!(q.is_empty());
     assert!(q.push(u32::MAX - 1));
-    assert!(q.due(3), "an edge after the counter wrapped");
+    assert_eq!(
+        q.due(3),
+        Some(u32::MAX - 1),
+        "an edge after the counter wrapped"
+    );
     for k in 0..4 {
         assert!(q.push(k));
     }
     assert!(!q.push(4), "a fifth pending index is reported lost");
 }
 
-/// Capture timestamps (TIM2 ticks at 170 MHz, not yet wrapped) of a 1024-line disc on a shaft
-/// running ω(φ) = ω̄·(1 + ε·sin(φ/8))·(1 + 0.004·φ/Φ) over the run's angle Φ (the slow drift
-/// makes every window differ from the one shifted by an edge, so misframing shows), and the
-/// index pulse of every revolution, `index_lead` ticks before its tooth 0 (0: at its tick).
-fn stream(omega: f64, revolutions: usize, start: u64, index_lead: u64) -> (Vec<u64>, Vec<u64>) {
+/// Capture timestamps (TIM2 ticks at 170 MHz, not yet wrapped) of a `lines`-line disc on a
+/// shaft running ω(φ) = ω̄·(1 + ε·sin(φ/8))·(1 + 0.004·φ/Φ) over the run's angle Φ (the slow
+/// drift makes every window differ from the one shifted by an edge, so misframing shows),
+/// and the index pulse of every revolution, `index_lead` ticks before its tooth 0 (0: at its
+/// tick).
+fn stream(
+    lines: usize,
+    omega: f64,
+    revolutions: usize,
+    start: u64,
+    index_lead: u64,
+) -> (Vec<u64>, Vec<u64>) {
     const EPS: f64 = 0.015;
-    let lines = usize::from(config::LINES);
     let pitch = core::f64::consts::TAU / lines as f64;
     let run = pitch * (lines * revolutions) as f64;
     let mut t = 0.0f64;
@@ -228,36 +245,48 @@ fn stream(omega: f64, revolutions: usize, start: u64, index_lead: u64) -> (Vec<u
     (edges, indices)
 }
 
+/// The firmware's monitor, configured in place as `main` does it, with `encoder` (the
+/// firmware's, `config::encoder`, or a variant of it).
+fn monitor(encoder: EncoderConfig) -> Monitor {
+    let mut m = Monitor::unconfigured();
+    m.configure_from(encoder, config::window(), Some(config::alarm()))
+        .expect("the firmware's configuration is valid");
+    m
+}
+
+/// What a run reported.
+#[derive(Debug)]
+struct Run {
+    outcomes: Vec<WindowOutcome>,
+    diagnostics: Diagnostics,
+    overruns: u32,
+    /// Length of every block handed to `feed_block`.
+    blocks: Vec<usize>,
+}
+
 /// The firmware's path, modelled: TIM2 latches the index, DMA1 fills the ring, DMA1_CHANNEL1's
-/// handler and a 100 Hz poll feed what the cursor gives them, with `feed.rs`'s loop.
-fn run_firmware_path(seed: u64, edges: &[u64], indices: &[u64]) -> (Vec<WindowOutcome>, u32) {
+/// handler and a 100 Hz poll feed what the cursor gives them with the firmware's `feed_block`,
+/// and the poll hands over the index pulses no edge has followed with `release_indices`.
+fn run_firmware_path(mut m: Monitor, seed: u64, edges: &[u64], indices: &[u64]) -> Run {
     const POLL_TICKS: u64 = 1_700_000; // 100 Hz at 170 MHz
     const SETTLE_TICKS: u32 = 1_700; // `Feeder::settle_ticks`
     let mut rng = Rng(seed);
-    let mut monitor = config::monitor(170e6).expect("the firmware's configuration is valid");
     let mut dma = Dma::new();
     let mut cursor = Cursor::new();
     let mut queue = IndexQueue::new();
     let mut latch: Option<u32> = None;
     let mut outcomes = Vec::new();
+    let mut blocks = Vec::new();
     let mut latency = rng.below(HALF as u64 / 2);
     let mut next_poll = edges[0] - edges[0] % POLL_TICKS + POLL_TICKS;
     let mut overruns = 0;
     let (mut e, mut x) = (0, 0);
 
-    // `Feeder::feed`.
-    let feed = |monitor: &mut config::Monitor,
-                queue: &mut IndexQueue,
-                captures: &[u32],
-                outcomes: &mut Vec<WindowOutcome>| {
-        for &ticks in captures {
-            while queue.due(ticks) {
-                monitor.on_index();
-            }
-            if let Some(o) = monitor.on_edge(ticks, Some(Direction::Forward)) {
-                outcomes.push(o);
-            }
-        }
+    // `Feeder::feed_slots` and `Feeder::feed`.
+    let mut feed = |m: &mut Monitor, queue: &mut IndexQueue, dma: &Dma, start, end| {
+        let block = dma.ring[start..end].to_vec();
+        blocks.push(block.len());
+        feed_block(m, queue, &block, |o| outcomes.push(o));
     };
     let collect = |latch: &mut Option<u32>, queue: &mut IndexQueue| {
         if let Some(ticks) = latch.take() {
@@ -279,15 +308,13 @@ fn run_firmware_path(seed: u64, edges: &[u64], indices: &[u64]) -> (Vec<WindowOu
             }
             collect(&mut latch, &mut queue);
             if let Step::Feed { start, end } = cursor.on_poll(write) {
-                let block = dma.ring[start..end].to_vec();
-                feed(&mut monitor, &mut queue, &block, &mut outcomes);
+                feed(&mut m, &mut queue, &dma, start, end);
             }
-            if let Some(o) = monitor.poll(now) {
-                outcomes.push(o);
+            if let Some(o) = m.poll(now) {
+                // Through `feed`'s closure too: `outcomes` is borrowed by it.
+                panic!("a running shaft was taken for a stopped one: {o:?}");
             }
-            while queue.due(now.wrapping_sub(SETTLE_TICKS)) {
-                monitor.on_index();
-            }
+            release_indices(&mut m, &mut queue, now.wrapping_sub(SETTLE_TICKS));
             continue;
         }
         if index_time <= edge_time {
@@ -310,8 +337,7 @@ fn run_firmware_path(seed: u64, edges: &[u64], indices: &[u64]) -> (Vec<WindowOu
             match cursor.on_dma(half, complete, dma.write) {
                 Step::Feed { start, end } => {
                     collect(&mut latch, &mut queue);
-                    let block = dma.ring[start..end].to_vec();
-                    feed(&mut monitor, &mut queue, &block, &mut outcomes);
+                    feed(&mut m, &mut queue, &dma, start, end);
                 }
                 Step::Overrun => overruns += 1,
                 Step::Idle => {}
@@ -323,49 +349,76 @@ fn run_firmware_path(seed: u64, edges: &[u64], indices: &[u64]) -> (Vec<WindowOu
         let (half, complete) = dma.take();
         if let Step::Feed { start, end } = cursor.on_dma(half, complete, dma.write) {
             collect(&mut latch, &mut queue);
-            let block = dma.ring[start..end].to_vec();
-            feed(&mut monitor, &mut queue, &block, &mut outcomes);
+            feed(&mut m, &mut queue, &dma, start, end);
         }
     }
     if let Step::Feed { start, end } = cursor.on_poll(dma.write) {
-        let block = dma.ring[start..end].to_vec();
-        feed(&mut monitor, &mut queue, &block, &mut outcomes);
+        feed(&mut m, &mut queue, &dma, start, end);
     }
-    (outcomes, overruns)
+    Run {
+        outcomes,
+        diagnostics: m.diagnostics(),
+        overruns,
+        blocks,
+    }
 }
 
-/// The reference: every edge straight into the monitor, `on_index` just before each tooth 0.
-fn run_edge_by_edge(edges: &[u64]) -> Vec<WindowOutcome> {
-    let lines = usize::from(config::LINES);
-    let mut monitor = config::monitor(170e6).expect("the firmware's configuration is valid");
+/// The reference: every edge straight into the monitor by `on_edge`, each index by
+/// `on_index` with its timestamp just before the first edge at or after it.
+fn run_edge_by_edge<const N: usize>(
+    mut m: DeltaMonitor<N>,
+    edges: &[u64],
+    indices: &[u64],
+) -> (Vec<WindowOutcome>, Diagnostics) {
     let mut outcomes = Vec::new();
-    for (i, &t) in edges.iter().enumerate() {
-        if i % lines == 0 {
-            monitor.on_index();
+    let mut x = 0;
+    for &t in edges {
+        while x < indices.len() && indices[x] <= t {
+            m.on_index(indices[x] as u32);
+            x += 1;
         }
-        if let Some(o) = monitor.on_edge(t as u32, Some(Direction::Forward)) {
+        if let Some(o) = m.on_edge(t as u32, Some(Direction::Forward)) {
             outcomes.push(o);
         }
     }
-    outcomes
+    (outcomes, m.diagnostics())
 }
 
-fn assert_same_windows(omega: f64, revolutions: usize, start: u64, index_lead: u64) {
-    let (edges, indices) = stream(omega, revolutions, start, index_lead);
-    let reference = run_edge_by_edge(&edges);
+/// Runs the firmware path over six seeds (handler latencies, when the index latch is taken)
+/// and checks it reports exactly the windows and counters of edge-by-edge feeding; returns
+/// the runs.
+fn assert_same_windows(
+    encoder: EncoderConfig,
+    edges: &[u64],
+    indices: &[u64],
+    what: &str,
+) -> Vec<Run> {
+    let (reference, diagnostics) = run_edge_by_edge(monitor(encoder), edges, indices);
     let valid = reference.iter().filter(|o| o.report.valid()).count();
     assert!(
         valid >= 2,
-        "ω̄ {omega}: only {valid} valid windows, the comparison is weak"
+        "{what}: only {valid} valid windows, the comparison is weak: {reference:?}"
     );
+    let mut runs = Vec::new();
     for seed in 1..=6 {
-        let (outcomes, overruns) = run_firmware_path(seed, &edges, &indices);
-        assert_eq!(overruns, 0);
+        let run = run_firmware_path(monitor(encoder), seed, edges, indices);
+        assert_eq!(run.overruns, 0, "{what}, seed {seed}");
+        assert_eq!(run.outcomes, reference, "{what}, seed {seed}");
+        assert_eq!(run.diagnostics, diagnostics, "{what}, seed {seed}");
         assert_eq!(
-            outcomes, reference,
-            "ω̄ {omega}, index {index_lead} ticks early, seed {seed}"
+            run.blocks.iter().sum::<usize>(),
+            edges.len(),
+            "{what}, seed {seed}: every capture fed once"
         );
+        runs.push(run);
     }
+    runs
+}
+
+/// The fraction of captures that reached the core in whole halves of the ring.
+fn in_whole_halves(run: &Run) -> f64 {
+    let whole: usize = run.blocks.iter().filter(|&&n| n == HALF).sum();
+    whole as f64 / run.blocks.iter().sum::<usize>() as f64
 }
 
 #[test]
@@ -373,14 +426,93 @@ fn the_firmware_path_reports_the_windows_of_edge_by_edge_feeding() {
     // 134 rad/s, starting 1 ms before the 32-bit counter wraps; index at tooth 0's tick, and
     // half a pitch early.
     let start = (1u64 << 32) - 170_000;
-    assert_same_windows(134.0, 8 * 4 + 2, start, 0);
-    assert_same_windows(134.0, 8 * 4 + 2, start, 3_900);
+    for lead in [0, 3_900] {
+        let (edges, indices) = stream(usize::from(config::LINES), 134.0, 8 * 4 + 2, start, lead);
+        let what = format!("134 rad/s, index {lead} ticks early");
+        for run in assert_same_windows(config::encoder(170e6), &edges, &indices, &what) {
+            // A half fills in 1.5 ms and the poll comes every 10 ms: most captures reach the
+            // core through the DMA interrupt, a whole half per `on_captures`.
+            let whole = in_whole_halves(&run);
+            assert!(
+                whole > 0.7,
+                "{what}: {whole} of the captures in whole halves"
+            );
+        }
+    }
 }
 
 #[test]
 fn a_slow_shaft_is_not_taken_for_a_stopped_one_while_its_half_fills() {
     // 2 rad/s: 64 captures take 196 ms, far beyond the 6 ms standstill timeout, so the poll
     // must feed the part of the half filled so far. The run crosses two counter wraps.
-    assert_same_windows(2.0, 8 * 2 + 3, 1_000, 0);
-    assert_same_windows(2.0, 8 * 2 + 3, 1_000, 260_000);
+    for lead in [0, 260_000] {
+        let (edges, indices) = stream(usize::from(config::LINES), 2.0, 8 * 2 + 3, 1_000, lead);
+        let what = format!("2 rad/s, index {lead} ticks early");
+        for run in assert_same_windows(config::encoder(170e6), &edges, &indices, &what) {
+            let whole = in_whole_halves(&run);
+            assert!(
+                whole < 0.1,
+                "{what}: {whole} of the captures in whole halves"
+            );
+        }
+    }
+}
+
+#[test]
+fn prescaled_captures_take_the_same_path() {
+    // The timer's input prescaler at 4 (`config::EDGES_PER_CAPTURE`): one capture every fourth
+    // line, starting at the second, so the index falls between captures; the core is told
+    // `prescaler = 4`.
+    let mut encoder = config::encoder(170e6);
+    encoder.prescaler = 4;
+    let start = (1u64 << 32) - 170_000;
+    let (edges, indices) = stream(usize::from(config::LINES), 134.0, 8 * 4 + 2, start, 0);
+    let captured: Vec<u64> = edges.iter().skip(1).step_by(4).copied().collect();
+    for run in assert_same_windows(encoder, &captured, &indices, "prescaler 4") {
+        // A half (256 lines) takes 11.7 ms, longer than the poll's 10 ms: most halves reach
+        // the core in two parts, each still a batch.
+        let mean = captured.len() as f64 / run.blocks.len() as f64;
+        assert!(mean > 16.0, "{mean} captures per block");
+    }
+}
+
+#[test]
+fn feed_block_splits_at_every_index_whatever_the_block_boundaries() {
+    // A 16-line disc: a block of up to 60 captures holds up to four index pulses (as many as
+    // the queue holds), and a block may end at, just before or just after one.
+    let lines = 16;
+    let mut encoder = EncoderConfig::indexed(lines as u16, 170e6);
+    encoder.min_speed = config::MIN_SPEED;
+    let make = || {
+        let mut m = DeltaMonitor::<16>::unconfigured();
+        m.configure_from(encoder, config::window(), Some(config::alarm()))
+            .expect("valid");
+        m
+    };
+    for lead in [0, 1, 20_000] {
+        let (edges, indices) = stream(lines, 8.0, 8 * 6 + 1, (1u64 << 32) - 9_000_000, lead);
+        let (reference, diagnostics) = run_edge_by_edge(make(), &edges, &indices);
+        assert!(reference.iter().filter(|o| o.report.valid()).count() >= 4);
+        let wrapped: Vec<u32> = edges.iter().map(|&t| t as u32).collect();
+        for seed in 1..=20 {
+            let mut rng = Rng(seed);
+            let mut m = make();
+            let mut queue = IndexQueue::new();
+            let mut outcomes = Vec::new();
+            let (mut k, mut x) = (0, 0);
+            while k < wrapped.len() {
+                let n = (1 + rng.below(60) as usize).min(wrapped.len() - k);
+                let block = &wrapped[k..k + n];
+                // Every index captured up to the block's last edge is queued.
+                while x < indices.len() && indices[x] <= edges[k + n - 1] {
+                    assert!(queue.push(indices[x] as u32));
+                    x += 1;
+                }
+                feed_block(&mut m, &mut queue, block, |o| outcomes.push(o));
+                k += n;
+            }
+            assert_eq!(outcomes, reference, "index {lead} ticks early, seed {seed}");
+            assert_eq!(m.diagnostics(), diagnostics, "seed {seed}");
+        }
+    }
 }
