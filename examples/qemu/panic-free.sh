@@ -25,7 +25,19 @@ if [ -z "$objdump" ]; then
     exit 1
 fi
 
-"$objdump" -d --no-show-raw-insn "$elf" | awk -v profile="$profile" '
+# The linker fills the gap before an aligned function with 0xd4d4 halfwords, which
+# disassemble as a branch ("bmi"); a d4d4 that no instruction follows in its function is that
+# fill, not code (a conditional branch cannot end a function), and is dropped (the raw
+# bytes are shown for this only).
+strip_fill() {
+    awk '
+        fill != "" { if ($0 ~ /^ *[0-9a-f]+:/) print fill; fill = "" }
+        /^ *[0-9a-f]+: d4d4 / { fill = $0; next }
+        { print }
+    '
+}
+
+"$objdump" -d "$elf" | strip_fill | awk -v profile="$profile" '
     # A function: "00012345 <symbol>:"
     /^[0-9a-f]+ <[^>]+>:$/ {
         cur = substr($2, 2, length($2) - 3)
