@@ -405,6 +405,16 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         if let Some(o) = self.spill.take() {
             on_window(o);
         }
+        let uniform = self.encoder.is_uniform() && P::NOMINAL;
+        let mut rest = captures;
+        if !O::WATCHES_TEETH && uniform {
+            // The ordinary teeth at the batch's start in one tight loop, as the fast path
+            // would take them (the usual case: the whole batch), before anything else is set up.
+            rest = self.bulk(rest);
+            if rest.is_empty() {
+                return;
+            }
+        }
         let mut feed = Feed {
             // Set before each edge that can end a window (the careful path).
             last_edge: 0,
@@ -417,8 +427,6 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             observer,
             out: on_window,
         };
-        let uniform = self.encoder.is_uniform() && P::NOMINAL;
-        let mut rest = captures;
         while !rest.is_empty() {
             if !O::WATCHES_TEETH && uniform {
                 // The ordinary teeth in one tight loop, as the fast path would take them.
@@ -455,6 +463,20 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         if self.spill.is_some() {
             self.tracker.block_fast();
         }
+    }
+
+    /// [`SpeedTracker::bulk`] on the leading captures of `captures` (a uniform disc at its
+    /// nominal pitches, no observer), folded into the window; the captures it left.
+    #[inline(always)]
+    fn bulk<'c>(&mut self, captures: &'c [u32]) -> &'c [u32] {
+        let mut extremes = self.state.uniform_extremes();
+        let (taken, ticks) = self.tracker.bulk(&self.encoder, captures, &mut extremes);
+        if taken == 0 {
+            return captures;
+        }
+        self.state
+            .add_run(ticks, extremes, self.encoder.uniform_span());
+        captures.get(taken..).unwrap_or(&[])
     }
 
     /// Checks for standstill at time `now` (ticks); returns the window cut short, if any.

@@ -1507,10 +1507,11 @@ impl SpeedTracker {
     /// points are the fast path's, and the state it leaves is the one the fast path would.
     ///
     /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
-    /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), two compares
-    /// for the extremes. The capture times before the batch come from the ring once per call,
-    /// and the ring is written once, at the end. Out of line: the batch loop keeps its state
-    /// in registers whatever the caller.
+    /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), one range
+    /// test for the extremes. The capture times before the batch come from the ring, laid out
+    /// from its start (so the first `K` samples start at consecutive slots), and the ring is
+    /// written once, at the end, by a copy of fixed size. The loops themselves are
+    /// [`Run::batch`], out of line so that they keep their state in registers.
     #[inline(never)]
     pub(crate) fn bulk(
         &mut self,
@@ -1525,59 +1526,23 @@ impl SpeedTracker {
         let n = caps.len().min(room).min(enc.bulk_max());
         let caps = caps.get(..n).unwrap_or(&[]);
         let k = usize::from(enc.samples_span());
-        // The ring's last `m` times (the last K, and at least two for the newest interval),
-        // laid out from its start: a batch reads the K before it in one piece.
-        let m = k.max(2);
+        // The ring's last `m` times (at least the last K, and two for the newest interval),
+        // laid out from its start: a batch reads the K before it in one piece. `m` is 16 or
+        // 32, so that writing them back is a copy of fixed size (a few block moves).
+        let m = if k <= LAID_SHORT {
+            LAID_SHORT
+        } else {
+            MAX_SPAN
+        };
         if self.pos != m as u32 {
             self.linearize(m);
         }
         let head = self.ring.get(m.wrapping_sub(k)..m).unwrap_or(&[]);
         let last0 = self.last;
-        let mut run = Run {
-            last: last0,
-            lo: self.lo,
-            width: self.width,
-            slowest: extremes.0,
-            fastest: extremes.1,
-        };
-        let mut i = 0usize;
+        let mut run = Run::new(last0, self.lo, self.width, *extremes);
         // Captures up to and including the next one on a refresh tooth.
-        let mut refresh = usize::from(BAND_REFRESH.wrapping_sub(self.tooth & (BAND_REFRESH - 1)));
-        loop {
-            let end = n.min(refresh);
-            // Samples that start before the batch (at the ring's times), then the others (at
-            // the batch's own captures, K back).
-            let mid = end.min(k);
-            // (`i` counts captures taken, at most `n`: the sums below do not wrap; `i ≥ k` in
-            // the second run, since `mid < end` means `mid = k`.)
-            if i < mid {
-                i = i.wrapping_add(run.take(
-                    caps.get(i..mid).unwrap_or(&[]),
-                    head.get(i..).unwrap_or(&[]),
-                ));
-            }
-            if i >= mid && i < end {
-                let now = caps.get(i..end).unwrap_or(&[]);
-                i = i.wrapping_add(run.take(now, caps.get(i.wrapping_sub(k)..).unwrap_or(&[])));
-            }
-            if i != refresh {
-                break;
-            }
-            // The fast path's refresh after this tooth: around the mean of the last K (`i` =
-            // `refresh` ≥ 1).
-            let from = if i > k {
-                caps.get(i.wrapping_sub(1).wrapping_sub(k))
-            } else {
-                head.get(i.wrapping_sub(1))
-            };
-            (run.lo, run.width) = enc
-                .band(run.last.wrapping_sub(from.copied().unwrap_or(0)))
-                .unwrap_or((u32::MAX, 0));
-            refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
-            if i >= n {
-                break;
-            }
-        }
+        let refresh = usize::from(BAND_REFRESH.wrapping_sub(self.tooth & (BAND_REFRESH - 1)));
+        let i = run.batch(enc, caps, head, refresh);
         if i == 0 {
             return (0, 0);
         }
@@ -1589,9 +1554,8 @@ impl SpeedTracker {
         let sum = run.last.wrapping_sub(from.copied().unwrap_or(0));
         // Leave what the fast path would have left, laid out from the ring's start: the last
         // `m` times.
-        if let Some(tail) = i.checked_sub(m).and_then(|from| caps.get(from..i)) {
-            each_pair(&mut self.ring, tail, |d, &c| *d = c);
-        } else {
+        let tail = i.checked_sub(m).and_then(|from| caps.get(from..i));
+        if !(lay::<LAID_SHORT>(&mut self.ring, tail) || lay::<MAX_SPAN>(&mut self.ring, tail)) {
             // A short batch (`i` < `m` ≤ 32): the older times move down, the batch's follow.
             let keep = m.saturating_sub(i);
             for j in 0..keep {
@@ -1609,7 +1573,7 @@ impl SpeedTracker {
         self.sum = sum;
         self.lo = run.lo;
         self.width = run.width;
-        *extremes = (run.slowest, run.fastest);
+        *extremes = run.extremes();
         // At most `bulk_max` intervals within the timeout: their total fits in 32 bits.
         (i, u64::from(run.last.wrapping_sub(last0)))
     }
@@ -1669,35 +1633,148 @@ impl SpeedTracker {
     }
 }
 
+/// Times a batch lays out from the ring's start when `K` is at most this many (else all of
+/// [`MAX_SPAN`]).
+const LAID_SHORT: usize = 16;
+
+/// Copies `tail` to the start of `ring` if it holds exactly `M` times (a copy of fixed size);
+/// whether it did.
+#[inline(always)]
+fn lay<const M: usize>(ring: &mut [u32; MAX_SPAN], tail: Option<&[u32]>) -> bool {
+    match (
+        ring.first_chunk_mut::<M>(),
+        tail.and_then(|t| <&[u32; M]>::try_from(t).ok()),
+    ) {
+        (Some(d), Some(t)) => {
+            *d = *t;
+            true
+        }
+        _ => false,
+    }
+}
+
 /// The state of a bulk run: the last capture, the band, the extremes.
 #[derive(Clone, Copy)]
 struct Run {
     last: u32,
     lo: u32,
     width: u32,
-    slowest: u32,
+    /// The extremes as the fastest sample's ticks and the range up to the slowest's: with
+    /// `fastest ≤ slowest`, one modular test `t − fastest ≤ range` says a sample is neither.
     fastest: u32,
+    range: u32,
+    /// The extremes are the wrong way round (a window that has just started holds `(0,
+    /// u32::MAX)`, slower and faster than anything): the first sample sets both.
+    fresh: bool,
 }
 
 impl Run {
+    /// A run from the last capture, the band and the window's extremes `(slowest, fastest)`.
+    #[inline(always)]
+    fn new(last: u32, lo: u32, width: u32, (slowest, fastest): (u32, u32)) -> Self {
+        Run {
+            last,
+            lo,
+            width,
+            fastest,
+            range: slowest.wrapping_sub(fastest),
+            fresh: fastest > slowest,
+        }
+    }
+
+    /// The extremes `(slowest, fastest)`.
+    #[inline(always)]
+    fn extremes(&self) -> (u32, u32) {
+        (self.fastest.wrapping_add(self.range), self.fastest)
+    }
+
+    /// Takes the leading captures of `caps` while their intervals are in the band, the first
+    /// `K = head.len()` samples starting at `head`, the others `K` captures back in `caps`,
+    /// and refreshes the band after capture `refresh − 1` and every [`BAND_REFRESH`] after it
+    /// as the fast path does. Returns how many were taken. Out of line: the run's state stays
+    /// in registers through all its loops.
+    #[inline(never)]
+    fn batch(&mut self, enc: &Encoder, caps: &[u32], head: &[u32], mut refresh: usize) -> usize {
+        let (n, k) = (caps.len(), head.len());
+        let mut i = 0usize;
+        if self.fresh {
+            // The first sample is both extremes (then `fastest ≤ slowest` holds).
+            let (Some(&c), Some(&s)) = (caps.first(), head.first()) else {
+                return 0;
+            };
+            if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
+                return 0;
+            }
+            let t = c.wrapping_sub(s);
+            let slowest = self.fastest.wrapping_add(self.range).max(t);
+            self.fastest = self.fastest.min(t);
+            self.range = slowest.wrapping_sub(self.fastest);
+            self.fresh = false;
+            self.last = c;
+            i = 1;
+        }
+        loop {
+            let end = n.min(refresh);
+            // Samples that start before the batch (at the ring's times), then the others (at
+            // the batch's own captures, K back).
+            let mid = end.min(k);
+            // (`i` counts captures taken, at most `n`: the sums below do not wrap; `i ≥ k` in
+            // the second run, since `mid < end` means `mid = k`.)
+            if i < mid {
+                i = i.wrapping_add(self.take(
+                    caps.get(i..mid).unwrap_or(&[]),
+                    head.get(i..).unwrap_or(&[]),
+                ));
+            }
+            if i >= mid && i < end {
+                let now = caps.get(i..end).unwrap_or(&[]);
+                i = i.wrapping_add(self.take(now, caps.get(i.wrapping_sub(k)..).unwrap_or(&[])));
+            }
+            if i != refresh {
+                return i;
+            }
+            // The fast path's refresh after this tooth: around the mean of the last K (`i` =
+            // `refresh` ≥ 1).
+            let from = if i > k {
+                caps.get(i.wrapping_sub(1).wrapping_sub(k))
+            } else {
+                head.get(i.wrapping_sub(1))
+            };
+            (self.lo, self.width) = enc
+                .band(self.last.wrapping_sub(from.copied().unwrap_or(0)))
+                .unwrap_or((u32::MAX, 0));
+            refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
+            if i >= n {
+                return i;
+            }
+        }
+    }
+
     /// Takes captures `now` while their intervals are in the band; `start[j]` is when the
     /// `K`-edge sample ending at `now[j]` starts. Returns how many were taken. Four captures a
-    /// turn; per capture a load, the band test, the sample and two selects for the extremes
-    /// (selects, not branches: a run-up, every sample a new extreme, costs the same as steady
-    /// running).
-    #[inline(never)]
+    /// turn; per capture a load, the band test, the sample and the range test of the extremes
+    /// (a branch taken only by a new extreme).
+    #[inline(always)]
     fn take(&mut self, now: &[u32], start: &[u32]) -> usize {
         let n = now.len().min(start.len());
         let (mut now, mut start) = (now.get(..n).unwrap_or(&[]), start.get(..n).unwrap_or(&[]));
         let (lo, width) = (self.lo, self.width);
-        let (mut last, mut slowest, mut fastest) = (self.last, self.slowest, self.fastest);
+        let (mut last, mut fastest, mut range) = (self.last, self.fastest, self.range);
         let mut step = |c: u32, s: u32| {
             if c.wrapping_sub(last).wrapping_sub(lo) > width {
                 return false;
             }
             let t = c.wrapping_sub(s);
-            slowest = slowest.max(t);
-            fastest = fastest.min(t);
+            let above = t.wrapping_sub(fastest);
+            if above > range {
+                // A new extreme: the slowest (`t` above the range) or the fastest.
+                if t < fastest {
+                    range = range.wrapping_add(fastest.wrapping_sub(t));
+                    fastest = t;
+                } else {
+                    range = above;
+                }
+            }
             last = c;
             true
         };
@@ -1732,8 +1809,8 @@ impl Run {
             n
         };
         self.last = last;
-        self.slowest = slowest;
         self.fastest = fastest;
+        self.range = range;
         taken
     }
 }
@@ -1848,6 +1925,95 @@ fn tooth_back(tooth: u16, n: u16, edges: u16) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`Run::batch`] against a capture-by-capture reference (the fast path's rules written
+    /// plainly: band test, sample, `max`/`min` of the extremes, band refresh after every
+    /// refresh tooth), on random batches: extremes from a window that has just started, equal,
+    /// or at the ends of the range, bands that stop the run anywhere, refreshes anywhere.
+    #[test]
+    fn a_bulk_run_takes_what_capture_by_capture_takes() {
+        let enc = Encoder::new(crate::encoder::EncoderConfig::indexed(1024, 84e6)).unwrap();
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |m: u32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 16) as u32 % m
+        };
+        for _ in 0..20_000 {
+            let most = if next(4) == 0 { 200 } else { 70 };
+            let n = next(most) as usize;
+            let k = 1 + next(32) as usize;
+            let dt = 1 + next(4000);
+            let jitter = next(3) * next(dt / 2 + 1);
+            let mut t = next(u32::MAX);
+            let mut times = Vec::new();
+            for _ in 0..k + n {
+                t = t
+                    .wrapping_add(dt)
+                    .wrapping_add(next(jitter + 1))
+                    .wrapping_sub(jitter / 2);
+                times.push(t);
+            }
+            let (head, caps) = times.split_at(k);
+            let last = *head.last().unwrap();
+            let (lo, width) = enc.band(dt.wrapping_mul(k as u32)).unwrap_or((u32::MAX, 0));
+            let (lo, width) = match next(8) {
+                0 => (lo.wrapping_add(next(50)), width.saturating_sub(next(50))),
+                1 => (u32::MAX, 0),
+                _ => (lo, width),
+            };
+            let extremes = match next(7) {
+                0 => (0, u32::MAX),
+                6 => {
+                    let a = next(u32::MAX);
+                    (a, next(u32::MAX))
+                }
+                1 => (0, 0),
+                2 => (u32::MAX, 0),
+                3 => {
+                    let x = next(u32::MAX);
+                    (x, x)
+                }
+                _ => {
+                    let a = dt.wrapping_mul(k as u32);
+                    let b = a.wrapping_sub(next(jitter * 4 + 1));
+                    (a.max(b), a.min(b))
+                }
+            };
+            let refresh = 1 + next(64) as usize;
+
+            // The reference.
+            let (mut r_last, mut r_lo, mut r_width) = (last, lo, width);
+            let (mut slowest, mut fastest) = extremes;
+            let (mut taken, mut r_refresh) = (0, refresh);
+            for (j, &c) in caps.iter().enumerate() {
+                let start = if j < k { head[j] } else { caps[j - k] };
+                if c.wrapping_sub(r_last).wrapping_sub(r_lo) > r_width {
+                    break;
+                }
+                let sample = c.wrapping_sub(start);
+                slowest = slowest.max(sample);
+                fastest = fastest.min(sample);
+                r_last = c;
+                taken += 1;
+                if taken == r_refresh {
+                    (r_lo, r_width) = enc.band(sample).unwrap_or((u32::MAX, 0));
+                    r_refresh += usize::from(BAND_REFRESH);
+                }
+            }
+
+            let mut run = Run::new(last, lo, width, extremes);
+            let got = run.batch(&enc, caps, head, refresh);
+            let case = (n, k, dt, jitter, lo, width, extremes, refresh);
+            assert_eq!(got, taken, "{case:?}");
+            assert_eq!(run.last, r_last, "{case:?}");
+            assert_eq!((run.lo, run.width), (r_lo, r_width), "{case:?}");
+            if taken > 0 {
+                assert_eq!(run.extremes(), (slowest, fastest), "{case:?}");
+            }
+        }
+    }
 
     #[test]
     fn log_is_accurate_enough_to_judge_swings() {
