@@ -87,8 +87,10 @@ pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
 }
 
 /// Where the tracker's findings go during one call: the window, the alarm, the observer, and
-/// the caller's window callback.
-struct Feed<'a, O: EdgeSink, F: FnMut(WindowOutcome)> {
+/// the call's finished windows (the first one, and a second spilled to the next call). One
+/// type per observer, whatever the caller's window callback: the careful path is compiled
+/// once for every entry point.
+struct Feed<'a, O: EdgeSink> {
     encoder: &'a Encoder,
     uniform: bool,
     /// Number of the last accepted edge (where an aborted window ends).
@@ -98,10 +100,11 @@ struct Feed<'a, O: EdgeSink, F: FnMut(WindowOutcome)> {
     alarm: &'a mut Option<DeltaAlarm>,
     diag: &'a mut Diagnostics,
     observer: &'a mut O,
-    out: F,
+    first: Option<WindowOutcome>,
+    spill: &'a mut Option<WindowOutcome>,
 }
 
-impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
+impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     #[inline(always)]
     fn tooth(&mut self, tooth: &Tooth) {
         self.observer.tooth(tooth);
@@ -116,7 +119,7 @@ impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
             self.uniform,
         ) {
             let o = finish(self.alarm, self.diag, r);
-            (self.out)(o);
+            keep(&mut self.first, self.spill, o);
         }
     }
 
@@ -125,7 +128,7 @@ impl<O: EdgeSink, F: FnMut(WindowOutcome)> EdgeSink for Feed<'_, O, F> {
         self.observer.fault(fault, time);
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
             let o = finish(self.alarm, self.diag, r);
-            (self.out)(o);
+            keep(&mut self.first, self.spill, o);
         }
     }
 }
@@ -366,8 +369,6 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         direction: Option<Direction>,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
-        let mut first = self.spill.take();
-        let spill = &mut self.spill;
         let mut feed = Feed {
             last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
@@ -377,10 +378,12 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             alarm: &mut self.alarm,
             diag: &mut self.diag,
             observer,
-            out: |o| keep(&mut first, spill, o),
+            first: self.spill.take(),
+            spill: &mut self.spill,
         };
         self.tracker
             .on_edge(&self.encoder, &self.table, ticks, direction, &mut feed);
+        let first = feed.first;
         if self.spill.is_some() {
             self.tracker.block_fast();
         }
@@ -415,29 +418,10 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                 return;
             }
         }
-        let mut feed = Feed {
-            // Set before each edge that can end a window (the careful path).
-            last_edge: 0,
-            encoder: &self.encoder,
-            uniform: self.encoder.is_uniform() && P::NOMINAL,
-            window: &self.window,
-            state: &mut self.state,
-            alarm: &mut self.alarm,
-            diag: &mut self.diag,
-            observer,
-            out: on_window,
-        };
         while !rest.is_empty() {
             if !O::WATCHES_TEETH && uniform {
                 // The ordinary teeth in one tight loop, as the fast path would take them.
-                let mut extremes = feed.state.uniform_extremes();
-                let (taken, ticks) = self.tracker.bulk(&self.encoder, rest, &mut extremes);
-                if taken > 0 {
-                    feed.state
-                        .add_run(ticks, extremes, self.encoder.uniform_span());
-                    rest = rest.get(taken..).unwrap_or(&[]);
-                    continue;
-                }
+                rest = self.bulk(rest);
             }
             let Some((&t, tail)) = rest.split_first() else {
                 break;
@@ -447,21 +431,19 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                 .tracker
                 .try_fast(&self.encoder, &self.table, t, uniform)
             {
-                feed.observer.tooth(&tooth);
-                feed.state.add(tooth.dt, tooth.sample, uniform);
+                observer.tooth(&tooth);
+                self.state.add(tooth.dt, tooth.sample, uniform);
             } else {
-                feed.last_edge = self.tracker.counters().accepted;
-                self.tracker.on_edge(
-                    &self.encoder,
-                    &self.table,
-                    t,
-                    Some(Direction::Forward),
-                    &mut feed,
-                );
+                // The careful path as `on_edge` takes it (one copy of it for every caller's
+                // callback); a second window it ends is handed on at once, and the edge after
+                // it takes the careful path, as it would after `on_edge`.
+                if let Some(o) = self.slow_edge(t, Some(Direction::Forward), observer) {
+                    on_window(o);
+                }
+                if let Some(o) = self.spill.take() {
+                    on_window(o);
+                }
             }
-        }
-        if self.spill.is_some() {
-            self.tracker.block_fast();
         }
     }
 
@@ -491,8 +473,6 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         now: u32,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
-        let mut first = self.spill.take();
-        let spill = &mut self.spill;
         let mut feed = Feed {
             last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
@@ -502,11 +482,12 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             alarm: &mut self.alarm,
             diag: &mut self.diag,
             observer,
-            out: |o| keep(&mut first, spill, o),
+            first: self.spill.take(),
+            spill: &mut self.spill,
         };
         self.tracker
             .poll(&self.encoder, &self.table, now, &mut feed);
-        first
+        feed.first
     }
 }
 

@@ -1582,8 +1582,20 @@ impl SpeedTracker {
     #[cold]
     #[inline(never)]
     fn linearize(&mut self, m: usize) {
+        let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
+        if first.wrapping_add(m) <= MAX_SPAN {
+            // Not wrapped (the usual case: a few careful edges after a batch): moved down in
+            // place, each time read before anything overwrites it (`first + j ≥ j`).
+            for j in 0..m {
+                let v = self.ring.get(first.wrapping_add(j)).copied().unwrap_or(0);
+                if let Some(d) = self.ring.get_mut(j) {
+                    *d = v;
+                }
+            }
+            self.pos = m as u32;
+            return;
+        }
         let mut laid = [0u32; MAX_SPAN];
-        let first = self.pos.wrapping_sub(m as u32) as usize;
         for (j, d) in laid.iter_mut().take(m).enumerate() {
             *d = self
                 .ring
@@ -1697,20 +1709,27 @@ impl Run {
     fn batch(&mut self, enc: &Encoder, caps: &[u32], head: &[u32], mut refresh: usize) -> usize {
         let (n, k) = (caps.len(), head.len());
         let mut i = 0usize;
-        if self.fresh {
-            // The first sample is both extremes (then `fastest ≤ slowest` holds).
+        if self.fresh || refresh == 1 {
+            // The first capture alone: the first sample of a window is both extremes (then
+            // `fastest ≤ slowest` holds), and a single capture before a refresh tooth (a batch
+            // that starts one tooth before it, as an aligned DMA half-buffer does) costs less
+            // as one step than as a run of its own.
             let (Some(&c), Some(&s)) = (caps.first(), head.first()) else {
                 return 0;
             };
-            if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
+            if self.fresh {
+                if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
+                    return 0;
+                }
+                let t = c.wrapping_sub(s);
+                let slowest = self.fastest.wrapping_add(self.range).max(t);
+                self.fastest = self.fastest.min(t);
+                self.range = slowest.wrapping_sub(self.fastest);
+                self.fresh = false;
+                self.last = c;
+            } else if !self.step(c, s) {
                 return 0;
             }
-            let t = c.wrapping_sub(s);
-            let slowest = self.fastest.wrapping_add(self.range).max(t);
-            self.fastest = self.fastest.min(t);
-            self.range = slowest.wrapping_sub(self.fastest);
-            self.fresh = false;
-            self.last = c;
             i = 1;
         }
         loop {
@@ -1748,6 +1767,27 @@ impl Run {
                 return i;
             }
         }
+    }
+
+    /// Takes capture `c` if its interval is in the band, the sample ending at it starting at
+    /// `s`; whether it did.
+    #[inline(always)]
+    fn step(&mut self, c: u32, s: u32) -> bool {
+        if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
+            return false;
+        }
+        let t = c.wrapping_sub(s);
+        let above = t.wrapping_sub(self.fastest);
+        if above > self.range {
+            if t < self.fastest {
+                self.range = self.range.wrapping_add(self.fastest.wrapping_sub(t));
+                self.fastest = t;
+            } else {
+                self.range = above;
+            }
+        }
+        self.last = c;
+        true
     }
 
     /// Takes captures `now` while their intervals are in the band; `start[j]` is when the
