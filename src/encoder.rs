@@ -334,7 +334,8 @@ pub struct Encoder {
 }
 
 impl Encoder {
-    /// A placeholder with no edges: a monitor holding it ignores everything until configured.
+    /// The encoder of an unconfigured monitor: no edges, so the monitor ignores everything
+    /// until `configure` replaces it.
     pub const UNCONFIGURED: Encoder = Encoder {
         config: EncoderConfig {
             wheel: Wheel::Unframed { lines: 0 },

@@ -103,7 +103,7 @@ impl WindowConfig {
 }
 
 impl Window {
-    /// A placeholder (one revolution) for an unconfigured monitor.
+    /// The window of an unconfigured monitor (one revolution); `configure` replaces it.
     pub(crate) const UNCONFIGURED: Window = Window {
         revolutions: 1,
         steady_tolerance: 0.02,

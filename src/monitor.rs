@@ -369,21 +369,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         direction: Option<Direction>,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
-        let mut feed = Feed {
-            last_edge: self.tracker.counters().accepted,
-            encoder: &self.encoder,
-            uniform: self.encoder.is_uniform() && P::NOMINAL,
-            window: &self.window,
-            state: &mut self.state,
-            alarm: &mut self.alarm,
-            diag: &mut self.diag,
-            observer,
-            first: self.spill.take(),
-            spill: &mut self.spill,
-        };
-        self.tracker
-            .on_edge(&self.encoder, &self.table, ticks, direction, &mut feed);
-        let first = feed.first;
+        let first = self.fed(observer, |tracker, encoder, table, feed| {
+            tracker.on_edge(encoder, table, ticks, direction, feed);
+        });
         if self.spill.is_some() {
             self.tracker.block_fast();
         }
@@ -473,6 +461,19 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         now: u32,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
+        self.fed(observer, |tracker, encoder, table, feed| {
+            tracker.poll(encoder, table, now, feed);
+        })
+    }
+
+    /// Runs `step` on the tracker with a [`Feed`] into this monitor's window, alarm and
+    /// `observer`; returns the first window the step ends (a second one waits in `spill`).
+    #[inline(always)]
+    fn fed<O: EdgeSink>(
+        &mut self,
+        observer: &mut O,
+        step: impl FnOnce(&mut SpeedTracker, &Encoder, &P, &mut Feed<'_, O>),
+    ) -> Option<WindowOutcome> {
         let mut feed = Feed {
             last_edge: self.tracker.counters().accepted,
             encoder: &self.encoder,
@@ -485,8 +486,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             first: self.spill.take(),
             spill: &mut self.spill,
         };
-        self.tracker
-            .poll(&self.encoder, &self.table, now, &mut feed);
+        step(&mut self.tracker, &self.encoder, &self.table, &mut feed);
         feed.first
     }
 }
