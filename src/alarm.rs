@@ -15,7 +15,7 @@
     deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
 )]
 
-use crate::error::{non_negative_f32, positive_f32, ConfigError};
+use crate::error::{non_negative_f32, positive_f32, tri, ConfigError};
 use crate::irregularity::WindowReport;
 use embedded_hal::digital::OutputPin;
 
@@ -37,7 +37,7 @@ pub struct AlarmConfig {
 
 impl AlarmConfig {
     /// Limit `limit`, 3 of 5 windows, 10 % hysteresis, floor at most 20 % of the limit.
-    pub fn new(limit: f32) -> Self {
+    pub const fn new(limit: f32) -> Self {
         AlarmConfig {
             limit,
             raise_after: 3,
@@ -48,19 +48,19 @@ impl AlarmConfig {
     }
 
     /// Checks the settings.
-    pub fn validate(self) -> Result<DeltaAlarm, ConfigError> {
-        positive_f32("delta_limit", self.limit)?;
+    pub const fn validate(self) -> Result<DeltaAlarm, ConfigError> {
+        tri!(positive_f32("delta_limit", self.limit));
         if self.of_last == 0 || self.of_last > 32 {
             return Err(ConfigError::OutOfRange("of_last"));
         }
         if self.raise_after == 0 || self.raise_after > self.of_last {
             return Err(ConfigError::OutOfRange("raise_after"));
         }
-        let h = non_negative_f32("hysteresis", self.hysteresis)?;
+        let h = tri!(non_negative_f32("hysteresis", self.hysteresis));
         if h > 0.9 {
             return Err(ConfigError::OutOfRange("hysteresis"));
         }
-        let f = positive_f32("floor_fraction", self.floor_fraction)?;
+        let f = tri!(positive_f32("floor_fraction", self.floor_fraction));
         if f > 1.0 {
             return Err(ConfigError::OutOfRange("floor_fraction"));
         }

@@ -31,8 +31,8 @@
     deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
 )]
 
-use crate::error::{positive, ConfigError};
-use core::num::{NonZeroU16, NonZeroU32, NonZeroUsize};
+use crate::error::{positive, tri, ConfigError};
+use crate::math;
 
 /// Largest number of lines (grid positions) per revolution: a turn is at most 2^30 units.
 pub const MAX_LINES: u16 = 16_384;
@@ -84,57 +84,68 @@ impl Pattern {
     }
 
     /// A wheel of `positions` positions with gaps `(first missing position, count)`.
-    pub fn with_gaps(positions: u8, gaps: &[(u8, u8)]) -> Result<Self, ConfigError> {
+    pub const fn with_gaps(positions: u8, gaps: &[(u8, u8)]) -> Result<Self, ConfigError> {
         if positions == 0 || positions > MAX_PATTERN_POSITIONS {
             return Err(ConfigError::OutOfRange("pattern.positions"));
         }
-        let all = mask_of(positions);
-        let mut present = all;
-        for &(start, count) in gaps {
+        let mut present = mask_of(positions);
+        let mut rest = gaps;
+        while let [(start, count), tail @ ..] = rest {
+            let (start, count) = (*start, *count);
             // Two u8 in a u16: the sum does not wrap (and within a u8 past this check).
-            if start >= positions
-                || count == 0
-                || u16::from(start).wrapping_add(u16::from(count)) > 255
-            {
+            if start >= positions || count == 0 || (start as u16).wrapping_add(count as u16) > 255 {
                 return Err(ConfigError::OutOfRange("pattern.gaps"));
             }
-            for p in start..start.wrapping_add(count) {
-                present &= !(1u128 << p.checked_rem(positions).unwrap_or(0));
+            let mut p = start;
+            while p < start.wrapping_add(count) {
+                // A gap may run past the last position onto the first ones.
+                let at = match p.checked_rem(positions) {
+                    Some(at) => at,
+                    None => 0,
+                };
+                present &= !(1u128 << at);
+                p = p.wrapping_add(1);
             }
+            rest = tail;
         }
         Ok(Pattern { positions, present })
     }
 
     /// A wheel of `positions` positions with teeth at the listed positions.
-    pub fn from_teeth(positions: u8, teeth: &[u8]) -> Result<Self, ConfigError> {
+    pub const fn from_teeth(positions: u8, teeth: &[u8]) -> Result<Self, ConfigError> {
         if positions == 0 || positions > MAX_PATTERN_POSITIONS {
             return Err(ConfigError::OutOfRange("pattern.positions"));
         }
         let mut present = 0u128;
-        for &p in teeth {
-            if p >= positions {
+        let mut rest = teeth;
+        while let [p, tail @ ..] = rest {
+            if *p >= positions {
                 return Err(ConfigError::OutOfRange("pattern.teeth"));
             }
-            present |= 1u128 << p;
+            present |= 1u128 << *p;
+            rest = tail;
         }
         Ok(Pattern { positions, present })
     }
 
     /// Grid positions per revolution.
-    pub fn positions(&self) -> u8 {
+    pub const fn positions(&self) -> u8 {
         self.positions
     }
 
     /// The present teeth as a bit mask over the grid positions.
-    pub fn present(&self) -> u128 {
+    pub const fn present(&self) -> u128 {
         self.present
     }
 
     /// Number of teeth.
-    pub fn teeth(&self) -> u32 {
+    pub const fn teeth(&self) -> u32 {
         (self.present & mask_of(self.positions)).count_ones()
     }
 }
+
+/// Whether this build takes pattern wheels (the `pattern-wheels` feature).
+const PATTERNS: bool = cfg!(feature = "pattern-wheels");
 
 /// Bits `0..n` set.
 const fn mask_of(n: u8) -> u128 {
@@ -163,16 +174,18 @@ pub enum Wheel {
         /// Lines per revolution (2 to [`MAX_LINES`]).
         lines: u16,
     },
-    /// A toothed wheel whose missing or extra teeth frame the revolution.
+    /// A toothed wheel whose missing or extra teeth frame the revolution (needs the
+    /// `pattern-wheels` feature, on by default; refused as `ConfigError::Unsupported("wheel")`
+    /// without it).
     Pattern(Pattern),
 }
 
 impl Wheel {
     /// Grid positions per revolution (lines of a uniform disc).
-    pub fn positions(&self) -> u16 {
+    pub const fn positions(&self) -> u16 {
         match *self {
             Wheel::Indexed { lines } | Wheel::Unframed { lines } => lines,
-            Wheel::Pattern(p) => u16::from(p.positions),
+            Wheel::Pattern(p) => p.positions as u16,
         }
     }
 }
@@ -215,13 +228,18 @@ pub struct Tolerances {
     pub fault_margin: f32,
 }
 
+impl Tolerances {
+    /// The defaults (see each field), as a `const`.
+    pub const DEFAULT: Tolerances = Tolerances {
+        accept: 1.45,
+        glitch_fraction: 0.35,
+        fault_margin: 0.3,
+    };
+}
+
 impl Default for Tolerances {
     fn default() -> Self {
-        Tolerances {
-            accept: 1.45,
-            glitch_fraction: 0.35,
-            fault_margin: 0.3,
-        }
+        Tolerances::DEFAULT
     }
 }
 
@@ -250,7 +268,7 @@ pub struct EncoderConfig {
 }
 
 impl EncoderConfig {
-    fn with_wheel(wheel: Wheel, timer_hz: f64) -> Self {
+    const fn with_wheel(wheel: Wheel, timer_hz: f64) -> Self {
         EncoderConfig {
             wheel,
             timer_hz,
@@ -258,29 +276,29 @@ impl EncoderConfig {
             prescaler: 1,
             min_speed: 1.0,
             estimator: Estimator::Edges(1),
-            tolerances: Tolerances::default(),
+            tolerances: Tolerances::DEFAULT,
         }
     }
 
     /// A uniform disc of `lines` lines framed by an index pulse; a 32-bit timer at `timer_hz`,
     /// per-edge speed, a minimum speed of 1 rad/s, default tolerances.
-    pub fn indexed(lines: u16, timer_hz: f64) -> Self {
+    pub const fn indexed(lines: u16, timer_hz: f64) -> Self {
         Self::with_wheel(Wheel::Indexed { lines }, timer_hz)
     }
 
     /// A uniform disc of `lines` lines without a frame marker (otherwise as
     /// [`EncoderConfig::indexed`]).
-    pub fn unframed(lines: u16, timer_hz: f64) -> Self {
+    pub const fn unframed(lines: u16, timer_hz: f64) -> Self {
         Self::with_wheel(Wheel::Unframed { lines }, timer_hz)
     }
 
     /// A toothed wheel framed by its pattern (otherwise as [`EncoderConfig::indexed`]).
-    pub fn pattern(pattern: Pattern, timer_hz: f64) -> Self {
+    pub const fn pattern(pattern: Pattern, timer_hz: f64) -> Self {
         Self::with_wheel(Wheel::Pattern(pattern), timer_hz)
     }
 
     /// A missing-tooth wheel such as 60-2: `positions` positions, the last `missing` absent.
-    pub fn missing_teeth(positions: u8, missing: u8, timer_hz: f64) -> Self {
+    pub const fn missing_teeth(positions: u8, missing: u8, timer_hz: f64) -> Self {
         Self::pattern(Pattern::missing_teeth(positions, missing), timer_hz)
     }
 }
@@ -344,11 +362,7 @@ impl Encoder {
             prescaler: 1,
             min_speed: 0.0,
             estimator: Estimator::Edges(1),
-            tolerances: Tolerances {
-                accept: 1.45,
-                glitch_fraction: 0.35,
-                fault_margin: 0.3,
-            },
+            tolerances: Tolerances::DEFAULT,
         },
         framing: Framing::None,
         edges: 0,
@@ -375,7 +389,7 @@ impl Encoder {
     /// `min_speed` must last fewer ticks than the counter holds (`Inconsistent("min_speed")`)
     /// and at least 2 ticks (`Inconsistent("timer_hz")`), and `K` of them must fit in 32 bits
     /// (`Inconsistent("estimator.edges")`).
-    pub fn new(config: EncoderConfig) -> Result<Self, ConfigError> {
+    pub const fn new(config: EncoderConfig) -> Result<Self, ConfigError> {
         let mut pattern = [0u8; MAX_PATTERN_TEETH];
         let prescaler = config.prescaler;
         if !matches!(prescaler, 1 | 2 | 4 | 8) {
@@ -383,28 +397,35 @@ impl Encoder {
         }
         let (framing, positions, edges, base, long, short) = match config.wheel {
             Wheel::Indexed { lines } | Wheel::Unframed { lines } => {
-                if !(2..=MAX_LINES).contains(&lines) {
+                if lines < 2 || lines > MAX_LINES {
                     return Err(ConfigError::OutOfRange("lines"));
                 }
-                // 1, 2, 4 or 8.
-                let p = NonZeroU16::new(u16::from(prescaler)).unwrap_or(NonZeroU16::MIN);
-                if lines % p != 0 || lines / p < 2 {
+                // 1, 2, 4 or 8: never a division by zero.
+                let p = prescaler as u16;
+                let (rest, per) = match (lines.checked_rem(p), lines.checked_div(p)) {
+                    (Some(r), Some(q)) => (r, q),
+                    _ => (1, 0),
+                };
+                if rest != 0 || per < 2 {
                     return Err(ConfigError::Inconsistent("prescaler"));
                 }
                 let framing = match config.wheel {
                     Wheel::Indexed { .. } => Framing::Index,
                     _ => Framing::None,
                 };
-                (framing, lines, lines / p, prescaler, 0, 0)
+                (framing, lines, per, prescaler, 0, 0)
             }
             Wheel::Pattern(p) => {
+                if !PATTERNS {
+                    return Err(ConfigError::Unsupported("wheel"));
+                }
                 if prescaler != 1 {
                     return Err(ConfigError::Inconsistent("prescaler"));
                 }
-                let (edges, base, long, short) = pattern_table(p, &mut pattern)?;
+                let (edges, base, long, short) = tri!(pattern_table(p, &mut pattern));
                 (
                     Framing::Pattern,
-                    u16::from(p.positions),
+                    p.positions as u16,
                     edges,
                     base,
                     long,
@@ -412,11 +433,11 @@ impl Encoder {
                 )
             }
         };
-        let timer_hz = positive("timer_hz", config.timer_hz)?;
-        if !(1.0..=1.0e10).contains(&timer_hz) {
+        let timer_hz = tri!(positive("timer_hz", config.timer_hz));
+        if timer_hz < 1.0 || timer_hz > 1.0e10 {
             return Err(ConfigError::OutOfRange("timer_hz"));
         }
-        if !(16..=32).contains(&config.counter_bits) {
+        if config.counter_bits < 16 || config.counter_bits > 32 {
             return Err(ConfigError::OutOfRange("counter_bits"));
         }
         let mask = if config.counter_bits == 32 {
@@ -424,29 +445,34 @@ impl Encoder {
         } else {
             (1u32 << config.counter_bits).wrapping_sub(1)
         };
-        let min_speed = positive("min_speed", config.min_speed)?;
+        let min_speed = tri!(positive("min_speed", config.min_speed));
         let Estimator::Edges(k) = config.estimator;
-        if k == 0 || k > edges || usize::from(k) > MAX_SPAN {
+        if k == 0 || k > edges || k as usize > MAX_SPAN {
             return Err(ConfigError::OutOfRange("estimator.edges"));
         }
         let t = config.tolerances;
-        check_range("tolerances.accept", t.accept, 1.05, 2.0)?;
-        check_range("tolerances.glitch_fraction", t.glitch_fraction, 0.05, 0.6)?;
-        check_range("tolerances.fault_margin", t.fault_margin, 0.05, 2.0)?;
-        let longest = if framing == Framing::Pattern {
-            pattern
-                .iter()
-                .take(usize::from(edges))
-                .copied()
-                .max()
-                .unwrap_or(1)
+        tri!(check_range("tolerances.accept", t.accept, 1.05, 2.0));
+        tri!(check_range(
+            "tolerances.glitch_fraction",
+            t.glitch_fraction,
+            0.05,
+            0.6
+        ));
+        tri!(check_range(
+            "tolerances.fault_margin",
+            t.fault_margin,
+            0.05,
+            2.0
+        ));
+        let longest = if matches!(framing, Framing::Pattern) {
+            longest_pitch(&pattern, edges)
         } else {
             base
         };
-        let grid = core::f64::consts::TAU / f64::from(positions);
-        let timeout = grid * f64::from(longest) / min_speed * timer_hz;
+        let grid = core::f64::consts::TAU / positions as f64;
+        let timeout = grid * longest as f64 / min_speed * timer_hz;
         // Intervals are measured modulo the counter: a timeout beyond its range cannot be seen.
-        if !timeout.is_finite() || timeout >= f64::from(mask) {
+        if !timeout.is_finite() || timeout >= mask as f64 {
             return Err(ConfigError::Inconsistent("min_speed"));
         }
         // A pitch at the minimum speed shorter than 2 ticks carries no speed information.
@@ -454,77 +480,81 @@ impl Encoder {
             return Err(ConfigError::Inconsistent("timer_hz"));
         }
         // A K-edge sample (a sum of K intervals) must fit in 32 bits even at the slowest speed.
-        if timeout * f64::from(k) >= f64::from(u32::MAX) {
+        if timeout * k as f64 >= u32::MAX as f64 {
             return Err(ConfigError::Inconsistent("estimator.edges"));
         }
         let uniform = long == 0 && short == 0;
+        let accept = t.accept as f64;
         Ok(Encoder {
             config,
             framing,
             edges,
             k,
             mask,
-            timeout: libm::ceil(timeout) as u32,
-            band_lo: fraction_q32(1.0 / f64::from(t.accept) / f64::from(k)),
-            band_half_width: fraction_q32(
-                (f64::from(t.accept) - 1.0 / f64::from(t.accept)) / 2.0 / f64::from(k),
-            ),
+            timeout: math::ceil(timeout) as u32,
+            band_lo: fraction_q32(1.0 / accept / k as f64),
+            band_half_width: fraction_q32((accept - 1.0 / accept) / 2.0 / k as f64),
             // The band's top is mean·accept + 2 ticks at most: keep it at or below the timeout.
             band_sum_max: {
-                let m = (libm::floor(timeout) - 4.0) * f64::from(k) / f64::from(t.accept);
+                let m = (math::floor(timeout) - 4.0) * k as f64 / accept;
                 if m <= 0.0 {
                     0
-                } else if m >= f64::from(u32::MAX) {
+                } else if m >= u32::MAX as f64 {
                     u32::MAX
                 } else {
                     m as u32
                 }
             },
-            bulk_max: (f64::from(u32::MAX) / libm::ceil(timeout)) as u32,
+            bulk_max: (u32::MAX as f64 / math::ceil(timeout)) as u32,
             timer_hz: timer_hz as f32,
-            unit_rad: (grid / f64::from(PITCH_UNITS)) as f32,
+            unit_rad: (grid / PITCH_UNITS as f64) as f32,
             pattern,
             base,
             long,
             short,
             // At most 32 · 255 · 2^16 (< 2^30): no wrap.
-            uniform_span: u32::from(k)
-                .wrapping_mul(u32::from(base))
+            uniform_span: (k as u32)
+                .wrapping_mul(base as u32)
                 .wrapping_mul(PITCH_UNITS),
             uniform,
         })
     }
 
     /// The configuration this encoder was built from.
-    pub fn config(&self) -> &EncoderConfig {
+    pub const fn config(&self) -> &EncoderConfig {
         &self.config
     }
     /// How revolutions are framed.
-    pub fn framing(&self) -> Framing {
-        self.framing
+    pub const fn framing(&self) -> Framing {
+        // Without pattern wheels in the build, a pattern framing is never returned, so every
+        // test for it folds away (it cannot be stored: `new` refuses pattern wheels then).
+        match self.framing {
+            Framing::Pattern if !PATTERNS => Framing::None,
+            f => f,
+        }
     }
     /// Captured edges per revolution (teeth, or lines over the prescaler).
-    pub fn edges(&self) -> u16 {
+    pub const fn edges(&self) -> u16 {
         self.edges
     }
     /// Edges averaged per speed sample.
-    pub fn samples_span(&self) -> u16 {
+    pub const fn samples_span(&self) -> u16 {
         self.k
     }
     /// Counter mask (2^bits − 1).
-    pub fn mask(&self) -> u32 {
+    pub const fn mask(&self) -> u32 {
         self.mask
     }
     /// Ticks without an edge after which the shaft is at standstill.
-    pub fn timeout_ticks(&self) -> u32 {
+    pub const fn timeout_ticks(&self) -> u32 {
         self.timeout
     }
     /// Timer clock, Hz.
-    pub fn timer_hz(&self) -> f32 {
+    pub const fn timer_hz(&self) -> f32 {
         self.timer_hz
     }
     /// Radians per angle unit.
-    pub fn unit_rad(&self) -> f32 {
+    pub const fn unit_rad(&self) -> f32 {
         self.unit_rad
     }
     /// Whether the interval ring holds capture times (a 32-bit counter: a `K`-edge sample is
@@ -538,8 +568,8 @@ impl Encoder {
         self.bulk_max as usize
     }
     /// Whether every tooth has the same nominal pitch (a uniform disc).
-    pub fn is_uniform(&self) -> bool {
-        self.uniform
+    pub const fn is_uniform(&self) -> bool {
+        !PATTERNS || self.uniform
     }
     /// Nominal pitch of `tooth` (the angle from the edge before it) in units; 0 beyond the
     /// wheel.
@@ -552,7 +582,7 @@ impl Encoder {
     pub(crate) fn grid_pitch(&self, tooth: u16) -> u32 {
         if tooth >= self.edges {
             0
-        } else if self.framing != Framing::Pattern {
+        } else if self.framing() != Framing::Pattern {
             u32::from(self.base)
         } else {
             self.pattern
@@ -566,16 +596,24 @@ impl Encoder {
     }
     /// Teeth whose pitch is longer than the base (bit k = tooth k; pattern wheels).
     pub(crate) fn long_teeth(&self) -> u64 {
-        self.long
+        if PATTERNS {
+            self.long
+        } else {
+            0
+        }
     }
     /// Teeth whose pitch is shorter than the base (bit k = tooth k; pattern wheels).
     pub(crate) fn short_teeth(&self) -> u64 {
-        self.short
+        if PATTERNS {
+            self.short
+        } else {
+            0
+        }
     }
     /// Teeth that end two short pitches which together span at most one base pitch: the
     /// second half of a pitch split by an extra tooth (bit k = tooth k; pattern wheels).
     pub(crate) fn pair_teeth(&self) -> u64 {
-        if self.short == 0 {
+        if self.short_teeth() == 0 {
             return 0;
         }
         let mut pairs = 0u64;
@@ -592,7 +630,7 @@ impl Encoder {
         pairs
     }
     /// Span of `samples_span()` teeth on a uniform disc, units.
-    pub fn uniform_span(&self) -> u32 {
+    pub const fn uniform_span(&self) -> u32 {
         self.uniform_span
     }
     /// The accept band around the mean of the last `K` intervals, whose sum is `sum`:
@@ -618,8 +656,8 @@ fn mul_hi(x: u32, f: u32) -> u32 {
 }
 
 /// `x` (in `[0, 1)`) as a 0.32 fixed-point fraction.
-fn fraction_q32(x: f64) -> u32 {
-    let q = libm::round(x * 4_294_967_296.0);
+const fn fraction_q32(x: f64) -> u32 {
+    let q = math::round(x * 4_294_967_296.0);
     if q >= 4_294_967_295.0 {
         u32::MAX
     } else if q <= 0.0 {
@@ -629,75 +667,112 @@ fn fraction_q32(x: f64) -> u32 {
     }
 }
 
-fn check_range(name: &'static str, x: f32, lo: f32, hi: f32) -> Result<(), ConfigError> {
+const fn check_range(name: &'static str, x: f32, lo: f32, hi: f32) -> Result<(), ConfigError> {
     if !x.is_finite() {
         return Err(ConfigError::NonFinite(name));
     }
-    if !(lo..=hi).contains(&x) {
+    if x < lo || x > hi {
         return Err(ConfigError::OutOfRange(name));
     }
     Ok(())
 }
 
+/// The longest of the first `edges` pitches of `table`.
+const fn longest_pitch(table: &[u8; MAX_PATTERN_TEETH], edges: u16) -> u8 {
+    let mut longest = 0u8;
+    let mut rest: &[u8] = table;
+    let mut left = edges;
+    while let [p, tail @ ..] = rest {
+        if left == 0 {
+            break;
+        }
+        if *p > longest {
+            longest = *p;
+        }
+        left = left.wrapping_sub(1);
+        rest = tail;
+    }
+    longest
+}
+
 /// Validates a pattern and writes the grid pitch of every tooth, tooth 0 first, into `table`.
 /// Returns (teeth, base pitch, long-teeth mask, short-teeth mask).
-fn pattern_table(
+// Configuration only (not on a per-edge path). Every index below is under `teeth`, itself at
+// most the arrays' length (`MAX_PATTERN_TEETH`, checked first), or a sum of two such indices
+// brought back under it: nothing can fail. Loops are `while` loops: this is a `const fn`.
+#[allow(clippy::indexing_slicing)]
+const fn pattern_table(
     p: Pattern,
     table: &mut [u8; MAX_PATTERN_TEETH],
 ) -> Result<(u16, u8, u64, u64), ConfigError> {
     let n = p.positions;
-    let Some(grid) =
-        NonZeroU16::new(u16::from(n)).filter(|_| (3..=MAX_PATTERN_POSITIONS).contains(&n))
-    else {
+    if n < 3 || n > MAX_PATTERN_POSITIONS {
         return Err(ConfigError::OutOfRange("pattern.positions"));
-    };
+    }
     let present = p.present;
     if present & !mask_of(n) != 0 {
         return Err(ConfigError::OutOfRange("pattern.teeth"));
     }
     let teeth = present.count_ones() as usize;
-    let Some(wheel) = NonZeroUsize::new(teeth).filter(|_| teeth >= 3) else {
+    if teeth < 3 {
         return Err(ConfigError::OutOfRange("pattern.teeth"));
-    };
+    }
     if teeth > MAX_PATTERN_TEETH {
         return Err(ConfigError::Capacity("pattern.teeth"));
+    }
+    // `i + shift` for `i`, `shift` < `teeth`, brought back under `teeth`.
+    const fn around(i: usize, shift: usize, teeth: usize) -> usize {
+        let j = i.wrapping_add(shift);
+        if j >= teeth {
+            j.wrapping_sub(teeth)
+        } else {
+            j
+        }
     }
     // Pitches in grid order: tooth i ends the pitch from the tooth before it.
     let mut pitch = [0u8; MAX_PATTERN_TEETH];
     let mut pos = [0u8; MAX_PATTERN_TEETH];
     let mut j = 0usize;
-    for q in 0..n {
+    let mut q = 0u8;
+    while q < n {
         if present & (1u128 << q) != 0 {
-            if let Some(slot) = pos.get_mut(j) {
-                *slot = q;
-            }
-            j = j.wrapping_add(1); // at most 128
+            // `j` counts the set bits below `q`: under `teeth`.
+            pos[j] = q;
+            j = j.wrapping_add(1);
         }
+        q = q.wrapping_add(1);
     }
-    for i in 0..teeth {
-        let here = pos.get(i).copied().unwrap_or(0);
-        // (`i` < `teeth` and `before` < `n`: no wrap.)
-        let before = pos
-            .get(i.wrapping_add(teeth).wrapping_sub(1) % wheel)
-            .copied()
-            .unwrap_or(0);
-        let d = u16::from(here)
-            .wrapping_add(u16::from(n))
-            .wrapping_sub(u16::from(before))
-            % grid;
-        if let Some(slot) = pitch.get_mut(i) {
-            *slot = if d == 0 { n } else { d as u8 };
+    let mut i = 0usize;
+    while i < teeth {
+        let here = pos[i] as u16;
+        let before = pos[around(i, teeth.wrapping_sub(1), teeth)] as u16;
+        // `here`, `before` < `n`: the difference modulo `n` without a division.
+        let mut d = here.wrapping_add(n as u16).wrapping_sub(before);
+        if d >= n as u16 {
+            d = d.wrapping_sub(n as u16);
         }
+        pitch[i] = if d == 0 { n } else { d as u8 };
+        i = i.wrapping_add(1);
     }
     // The base pitch is the most common one; special teeth differ from it.
     let mut base = 0u8;
     let mut best = 0usize;
-    for &c in pitch.iter().take(teeth) {
-        let count = pitch.iter().take(teeth).filter(|&&x| x == c).count();
+    let mut a = 0usize;
+    while a < teeth {
+        let c = pitch[a];
+        let mut count = 0usize;
+        let mut b = 0usize;
+        while b < teeth {
+            if pitch[b] == c {
+                count = count.wrapping_add(1);
+            }
+            b = b.wrapping_add(1);
+        }
         if count > best || (count == best && c < base) {
             best = count;
             base = c;
         }
+        a = a.wrapping_add(1);
     }
     if best == teeth {
         return Err(ConfigError::Inconsistent(
@@ -705,61 +780,74 @@ fn pattern_table(
         ));
     }
     // Special pitches must be told from the base at a glance: at least 1.5× or at most 0.75×.
-    for &c in pitch.iter().take(teeth) {
+    let mut i = 0usize;
+    while i < teeth {
         // u8 values in u16: the products do not wrap.
-        let (c, b) = (u16::from(c), u16::from(base));
+        let (c, b) = (pitch[i] as u16, base as u16);
         if c != b && c.wrapping_mul(4) > b.wrapping_mul(3) && c.wrapping_mul(2) < b.wrapping_mul(3)
         {
             return Err(ConfigError::Inconsistent(
                 "pattern (a pitch too close to the base)",
             ));
         }
+        i = i.wrapping_add(1);
     }
     // The frame tooth: the one whose pitch differs most from the base (ratio in either
     // direction), the first in grid order among equals.
-    let distinct = |c: u8| -> u32 {
-        let (c, b) = (u32::from(c), u32::from(base));
+    const fn distinct(c: u8, base: u8) -> u32 {
+        let (c, b) = (c as u32, base as u32);
         // Compare max(c/b, b/c) without division: scale both ways by b·c.
-        // (u8 values in u32: the products do not wrap.)
+        // (u8 values in u32: the products do not wrap; pitches are at least 1.)
         let square = if c >= b {
             c.wrapping_mul(c)
         } else {
             b.wrapping_mul(b)
         };
-        square.saturating_mul(1000) / NonZeroU32::new(b.wrapping_mul(c)).unwrap_or(NonZeroU32::MIN)
-    };
+        match square.saturating_mul(1000).checked_div(b.wrapping_mul(c)) {
+            Some(q) => q,
+            None => 0,
+        }
+    }
     let mut frame = 0usize;
-    for i in 0..teeth {
-        if distinct(pitch.get(i).copied().unwrap_or(base))
-            > distinct(pitch.get(frame).copied().unwrap_or(base))
-        {
+    let mut i = 0usize;
+    while i < teeth {
+        if distinct(pitch[i], base) > distinct(pitch[frame], base) {
             frame = i;
         }
+        i = i.wrapping_add(1);
     }
     // A pattern that repeats after a fraction of a turn cannot frame a revolution.
-    for shift in 1..teeth {
-        if teeth.checked_rem(shift) == Some(0)
-            && (0..teeth).all(|i| pitch.get(i) == pitch.get(i.wrapping_add(shift) % wheel))
-        {
-            return Err(ConfigError::Inconsistent(
-                "pattern (rotationally symmetric)",
-            ));
+    let mut shift = 1usize;
+    while shift < teeth {
+        if matches!(teeth.checked_rem(shift), Some(0)) {
+            let mut same = true;
+            let mut i = 0usize;
+            while i < teeth {
+                if pitch[i] != pitch[around(i, shift, teeth)] {
+                    same = false;
+                }
+                i = i.wrapping_add(1);
+            }
+            if same {
+                return Err(ConfigError::Inconsistent(
+                    "pattern (rotationally symmetric)",
+                ));
+            }
         }
+        shift = shift.wrapping_add(1);
     }
     let (mut long, mut short) = (0u64, 0u64);
-    for i in 0..teeth {
-        let c = pitch
-            .get(frame.wrapping_add(i) % wheel)
-            .copied()
-            .unwrap_or(base);
-        if let Some(slot) = table.get_mut(i) {
-            *slot = c;
-        }
+    let mut i = 0usize;
+    while i < teeth {
+        let c = pitch[around(frame, i, teeth)];
+        table[i] = c;
+        // `i` < `teeth` ≤ 64.
         if c > base {
             long |= 1 << i;
         } else if c < base {
             short |= 1 << i;
         }
+        i = i.wrapping_add(1);
     }
     Ok((teeth as u16, base, long, short))
 }
@@ -767,6 +855,64 @@ fn pattern_table(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Encoders built by the compiler (in a `const`) are the ones built at run time: the
+    /// `const fn` rounding and loops give the same integers as the run-time path, wheel by
+    /// wheel (a pattern with three gaps, a 12+1, an index disc with 8-edge samples on a 16-bit
+    /// counter, a 60-2 at its tightest tolerances).
+    #[test]
+    fn encoders_built_by_the_compiler_are_the_ones_built_at_run_time() {
+        const fn ok<T: Copy>(r: Result<T, ConfigError>) -> T {
+            match r {
+                Ok(v) => v,
+                Err(_) => panic!("rejected"),
+            }
+        }
+        const GAPS: Pattern = ok(Pattern::with_gaps(36, &[(0, 2), (12, 2), (27, 2)]));
+        const PLUS_ONE: Pattern = ok(Pattern::from_teeth(
+            24,
+            &[0, 1, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22],
+        ));
+        const INDEXED: EncoderConfig = {
+            let mut c = EncoderConfig::indexed(1000, 84e6);
+            c.estimator = Estimator::Edges(8);
+            c.counter_bits = 16;
+            c.min_speed = 200.0;
+            c
+        };
+        const SIXTY_TWO: EncoderConfig = {
+            let mut c = EncoderConfig::missing_teeth(60, 2, 1e6);
+            c.tolerances.accept = 1.05;
+            c.tolerances.glitch_fraction = 0.6;
+            c.min_speed = 3.7;
+            c
+        };
+        const BUILT: [Result<Encoder, ConfigError>; 4] = [
+            Encoder::new(EncoderConfig::pattern(GAPS, 1e6)),
+            Encoder::new(EncoderConfig::pattern(PLUS_ONE, 2e6)),
+            Encoder::new(INDEXED),
+            Encoder::new(SIXTY_TWO),
+        ];
+        let gaps = Pattern::with_gaps(36, &std::hint::black_box([(0, 2), (12, 2), (27, 2)]));
+        let plus_one = Pattern::from_teeth(
+            24,
+            &std::hint::black_box([0, 1, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22]),
+        );
+        assert_eq!(gaps, Ok(GAPS));
+        assert_eq!(plus_one, Ok(PLUS_ONE));
+        let now = [
+            EncoderConfig::pattern(GAPS, 1e6),
+            EncoderConfig::pattern(PLUS_ONE, 2e6),
+            INDEXED,
+            SIXTY_TWO,
+        ]
+        .map(|c| Encoder::new(std::hint::black_box(c)));
+        for (built, now) in BUILT.iter().zip(&now) {
+            let built = built.as_ref().expect("valid");
+            assert_eq!(Ok(built), now.as_ref());
+            assert!(built.timeout_ticks() > 0 && built.uniform_span() > 0);
+        }
+    }
 
     #[test]
     fn uniform_discs_have_exact_integer_pitches() {

@@ -18,18 +18,22 @@ pub enum ConfigError {
     Capacity(&'static str),
     /// Parameters that are each valid but contradict each other.
     Inconsistent(&'static str),
+    /// A valid value this build leaves out (a cargo feature of the core is off: the
+    /// pattern wheels of `wheel` need `pattern-wheels`).
+    Unsupported(&'static str),
 }
 
 impl ConfigError {
     /// The name of the parameter that was rejected.
-    pub fn parameter(&self) -> &'static str {
+    pub const fn parameter(&self) -> &'static str {
         match *self {
             ConfigError::NonFinite(p)
             | ConfigError::NotPositive(p)
             | ConfigError::Negative(p)
             | ConfigError::OutOfRange(p)
             | ConfigError::Capacity(p)
-            | ConfigError::Inconsistent(p) => p,
+            | ConfigError::Inconsistent(p)
+            | ConfigError::Unsupported(p) => p,
         }
     }
 }
@@ -43,16 +47,34 @@ impl core::fmt::Display for ConfigError {
             ConfigError::OutOfRange(p) => write!(f, "`{p}` is out of range"),
             ConfigError::Capacity(p) => write!(f, "`{p}` exceeds the fixed capacity"),
             ConfigError::Inconsistent(p) => write!(f, "`{p}` contradicts other parameters"),
+            ConfigError::Unsupported(p) => {
+                write!(f, "`{p}` is not supported by this build (a feature is off)")
+            }
         }
     }
 }
 
 impl core::error::Error for ConfigError {}
 
+/// `?` for a `const fn`, where the operator is not available: the value of `Ok`, or return the
+/// error.
+macro_rules! tri {
+    ($e:expr) => {
+        match $e {
+            Ok(v) => v,
+            Err(e) => return Err(e),
+        }
+    };
+}
+pub(crate) use tri;
+
+// The validators are `const fn`, so that a configuration written as a `const` is checked by
+// the compiler (a bad value stops the build) and no checking code reaches the firmware.
+
 /// `x` if it is finite and positive (subnormals rejected: they are not physical and lose
 /// their digits in the first division), else the error naming `name`.
-pub fn positive(name: &'static str, x: f64) -> Result<f64, ConfigError> {
-    let x = finite(name, x)?;
+pub const fn positive(name: &'static str, x: f64) -> Result<f64, ConfigError> {
+    let x = tri!(finite(name, x));
     if x >= f64::MIN_POSITIVE {
         Ok(x)
     } else {
@@ -61,8 +83,8 @@ pub fn positive(name: &'static str, x: f64) -> Result<f64, ConfigError> {
 }
 
 /// `x` if it is finite and not negative (a subnormal positive value is rejected).
-pub fn non_negative(name: &'static str, x: f64) -> Result<f64, ConfigError> {
-    let x = finite(name, x)?;
+pub const fn non_negative(name: &'static str, x: f64) -> Result<f64, ConfigError> {
+    let x = tri!(finite(name, x));
     if x == 0.0 || x >= f64::MIN_POSITIVE {
         Ok(x)
     } else if x < 0.0 {
@@ -74,8 +96,8 @@ pub fn non_negative(name: &'static str, x: f64) -> Result<f64, ConfigError> {
 
 /// `x` if it is finite and positive as an f32: like [`positive`], with f32's own subnormals
 /// (below `f32::MIN_POSITIVE`, normal once widened to f64) rejected.
-pub fn positive_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
-    positive(name, f64::from(x))?;
+pub const fn positive_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
+    tri!(positive(name, x as f64));
     if x >= f32::MIN_POSITIVE {
         Ok(x)
     } else {
@@ -84,8 +106,8 @@ pub fn positive_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
 }
 
 /// `x` if it is finite and not negative as an f32 (an f32 subnormal is rejected).
-pub fn non_negative_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
-    non_negative(name, f64::from(x))?;
+pub const fn non_negative_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> {
+    tri!(non_negative(name, x as f64));
     if x == 0.0 || x >= f32::MIN_POSITIVE {
         Ok(x)
     } else {
@@ -94,7 +116,7 @@ pub fn non_negative_f32(name: &'static str, x: f32) -> Result<f32, ConfigError> 
 }
 
 /// `x` if it is finite.
-pub fn finite(name: &'static str, x: f64) -> Result<f64, ConfigError> {
+pub const fn finite(name: &'static str, x: f64) -> Result<f64, ConfigError> {
     if x.is_finite() {
         Ok(x)
     } else {

@@ -24,7 +24,8 @@
     deny(clippy::arithmetic_side_effects, clippy::indexing_slicing)
 )]
 
-use crate::error::{positive, positive_f32, ConfigError};
+use crate::error::{positive, positive_f32, tri, ConfigError};
+use crate::math;
 use crate::speed::{Fault, Sample, Tooth};
 
 /// Largest window, in revolutions.
@@ -44,7 +45,7 @@ pub enum WindowLength {
 
 impl WindowLength {
     /// The window in revolutions.
-    pub fn revolutions(self) -> Result<u16, ConfigError> {
+    pub const fn revolutions(self) -> Result<u16, ConfigError> {
         match self {
             WindowLength::Revolutions(n) => {
                 if n == 0 || n > MAX_WINDOW_REVS {
@@ -54,13 +55,16 @@ impl WindowLength {
                 }
             }
             WindowLength::LoadOrder(order) => {
-                let order = positive("window.load_order", order)?;
-                for w in 1..=MAX_WINDOW_REVS {
+                let order = tri!(positive("window.load_order", order));
+                let mut w = 1u16;
+                while w <= MAX_WINDOW_REVS {
                     let cycles = order * w as f64;
-                    let whole = libm::round(cycles);
-                    if whole >= 1.0 && (cycles - whole).abs() <= 1e-4 * cycles {
+                    let whole = math::round(cycles);
+                    let off = cycles - whole;
+                    if whole >= 1.0 && off <= 1e-4 * cycles && -off <= 1e-4 * cycles {
                         return Ok(w);
                     }
+                    w = w.wrapping_add(1);
                 }
                 Err(ConfigError::OutOfRange("window.load_order"))
             }
@@ -89,9 +93,9 @@ pub struct Window {
 
 impl WindowConfig {
     /// Checks the settings.
-    pub fn validate(self) -> Result<Window, ConfigError> {
-        let revolutions = self.length.revolutions()?;
-        let t = positive_f32("steady_tolerance", self.steady_tolerance)?;
+    pub const fn validate(self) -> Result<Window, ConfigError> {
+        let revolutions = tri!(self.length.revolutions());
+        let t = tri!(positive_f32("steady_tolerance", self.steady_tolerance));
         if t >= 1.0 {
             return Err(ConfigError::OutOfRange("steady_tolerance"));
         }
@@ -110,7 +114,7 @@ impl Window {
     };
 
     /// Revolutions per window.
-    pub fn revolutions(&self) -> u16 {
+    pub const fn revolutions(&self) -> u16 {
         self.revolutions
     }
 }

@@ -15,6 +15,11 @@
 //! Every call is O(1) per edge, allocation-free and panic-free for any input. A monitor can be
 //! built in place: [`DeltaMonitor::unconfigured`] is a `const` value for a `static`, and
 //! [`DeltaMonitor::configure`] fills it without large temporaries.
+//!
+//! The whole configuration can also be validated by the compiler: [`MonitorConfig::new`] is a
+//! `const fn`, so firmware writes its configuration as a `const` (a bad value stops the build,
+//! naming it) and [`DeltaMonitor::apply`] installs it, with no validation code and no
+//! software floating point in the image.
 
 // The per-edge path runs through this module: no integer operation here may overflow or
 // divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
@@ -26,7 +31,7 @@
 
 use crate::alarm::{AlarmConfig, AlarmEvent, DeltaAlarm, Verdict};
 use crate::encoder::{Encoder, EncoderConfig};
-use crate::error::ConfigError;
+use crate::error::{tri, ConfigError};
 use crate::irregularity::{Window, WindowConfig, WindowReport, WindowState};
 use crate::pitch::{deviations, Nominal, PitchTable};
 use crate::speed::{
@@ -66,6 +71,75 @@ impl EdgeSink for () {
     fn tooth(&mut self, _tooth: &Tooth) {}
     #[inline(always)]
     fn fault(&mut self, _fault: Fault, _time: u32) {}
+}
+
+/// A monitor's whole configuration, validated: the encoder, the window and the alarm.
+///
+/// Built once by [`MonitorConfig::new`], at run time or, as a `const`, by the compiler:
+///
+/// ```
+/// use drive_monitor::encoder::EncoderConfig;
+/// use drive_monitor::irregularity::{WindowConfig, WindowLength};
+/// use drive_monitor::monitor::{DeltaMonitor, MonitorConfig};
+///
+/// const CONFIG: MonitorConfig = match MonitorConfig::new(
+///     EncoderConfig::indexed(1024, 84e6),
+///     WindowConfig { length: WindowLength::LoadOrder(0.125), steady_tolerance: 0.02 },
+///     None,
+/// ) {
+///     Ok(c) => c,
+///     // A bad value is a compile error naming the parameter.
+///     Err(e) => panic!("{}", e.parameter()),
+/// };
+///
+/// let mut m: DeltaMonitor<1024> = DeltaMonitor::unconfigured();
+/// m.apply(&CONFIG).unwrap();
+/// assert_eq!(m.window_revolutions(), 8);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct MonitorConfig {
+    encoder: Encoder,
+    window: Window,
+    alarm: Option<DeltaAlarm>,
+}
+
+impl MonitorConfig {
+    /// Validates the encoder, the window and the alarm.
+    pub const fn new(
+        encoder: EncoderConfig,
+        window: WindowConfig,
+        alarm: Option<AlarmConfig>,
+    ) -> Result<Self, ConfigError> {
+        Self::with_encoder(tri!(Encoder::new(encoder)), window, alarm)
+    }
+
+    /// Validates the window and the alarm for an encoder already validated.
+    pub const fn with_encoder(
+        encoder: Encoder,
+        window: WindowConfig,
+        alarm: Option<AlarmConfig>,
+    ) -> Result<Self, ConfigError> {
+        let window = tri!(window.validate());
+        let alarm = match alarm {
+            Some(a) => Some(tri!(a.validate())),
+            None => None,
+        };
+        Ok(MonitorConfig {
+            encoder,
+            window,
+            alarm,
+        })
+    }
+
+    /// The encoder.
+    pub const fn encoder(&self) -> &Encoder {
+        &self.encoder
+    }
+
+    /// The window.
+    pub const fn window(&self) -> &Window {
+        &self.window
+    }
 }
 
 /// Monitor of running irregularity for a wheel of up to `N` edges per revolution, with pitch
@@ -225,20 +299,23 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         window: WindowConfig,
         alarm: Option<AlarmConfig>,
     ) -> Result<(), ConfigError> {
-        if usize::from(encoder.edges()) > N {
+        self.apply(&MonitorConfig::with_encoder(encoder, window, alarm)?)
+    }
+
+    /// Installs a validated configuration in place (checking only that the wheel fits `N` and
+    /// the pitch table), then resets all per-edge state and the pitch table to nominal. On
+    /// error the monitor is left as it was.
+    pub fn apply(&mut self, config: &MonitorConfig) -> Result<(), ConfigError> {
+        let edges = usize::from(config.encoder.edges());
+        if edges > N {
             return Err(ConfigError::Capacity("edges per revolution"));
         }
-        if !P::NOMINAL && usize::from(encoder.edges()) > P::CAPACITY {
+        if !P::NOMINAL && edges > P::CAPACITY {
             return Err(ConfigError::Capacity("pitch table"));
         }
-        let window = window.validate()?;
-        let alarm = match alarm {
-            Some(a) => Some(a.validate()?),
-            None => None,
-        };
-        self.encoder = encoder;
-        self.window = window;
-        self.alarm = alarm;
+        self.encoder = config.encoder.clone();
+        self.window = config.window;
+        self.alarm = config.alarm;
         self.table.store(&[]);
         self.tracker = SpeedTracker::new();
         self.state = WindowState::new();

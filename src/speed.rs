@@ -1211,8 +1211,9 @@ impl SpeedTracker {
         } else {
             enc.base_pitch()
         };
-        // No pitch (grid 0): the interval as it is.
-        let per_base = if grid == enc.base_pitch() {
+        // No pitch (grid 0): the interval as it is. A uniform disc's grid is always the base
+        // or 0: said first, so that without pattern wheels the 64-bit division folds away.
+        let per_base = if enc.is_uniform() || grid == enc.base_pitch() {
             dt
         } else {
             u64::from(dt)

@@ -60,13 +60,33 @@ strip_fill() {
         if (t != cur) edges[cur] = edges[cur] " " t
         next
     }
+    function code_size(what, configure,    i, j, f, g, out, bytes, mem) {
+        m = 0
+        split("", s2)
+        for (f in names) if (f ~ ("12entry_points(" configure "|7on_edge17|11on_captures|8on_index|4poll)")) { q2[m++] = f; s2[f] = 1 }
+        for (i = 0; i < m; i++) {
+            split(edges[q2[i]], out, " ")
+            for (j in out) { g = out[j]; if (g != "" && !(g in s2)) { s2[g] = 1; q2[m++] = g } }
+        }
+        bytes = 0
+        mem = 0
+        for (i = 0; i < m; i++) {
+            bytes += size[q2[i]]
+            # The memory routines (memcpy, memmove, memset and their aeabi entries), which any
+            # Rust firmware links: shown apart.
+            if (q2[i] ~ /compiler_builtins3mem|^__aeabi_mem/) mem += size[q2[i]]
+        }
+        printf "monitor code (%s, %s): %d bytes in %d functions (on_edge, on_captures, on_index, poll of a DeltaMonitor<1024>; %d of them the memory routines)\n", profile, what, bytes, m, mem
+        # PANIC_FREE_SIZES=1: each function and its size.
+        if (ENVIRON["PANIC_FREE_SIZES"] != "") for (i = 0; i < m; i++) printf "%8d %s\n", size[q2[i]], q2[i]
+    }
     # An indirect call or jump (a register holds the target; "bx lr" is a return): not
     # followed, so not allowed.
     cur != "" && /\t(blx|bx)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?\t(r[0-9]+|ip|sb|sl|fp)([^0-9a-z]|$)/ { indirect[cur] = 1 }
     cur != "" && /\t(mov|ldr)(eq|ne|cs|cc|hs|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al)?(\.w)?\tpc,/ { indirect[cur] = 1 }
     END {
         n = 0
-        for (f in names) if (f ~ /12entry_points/ && f !~ /17configure_monitor/) { queue[n++] = f; seen[f] = "(entry)" }
+        for (f in names) if (f ~ /12entry_points/ && f !~ /12entry_points(17configure_monitor|12apply_config)/) { queue[n++] = f; seen[f] = "(entry)" }
         if (n == 0) { print "panic-free.sh: no entry points found in the image" > "/dev/stderr"; exit 1 }
         roots = n
         for (i = 0; i < n; i++) {
@@ -94,17 +114,12 @@ strip_fill() {
         }
         if (bad > 0) exit 1
         printf "panic-free (%s): %d functions reached from %d per-edge entry points, none can panic\n", profile, n, roots
-        # The code of a DeltaMonitor<1024> in firmware: everything its configuration, on_edge,
-        # on_captures, on_index and poll reach (not the learner or the corrected table).
-        m = 0
-        for (f in names) if (f ~ /12entry_points(17configure_monitor|7on_edge17|11on_captures|8on_index|4poll)/) { q2[m++] = f; s2[f] = 1 }
-        for (i = 0; i < m; i++) {
-            split(edges[q2[i]], out, " ")
-            for (j in out) { g = out[j]; if (g != "" && !(g in s2)) { s2[g] = 1; q2[m++] = g } }
-        }
-        bytes = 0
-        for (i = 0; i < m; i++) bytes += size[q2[i]]
-        printf "monitor code (%s): %d bytes in %d functions (configure, on_edge, on_captures, on_index, poll of a DeltaMonitor<1024>)\n", profile, bytes, m
-        if (ENVIRON["PANIC_FREE_SIZES"] != "") for (i = 0; i < m; i++) printf "%8d %s\n", size[q2[i]], q2[i]
+        # The code of a DeltaMonitor<1024> in firmware: everything on_edge, on_captures,
+        # on_index, poll and the configuration reach (not the learner or the corrected table):
+        # with a configuration the compiler validated (a `const` installed by `apply`), and
+        # with one validated at run time (`configure_from`, whose f64 checks bring in the
+        # software floating point).
+        code_size("compile-time configuration", "12apply_config")
+        code_size("run-time configuration", "17configure_monitor")
     }
 '

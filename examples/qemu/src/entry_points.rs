@@ -7,13 +7,13 @@ use drive_monitor::alarm::AlarmConfig;
 use drive_monitor::encoder::EncoderConfig;
 use drive_monitor::irregularity::WindowConfig;
 use drive_monitor::learn::ToothLearner;
-use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
+use drive_monitor::monitor::{DeltaMonitor, MonitorConfig, WindowOutcome};
 use drive_monitor::pitch::Corrected;
 use drive_monitor::speed::Direction;
 use drive_monitor::ConfigError;
 
-/// Configuration in place (not a per-edge path: `panic-free.sh` leaves it out of its check
-/// and counts it in the monitor's code size).
+/// Configuration in place, validated at run time (not a per-edge path: `panic-free.sh` leaves
+/// it out of its check and counts it in the monitor's code size with run-time configuration).
 #[inline(never)]
 pub fn configure_monitor(
     m: &mut DeltaMonitor<1024>,
@@ -22,6 +22,14 @@ pub fn configure_monitor(
     alarm: Option<AlarmConfig>,
 ) -> Result<(), ConfigError> {
     m.configure_from(encoder, window, alarm)
+}
+
+/// A configuration the compiler validated, installed in place (what firmware with a fixed
+/// configuration links instead of [`configure_monitor`]; left out of the panic-free check
+/// like it, and counted in the monitor's code size).
+#[inline(never)]
+pub fn apply_config(m: &mut DeltaMonitor<1024>, config: &MonitorConfig) -> Result<(), ConfigError> {
+    m.apply(config)
 }
 
 /// An edge from a capture interrupt.

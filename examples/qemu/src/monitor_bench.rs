@@ -21,9 +21,10 @@ use drive_monitor::alarm::AlarmConfig;
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength, MAX_WINDOW_REVS};
 use drive_monitor::learn::ToothLearner;
-use drive_monitor::monitor::DeltaMonitor;
+use drive_monitor::monitor::{DeltaMonitor, MonitorConfig};
 use drive_monitor::pitch::Corrected;
 use drive_monitor::speed::Direction;
+use drive_monitor::ConfigError;
 
 use crate::bench::ensure;
 use crate::entry_points;
@@ -52,19 +53,27 @@ fn generate(ticks: &mut Ticks) {
     }
 }
 
-fn encoder_config(k: u16) -> EncoderConfig {
+const fn encoder_config(k: u16) -> EncoderConfig {
     let mut c = EncoderConfig::indexed(LINES, TIMER_HZ);
     c.estimator = Estimator::Edges(k);
     c.min_speed = 10.0;
     c
 }
 
-fn window(revs: u16) -> WindowConfig {
+const fn window(revs: u16) -> WindowConfig {
     WindowConfig {
         length: WindowLength::Revolutions(revs),
         steady_tolerance: 0.02,
     }
 }
+
+/// The configuration of the entry-point check (16-edge samples, 8-revolution windows, δ
+/// limit 0.06), validated by the compiler: no checking code for it is in the image.
+const CONFIG: MonitorConfig =
+    match MonitorConfig::new(encoder_config(16), window(8), Some(AlarmConfig::new(0.06))) {
+        Ok(c) => c,
+        Err(e) => panic!("{}", e.parameter()),
+    };
 
 fn encoder(k: u16) -> Encoder {
     match Encoder::new(encoder_config(k)) {
@@ -422,7 +431,31 @@ fn entry_points_agree(ticks: &Ticks, delta: f32) {
         "configuration rejected: {:?}",
         configured
     );
-    let mut batched = monitor(16, 8);
+    // The same configuration validated at run time and by the compiler is the same value.
+    let checked_now = MonitorConfig::new(
+        black_box(encoder_config(16)),
+        black_box(window(8)),
+        black_box(Some(AlarmConfig::new(0.06))),
+    );
+    ensure!(
+        checked_now.as_ref() == Ok(&CONFIG),
+        "the compile-time configuration differs from the run-time one: {:?}",
+        checked_now
+    );
+    // This image is built without pattern wheels: one is refused, naming the wheel.
+    let crank = MonitorConfig::new(
+        black_box(EncoderConfig::missing_teeth(36, 2, TIMER_HZ)),
+        window(8),
+        None,
+    );
+    ensure!(
+        crank == Err(ConfigError::Unsupported("wheel")),
+        "a pattern wheel in a build without them: {:?}",
+        crank
+    );
+    let mut batched = DeltaMonitor::unconfigured();
+    let applied = entry_points::apply_config(&mut batched, &CONFIG);
+    ensure!(applied.is_ok(), "configuration not applied: {:?}", applied);
     let mut learning = monitor(16, 8);
     let Ok(mut learner) = ToothLearner::new(learning.encoder(), 0.01) else {
         crate::bench::fail(format_args!("learner rejected"));

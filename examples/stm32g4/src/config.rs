@@ -1,12 +1,13 @@
 //! What the monitor is told about the machine: the disc, the capture timer, the δ window and
-//! the alarm. Validated once at start-up, in place in the monitor's `static`; a rejected value
-//! stops the firmware with the [`ConfigError`] naming it.
+//! the alarm. Validated by the compiler ([`CONFIG`] is a `const`: a rejected value stops the
+//! build with the parameter's name), so the image holds no checking code and no software
+//! floating point; at start-up the firmware checks that TIM2 really counts at [`TIMER_HZ`] and
+//! installs [`CONFIG`] in the monitor's `static`.
 
 use drive_monitor::alarm::AlarmConfig;
 use drive_monitor::encoder::{EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength};
-use drive_monitor::monitor::DeltaMonitor;
-use drive_monitor::ConfigError;
+use drive_monitor::monitor::{DeltaMonitor, MonitorConfig};
 
 /// Lines on the encoder disc: channel A's rising edges per revolution.
 pub const LINES: u16 = 1024;
@@ -46,9 +47,12 @@ pub const LOAD_ORDER: f64 = 0.125;
 /// Permissible δ.
 pub const DELTA_LIMIT: f32 = 0.06;
 
-/// The encoder and capture timer, for a timer counting at `timer_hz` (the real TIM2 counter
-/// clock after the RCC setup).
-pub fn encoder(timer_hz: f64) -> EncoderConfig {
+/// TIM2's counter clock, Hz: the 170 MHz `board::clocks` sets up, with the timer's prescaler
+/// at 1. The firmware compares it with the clock read back from the RCC before it runs.
+pub const TIMER_HZ: u32 = 170_000_000;
+
+/// The encoder and capture timer, for a timer counting at `timer_hz`.
+pub const fn encoder(timer_hz: f64) -> EncoderConfig {
     let mut encoder = if USE_INDEX {
         EncoderConfig::indexed(LINES, timer_hz)
     } else {
@@ -62,7 +66,7 @@ pub fn encoder(timer_hz: f64) -> EncoderConfig {
 }
 
 /// The δ window: one load cycle.
-pub fn window() -> WindowConfig {
+pub const fn window() -> WindowConfig {
     WindowConfig {
         length: WindowLength::LoadOrder(LOAD_ORDER),
         steady_tolerance: 0.02,
@@ -70,12 +74,13 @@ pub fn window() -> WindowConfig {
 }
 
 /// The δ alarm: over [`DELTA_LIMIT`] in 3 of the last 5 windows.
-pub fn alarm() -> AlarmConfig {
+pub const fn alarm() -> AlarmConfig {
     AlarmConfig::new(DELTA_LIMIT)
 }
 
-/// Configures `monitor` in place (it starts as `Monitor::unconfigured()` in a `static`) for a
-/// capture timer counting at `timer_hz`.
-pub fn configure(monitor: &mut Monitor, timer_hz: f64) -> Result<(), ConfigError> {
-    monitor.configure_from(encoder(timer_hz), window(), Some(alarm()))
-}
+/// The monitor's configuration, validated by the compiler.
+pub const CONFIG: MonitorConfig =
+    match MonitorConfig::new(encoder(TIMER_HZ as f64), window(), Some(alarm())) {
+        Ok(c) => c,
+        Err(e) => panic!("{}", e.parameter()),
+    };

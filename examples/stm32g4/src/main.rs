@@ -55,7 +55,8 @@ const INDEX_PRIORITY: Priority = Priority::P1;
 const FEED_PRIORITY: Priority = Priority::P2;
 
 /// The monitor lives in a static, built by the compiler as `DeltaMonitor::unconfigured()` and
-/// configured in place at start-up (`config::configure`): it never passes through the stack.
+/// configured in place at start-up (`config::CONFIG`, applied): it never passes through the
+/// stack.
 static MONITOR: ConstStaticCell<Monitor> = ConstStaticCell::new(Monitor::unconfigured());
 
 /// The feeder, shared by the three interrupt handlers.
@@ -86,7 +87,15 @@ fn main() -> ! {
     let Some(monitor) = MONITOR.try_take() else {
         defmt::panic!("monitor already taken");
     };
-    if let Err(e) = config::configure(monitor, f64::from(counter_hz)) {
+    // The configuration was validated by the compiler for this clock: check it is the real one.
+    if counter_hz != config::TIMER_HZ {
+        defmt::panic!(
+            "TIM2 counts at {=u32} Hz, the configuration was built for {=u32} Hz (config::TIMER_HZ)",
+            counter_hz,
+            config::TIMER_HZ
+        );
+    }
+    if let Err(e) = monitor.apply(&config::CONFIG) {
         defmt::panic!("configuration rejected: {}", e);
     }
     defmt::info!(

@@ -282,6 +282,7 @@ fn core_message(e: &ConfigError, several: bool) -> String {
         }
         ConfigError::OutOfRange(_) => "out of range".into(),
         ConfigError::Capacity(_) => "more than the fixed capacity holds".into(),
+        ConfigError::Unsupported(_) => "not supported by this build of the core".into(),
         // The core names what contradicts in parentheses: "pattern (rotationally symmetric)".
         ConfigError::Inconsistent(p) => match p.split_once(" (") {
             Some((_, why)) => format!("contradict each other ({}", why),

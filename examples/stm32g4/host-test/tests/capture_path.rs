@@ -9,7 +9,7 @@
 //! pulses) and `ring::release_indices`.
 
 use drive_monitor::encoder::EncoderConfig;
-use drive_monitor::monitor::{DeltaMonitor, Diagnostics, WindowOutcome};
+use drive_monitor::monitor::{DeltaMonitor, Diagnostics, MonitorConfig, WindowOutcome};
 use drive_monitor::speed::Direction;
 use drive_monitor_stm32g4_host_test::config::{self, Monitor};
 use drive_monitor_stm32g4_host_test::ring::{
@@ -143,6 +143,24 @@ fn run_cursor(seed: u64, n: u32, max_latency: u64, race: u64) -> (Vec<u32>, u32)
     let step = cursor.on_poll(dma.write);
     feed(step, &dma, &mut fed, &mut overruns);
     (fed, overruns)
+}
+
+/// The configuration the compiler validated (`config::CONFIG`) is the one validated at run
+/// time for the same clock, and the firmware's monitor takes it.
+#[test]
+fn the_compile_time_configuration_is_the_run_time_one() {
+    let now = MonitorConfig::new(
+        config::encoder(f64::from(std::hint::black_box(config::TIMER_HZ))),
+        config::window(),
+        Some(config::alarm()),
+    )
+    .expect("the firmware's configuration is valid");
+    assert_eq!(now, config::CONFIG);
+    let mut m = Monitor::unconfigured();
+    m.apply(&config::CONFIG)
+        .expect("the wheel fits the monitor");
+    assert_eq!(usize::from(m.encoder().edges()), config::CAPACITY);
+    assert_eq!(m.window_revolutions(), 8);
 }
 
 #[test]
