@@ -299,29 +299,48 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         window: WindowConfig,
         alarm: Option<AlarmConfig>,
     ) -> Result<(), ConfigError> {
-        self.apply(&MonitorConfig::with_encoder(encoder, window, alarm)?)
+        Self::fits(&encoder)?;
+        let window = window.validate()?;
+        let alarm = match alarm {
+            Some(a) => Some(a.validate()?),
+            None => None,
+        };
+        self.install(&encoder, window, alarm);
+        Ok(())
     }
 
     /// Installs a validated configuration in place (checking only that the wheel fits `N` and
     /// the pitch table), then resets all per-edge state and the pitch table to nominal. On
     /// error the monitor is left as it was.
     pub fn apply(&mut self, config: &MonitorConfig) -> Result<(), ConfigError> {
-        let edges = usize::from(config.encoder.edges());
+        Self::fits(&config.encoder)?;
+        self.install(&config.encoder, config.window, config.alarm);
+        Ok(())
+    }
+
+    /// Whether the wheel's edges fit `N` and the pitch table.
+    fn fits(encoder: &Encoder) -> Result<(), ConfigError> {
+        let edges = usize::from(encoder.edges());
         if edges > N {
             return Err(ConfigError::Capacity("edges per revolution"));
         }
         if !P::NOMINAL && edges > P::CAPACITY {
             return Err(ConfigError::Capacity("pitch table"));
         }
-        self.encoder = config.encoder.clone();
-        self.window = config.window;
-        self.alarm = config.alarm;
+        Ok(())
+    }
+
+    /// Takes validated pieces (copied straight into place: no temporary configuration on the
+    /// stack) and resets everything else.
+    fn install(&mut self, encoder: &Encoder, window: Window, alarm: Option<DeltaAlarm>) {
+        self.encoder = encoder.clone();
+        self.window = window;
+        self.alarm = alarm;
         self.table.store(&[]);
         self.tracker = SpeedTracker::new();
         self.state = WindowState::new();
         self.diag = Diagnostics::default();
         self.spill = None;
-        Ok(())
     }
 
     /// Validates `config` into an [`Encoder`] and configures the monitor with it.
