@@ -269,8 +269,16 @@ impl<R: BufRead> CaptureReader<R> {
                 )),
             };
         match r.format {
-            CaptureFormat::Saleae => r.header_saleae(&first)?,
-            CaptureFormat::Plain => r.header_plain(&first)?,
+            CaptureFormat::Saleae => r.header_columns(
+                &first,
+                "Time [s]",
+                "the Saleae Logic 2 header `Time [s],Channel 0,...`",
+            )?,
+            CaptureFormat::Plain => r.header_columns(
+                &first,
+                "time_s",
+                "the header `time_s,level` (or `time_s,level,index`)",
+            )?,
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
         }
         if r.channels.is_empty() {
@@ -344,25 +352,17 @@ impl<R: BufRead> CaptureReader<R> {
         Ok(Some(l.to_string()))
     }
 
-    fn header_saleae(&mut self, first: &str) -> Result<(), CaptureError> {
+    /// A header row whose first column is `time` and whose others name the channels;
+    /// `expected` shows the header in the error when the first column is something else.
+    fn header_columns(
+        &mut self,
+        first: &str,
+        time: &str,
+        expected: &str,
+    ) -> Result<(), CaptureError> {
         let mut f = first.split(',');
-        if f.next().map(str::trim) != Some("Time [s]") {
-            return Err(self.err_here(&format!(
-                "expected the Saleae Logic 2 header `Time [s],Channel 0,...`, found `{}`",
-                clip(first)
-            )));
-        }
-        self.channels = f.map(|c| c.trim().to_string()).collect();
-        Ok(())
-    }
-
-    fn header_plain(&mut self, first: &str) -> Result<(), CaptureError> {
-        let mut f = first.split(',');
-        if f.next().map(str::trim) != Some("time_s") {
-            return Err(self.err_here(&format!(
-                "expected the header `time_s,level` (or `time_s,level,index`), found `{}`",
-                clip(first)
-            )));
+        if f.next().map(str::trim) != Some(time) {
+            return Err(self.err_here(&format!("expected {expected}, found `{}`", clip(first))));
         }
         self.channels = f.map(|c| c.trim().to_string()).collect();
         Ok(())

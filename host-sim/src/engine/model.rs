@@ -22,10 +22,13 @@ pub struct Shaft {
 pub trait Effect: Send + Sync {
     /// Short name, used in reports and in per-component evaluation counts.
     fn name(&self) -> &'static str;
-    /// Number of state variables this effect owns (0 for a pure torque such as a load).
-    fn dim(&self) -> usize;
+    /// Number of state variables this effect owns (by default 0: a pure torque such as a
+    /// load, which then needs neither this nor [`Effect::init`]).
+    fn dim(&self) -> usize {
+        0
+    }
     /// Writes the initial values of the effect's own states (`y.len() == self.dim()`).
-    fn init(&self, y: &mut [f64]);
+    fn init(&self, _y: &mut [f64]) {}
     /// Writes `dy` (the derivatives of the effect's own states `y`) at time `t` with the shaft
     /// in state `shaft`, and returns the torque the effect applies to the shaft, N·m
     /// (positive drives the shaft forward).

@@ -220,10 +220,6 @@ impl Effect for RotorLoads {
     fn name(&self) -> &'static str {
         "rotor_loads"
     }
-    fn dim(&self) -> usize {
-        0
-    }
-    fn init(&self, _y: &mut [f64]) {}
     fn eval(&self, _t: f64, _shaft: Shaft, _y: &[f64], _dy: &mut [f64]) -> f64 {
         0.0
     }

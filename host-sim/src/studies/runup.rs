@@ -30,16 +30,23 @@ pub struct RampRun {
     pub capture: Option<CaptureReport>,
 }
 
+/// Errors (naming `key`, the value scaled) unless the `what` factor is positive and finite.
+fn slowdown_factor(file: &Path, key: &str, what: &str, factor: f64) -> Result<(), SceneError> {
+    if factor.is_finite() && factor > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::value(
+            file,
+            key,
+            format!("{what} factor must be positive and finite, got {factor}"),
+        ))
+    }
+}
+
 /// `scene` with its prescribed ramp `factor` times as long (the hold after the ramp kept).
 /// Errors unless the scene's motor is a ramp and `factor` is positive and finite.
 pub fn with_ramp_stretched(scene: &Scene, file: &Path, factor: f64) -> Result<Scene, SceneError> {
-    if !(factor.is_finite() && factor > 0.0) {
-        return Err(SceneError::value(
-            file,
-            "motor.duration",
-            format!("ramp time factor must be positive and finite, got {factor}"),
-        ));
-    }
+    slowdown_factor(file, "motor.duration", "ramp time", factor)?;
     let mut s = scene.clone();
     let Some(MotorSpec::Ramp { duration, .. }) = &mut s.motor else {
         return Err(SceneError::value(
@@ -59,13 +66,7 @@ pub fn with_ramp_stretched(scene: &Scene, file: &Path, factor: f64) -> Result<Sc
 /// falls as the inertia rises). Errors unless the scene's shaft is motor-driven (`[shaft]`
 /// and a Kloss or parabola `[motor]`) and `factor` is positive and finite.
 pub fn with_inertia_scaled(scene: &Scene, file: &Path, factor: f64) -> Result<Scene, SceneError> {
-    if !(factor.is_finite() && factor > 0.0) {
-        return Err(SceneError::value(
-            file,
-            "shaft.inertia",
-            format!("inertia factor must be positive and finite, got {factor}"),
-        ));
-    }
+    slowdown_factor(file, "shaft.inertia", "inertia", factor)?;
     let mut s = scene.clone();
     if !matches!(
         s.motor,

@@ -16,10 +16,6 @@ impl Effect for Load {
     fn name(&self) -> &'static str {
         "load"
     }
-    fn dim(&self) -> usize {
-        0
-    }
-    fn init(&self, _y: &mut [f64]) {}
     fn eval(&self, _t: f64, shaft: Shaft, _y: &[f64], _dy: &mut [f64]) -> f64 {
         -self.torque(shaft.phi)
     }
@@ -44,10 +40,6 @@ impl Effect for ViscousFriction {
     fn name(&self) -> &'static str {
         "friction"
     }
-    fn dim(&self) -> usize {
-        0
-    }
-    fn init(&self, _y: &mut [f64]) {}
     fn eval(&self, _t: f64, shaft: Shaft, _y: &[f64], _dy: &mut [f64]) -> f64 {
         -self.coefficient * shaft.omega
     }

@@ -37,10 +37,6 @@ impl Effect for ConstantTorque {
     fn name(&self) -> &'static str {
         "constant_torque"
     }
-    fn dim(&self) -> usize {
-        0
-    }
-    fn init(&self, _y: &mut [f64]) {}
     fn eval(&self, _t: f64, _shaft: Shaft, _y: &[f64], _dy: &mut [f64]) -> f64 {
         self.torque
     }

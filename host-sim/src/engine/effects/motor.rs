@@ -16,10 +16,6 @@ impl Effect for Motor {
     fn name(&self) -> &'static str {
         "motor"
     }
-    fn dim(&self) -> usize {
-        0
-    }
-    fn init(&self, _y: &mut [f64]) {}
     fn eval(&self, _t: f64, shaft: Shaft, _y: &[f64], _dy: &mut [f64]) -> f64 {
         self.torque(shaft.omega)
     }

@@ -1,24 +1,85 @@
 //! The Dormand–Prince stages of [`Solver`]: one attempted step of DOPRI5 and of DOP853 with its
 //! error estimate, and each method's dense output, from Hairer's tableaux.
 
+use std::ops::Range;
+
 use super::Buf;
 use super::{OdeSystem, Solver, Tol};
 
 impl Solver {
-    /// `ytmp = y + h·Σ_j a_j·k_j` over the stages `j < a.len()` (zero coefficients skipped).
-    fn stage_input(&mut self, a: &[f64], h: f64) {
+    /// Component `i` of `y + h·Σ_j w_j·k_j` over the stages `j < w.len()` (zero weights
+    /// skipped).
+    fn increment(&self, w: &[f64], h: f64, i: usize) -> f64 {
         let n = self.n;
-        for i in 0..n {
-            let mut acc = 0.0;
-            for (j, aj) in a.iter().enumerate() {
-                if *aj != 0.0 {
-                    acc += aj * self.k[j * n + i];
-                }
+        let mut acc = 0.0;
+        for (j, wj) in w.iter().enumerate() {
+            if *wj != 0.0 {
+                acc += wj * self.k[j * n + i];
             }
-            self.ytmp[i] = self.y[i] + h * acc;
+        }
+        self.y[i] + h * acc
+    }
+
+    /// `ytmp = y + h·Σ_j a_j·k_j`, the input of the stage whose row is `a`.
+    fn stage_input(&mut self, a: &[f64], h: f64) {
+        for i in 0..self.n {
+            self.ytmp[i] = self.increment(a, h, i);
         }
     }
 
+    /// Evaluates stages `stages` of the step [t, t + h] of an explicit tableau (nodes `c`,
+    /// lower-triangular rows `a`) into their blocks of `k`.
+    fn run_stages<S: OdeSystem + ?Sized, const W: usize>(
+        &mut self,
+        sys: &mut S,
+        a: &[[f64; W]],
+        c: &[f64],
+        stages: Range<usize>,
+        h: f64,
+    ) {
+        let t = self.t;
+        for s in stages {
+            self.stage_input(&a[s][..s], h);
+            self.eval(sys, t + c[s] * h, Buf::Stage, s);
+        }
+    }
+
+    /// The end of an attempted step, the same for both tableaux once `ynew` is formed:
+    /// f(t + h, ynew) into `fnew` (FSAL; evaluated on every attempt, so each costs the same),
+    /// NaN when `ynew` is not finite, 0 for an empty system, and otherwise
+    /// `norm(sums, n)` where `sums[m]` = Σᵢ (eₘᵢ / skᵢ)² over the components, eᵢ =
+    /// `estimates(self, i)` the tableau's `M` error estimates and skᵢ the error scale of
+    /// [`Solver::scale`].
+    fn finish_attempt<S: OdeSystem + ?Sized, const M: usize>(
+        &mut self,
+        sys: &mut S,
+        h: f64,
+        tol: Tol,
+        estimates: impl Fn(&Self, usize) -> [f64; M],
+        norm: impl FnOnce([f64; M], f64) -> f64,
+    ) -> f64 {
+        let t = self.t;
+        self.eval(sys, t + h, Buf::FNew, 0);
+        if self.ynew.iter().any(|v| !v.is_finite()) {
+            return f64::NAN;
+        }
+        let n = self.n;
+        if n == 0 {
+            return 0.0;
+        }
+        let mut sums = [0.0; M];
+        for i in 0..n {
+            let e = estimates(self, i);
+            let sk = self.scale(sys.error_reference(i), i, tol);
+            for (sum, e) in sums.iter_mut().zip(e) {
+                *sum += (e / sk).powi(2);
+            }
+        }
+        norm(sums, n as f64)
+    }
+
+    /// One attempted DOPRI5 step of length `h`: `ynew`, `fnew` and the RMS of the scaled
+    /// 5th/4th-order difference.
     pub(super) fn attempt_dp5<S: OdeSystem + ?Sized>(
         &mut self,
         sys: &mut S,
@@ -26,13 +87,10 @@ impl Solver {
         tol: Tol,
     ) -> f64 {
         let n = self.n;
-        let t = self.t;
         // Stage s (1-based 2..6) in block s-1; block 0 mirrors f.
         self.k[..n].copy_from_slice(&self.f);
-        for s in 1..6 {
-            self.stage_input(&DP5_A[s][..s], h);
-            self.eval(sys, t + DP5_C[s] * h, Buf::Stage, s);
-        }
+        self.run_stages(sys, &DP5_A, &DP5_C, 1..6, h);
+        // Every weight, the zero one included: a non-finite stage makes ynew non-finite.
         for i in 0..n {
             let mut acc = 0.0;
             for (j, b) in DP5_B.iter().enumerate() {
@@ -40,23 +98,19 @@ impl Solver {
             }
             self.ynew[i] = self.y[i] + h * acc;
         }
-        self.eval(sys, t + h, Buf::FNew, 0);
-        if self.ynew.iter().any(|v| !v.is_finite()) {
-            return f64::NAN;
-        }
-        if n == 0 {
-            return 0.0;
-        }
-        let mut sum = 0.0;
-        for i in 0..n {
-            let mut acc = DP5_E[6] * self.fnew[i];
-            for (j, e) in DP5_E.iter().enumerate().take(6) {
-                acc += e * self.k[j * n + i];
-            }
-            let sk = self.scale(sys.error_reference(i), i, tol);
-            sum += (h * acc / sk).powi(2);
-        }
-        (sum / n as f64).sqrt()
+        self.finish_attempt(
+            sys,
+            h,
+            tol,
+            |s, i| {
+                let mut acc = DP5_E[6] * s.fnew[i];
+                for (j, e) in DP5_E.iter().enumerate().take(6) {
+                    acc += e * s.k[j * n + i];
+                }
+                [h * acc]
+            },
+            |[sum], n| (sum / n).sqrt(),
+        )
     }
 
     /// Shampine's continuous extension in Hairer's DOPRI5 form (its block 2 is the Hermite
@@ -78,6 +132,8 @@ impl Solver {
         self.set_dense(t, h, 4);
     }
 
+    /// One attempted DOP853 step of length `h`: `ynew`, `fnew` and Hairer's combined
+    /// 5th/3rd-order error estimate.
     pub(super) fn attempt_dp853<S: OdeSystem + ?Sized>(
         &mut self,
         sys: &mut S,
@@ -85,59 +141,41 @@ impl Solver {
         tol: Tol,
     ) -> f64 {
         let n = self.n;
-        let t = self.t;
         self.k[..n].copy_from_slice(&self.f);
-        for s in 1..12 {
-            self.stage_input(&DP8_A[s][..s], h);
-            self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
-        }
+        self.run_stages(sys, &DP8_A, &DP8_C, 1..12, h);
+        // Row 12 holds the weights b.
         for i in 0..n {
-            let mut acc = 0.0;
-            for (j, b) in DP8_A[12].iter().enumerate().take(12) {
-                if *b != 0.0 {
-                    acc += b * self.k[j * n + i];
+            self.ynew[i] = self.increment(&DP8_A[12][..12], h, i);
+        }
+        self.finish_attempt(
+            sys,
+            h,
+            tol,
+            |s, i| {
+                let mut e5 = 0.0;
+                let mut e3 = 0.0;
+                for j in 0..12 {
+                    let kj = s.k[j * n + i];
+                    e5 += DP8_E5[j] * kj;
+                    e3 += (DP8_A[12][j] - DP8_BHH[j]) * kj;
                 }
-            }
-            self.ynew[i] = self.y[i] + h * acc;
-        }
-        // Combined 5th/3rd-order error estimate (Hairer's DOP853).
-        let mut err5 = 0.0;
-        let mut err3 = 0.0;
-        for i in 0..n {
-            let mut e5 = 0.0;
-            let mut e3 = 0.0;
-            for j in 0..12 {
-                let kj = self.k[j * n + i];
-                e5 += DP8_E5[j] * kj;
-                e3 += (DP8_A[12][j] - DP8_BHH[j]) * kj;
-            }
-            let sk = self.scale(sys.error_reference(i), i, tol);
-            err5 += (e5 / sk).powi(2);
-            err3 += (e3 / sk).powi(2);
-        }
-        let ok = self.ynew.iter().all(|v| v.is_finite());
-        self.eval(sys, t + h, Buf::FNew, 0);
-        if !ok {
-            return f64::NAN;
-        }
-        if n == 0 {
-            return 0.0;
-        }
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        h.abs() * err5 / (deno * n as f64).sqrt()
+                [e5, e3]
+            },
+            |[err5, err3], n| {
+                let mut deno = err5 + 0.01 * err3;
+                if deno <= 0.0 {
+                    deno = 1.0;
+                }
+                h.abs() * err5 / (deno * n).sqrt()
+            },
+        )
     }
 
     pub(super) fn dense_dp853<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, t: f64, h: f64) {
         let n = self.n;
         // Block 12 holds f(t + h, ynew); blocks 13..15 the three extra stages.
         self.k[12 * n..13 * n].copy_from_slice(&self.fnew);
-        for s in 13..16 {
-            self.stage_input(&DP8_A[s][..s], h);
-            self.eval(sys, t + DP8_C[s] * h, Buf::Stage, s);
-        }
+        self.run_stages(sys, &DP8_A, &DP8_C, 13..16, h);
         self.hermite_blocks(h);
         for i in 0..n {
             for (r, drow) in DP8_D.iter().enumerate() {
