@@ -30,20 +30,13 @@ fi
 [ "$missing" -eq 0 ] || exit 1
 
 echo "== build (release, thumbv7em-none-eabihf)"
-elf="$(cargo build --release --locked --message-format=json-render-diagnostics |
-    sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)"
-if [ -z "$elf" ] || [ ! -f "$elf" ]; then
-    echo "run.sh: the build produced no executable" >&2
-    exit 1
-fi
+source ../tools/firmware.sh
+elf="$(release_elf run.sh)"
 echo "ELF: $elf"
 
 echo "== footprint"
-size "$elf"
-# Berkeley format: text data bss. Flash holds text and the initial values of data; RAM holds
-# data and bss statically, plus the stack (its peak is printed by the firmware).
-size "$elf" | awk 'NR == 2 {
-    printf "footprint: flash %d bytes, static RAM %d bytes\n", $1 + $2, $2 + $3 }'
+footprint "$elf"
+# The stack comes on top of the static RAM: the firmware prints its peak.
 
 echo "== run under QEMU (timeout ${timeout_s} s)"
 log="$(mktemp)"

@@ -39,20 +39,13 @@ fi
 [ "$missing" -eq 0 ] || exit 1
 
 echo "== build (release, thumbv7em-none-eabihf${chip:+, chip $chip})"
-elf="$(cargo build --release --locked --message-format=json-render-diagnostics |
-    sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)"
-if [ -z "$elf" ] || [ ! -f "$elf" ]; then
-    echo "build.sh: the build produced no executable" >&2
-    exit 1
-fi
+source ../tools/firmware.sh
+elf="$(release_elf build.sh)"
 echo "ELF: $elf"
 
 echo "== footprint"
-size "$elf"
-# Berkeley format: text data bss. Flash holds text and the initial values of data; RAM holds
-# data and bss statically, plus the stack, which takes the rest of the chip's SRAM.
-size "$elf" | awk 'NR == 2 {
-    printf "footprint: flash %d bytes, static RAM %d bytes\n", $1 + $2, $2 + $3 }'
+footprint "$elf"
+# The stack comes on top of the static RAM: it takes the rest of the chip's SRAM.
 # The two large statics, from the symbol table: the monitor (a `DeltaMonitor<1024>` built by
 # the compiler as `unconfigured()` and configured in place, in its `ConstStaticCell` with the
 # cell's taken flag) and the DMA ring of captures.
