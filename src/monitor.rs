@@ -271,18 +271,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             tracker: SpeedTracker::new(),
             state: WindowState::new(),
             diag: Diagnostics {
-                edges: EdgeCounters {
-                    accepted: 0,
-                    glitches: 0,
-                    missing: 0,
-                    extra: 0,
-                    missing_frames: 0,
-                    reversals: 0,
-                    timeouts: 0,
-                    revolutions: 0,
-                    syncs: 0,
-                    sync_losses: 0,
-                },
+                edges: EdgeCounters::ZERO,
                 valid_windows: 0,
                 invalid_windows: 0,
                 alarms_raised: 0,
@@ -300,6 +289,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         alarm: Option<AlarmConfig>,
     ) -> Result<(), ConfigError> {
         Self::fits(&encoder)?;
+        // Validated in place, not through `MonitorConfig::with_encoder`: no configuration
+        // temporary on the stack (`stack: construct`).
         let window = window.validate()?;
         let alarm = match alarm {
             Some(a) => Some(a.validate()?),

@@ -193,6 +193,22 @@ pub struct EdgeCounters {
     pub sync_losses: u32,
 }
 
+impl EdgeCounters {
+    /// Nothing counted yet (the `Default`, as a `const`).
+    pub const ZERO: EdgeCounters = EdgeCounters {
+        accepted: 0,
+        glitches: 0,
+        missing: 0,
+        extra: 0,
+        missing_frames: 0,
+        reversals: 0,
+        timeouts: 0,
+        revolutions: 0,
+        syncs: 0,
+        sync_losses: 0,
+    };
+}
+
 /// Pending raw edges awaiting judgement: the edge itself and two for lookahead.
 const PENDING: usize = 3;
 /// Index timestamps that may wait for their edge.
@@ -377,18 +393,7 @@ impl SpeedTracker {
             confirm: 0,
             seen_special: false,
             searched: 0,
-            counters: EdgeCounters {
-                accepted: 0,
-                glitches: 0,
-                missing: 0,
-                extra: 0,
-                missing_frames: 0,
-                reversals: 0,
-                timeouts: 0,
-                revolutions: 0,
-                syncs: 0,
-                sync_losses: 0,
-            },
+            counters: EdgeCounters::ZERO,
         }
     }
 
@@ -462,11 +467,16 @@ impl SpeedTracker {
         if enc.framing() == Framing::Pattern && self.sync != SyncState::Synced {
             return None;
         }
-        let span = if self.span == 0 {
+        self.sample(if self.span == 0 {
             enc.uniform_span()
         } else {
             self.span
-        };
+        })
+    }
+
+    /// The sample of the ring's sum over `span` units (none for an empty sum).
+    #[inline(always)]
+    fn sample(&self, span: u32) -> Option<Sample> {
         (self.sum > 0).then_some(Sample {
             span,
             ticks: self.sum,
@@ -1488,14 +1498,10 @@ impl SpeedTracker {
         if refresh {
             self.refresh_band(enc);
         }
-        let span = if uniform {
+        self.sample(if uniform {
             enc.uniform_span()
         } else {
             self.span
-        };
-        (self.sum > 0).then_some(Sample {
-            span,
-            ticks: self.sum,
         })
     }
 

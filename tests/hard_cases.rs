@@ -883,6 +883,26 @@ fn equal_partial_frequencies_double_roots() {
 /// damping, zone boundaries at exactly those speeds (1e-12).
 #[test]
 fn platform_mass_a_million_times_another() {
+    for (what, cfg) in mass_ratio_machines() {
+        let m = Machine::new(cfg, fine()).unwrap();
+        let (res, add) = reference_speeds(&cfg);
+        assert_all_close(m.resonant_speeds(), &res, 1e-13, &what);
+        assert_all_close(m.additional_speeds(), &add, 1e-13, &what);
+        let all = sorted(res.iter().chain(&add).copied().collect());
+        for (i, w) in all.windows(2).enumerate() {
+            assert!(w[0] <= w[1] * (1.0 + 1e-15), "{what}: interlacing {i}");
+        }
+        // Distinct speeds bound zones; coinciding ones (weak coupling) may cancel.
+        if all.windows(2).all(|w| rel(w[0], w[1]) > 1e-6) {
+            assert_all_close(&boundaries(&m), &all, 1e-12, &what);
+        }
+    }
+}
+
+/// Undamped two- and three-platform machines with one platform mass 10⁶ times another, over
+/// couplings from 1e-2 to 1e6 N/m, each named.
+fn mass_ratio_machines() -> Vec<(String, MachineConfig)> {
+    let mut out = Vec::new();
     for (m1, m2, m3) in [
         (1e6, 1.0, 30.0),
         (1.0, 1e6, 1.0),
@@ -903,23 +923,14 @@ fn platform_mass_a_million_times_another() {
             let mut b = balancer(2);
             b.load_mass = 1e-6;
             for n in 2..=3 {
-                let cfg = MachineConfig::new(&p[..n], &cs[..2 * n - 3], b).unwrap();
-                let m = Machine::new(cfg, fine()).unwrap();
-                let what = format!("{m1} {m2} {m3}, kc {kc}, {n} platforms");
-                let (res, add) = reference_speeds(&cfg);
-                assert_all_close(m.resonant_speeds(), &res, 1e-13, &what);
-                assert_all_close(m.additional_speeds(), &add, 1e-13, &what);
-                let all = sorted(res.iter().chain(&add).copied().collect());
-                for (i, w) in all.windows(2).enumerate() {
-                    assert!(w[0] <= w[1] * (1.0 + 1e-15), "{what}: interlacing {i}");
-                }
-                // Distinct speeds bound zones; coinciding ones (weak coupling) may cancel.
-                if all.windows(2).all(|w| rel(w[0], w[1]) > 1e-6) {
-                    assert_all_close(&boundaries(&m), &all, 1e-12, &what);
-                }
+                out.push((
+                    format!("{m1} {m2} {m3}, kc {kc}, {n} platforms"),
+                    MachineConfig::new(&p[..n], &cs[..2 * n - 3], b).unwrap(),
+                ));
             }
         }
     }
+    out
 }
 
 /// The sign function of Re H_ee for two platforms (exciter e, other a), written out as a real
@@ -1167,30 +1178,7 @@ fn fast_search_matches_the_scan_on_the_hard_machines() {
         configs.push(MachineConfig::new(&p3, &cs, balancer(2)).unwrap());
     }
     // A mass 10⁶ times another.
-    for (m1, m2, m3) in [
-        (1e6, 1.0, 30.0),
-        (1.0, 1e6, 1.0),
-        (1e-3, 1e3, 1e3),
-        (1e3, 1e-3, 1e-3),
-    ] {
-        for kc in [1e-2, 1e3, 1e6] {
-            let p = [
-                platform(m1, 1e4, 0.0),
-                platform(m2, 2e4, 0.0),
-                platform(m3, 5e3, 0.0),
-            ];
-            let cs = [
-                coupling(1, 2, kc, 0.0),
-                coupling(2, 3, 0.5 * kc, 0.0),
-                coupling(1, 3, 0.3 * kc, 0.0),
-            ];
-            let mut b = balancer(2);
-            b.load_mass = 1e-6;
-            for n in 2..=3 {
-                configs.push(MachineConfig::new(&p[..n], &cs[..2 * n - 3], b).unwrap());
-            }
-        }
-    }
+    configs.extend(mass_ratio_machines().into_iter().map(|(_, cfg)| cfg));
     // Damping to zero, and the support damping of platform 1 across the value (about
     // 1.4e3 N·s/m) that merges two boundaries and erases two zones.
     let two = |ca: f64, cc: f64| {

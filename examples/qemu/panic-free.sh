@@ -25,24 +25,23 @@ objdump="$(objdump_path)"
 disassemble "$objdump" "$elf" | awk -v profile="$profile" -f ../tools/callgraph.awk -f <(cat <<'AWK'
 # The code of a DeltaMonitor<1024> in firmware: what the per-edge entry points and the
 # configuration entry point `configure` (a name in entry_points.rs) reach, with its size.
-function code_size(what, configure,    i, j, f, g, out, bytes, mem, m, q2, s2) {
+function code_size(what, configure,    i, f, m, bytes, mem) {
+    split("", queue)
+    split("", seen)
     m = 0
-    for (f in names) if (f ~ ("12entry_points(" configure "|7on_edge17|11on_captures|8on_index|4poll)")) { q2[m++] = f; s2[f] = 1 }
-    for (i = 0; i < m; i++) {
-        split(edges[q2[i]], out, " ")
-        for (j in out) { g = out[j]; if (g != "" && !(g in s2)) { s2[g] = 1; q2[m++] = g } }
-    }
+    for (f in names) if (f ~ ("12entry_points(" configure "|7on_edge17|11on_captures|8on_index|4poll)")) { queue[m++] = f; seen[f] = "(entry)" }
+    m = walk(m, "^$", "")
     bytes = 0
     mem = 0
     for (i = 0; i < m; i++) {
-        bytes += size[q2[i]]
+        bytes += size[queue[i]]
         # The memory routines (memcpy, memmove, memset and their aeabi entries), which any
         # Rust firmware links: shown apart.
-        if (q2[i] ~ /compiler_builtins3mem|^__aeabi_mem/) mem += size[q2[i]]
+        if (queue[i] ~ /compiler_builtins3mem|^__aeabi_mem/) mem += size[queue[i]]
     }
     printf "monitor code (%s, %s): %d bytes in %d functions (on_edge, on_captures, on_index, poll of a DeltaMonitor<1024>; %d of them the memory routines)\n", profile, what, bytes, m, mem
     # PANIC_FREE_SIZES=1: each function and its size.
-    if (ENVIRON["PANIC_FREE_SIZES"] != "") for (i = 0; i < m; i++) printf "%8d %s\n", size[q2[i]], q2[i]
+    if (ENVIRON["PANIC_FREE_SIZES"] != "") for (i = 0; i < m; i++) printf "%8d %s\n", size[queue[i]], queue[i]
 }
 END {
     n = 0

@@ -207,19 +207,75 @@ fn refine(
     a + 0.5 * (b - a)
 }
 
-struct Boundaries {
+/// Zone boundaries as a search finds them (scaled speeds, ascending), before merging.
+pub(super) struct Boundaries {
     b: [f64; MAX_RAW],
     n: usize,
 }
 
 impl Boundaries {
-    fn push(&mut self, x: f64) -> Result<(), ConfigError> {
+    pub(super) const EMPTY: Boundaries = Boundaries {
+        b: [0.0; MAX_RAW],
+        n: 0,
+    };
+
+    pub(super) fn push(&mut self, x: f64) -> Result<(), ConfigError> {
         let slot = self
             .b
             .get_mut(self.n)
             .ok_or(ConfigError::Capacity("zones"))?;
         *slot = x;
         self.n += 1;
+        Ok(())
+    }
+
+    /// Writes the zones into `m`: pairs of boundaries closer than the search resolves (relative
+    /// `tol`) dropped, gathering below the first, alternating after each; `platforms` bounds
+    /// their number, `w_s` scales them back to rad/s.
+    pub(super) fn into_zones(
+        mut self,
+        m: &mut Machine,
+        tol: f64,
+        platforms: usize,
+        w_s: f64,
+    ) -> Result<(), ConfigError> {
+        // Drop pairs of boundaries closer than the search can resolve.
+        let merge = 1e3 * tol;
+        let mut i = 0;
+        while i + 1 < self.n {
+            if self.b[i + 1] - self.b[i] <= merge * self.b[i + 1] {
+                for j in i..self.n - 2 {
+                    self.b[j] = self.b[j + 2];
+                }
+                self.n -= 2;
+                i = i.saturating_sub(1);
+            } else {
+                i += 1;
+            }
+        }
+        if self.n + 1 > MAX_ZONES || self.n + 1 > 2 * platforms {
+            return Err(ConfigError::Capacity("zones"));
+        }
+        let mut kind = ZoneKind::Gathering;
+        let mut from = 0.0;
+        for (i, &b) in self.b.iter().take(self.n).enumerate() {
+            m.zones[i] = Zone {
+                from,
+                to: Some(b * w_s),
+                kind,
+            };
+            from = b * w_s;
+            kind = match kind {
+                ZoneKind::Gathering => ZoneKind::Balancing,
+                ZoneKind::Balancing => ZoneKind::Gathering,
+            };
+        }
+        m.zones[self.n] = Zone {
+            from,
+            to: None,
+            kind,
+        };
+        m.n_zones = (self.n + 1) as u8;
         Ok(())
     }
 }
@@ -426,10 +482,7 @@ fn find_zones(
             w: 0.0,
             s: criterion(solver, 0.0),
         },
-        out: Boundaries {
-            b: [0.0; MAX_RAW],
-            n: 0,
-        },
+        out: Boundaries::EMPTY,
     };
     if certified {
         // Every root of p is simple and accounted for: for each, first the narrowest
@@ -491,45 +544,7 @@ fn find_zones(
     if walk.prev.s.0 {
         return Err(ConfigError::Inconsistent("zone search"));
     }
-    let mut out = walk.out;
-    // Drop pairs of boundaries closer than the search can resolve.
-    let merge = 1e3 * tol;
-    let mut i = 0;
-    while i + 1 < out.n {
-        if out.b[i + 1] - out.b[i] <= merge * out.b[i + 1] {
-            for j in i..out.n - 2 {
-                out.b[j] = out.b[j + 2];
-            }
-            out.n -= 2;
-            i = i.saturating_sub(1);
-        } else {
-            i += 1;
-        }
-    }
-    if out.n + 1 > MAX_ZONES || out.n + 1 > 2 * sys.n {
-        return Err(ConfigError::Capacity("zones"));
-    }
-    let mut kind = ZoneKind::Gathering;
-    let mut from = 0.0;
-    for (i, &b) in out.b.iter().take(out.n).enumerate() {
-        m.zones[i] = Zone {
-            from,
-            to: Some(b * w_s),
-            kind,
-        };
-        from = b * w_s;
-        kind = match kind {
-            ZoneKind::Gathering => ZoneKind::Balancing,
-            ZoneKind::Balancing => ZoneKind::Gathering,
-        };
-    }
-    m.zones[out.n] = Zone {
-        from,
-        to: None,
-        kind,
-    };
-    m.n_zones = (out.n + 1) as u8;
-    Ok(())
+    walk.out.into_zones(m, tol, sys.n, w_s)
 }
 
 /// `D(Ω) = ω − Ω` for gathered loads turning at `Ω`; see [`Machine::capture_lag`].

@@ -18,14 +18,9 @@
 //! dropped: such a zone is below the resolution of the search (a pole and a zero that
 //! nearly cancel).
 
-use super::damped::{capture_lag, characteristic, scaled, Scaled};
+use super::damped::{capture_lag, characteristic, scaled, Boundaries, Scaled};
 use super::modal::System;
-use super::{
-    CaptureWindow, ConfigError, Machine, MachineConfig, SearchOptions, Zone, ZoneKind, MAX_ZONES,
-};
-
-/// Boundaries collected before merging (noise can add pairs; a physical machine has ≤ 5).
-const MAX_RAW: usize = 32;
+use super::{CaptureWindow, ConfigError, Machine, MachineConfig, SearchOptions, ZoneKind};
 
 fn gathering(sys: &System, w: f64) -> bool {
     sys.criterion(w) > 0.0
@@ -49,23 +44,6 @@ pub(crate) fn bisect(mut lo: f64, mut hi: f64, tol: f64, pred: impl Fn(f64) -> b
         }
     }
     lo + 0.5 * (hi - lo)
-}
-
-struct Boundaries {
-    b: [f64; MAX_RAW],
-    n: usize,
-}
-
-impl Boundaries {
-    fn push(&mut self, x: f64) -> Result<(), ConfigError> {
-        let slot = self
-            .b
-            .get_mut(self.n)
-            .ok_or(ConfigError::Capacity("zones"))?;
-        *slot = x;
-        self.n += 1;
-        Ok(())
-    }
 }
 
 /// Scans `[a, b]` with `nodes` log-spaced steps, continuing from the state `(w, sign)` of
@@ -108,10 +86,7 @@ pub(crate) fn find_zones(
     let (chars, n_chars) = characteristic(m, w_s);
     let nodes = opt.nodes_per_interval;
     let tol = opt.rel_tol;
-    let mut out = Boundaries {
-        b: [0.0; MAX_RAW],
-        n: 0,
-    };
+    let mut out = Boundaries::EMPTY;
     let first = chars.first().copied().unwrap_or(1.0);
     let mut prev = (0.0, gathering(&sys, 0.0));
     let mut a = first * 1e-3;
@@ -132,44 +107,7 @@ pub(crate) fn find_zones(
     if prev.1 {
         return Err(ConfigError::Inconsistent("zone search"));
     }
-    // Drop pairs of boundaries closer than the search can resolve.
-    let merge = 1e3 * tol;
-    let mut i = 0;
-    while i + 1 < out.n {
-        if out.b[i + 1] - out.b[i] <= merge * out.b[i + 1] {
-            for j in i..out.n - 2 {
-                out.b[j] = out.b[j + 2];
-            }
-            out.n -= 2;
-            i = i.saturating_sub(1);
-        } else {
-            i += 1;
-        }
-    }
-    if out.n + 1 > MAX_ZONES || out.n + 1 > 2 * sys.n {
-        return Err(ConfigError::Capacity("zones"));
-    }
-    let mut kind = ZoneKind::Gathering;
-    let mut from = 0.0;
-    for (i, &b) in out.b.iter().take(out.n).enumerate() {
-        m.zones[i] = Zone {
-            from,
-            to: Some(b * w_s),
-            kind,
-        };
-        from = b * w_s;
-        kind = match kind {
-            ZoneKind::Gathering => ZoneKind::Balancing,
-            ZoneKind::Balancing => ZoneKind::Gathering,
-        };
-    }
-    m.zones[out.n] = Zone {
-        from,
-        to: None,
-        kind,
-    };
-    m.n_zones = (out.n + 1) as u8;
-    Ok(())
+    out.into_zones(m, tol, sys.n, w_s)
 }
 
 /// `Ω + D(Ω)`: the rotor speed that holds gathered loads at `Ω`.

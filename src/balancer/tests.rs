@@ -1250,45 +1250,6 @@ fn fast_search_matches_the_scan_on_random_machines() {
     assert!(total.agreeing > 1000, "{total:?}");
 }
 
-#[test]
-fn debug_cluster() {
-    let eps = 1e-12;
-    let p = [
-        platform(100.0, 4e5, 0.0),
-        platform(100.0, 4e5 * (1.0 + eps), 0.0),
-        platform(100.0, 4e5 * (1.0 - eps), 0.0),
-    ];
-    let cs = [
-        coupling(1, 2, 1e-3, 0.0),
-        coupling(2, 3, 2e-3, 0.0),
-        coupling(1, 3, 1e-3, 0.0),
-    ];
-    let mut b = balancer(1);
-    b.housing_mass = 0.0;
-    b.load_mass = 1e-9;
-    let cfg = MachineConfig::new(&p, &cs, b).unwrap();
-    let m = Machine::new(cfg, SearchOptions::default()).unwrap();
-    std::println!(
-        "chars {:?} {:?}",
-        m.resonant_speeds(),
-        m.additional_speeds()
-    );
-    std::println!("zones {:?}", m.zones());
-    let s = Machine::new_scanned(cfg, SearchOptions::default()).unwrap();
-    std::println!("scan {:?}", s.zones());
-    let sys = System::new(&cfg);
-    let sc = damped::scaled(&sys);
-    let pp = sc.sys.re_numerator(false);
-    std::println!("p {:?}", pp.coefficients());
-    let (ch, nch) = damped::characteristic(&m, sc.w_s);
-    let h: Vec<f64> = ch[..nch].iter().map(|x| x * x).collect();
-    std::println!(
-        "hints {:?} near {:?}",
-        h,
-        super::poly::roots_near(pp.coefficients(), &h, 5e-14)
-    );
-}
-
 /// `Re H_ee`'s numerator polynomial against an independent evaluation: `p(ω²)` must equal
 /// `Re H(ω)·|det Z(ω)|²`, with `H` from the pivoted solve and `det Z` by cofactors in complex
 /// arithmetic, to 1e-9 of `b(ω²)·|det Z|²/|N·Δ|`-free scale `b(ω²)` (the absolute-value
