@@ -197,7 +197,8 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
         }
     }
 
-    #[inline]
+    /// Rare (a fault ends the window): one copy, out of line, for the tracker's many callers.
+    #[inline(never)]
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
@@ -456,8 +457,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         direction: Option<Direction>,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
+        // Every caller has tried the fast path (or the edge runs in reverse).
         let first = self.fed(observer, |tracker, encoder, table, feed| {
-            tracker.on_edge(encoder, table, ticks, direction, feed);
+            tracker.on_edge_careful(encoder, table, ticks, direction, feed);
         });
         if self.spill.is_some() {
             self.tracker.block_fast();
@@ -485,17 +487,10 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         }
         let uniform = self.encoder.is_uniform() && P::NOMINAL;
         let mut rest = captures;
-        if !O::WATCHES_TEETH && uniform {
-            // The ordinary teeth at the batch's start in one tight loop, as the fast path
-            // would take them (the usual case: the whole batch), before anything else is set up.
-            rest = self.bulk(rest);
-            if rest.is_empty() {
-                return;
-            }
-        }
-        while !rest.is_empty() {
+        loop {
             if !O::WATCHES_TEETH && uniform {
-                // The ordinary teeth in one tight loop, as the fast path would take them.
+                // The ordinary teeth in one tight loop, as the fast path would take them (the
+                // usual case: the whole batch at the first turn).
                 rest = self.bulk(rest);
             }
             let Some((&t, tail)) = rest.split_first() else {

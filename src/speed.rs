@@ -308,7 +308,8 @@ impl Default for SpeedTracker {
 
 /// Squared natural log of `a/b` for tick counts known to ±1 tick: the ratio is taken at the
 /// end of its quantization range nearest 1, so rounding alone never looks like a swing.
-/// Careful path only (f32).
+/// Careful path only (f32); out of line, one copy for every term of every hypothesis.
+#[inline(never)]
 fn log_sq(a: f32, b: f32) -> f32 {
     let (a, b) = if a >= b {
         ((a - 1.0).max(b + 1.0), b + 1.0)
@@ -320,6 +321,11 @@ fn log_sq(a: f32, b: f32) -> f32 {
     }
     let l = ln(a / b);
     l * l
+}
+
+/// The grid pitch of `tooth` in base pitches.
+fn pitch_ratio(enc: &Encoder, tooth: u16) -> f32 {
+    enc.grid_pitch(tooth) as f32 / enc.base_pitch() as f32
 }
 
 /// Natural log, accurate to about 1e-4 (ample for judging swings): exponent from the bits, a
@@ -514,8 +520,9 @@ impl SpeedTracker {
         }
         let t = ticks & enc.mask();
         if usize::from(self.nidx) >= INDEXES {
-            // The oldest waiting index lost its edge: drop it.
-            self.index.copy_within(1.., 0);
+            // The oldest waiting index lost its edge: drop it (moved element by element: a
+            // `copy_within` would link the general memmove for four pairs).
+            self.index = [self.index[1], self.index[2], self.index[3], (0, 0)];
             self.nidx = self.nidx.wrapping_sub(1);
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
         }
@@ -571,6 +578,21 @@ impl SpeedTracker {
                 return;
             }
         }
+        self.careful(enc, table, ticks & enc.mask(), direction, sink);
+    }
+
+    /// [`SpeedTracker::on_edge`] for an edge the fast path has just declined
+    /// ([`SpeedTracker::try_fast`] returned `None`, which changes nothing) or a reverse one:
+    /// straight to the careful judgement, without a second copy of the fast path.
+    #[inline(always)]
+    pub(crate) fn on_edge_careful<P: PitchTable, S: EdgeSink>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        ticks: u32,
+        direction: Option<Direction>,
+        sink: &mut S,
+    ) {
         self.careful(enc, table, ticks & enc.mask(), direction, sink);
     }
 
@@ -795,42 +817,41 @@ impl SpeedTracker {
         while self.npend > 0 {
             let e1 = self.pending[0];
             let s1 = self.pending_seq[0];
-            match self.judge(enc, flushing) {
+            let verdict = self.judge(enc, flushing);
+            // One tail for every verdict (a fault's bookkeeping, then one acceptance): the
+            // careful path's code stays small.
+            let lost = match verdict {
                 Verdict::Wait => return,
                 Verdict::Glitch => {
                     self.pop();
                     self.reject(e1, sink);
+                    continue;
                 }
                 Verdict::Tooth => {
                     self.pop();
                     self.accept(enc, table, e1, s1, true, sink);
+                    continue;
                 }
-                Verdict::Missing(n) => {
-                    self.pop();
-                    self.counters.missing = self.counters.missing.wrapping_add(u32::from(n));
-                    sink.fault(Fault::MissingEdge, e1);
-                    self.fault_in_revolution();
-                    self.advance_after_fault(enc, n);
-                    self.accept(enc, table, e1, s1, false, sink);
-                }
-                Verdict::Behind => {
-                    self.pop();
-                    self.counters.extra = self.counters.extra.wrapping_add(1);
-                    sink.fault(Fault::ExtraEdge, e1);
-                    self.fault_in_revolution();
-                    self.tooth = tooth_back(self.tooth, 1, enc.edges());
-                    self.reset_ring();
-                    self.accept(enc, table, e1, s1, false, sink);
-                }
-                Verdict::Ahead => {
-                    self.pop();
-                    self.counters.missing = self.counters.missing.wrapping_add(1);
-                    sink.fault(Fault::MissingEdge, e1);
-                    self.fault_in_revolution();
-                    self.advance_after_fault(enc, 1);
-                    self.accept(enc, table, e1, s1, false, sink);
-                }
+                Verdict::Missing(n) => n,
+                Verdict::Ahead => 1,
+                Verdict::Behind => 0,
+            };
+            self.pop();
+            if lost == 0 {
+                self.counters.extra = self.counters.extra.wrapping_add(1);
+                sink.fault(Fault::ExtraEdge, e1);
+            } else {
+                self.counters.missing = self.counters.missing.wrapping_add(u32::from(lost));
+                sink.fault(Fault::MissingEdge, e1);
             }
+            self.fault_in_revolution();
+            if lost == 0 {
+                self.tooth = tooth_back(self.tooth, 1, enc.edges());
+                self.reset_ring();
+            } else {
+                self.advance_after_fault(enc, lost);
+            }
+            self.accept(enc, table, e1, s1, false, sink);
         }
     }
 
@@ -914,53 +935,25 @@ impl SpeedTracker {
         }
         let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
         let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
-        let pitch = |k: u16| enc.grid_pitch(k) as f32 / base as f32;
-        // A hypothesis: e1 is tooth `first`, its interval spanning `spans` base pitches from the
-        // last accepted edge, which was tooth `before`; the following edges are the teeth
-        // after `first` (for a glitch, e1 and e2 merged are `first`). Its cost: the squared log
-        // swings of the per-pitch intervals against the swings the same teeth had one
-        // revolution earlier (against 1 without a recorded revolution).
-        let chain_cost = |before: u16, first: u16, spans: f32, skip_e1: bool| -> f32 {
-            let mut terms = [(0.0f32, 0u16); 3];
-            let mut len = 0usize;
-            let rest: [Option<u32>; 2] = if skip_e1 {
-                let Some(d2) = d2 else {
-                    return f32::INFINITY;
-                };
-                terms[0] = ((d1 as f32 + d2 as f32) / spans, first);
-                [d3, None]
-            } else {
-                terms[0] = (x / spans, first);
-                [d2, d3]
-            };
-            len = len.wrapping_add(1);
-            let mut tooth = first;
-            for d in rest.iter().flatten() {
-                tooth = tooth_after(tooth, 1, edges);
-                if let Some(slot) = terms.get_mut(len) {
-                    *slot = (*d as f32 / pitch(tooth), tooth);
-                }
-                len = len.wrapping_add(1);
-            }
-            let (mut prev, mut prev_tooth) = (r as f32, before);
-            let mut cost = 0.0;
-            for &(v, tooth) in terms.iter().take(len) {
-                cost += log_sq(v, prev * self.recorded_swing(prev_tooth, tooth));
-                prev = v;
-                prev_tooth = tooth;
-            }
-            cost
-        };
+        let pitch = |k: u16| pitch_ratio(enc, k);
         let margin = tol.fault_margin;
         let p_next = pitch(next);
         let here = self.tooth;
-        let mut best = (chain_cost(here, next, p_next, false), Verdict::Tooth);
+        let mut best = (
+            self.chain_cost(enc, here, next, x / p_next, [d2, d3]),
+            Verdict::Tooth,
+        );
         let mut consider = |cost: f32, v: Verdict| {
             if cost + margin < best.0 {
                 best = (cost, v);
             }
         };
-        consider(chain_cost(here, next, p_next, true), Verdict::Glitch);
+        // A glitch: e1 and e2 merged are the expected tooth.
+        let glitch = match d2 {
+            Some(d2) => self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, [d3, None]),
+            None => f32::INFINITY,
+        };
+        consider(glitch, Verdict::Glitch);
         if synced {
             let mut spans = p_next;
             let mut tooth = next;
@@ -969,7 +962,8 @@ impl SpeedTracker {
                 spans += pitch(tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
                 consider(
-                    chain_cost(here, tooth, spans, false) + margin * f32::from(j.wrapping_sub(1)),
+                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3])
+                        + margin * f32::from(j.wrapping_sub(1)),
                     Verdict::Missing(j),
                 );
             }
@@ -977,14 +971,44 @@ impl SpeedTracker {
                 let behind = tooth_back(next, 1, edges);
                 let before_behind = tooth_back(behind, 1, edges);
                 consider(
-                    chain_cost(before_behind, behind, pitch(behind), false),
+                    self.chain_cost(enc, before_behind, behind, x / pitch(behind), [d2, d3]),
                     Verdict::Behind,
                 );
                 let ahead = tooth_after(next, 1, edges);
-                consider(chain_cost(next, ahead, pitch(ahead), false), Verdict::Ahead);
+                consider(
+                    self.chain_cost(enc, next, ahead, x / pitch(ahead), [d2, d3]),
+                    Verdict::Ahead,
+                );
             }
         }
         best.1
+    }
+
+    /// The cost of a hypothesis on the pending edges: the first is tooth `first` with the
+    /// per-pitch interval `head`, after the last accepted edge, which was tooth `before`; the
+    /// intervals `rest` that follow are the teeth after `first`. The cost is the sum of the
+    /// squared log swings of the per-pitch intervals against the swings the same teeth had one
+    /// revolution earlier (against 1 without a recorded revolution). One routine, out of line,
+    /// for every hypothesis.
+    #[inline(never)]
+    fn chain_cost(
+        &self,
+        enc: &Encoder,
+        before: u16,
+        first: u16,
+        head: f32,
+        rest: [Option<u32>; 2],
+    ) -> f32 {
+        let mut cost = log_sq(head, self.prev as f32 * self.recorded_swing(before, first));
+        let (mut prev, mut tooth) = (head, first);
+        for d in rest.iter().flatten() {
+            let next = tooth_after(tooth, 1, enc.edges());
+            let v = *d as f32 / pitch_ratio(enc, next);
+            cost += log_sq(v, prev * self.recorded_swing(tooth, next));
+            prev = v;
+            tooth = next;
+        }
+        cost
     }
 
     /// Whether `tooth` needs the careful judgement when it comes next.
