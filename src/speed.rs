@@ -1439,7 +1439,9 @@ impl SpeedTracker {
         self.block_fast();
     }
 
-    /// `t` is a new time reference: no interval, nothing pending.
+    /// `t` is a new time reference: no interval, nothing pending. Rare (a start, a timeout, a
+    /// reversal): one copy, out of line.
+    #[inline(never)]
     fn restart_at(&mut self, t: u32) {
         self.has_ref = true;
         self.last = t;
@@ -1653,7 +1655,8 @@ impl SpeedTracker {
         self.width = width;
     }
 
-    /// Teeth are no longer identified.
+    /// Teeth are no longer identified. Rare: one copy, out of line.
+    #[inline(never)]
     fn lose_sync(&mut self, counted: bool) {
         if self.sync == SyncState::Synced || counted {
             self.counters.sync_losses = self.counters.sync_losses.wrapping_add(1);
