@@ -578,7 +578,7 @@ impl SpeedTracker {
                 return;
             }
         }
-        self.careful(enc, table, ticks & enc.mask(), direction, sink);
+        self.on_edge_careful(enc, table, ticks, direction, sink);
     }
 
     /// [`SpeedTracker::on_edge`] for an edge the fast path has just declined
@@ -832,6 +832,7 @@ impl SpeedTracker {
                     self.accept(enc, table, e1, s1, true, sink);
                     continue;
                 }
+                // Teeth lost before it (`Missing` is 1 or 2), or none: the count was one ahead.
                 Verdict::Missing(n) => n,
                 Verdict::Ahead => 1,
                 Verdict::Behind => 0,
