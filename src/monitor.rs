@@ -192,8 +192,7 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
             e.samples_span(),
             self.uniform,
         ) {
-            let o = finish(self.alarm, self.diag, r);
-            keep(&mut self.first, self.spill, o);
+            finish(self.alarm, self.diag, r, &mut self.first, self.spill);
         }
     }
 
@@ -202,21 +201,24 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
-            let o = finish(self.alarm, self.diag, r);
-            keep(&mut self.first, self.spill, o);
+            finish(self.alarm, self.diag, r, &mut self.first, self.spill);
         }
     }
 }
 
-/// Counts a finished window and runs the alarm on it: once per window, kept out of line so
-/// the per-edge path stays small.
+/// Counts a finished window, runs the alarm on it and keeps the outcome: the first of a call
+/// in `first`, a second one in `spill` for the next call. Once per window, kept out of line
+/// (the outcome is built in place, not returned through the callers) so the per-edge path
+/// stays small.
 #[cold]
 #[inline(never)]
 fn finish(
     alarm: &mut Option<DeltaAlarm>,
     diag: &mut Diagnostics,
     report: WindowReport,
-) -> WindowOutcome {
+    first: &mut Option<WindowOutcome>,
+    spill: &mut Option<WindowOutcome>,
+) {
     if report.valid() {
         diag.valid_windows = diag.valid_windows.wrapping_add(1);
     } else {
@@ -232,16 +234,11 @@ fn finish(
     if event == Some(AlarmEvent::Raised) {
         diag.alarms_raised = diag.alarms_raised.wrapping_add(1);
     }
-    WindowOutcome {
+    let o = WindowOutcome {
         report,
         verdict,
         event,
-    }
-}
-
-/// Keeps the first outcome of a call and spills a second one to the next call.
-#[inline(always)]
-fn keep(first: &mut Option<WindowOutcome>, spill: &mut Option<WindowOutcome>, o: WindowOutcome) {
+    };
     if first.is_none() {
         *first = Some(o);
     } else {
