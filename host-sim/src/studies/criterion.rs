@@ -20,7 +20,10 @@
 //! The loads start at the balancing position turning with the rotor, one of them displaced by
 //! 0.05 rad ([`crate::app::run::vibration_params`]); where the exact classifier commits to
 //! `Balancing` the machine is also started with the loads together at rest (0.01 rad apart),
-//! the other attractor a run-up can leave them in. A run lasts at least the scene's
+//! the other attractor a run-up can leave them in. Where it says `Bistable` (outside the
+//! margin band) the loads are started together at rest too: loads that stay gathered there
+//! show the second attractor exists, so the speed is bistable indeed; loads that balance show
+//! only that it is not reached from that start. A run lasts at least the scene's
 //! `T = clamp(30/r, 1000, 10000)` in the seed's time `τ = ω̃·t` (`r = min(ε·β, 1/β)`, the slower
 //! of the loads' own relaxation and the overdamped drift of the balancing position), and at
 //! least `10/|σ|` with `σ` the Floquet growth rate of the least stable perturbation at that
@@ -332,7 +335,9 @@ pub struct Point {
     pub criterion_distance: f64,
     /// Started near the balancing position.
     pub simulated: Outcome,
-    /// Started with the loads together at rest (only where the exact class is `Balancing`).
+    /// Started with the loads together at rest: only where the exact class is `Balancing` or
+    /// `Bistable` and [`Point::distance`] exceeds the default margin band. Where the class is
+    /// `Bistable` it shows whether the gathered attractor exists.
     pub together: Option<Outcome>,
 }
 
@@ -519,7 +524,9 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
         let class = classifier.classify(w as f32);
         let simulated = outcome(&scene, &file, w, false, min_run(sigma))?;
         let near = distance(w, classifier.boundaries().iter().map(|&b| f64::from(b)));
-        let together = if class == Regime::Balancing && near > BAND {
+        // Balancing: does the gathered state also balance? Bistable: is it there at all?
+        let both = matches!(class, Regime::Balancing | Regime::Bistable(_));
+        let together = if both && near > BAND {
             Some(outcome(&scene, &file, w, true, min_run(sigma))?)
         } else {
             None
@@ -611,6 +618,38 @@ pub fn study(seed: u64, count: usize, progress: bool) -> Result<Study, SceneErro
     })
 }
 
+/// What loads started together at rest did at the speeds of one bistable reason.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Together {
+    /// Speeds classed bistable for this reason (outside the margin band).
+    pub speeds: usize,
+    /// Of those, where the loads were also started together at rest (outside the default
+    /// band only).
+    pub started: usize,
+    /// Of those, where they stayed gathered (settled: residual at least 10 % throughout the
+    /// final quarter): the gathered attractor exists beside the balancing one.
+    pub gathered: usize,
+    /// Where they balanced (settled): the gathered state was not reached from that start.
+    pub balanced: usize,
+    /// Where the run had not settled after its doublings.
+    pub unsettled: usize,
+}
+
+impl Together {
+    fn count(&mut self, p: &Point) {
+        self.speeds += 1;
+        let Some(o) = p.together else {
+            return;
+        };
+        self.started += 1;
+        match (o.settled, o.balancing) {
+            (false, _) => self.unsettled += 1,
+            (true, true) => self.balanced += 1,
+            (true, false) => self.gathered += 1,
+        }
+    }
+}
+
 /// The exact classifier's record at one margin.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct Tally {
@@ -633,6 +672,10 @@ pub struct Tally {
     pub capture: usize,
     /// Speeds classed bistable for coexisting gathered loads.
     pub coexisting: usize,
+    /// Loads started together at rest at the speeds bistable for capture.
+    pub capture_together: Together,
+    /// Loads started together at rest at the speeds bistable for coexisting gathered loads.
+    pub coexisting_together: Together,
 }
 
 impl Tally {
@@ -644,6 +687,12 @@ impl Tally {
     pub fn agreement(&self) -> f64 {
         self.agreeing as f64 / self.committed.max(1) as f64
     }
+    /// What if: the committed fraction were every bistable speed where loads started together
+    /// at rest balanced (settled) committed as balancing. Not the classifier's figure.
+    pub fn what_if_commit_rate(&self) -> f64 {
+        (self.committed + self.capture_together.balanced + self.coexisting_together.balanced) as f64
+            / self.speeds.max(1) as f64
+    }
 }
 
 /// The exact classifier's record over the study with margin `margin`.
@@ -653,17 +702,23 @@ pub fn tally(s: &Study, margin: f64) -> Tally {
 
 /// [`tally`] over the points `keep` accepts.
 pub fn tally_where(s: &Study, margin: f64, keep: impl Fn(&MachineResult, &Point) -> bool) -> Tally {
+    tally_points(
+        margin,
+        s.machines
+            .iter()
+            .flat_map(|m| m.points.iter().map(move |p| (m, p)))
+            .filter(|(m, p)| keep(m, p))
+            .map(|(_, p)| p),
+    )
+}
+
+/// The exact classifier's record over `points` with margin `margin`.
+pub fn tally_points<'a>(margin: f64, points: impl Iterator<Item = &'a Point>) -> Tally {
     let mut t = Tally {
         margin,
         ..Tally::default()
     };
-    for p in s
-        .machines
-        .iter()
-        .flat_map(|m| m.points.iter().map(move |p| (m, p)))
-        .filter(|(m, p)| keep(m, p))
-        .map(|(_, p)| p)
-    {
+    for p in points {
         t.speeds += 1;
         if p.distance <= margin {
             continue;
@@ -680,8 +735,14 @@ pub fn tally_where(s: &Study, margin: f64, keep: impl Fn(&MachineResult, &Point)
                 t.committed += 1;
                 t.agreeing += usize::from(!p.simulated.balancing);
             }
-            (_, Some("capture")) => t.capture += 1,
-            _ => t.coexisting += 1,
+            (_, Some("capture")) => {
+                t.capture += 1;
+                t.capture_together.count(p);
+            }
+            _ => {
+                t.coexisting += 1;
+                t.coexisting_together.count(p);
+            }
         }
     }
     t
@@ -793,7 +854,11 @@ pub fn headline(s: &Study) -> String {
         .machines
         .iter()
         .flat_map(|m| &m.points)
-        .flat_map(|p| std::iter::once(&p.simulated).chain(p.together.as_ref()))
+        .flat_map(|p| {
+            // The together-start runs at bistable speeds are reported on their own.
+            let together = p.together.as_ref().filter(|_| p.class == "balancing");
+            std::iter::once(&p.simulated).chain(together)
+        })
         .filter(|o| !o.settled)
         .count();
     format!(
@@ -891,8 +956,8 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
          together by the criterion's `Re H > 0` (`coexisting`). Each machine is then simulated \
          at {GRID} prescribed rotor speeds from half its first damped characteristic speed to \
          twice its last (and past its capture windows), the loads started at the balancing \
-         position with one displaced by 0.05 rad; where the classifier commits to balancing, \
-         also with the loads together at rest. Judgement (module docs): balancing when the \
+         position with one displaced by 0.05 rad; where the classifier commits to balancing or \
+         says bistable, also with the loads together at rest. Judgement (module docs): balancing when the \
          residual unbalance stays at most 1 % of the rotor's over the final quarter of the run, \
          gathering when it reaches 10 % there (started together: stays above 10 % there); runs \
          last at least the machine's base time and \
@@ -947,7 +1012,9 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         .machines
         .iter()
         .flat_map(|m| m.points.iter().map(move |p| (m, p)))
-        .filter(|(_, p)| p.distance > BAND && p.together.is_some_and(|o| !o.balancing))
+        .filter(|(_, p)| {
+            p.class == "balancing" && p.distance > BAND && p.together.is_some_and(|o| !o.balancing)
+        })
         .collect();
     if !misses.is_empty() {
         let near = misses.iter().filter(|(_, p)| p.distance <= 0.03).count();
@@ -1096,6 +1163,7 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         pct(committed as f64 / main.speeds.max(1) as f64),
         pct(committed_agree as f64 / committed.max(1) as f64)
     );
+    together_section(&mut t, s);
     // Exact boundaries checked.
     let checks = all_checks(s);
     let sim_ok = checks.iter().filter(|(_, c)| c.agrees).count();
@@ -1360,6 +1428,141 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(vec![md, svg1, svg2])
 }
 
+/// The loads started together at rest at the bistable speeds: is the gathered state there?
+fn together_section(t: &mut String, s: &Study) {
+    let main = tally(s, BAND);
+    let c = main.capture_together;
+    let mut slips: Vec<f64> = s
+        .machines
+        .iter()
+        .flat_map(|m| &m.points)
+        .filter(|p| p.reason == Some("capture") && p.distance > BAND)
+        .filter_map(|p| p.together)
+        .filter(|o| o.settled && !o.balancing)
+        .map(|o| o.slip)
+        .collect();
+    let _ = write!(
+        t,
+        "### Loads started together at rest in the capture bands\n\n\
+         At the {} speeds bistable for capture (outside the ±{:.0} % band) the loads were also \
+         started together at rest (gathered, the state a run-up can leave them in), with the \
+         same run lengths and judgement. They **stayed gathered at {} of {}** (residual at least 10 % of \
+         the rotor's throughout the final quarter): there the captured state is seen beside the \
+         balancing one the start near the balancing position reached, so both attractors exist \
+         and the speed is bistable indeed; the gathered loads turned slower than the rotor at \
+         the end of the run by {} to {} ({} at the median), captured below it. They **balanced at {}** ({}): from that start the \
+         captured state was not reached, which does not prove it absent there. Unsettled: {}.",
+        c.speeds,
+        100.0 * BAND,
+        c.gathered,
+        c.started,
+        pct(slips.iter().copied().fold(f64::INFINITY, f64::min)),
+        pct(slips.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+        pct(quantile(&mut slips, 0.5)),
+        c.balanced,
+        pct(c.balanced as f64 / c.started.max(1) as f64),
+        c.unsettled
+    );
+    if 4 * c.balanced >= c.started && c.started > 0 {
+        let _ = write!(
+            t,
+            " That is a large share: the speeds where gathered loads stay captured may be \
+             narrower than the core's capture windows, which the table marks bistable whole."
+        );
+    }
+    let [gathered, split, balanced, other] = capture_bands(s);
+    let _ = write!(
+        t,
+        "\n\nThe capture-bistable speeds of a machine form {} bands (runs of neighbouring grid \
+         speeds; unsettled runs left out): at {gathered} the loads started together stayed \
+         gathered throughout, at {split} they stayed gathered at the lower speeds and balanced \
+         at the upper ones, at {balanced} they balanced throughout, and at {other} the two \
+         alternate.",
+        gathered + split + balanced + other
+    );
+    if split > 4 * other {
+        t.push_str(" Where captured loads are seen, they are seen in the lower part of a band.");
+    }
+    let _ = writeln!(
+        t,
+        "\n\nWhat if every capture-bistable speed where the loads started together balanced \
+         were committed as balancing (not the classifier's figure: its table says bistable \
+         there): it would commit at {} of {} speeds (**{}**, against its {}).\n",
+        main.committed + c.balanced + main.coexisting_together.balanced,
+        main.speeds,
+        pct(main.what_if_commit_rate()),
+        pct(main.commit_rate())
+    );
+    let x = main.coexisting_together;
+    if x.speeds > 0 {
+        let _ = writeln!(
+            t,
+            "At the {} speeds bistable for coexisting gathered loads, loads started together at \
+             rest stayed gathered at {} of {}, balanced at {}, {} unsettled.\n",
+            x.speeds, x.gathered, x.started, x.balanced, x.unsettled
+        );
+    }
+    t.push_str(
+        "By third of β's range:\n\n\
+         | β | capture-bistable speeds | stayed gathered | balanced | unsettled |\n\
+         |---|---:|---:|---:|---:|\n",
+    );
+    let r = &s.range;
+    for third in 0..3 {
+        let edge = |k: f64| (r.beta[0].ln() + k / 3.0 * (r.beta[1].ln() - r.beta[0].ln())).exp();
+        let (a, b) = (edge(third as f64), edge(third as f64 + 1.0));
+        let x = tally_where(s, BAND, |m, _| m.sample.beta >= a && m.sample.beta < b);
+        let y = x.capture_together;
+        let _ = writeln!(
+            t,
+            "| [{a:.2}, {b:.2}) | {} | {} | {} | {} |",
+            y.speeds, y.gathered, y.balanced, y.unsettled
+        );
+    }
+    t.push('\n');
+}
+
+/// The bands of neighbouring grid speeds classed bistable for capture, by what loads started
+/// together at rest did across each (settled runs outside the default margin band only):
+/// `[stayed gathered throughout, gathered below and balanced above, balanced throughout,
+/// alternating]`.
+pub fn capture_bands(s: &Study) -> [usize; 4] {
+    capture_bands_of(s.machines.iter().map(|m| m.points.as_slice()))
+}
+
+/// [`capture_bands`] over the grid points of each machine.
+pub fn capture_bands_of<'a>(machines: impl Iterator<Item = &'a [Point]>) -> [usize; 4] {
+    let mut n = [0; 4];
+    let mut close = |band: &mut Vec<bool>| {
+        let split = band.iter().position(|&b| b).unwrap_or(band.len());
+        if !band.is_empty() {
+            let rest = band[split..].iter().all(|&b| b);
+            n[match (split, rest) {
+                (_, false) => 3,
+                (0, true) => 2,
+                (k, true) if k == band.len() => 0,
+                _ => 1,
+            }] += 1;
+        }
+        band.clear();
+    };
+    for points in machines {
+        // Balanced (true) or gathered (false), ascending speed.
+        let mut band = Vec::new();
+        for p in points {
+            if p.reason != Some("capture") {
+                close(&mut band);
+                continue;
+            }
+            if let Some(o) = p.together.filter(|o| o.settled && p.distance > BAND) {
+                band.push(o.balancing);
+            }
+        }
+        close(&mut band);
+    }
+    n
+}
+
 /// `ln y = c0 + a·ln ε + b·ln h + c·ln β` by least squares: `[C, a, b, c]` with `C = e^c0`
 /// and the RMS of the residuals in `ln y`; `None` with fewer than 5 points.
 pub fn power_fit(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 4], f64)> {
@@ -1444,6 +1647,123 @@ mod tests {
         // Deterministic in the seed.
         assert_eq!(draw(7, 3, 1, &RANGE).scene, draw(7, 3, 1, &RANGE).scene);
         assert_ne!(draw(7, 3, 1, &RANGE).scene, draw(8, 3, 1, &RANGE).scene);
+    }
+
+    fn point(class: &'static str, reason: Option<&'static str>, distance: f64) -> Point {
+        let o = Outcome {
+            speed: 60.0,
+            together: false,
+            balancing: class != "gathering",
+            settled: true,
+            residual_relative: 0.0,
+            residual_min_relative: 0.0,
+            duration_tau: 1000.0,
+            slip: 0.0,
+        };
+        Point {
+            speed: 60.0,
+            class,
+            reason,
+            stable: class != "gathering",
+            growth_rate: -1e-3,
+            distance,
+            criterion: "balancing",
+            criterion_distance: 1.0,
+            simulated: o,
+            together: None,
+        }
+    }
+
+    fn started(mut p: Point, balancing: bool, settled: bool) -> Point {
+        p.together = Some(Outcome {
+            together: true,
+            balancing,
+            settled,
+            ..p.simulated
+        });
+        p
+    }
+
+    #[test]
+    fn together_runs_at_bistable_speeds_are_tallied_apart() {
+        let cap = Some("capture");
+        let points = vec![
+            // Committed balancing, together-start gathered: the existing counts.
+            started(point("balancing", None, 0.5), false, true),
+            started(point("balancing", None, 0.5), true, true),
+            point("gathering", None, 0.5),
+            // Capture: gathered, gathered, balanced, unsettled (judged either way); in the
+            // band, not run.
+            started(point("bistable", cap, 0.5), false, true),
+            started(point("bistable", cap, 0.5), false, true),
+            started(point("bistable", cap, 0.5), true, true),
+            started(point("bistable", cap, 0.5), true, false),
+            started(point("bistable", cap, 0.5), false, false),
+            point("bistable", cap, 0.005),
+            started(point("bistable", Some("coexisting"), 0.5), true, true),
+            // Within the band: counted as a speed only.
+            started(point("bistable", cap, 0.001), true, true),
+        ];
+        let t = tally_points(BAND, points.iter());
+        assert_eq!(t.speeds, 11);
+        assert_eq!((t.committed, t.balancing, t.agreeing), (3, 2, 3));
+        // The balancing counts see only the committed-balancing speeds.
+        assert_eq!((t.together, t.together_balancing), (2, 1));
+        assert_eq!((t.capture, t.coexisting), (5, 1));
+        let c = t.capture_together;
+        assert_eq!(
+            (c.speeds, c.started, c.gathered, c.balanced, c.unsettled),
+            (5, 5, 2, 1, 2)
+        );
+        let x = t.coexisting_together;
+        assert_eq!((x.speeds, x.started, x.balanced), (1, 1, 1));
+        // What if the settled balanced bistable speeds were committed: 3 + 1 + 1 of 11.
+        assert!((t.what_if_commit_rate() - 5.0 / 11.0).abs() < 1e-15);
+        assert!((t.commit_rate() - 3.0 / 11.0).abs() < 1e-15);
+        // Without a margin the speeds in the band count too, started or not.
+        let all = tally_points(0.0, points.iter());
+        let c = all.capture_together;
+        assert_eq!((all.capture, c.speeds, c.started, c.balanced), (7, 7, 6, 2));
+    }
+
+    #[test]
+    fn capture_bands_are_classed_by_what_the_together_start_did() {
+        let cap = |balancing: bool, settled: bool| {
+            started(point("bistable", Some("capture"), 0.5), balancing, settled)
+        };
+        let gap = || point("balancing", None, 0.5);
+        let machine_a = vec![
+            gap(),
+            // Gathered below, balanced above; the unsettled run is left out.
+            cap(false, true),
+            cap(false, false),
+            cap(true, true),
+            cap(true, true),
+            gap(),
+            // Gathered throughout; a speed in the margin band does not end the band.
+            cap(false, true),
+            started(point("bistable", Some("capture"), 0.001), true, true),
+            cap(false, true),
+        ];
+        let machine_b = vec![
+            // Balanced throughout, then alternating, then only unsettled (no band).
+            cap(true, true),
+            gap(),
+            cap(false, true),
+            cap(true, true),
+            cap(false, true),
+            gap(),
+            cap(true, false),
+        ];
+        let n = capture_bands_of([machine_a.as_slice(), machine_b.as_slice()].into_iter());
+        assert_eq!(n, [1, 1, 1, 1]);
+        // A band ends at the machine's last point, not across machines.
+        let last = [cap(false, true)];
+        let first = [cap(true, true)];
+        assert_eq!(
+            capture_bands_of([last.as_slice(), first.as_slice()].into_iter()),
+            [1, 0, 1, 0]
+        );
     }
 
     #[test]
