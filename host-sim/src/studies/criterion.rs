@@ -1466,8 +1466,12 @@ fn together_section(t: &mut String, s: &Study) {
     if 4 * c.balanced >= c.started && c.started > 0 {
         let _ = write!(
             t,
-            " That is a large share: the speeds where gathered loads stay captured may be \
-             narrower than the core's capture windows, which the table marks bistable whole."
+            " That is a large share, but a start at rest at the final speed is not a run-up: on \
+             the run-up page (`docs/capture-one-mass-runup.md`) slow ramps keep the loads \
+             captured up to the core's `until` (the release approaches it as the ramp slows). A \
+             run that balanced here shows the captured state out of reach from rest at that \
+             speed, not absent; whether a band is narrower than the core's capture window would \
+             take a slow run-up to each speed, which this study does not run."
         );
     }
     let [gathered, split, balanced, other] = capture_bands(s);
