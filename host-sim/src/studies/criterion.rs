@@ -23,7 +23,10 @@
 //! the other attractor a run-up can leave them in. Where it says `Bistable` (outside the
 //! margin band) the loads are started together at rest too: loads that stay gathered there
 //! show the second attractor exists, so the speed is bistable indeed; loads that balance show
-//! only that it is not reached from that start. A run lasts at least the scene's
+//! only that it is not reached from that start. Where it says bistable for capture, the loads
+//! are also run up ([`runup_outcome`]): together at rest with the rotor at the lowest grid
+//! speed, the rotor ramped to the speed over `T` (below) and held there for `T`; loads still
+//! gathered at the end were captured by the run-up and stay so at that speed. A run lasts at least the scene's
 //! `T = clamp(30/r, 1000, 10000)` in the seed's time `τ = ω̃·t` (`r = min(ε·β, 1/β)`, the slower
 //! of the loads' own relaxation and the overdamped drift of the balancing position), and at
 //! least `10/|σ|` with `σ` the Floquet growth rate of the least stable perturbation at that
@@ -48,10 +51,11 @@
 use crate::app::predict;
 use crate::app::regimes::{self, Design};
 use crate::app::run::{run, Overrides};
-use crate::app::scene::{Scene, SceneError};
+use crate::app::scene::{MotorSpec, Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions};
 use drive_monitor::balancer::{
-    Classifier, Machine, Regime, RegimeTable, ZoneKind, DEFAULT_MARGIN, TABLE_MARGIN,
+    BistableReason, Classifier, Machine, Regime, RegimeTable, ZoneKind, DEFAULT_MARGIN,
+    TABLE_MARGIN,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -312,6 +316,56 @@ pub fn outcome(
     }
 }
 
+/// A run-up to `speed`: the loads started together at rest with the rotor at `from`, the
+/// rotor ramped linearly to `speed` over `ramp` seconds and held there as long (the final
+/// quarter, where the residual is judged, lies inside the hold). Gathered at the end (residual
+/// at least 10 % throughout the final quarter): the loads a run-up captured stayed captured at
+/// `speed`; balanced: they were released on the way or during the hold. One run, no doubling
+/// (`settled` says whether either holds).
+pub fn runup_outcome(
+    scene: &Scene,
+    file: &Path,
+    from: f64,
+    speed: f64,
+    ramp: f64,
+) -> Result<Outcome, SceneError> {
+    let mut s = scene.clone();
+    s.encoder = None;
+    s.motor = Some(MotorSpec::Ramp {
+        from,
+        to: speed,
+        duration: ramp,
+    });
+    s.simulation.duration = 2.0 * ramp;
+    let r = run(
+        &s,
+        file,
+        Overrides {
+            speed: None,
+            loads_together: true,
+        },
+    )?;
+    let Some(d) = r.regime_detail else {
+        return Err(SceneError::value(
+            file,
+            "autobalancer",
+            "the run produced no regime samples",
+        ));
+    };
+    let balanced = d.residual_relative <= BALANCED;
+    let away = d.residual_min_relative >= AWAY;
+    Ok(Outcome {
+        speed,
+        together: true,
+        balancing: balanced,
+        settled: balanced || away,
+        residual_relative: d.residual_relative,
+        residual_min_relative: d.residual_min_relative,
+        duration_tau: s.simulation.duration * OMEGA_REF,
+        slip: 1.0 - d.load_speed / d.rotor_speed,
+    })
+}
+
 /// One grid speed: the classes and what the simulation did.
 #[derive(Debug, Clone, Serialize)]
 pub struct Point {
@@ -339,6 +393,10 @@ pub struct Point {
     /// `Bistable` and [`Point::distance`] exceeds the default margin band. Where the class is
     /// `Bistable` it shows whether the gathered attractor exists.
     pub together: Option<Outcome>,
+    /// A slow run-up to this speed with the loads together at rest, then a hold
+    /// ([`runup_outcome`]): only where the class is bistable for capture outside the default
+    /// margin band. Whether loads a run-up captured stay captured here.
+    pub runup: Option<Outcome>,
 }
 
 /// An exact boundary checked by simulation and by a tighter integration.
@@ -518,6 +576,7 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
         (Some(&a), Some(&b)) => (0.5 * a, (2.0 * b).max(1.25 * until).min(8.0 * b)),
         _ => (0.5 * OMEGA_REF, 2.0 * OMEGA_REF),
     };
+    let base = scene.simulation.duration;
     let mut points = Vec::with_capacity(GRID);
     for w in grid(lo, hi, GRID) {
         let sigma = rate(w)?;
@@ -528,6 +587,13 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
         let both = matches!(class, Regime::Balancing | Regime::Bistable(_));
         let together = if both && near > BAND {
             Some(outcome(&scene, &file, w, true, min_run(sigma))?)
+        } else {
+            None
+        };
+        // Capture: from the grid's lowest speed (half the first characteristic speed), ramped
+        // over the machine's base run time and held as long.
+        let runup = if class.reason() == Some(BistableReason::Capture) && near > BAND {
+            Some(runup_outcome(&scene, &file, lo, w, base)?)
         } else {
             None
         };
@@ -542,6 +608,7 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
             criterion_distance: distance(w, criterion_bounds.iter().copied()),
             simulated,
             together,
+            runup,
         });
     }
     let mut checks = Vec::new();
@@ -636,9 +703,9 @@ pub struct Together {
 }
 
 impl Together {
-    fn count(&mut self, p: &Point) {
+    fn count(&mut self, o: Option<Outcome>) {
         self.speeds += 1;
-        let Some(o) = p.together else {
+        let Some(o) = o else {
             return;
         };
         self.started += 1;
@@ -674,6 +741,8 @@ pub struct Tally {
     pub coexisting: usize,
     /// Loads started together at rest at the speeds bistable for capture.
     pub capture_together: Together,
+    /// The same speeds after a slow run-up with the loads together ([`Point::runup`]).
+    pub capture_runup: Together,
     /// Loads started together at rest at the speeds bistable for coexisting gathered loads.
     pub coexisting_together: Together,
 }
@@ -687,10 +756,12 @@ impl Tally {
     pub fn agreement(&self) -> f64 {
         self.agreeing as f64 / self.committed.max(1) as f64
     }
-    /// What if: the committed fraction were every bistable speed where loads started together
-    /// at rest balanced (settled) committed as balancing. Not the classifier's figure.
+    /// What if: the committed fraction were every bistable speed where gathered loads were
+    /// not seen to persist committed as balancing: for capture, where a run-up released them
+    /// (settled, [`Point::runup`]); for coexisting loads, where loads started together at rest
+    /// balanced (settled). Not the classifier's figure.
     pub fn what_if_commit_rate(&self) -> f64 {
-        (self.committed + self.capture_together.balanced + self.coexisting_together.balanced) as f64
+        (self.committed + self.capture_runup.balanced + self.coexisting_together.balanced) as f64
             / self.speeds.max(1) as f64
     }
 }
@@ -737,11 +808,12 @@ pub fn tally_points<'a>(margin: f64, points: impl Iterator<Item = &'a Point>) ->
             }
             (_, Some("capture")) => {
                 t.capture += 1;
-                t.capture_together.count(p);
+                t.capture_together.count(p.together);
+                t.capture_runup.count(p.runup);
             }
             _ => {
                 t.coexisting += 1;
-                t.coexisting_together.count(p);
+                t.coexisting_together.count(p.together);
             }
         }
     }
@@ -957,7 +1029,9 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
          at {GRID} prescribed rotor speeds from half its first damped characteristic speed to \
          twice its last (and past its capture windows), the loads started at the balancing \
          position with one displaced by 0.05 rad; where the classifier commits to balancing or \
-         says bistable, also with the loads together at rest. Judgement (module docs): balancing when the \
+         says bistable, also with the loads together at rest, and where it says bistable for \
+         capture, also run up slowly to the speed with the loads together (below). Judgement \
+         (module docs): balancing when the \
          residual unbalance stays at most 1 % of the rotor's over the final quarter of the run, \
          gathering when it reaches 10 % there (started together: stays above 10 % there); runs \
          last at least the machine's base time and \
@@ -1463,15 +1537,35 @@ fn together_section(t: &mut String, s: &Study) {
         pct(c.balanced as f64 / c.started.max(1) as f64),
         c.unsettled
     );
-    if 4 * c.balanced >= c.started && c.started > 0 {
+    let u = main.capture_runup;
+    let _ = write!(
+        t,
+        "\n\nRun up instead (the loads together at rest with the rotor at the machine's lowest grid \
+         speed, ramped to the speed over the machine's base run time and held there as long, the \
+         residual judged over the final quarter): of the {} capture-bistable speeds the loads \
+         **stayed captured at {}** (gathered at the end of the hold) and were **released at {}** \
+         (balanced), {} unsettled.",
+        u.started, u.gathered, u.balanced, u.unsettled
+    );
+    let released: Vec<f64> = s
+        .machines
+        .iter()
+        .flat_map(|m| &m.points)
+        .filter(|p| p.reason == Some("capture") && p.distance > BAND)
+        .filter(|p| p.runup.is_some_and(|o| o.settled && o.balancing))
+        .map(|p| p.distance)
+        .collect();
+    if u.started > 0 {
+        let near = released.iter().filter(|&&d| d <= 0.05).count();
         let _ = write!(
             t,
-            " That is a large share, but a start at rest at the final speed is not a run-up: on \
-             the run-up page (`docs/capture-one-mass-runup.md`) slow ramps keep the loads \
-             captured up to the core's `until` (the release approaches it as the ramp slows). A \
-             run that balanced here shows the captured state out of reach from rest at that \
-             speed, not absent; whether a band is narrower than the core's capture window would \
-             take a slow run-up to each speed, which this study does not run."
+            " So a run-up kept gathered loads captured at {} of the {} speeds the table calls \
+             bistable for capture, where loads near the balancing position balanced. Of the {} \
+             releases, {} lie within 5 % of a boundary of the table (a band's end).",
+            pct(u.gathered as f64 / u.started as f64),
+            u.started,
+            released.len(),
+            near
         );
     }
     let [gathered, split, balanced, other] = capture_bands(s);
@@ -1489,10 +1583,12 @@ fn together_section(t: &mut String, s: &Study) {
     }
     let _ = writeln!(
         t,
-        "\n\nWhat if every capture-bistable speed where the loads started together balanced \
-         were committed as balancing (not the classifier's figure: its table says bistable \
-         there): it would commit at {} of {} speeds (**{}**, against its {}).\n",
-        main.committed + c.balanced + main.coexisting_together.balanced,
+        "\n\nWhat if every capture-bistable speed where a run-up released the loads were \
+         committed as balancing (not the classifier's figure: its table says bistable there): \
+         it would commit at {} of {} speeds (**{}**, against its {}). Committing the capture \
+         bands is what a higher commit rate would take, and the run-ups show loads captured \
+         there.\n",
+        main.committed + u.balanced + main.coexisting_together.balanced,
         main.speeds,
         pct(main.what_if_commit_rate()),
         pct(main.commit_rate())
@@ -1675,11 +1771,22 @@ mod tests {
             criterion_distance: 1.0,
             simulated: o,
             together: None,
+            runup: None,
         }
     }
 
     fn started(mut p: Point, balancing: bool, settled: bool) -> Point {
         p.together = Some(Outcome {
+            together: true,
+            balancing,
+            settled,
+            ..p.simulated
+        });
+        p
+    }
+
+    fn run_up(mut p: Point, balancing: bool, settled: bool) -> Point {
+        p.runup = Some(Outcome {
             together: true,
             balancing,
             settled,
@@ -1698,10 +1805,23 @@ mod tests {
             point("gathering", None, 0.5),
             // Capture: gathered, gathered, balanced, unsettled (judged either way); in the
             // band, not run.
-            started(point("bistable", cap, 0.5), false, true),
-            started(point("bistable", cap, 0.5), false, true),
-            started(point("bistable", cap, 0.5), true, true),
-            started(point("bistable", cap, 0.5), true, false),
+            // Run up: captured, captured, released, unsettled; one not run.
+            run_up(
+                started(point("bistable", cap, 0.5), false, true),
+                false,
+                true,
+            ),
+            run_up(
+                started(point("bistable", cap, 0.5), false, true),
+                false,
+                true,
+            ),
+            run_up(started(point("bistable", cap, 0.5), true, true), true, true),
+            run_up(
+                started(point("bistable", cap, 0.5), true, false),
+                true,
+                false,
+            ),
             started(point("bistable", cap, 0.5), false, false),
             point("bistable", cap, 0.005),
             started(point("bistable", Some("coexisting"), 0.5), true, true),
@@ -1719,9 +1839,15 @@ mod tests {
             (c.speeds, c.started, c.gathered, c.balanced, c.unsettled),
             (5, 5, 2, 1, 2)
         );
+        let u = t.capture_runup;
+        assert_eq!(
+            (u.speeds, u.started, u.gathered, u.balanced, u.unsettled),
+            (5, 4, 2, 1, 1)
+        );
         let x = t.coexisting_together;
         assert_eq!((x.speeds, x.started, x.balanced), (1, 1, 1));
-        // What if the settled balanced bistable speeds were committed: 3 + 1 + 1 of 11.
+        // What if the released capture speeds and the balanced coexisting one were committed:
+        // 3 + 1 + 1 of 11.
         assert!((t.what_if_commit_rate() - 5.0 / 11.0).abs() < 1e-15);
         assert!((t.commit_rate() - 3.0 / 11.0).abs() < 1e-15);
         // Without a margin the speeds in the band count too, started or not.
