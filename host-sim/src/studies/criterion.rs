@@ -53,6 +53,7 @@ use crate::app::regimes::{self, Design};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{MotorSpec, Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions};
+use crate::engine::vibration::regime::RegimeReport;
 use drive_monitor::balancer::{
     BistableReason, Classifier, Machine, Regime, RegimeTable, ZoneKind, DEFAULT_MARGIN,
     TABLE_MARGIN,
@@ -277,21 +278,7 @@ pub fn outcome(
     let mut k = 0;
     loop {
         s.simulation.duration = base * f64::from(1u32 << k);
-        let r = run(
-            &s,
-            file,
-            Overrides {
-                speed: Some(speed),
-                loads_together: together,
-            },
-        )?;
-        let Some(d) = r.regime_detail else {
-            return Err(SceneError::value(
-                file,
-                "autobalancer",
-                "the run produced no regime samples",
-            ));
-        };
+        let d = regime_of(&s, file, Some(speed), together)?;
         let balanced = d.residual_relative <= BALANCED;
         // Started near balance the residual begins below AWAY: reaching it means the loads
         // left. Started together it begins far above: only staying above it counts.
@@ -301,16 +288,15 @@ pub fn outcome(
             d.residual_relative >= AWAY
         };
         if balanced || away || k == DOUBLINGS {
-            return Ok(Outcome {
+            let balancing = balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt());
+            return Ok(Outcome::judged(
                 speed,
                 together,
-                balancing: balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt()),
-                settled: balanced || away,
-                residual_relative: d.residual_relative,
-                residual_min_relative: d.residual_min_relative,
-                duration_tau: s.simulation.duration * OMEGA_REF,
-                slip: 1.0 - d.load_speed / d.rotor_speed,
-            });
+                balancing,
+                balanced || away,
+                &d,
+                &s,
+            ));
         }
         k += 1;
     }
@@ -337,33 +323,60 @@ pub fn runup_outcome(
         duration: ramp,
     });
     s.simulation.duration = 2.0 * ramp;
-    let r = run(
-        &s,
-        file,
-        Overrides {
-            speed: None,
-            loads_together: true,
-        },
-    )?;
-    let Some(d) = r.regime_detail else {
-        return Err(SceneError::value(
-            file,
-            "autobalancer",
-            "the run produced no regime samples",
-        ));
-    };
+    let d = regime_of(&s, file, None, true)?;
     let balanced = d.residual_relative <= BALANCED;
     let away = d.residual_min_relative >= AWAY;
-    Ok(Outcome {
+    Ok(Outcome::judged(
         speed,
-        together: true,
-        balancing: balanced,
-        settled: balanced || away,
-        residual_relative: d.residual_relative,
-        residual_min_relative: d.residual_min_relative,
-        duration_tau: s.simulation.duration * OMEGA_REF,
-        slip: 1.0 - d.load_speed / d.rotor_speed,
+        true,
+        balanced,
+        balanced || away,
+        &d,
+        &s,
+    ))
+}
+
+/// Runs `s` (at a prescribed `speed`, or with its own motor) and returns its regime samples.
+fn regime_of(
+    s: &Scene,
+    file: &Path,
+    speed: Option<f64>,
+    loads_together: bool,
+) -> Result<RegimeReport, SceneError> {
+    let r = run(
+        s,
+        file,
+        Overrides {
+            speed,
+            loads_together,
+        },
+    )?;
+    r.regime_detail.ok_or_else(|| {
+        SceneError::value(file, "autobalancer", "the run produced no regime samples")
     })
+}
+
+impl Outcome {
+    /// The outcome of run `s` at `speed`, judged `balancing` (and `settled`) from `d`.
+    fn judged(
+        speed: f64,
+        together: bool,
+        balancing: bool,
+        settled: bool,
+        d: &RegimeReport,
+        s: &Scene,
+    ) -> Self {
+        Outcome {
+            speed,
+            together,
+            balancing,
+            settled,
+            residual_relative: d.residual_relative,
+            residual_min_relative: d.residual_min_relative,
+            duration_tau: s.simulation.duration * OMEGA_REF,
+            slip: 1.0 - d.load_speed / d.rotor_speed,
+        }
+    }
 }
 
 /// One grid speed: the classes and what the simulation did.
