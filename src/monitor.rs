@@ -52,6 +52,16 @@ pub struct Diagnostics {
     pub alarms_raised: u32,
 }
 
+impl Diagnostics {
+    /// Nothing counted yet (the `Default`, as a `const`).
+    pub const ZERO: Diagnostics = Diagnostics {
+        edges: EdgeCounters::ZERO,
+        valid_windows: 0,
+        invalid_windows: 0,
+        alarms_raised: 0,
+    };
+}
+
 /// A finished window with the alarm's view of it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -268,12 +278,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             table: P::EMPTY,
             tracker: SpeedTracker::new(),
             state: WindowState::new(),
-            diag: Diagnostics {
-                edges: EdgeCounters::ZERO,
-                valid_windows: 0,
-                invalid_windows: 0,
-                alarms_raised: 0,
-            },
+            diag: Diagnostics::ZERO,
             spill: None,
         }
     }
@@ -328,7 +333,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         self.table.store(&[]);
         self.tracker = SpeedTracker::new();
         self.state = WindowState::new();
-        self.diag = Diagnostics::default();
+        self.diag = Diagnostics::ZERO;
         self.spill = None;
     }
 
@@ -456,7 +461,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     ) -> Option<WindowOutcome> {
         // Every caller has tried the fast path (or the edge runs in reverse).
         let first = self.fed(observer, |tracker, encoder, table, feed| {
-            tracker.on_edge_careful(encoder, table, ticks, direction, feed);
+            tracker.careful(encoder, table, ticks, direction, feed);
         });
         if self.spill.is_some() {
             self.tracker.block_fast();

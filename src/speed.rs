@@ -578,22 +578,7 @@ impl SpeedTracker {
                 return;
             }
         }
-        self.on_edge_careful(enc, table, ticks, direction, sink);
-    }
-
-    /// [`SpeedTracker::on_edge`] for an edge the fast path has just declined
-    /// ([`SpeedTracker::try_fast`] returned `None`, which changes nothing) or a reverse one:
-    /// straight to the careful judgement, without a second copy of the fast path.
-    #[inline(always)]
-    pub(crate) fn on_edge_careful<P: PitchTable, S: EdgeSink>(
-        &mut self,
-        enc: &Encoder,
-        table: &P,
-        ticks: u32,
-        direction: Option<Direction>,
-        sink: &mut S,
-    ) {
-        self.careful(enc, table, ticks & enc.mask(), direction, sink);
+        self.careful(enc, table, ticks, direction, sink);
     }
 
     /// The path nearly every edge takes: running and synced with nothing pending, the next
@@ -710,17 +695,20 @@ impl SpeedTracker {
     }
 
     /// Every edge that is not the fast path's: start, restart, reversal, the frame and special
-    /// teeth, out-of-band intervals, unsynced edges. Out of line: it runs rarely.
+    /// teeth, out-of-band intervals, unsynced edges, at `ticks` (raw counter value). Out of
+    /// line: it runs rarely. The monitor calls it directly for an edge its own fast path has
+    /// just declined ([`SpeedTracker::try_fast`] returned `None`, which changes nothing).
     #[cold]
     #[inline(never)]
-    fn careful<P: PitchTable, S: EdgeSink>(
+    pub(crate) fn careful<P: PitchTable, S: EdgeSink>(
         &mut self,
         enc: &Encoder,
         table: &P,
-        t: u32,
+        ticks: u32,
         direction: Option<Direction>,
         sink: &mut S,
     ) {
+        let t = ticks & enc.mask();
         if enc.edges() == 0 {
             // An unconfigured monitor ignores everything.
             return;
@@ -936,9 +924,8 @@ impl SpeedTracker {
         }
         let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
         let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
-        let pitch = |k: u16| pitch_ratio(enc, k);
         let margin = tol.fault_margin;
-        let p_next = pitch(next);
+        let p_next = pitch_ratio(enc, next);
         let here = self.tooth;
         let mut best = (
             self.chain_cost(enc, here, next, x / p_next, [d2, d3]),
@@ -960,7 +947,7 @@ impl SpeedTracker {
             let mut tooth = next;
             for j in 1..=2u16 {
                 tooth = tooth_after(tooth, 1, edges);
-                spans += pitch(tooth);
+                spans += pitch_ratio(enc, tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
                 consider(
                     self.chain_cost(enc, here, tooth, x / spans, [d2, d3])
@@ -972,12 +959,18 @@ impl SpeedTracker {
                 let behind = tooth_back(next, 1, edges);
                 let before_behind = tooth_back(behind, 1, edges);
                 consider(
-                    self.chain_cost(enc, before_behind, behind, x / pitch(behind), [d2, d3]),
+                    self.chain_cost(
+                        enc,
+                        before_behind,
+                        behind,
+                        x / pitch_ratio(enc, behind),
+                        [d2, d3],
+                    ),
                     Verdict::Behind,
                 );
                 let ahead = tooth_after(next, 1, edges);
                 consider(
-                    self.chain_cost(enc, next, ahead, x / pitch(ahead), [d2, d3]),
+                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3]),
                     Verdict::Ahead,
                 );
             }

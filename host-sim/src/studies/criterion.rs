@@ -1515,15 +1515,19 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(vec![md, svg1, svg2])
 }
 
+/// The grid points bistable for capture outside the default margin band.
+fn capture_points(s: &Study) -> impl Iterator<Item = &Point> {
+    s.machines
+        .iter()
+        .flat_map(|m| &m.points)
+        .filter(|p| p.reason == Some("capture") && p.distance > BAND)
+}
+
 /// The loads started together at rest at the bistable speeds: is the gathered state there?
 fn together_section(t: &mut String, s: &Study) {
     let main = tally(s, BAND);
     let c = main.capture_together;
-    let mut slips: Vec<f64> = s
-        .machines
-        .iter()
-        .flat_map(|m| &m.points)
-        .filter(|p| p.reason == Some("capture") && p.distance > BAND)
+    let mut slips: Vec<f64> = capture_points(s)
         .filter_map(|p| p.together)
         .filter(|o| o.settled && !o.balancing)
         .map(|o| o.slip)
@@ -1560,23 +1564,26 @@ fn together_section(t: &mut String, s: &Study) {
          (balanced), {} unsettled.",
         u.started, u.gathered, u.balanced, u.unsettled
     );
-    let released: Vec<f64> = s
-        .machines
-        .iter()
-        .flat_map(|m| &m.points)
-        .filter(|p| p.reason == Some("capture") && p.distance > BAND)
+    let released: Vec<f64> = capture_points(s)
         .filter(|p| p.runup.is_some_and(|o| o.settled && o.balancing))
         .map(|p| p.distance)
         .collect();
+    // Both attractors seen: captured by the run-up, balanced from near the balancing position.
+    let both = capture_points(s)
+        .filter(|p| p.runup.is_some_and(|o| o.settled && !o.balancing))
+        .filter(|p| p.simulated.settled && p.simulated.balancing)
+        .count();
     if u.started > 0 {
         let near = released.iter().filter(|&&d| d <= 0.05).count();
         let _ = write!(
             t,
             " So a run-up kept gathered loads captured at {} of the {} speeds the table calls \
-             bistable for capture, where loads near the balancing position balanced. Of the {} \
-             releases, {} lie within 5 % of a boundary of the table (a band's end).",
+             bistable for capture; at {} of them loads started near the balancing position \
+             balanced too (both attractors seen). Of the {} releases, {} lie within 5 % of a \
+             boundary of the table (a band's end).",
             pct(u.gathered as f64 / u.started as f64),
             u.started,
+            both,
             released.len(),
             near
         );
@@ -1788,23 +1795,23 @@ mod tests {
         }
     }
 
-    fn started(mut p: Point, balancing: bool, settled: bool) -> Point {
-        p.together = Some(Outcome {
+    /// A run of `p`'s with the loads together, judged as given.
+    fn together_run(p: &Point, balancing: bool, settled: bool) -> Option<Outcome> {
+        Some(Outcome {
             together: true,
             balancing,
             settled,
             ..p.simulated
-        });
+        })
+    }
+
+    fn started(mut p: Point, balancing: bool, settled: bool) -> Point {
+        p.together = together_run(&p, balancing, settled);
         p
     }
 
     fn run_up(mut p: Point, balancing: bool, settled: bool) -> Point {
-        p.runup = Some(Outcome {
-            together: true,
-            balancing,
-            settled,
-            ..p.simulated
-        });
+        p.runup = together_run(&p, balancing, settled);
         p
     }
 
