@@ -352,6 +352,40 @@ pub struct Encoder {
 }
 
 impl Encoder {
+    /// Copies `other` in place field by field (a whole-struct copy of its ~190 bytes would
+    /// call `memcpy`, which configuration would then link); the list names every field.
+    pub(crate) fn copy_from(&mut self, other: &Encoder) {
+        let Encoder {
+            config,
+            framing,
+            edges,
+            k,
+            mask,
+            timeout,
+            band_lo,
+            band_half_width,
+            band_sum_max,
+            bulk_max,
+            timer_hz,
+            unit_rad,
+            pattern,
+            base,
+            long,
+            short,
+            uniform_span,
+            uniform,
+        } = self;
+        *config = other.config;
+        (*framing, *edges, *k, *mask) = (other.framing, other.edges, other.k, other.mask);
+        (*timeout, *band_lo, *band_half_width) =
+            (other.timeout, other.band_lo, other.band_half_width);
+        (*band_sum_max, *bulk_max, *timer_hz) =
+            (other.band_sum_max, other.bulk_max, other.timer_hz);
+        (*unit_rad, *base, *long, *short) = (other.unit_rad, other.base, other.long, other.short);
+        (*uniform_span, *uniform) = (other.uniform_span, other.uniform);
+        *pattern = other.pattern;
+    }
+
     /// The encoder of an unconfigured monitor: no edges, so the monitor ignores everything
     /// until `configure` replaces it.
     pub const UNCONFIGURED: Encoder = Encoder {

@@ -230,6 +230,23 @@ impl WindowState {
         }
     }
 
+    /// Back to [`WindowState::new`] in place without a call of `memset` (its 40 bytes are
+    /// zeros: see [`crate::speed::EdgeCounters::clear`]).
+    pub(crate) fn clear(&mut self) {
+        let z = core::hint::black_box(0u32);
+        let none = Sample { span: z, ticks: z };
+        *self = WindowState {
+            started: false,
+            revs: 0,
+            ticks: u64::from(z),
+            start_edge: z,
+            start_ticks: z,
+            max: none,
+            min: none,
+            prev_mean: 0.0,
+        };
+    }
+
     /// Whether a window is in progress.
     pub fn started(&self) -> bool {
         self.started

@@ -60,6 +60,13 @@ impl Diagnostics {
         invalid_windows: 0,
         alarms_raised: 0,
     };
+
+    /// Back to [`Diagnostics::ZERO`] in place without a call of `memset` (see
+    /// [`EdgeCounters::clear`]).
+    fn clear(&mut self) {
+        self.edges.clear();
+        (self.valid_windows, self.invalid_windows, self.alarms_raised) = (0, 0, 0);
+    }
 }
 
 /// A finished window with the alarm's view of it.
@@ -327,13 +334,13 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     /// Takes validated pieces (copied straight into place: no temporary configuration on the
     /// stack) and resets everything else.
     fn install(&mut self, encoder: &Encoder, window: Window, alarm: Option<DeltaAlarm>) {
-        self.encoder = encoder.clone();
+        self.encoder.copy_from(encoder);
         self.window = window;
         self.alarm = alarm;
         self.table.store(&[]);
-        self.tracker = SpeedTracker::new();
-        self.state = WindowState::new();
-        self.diag = Diagnostics::ZERO;
+        self.tracker.reset();
+        self.state.clear();
+        self.diag.clear();
         self.spill = None;
     }
 
@@ -412,7 +419,12 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     }
 
     /// An index pulse captured at `ticks` (raw counter value); report it before the captures
-    /// that follow it.
+    /// that follow it. It may come ahead of captures that precede it (a DMA half-buffer not yet
+    /// handed over) by less than half the counter's period: with a 32-bit counter, a whole
+    /// buffer. A narrower counter's timestamp cannot say where it falls among captures that
+    /// span more than that: report it where it falls, after the captures before it (split the
+    /// batch at it, e.g. by its position in the DMA ring when the index interrupt runs and a
+    /// comparison with the captures around it).
     pub fn on_index(&mut self, ticks: u32) {
         self.tracker.on_index(&self.encoder, ticks);
     }
@@ -471,7 +483,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
 
     /// A batch of captures (forward running), e.g. the half of a DMA ring that just filled;
     /// `on_window` gets every window that ends, in order. Same results as calling
-    /// [`DeltaMonitor::on_edge`] for each.
+    /// [`DeltaMonitor::on_edge`] for each (an index pulse among them: see
+    /// [`DeltaMonitor::on_index`]).
     pub fn on_captures<F: FnMut(WindowOutcome)>(&mut self, captures: &[u32], on_window: F) {
         self.on_captures_observed(captures, &mut (), on_window);
     }
@@ -1071,6 +1084,115 @@ mod tests {
         }
         m.on_captures(&chunk, |o| out.push(o));
         out
+    }
+
+    #[test]
+    fn a_reconfigured_monitor_behaves_as_a_new_one() {
+        // `configure` resets the per-edge state in place and leaves the ring, the per-tooth
+        // history, the pending edges and the waiting index pulses as they were: nothing may
+        // read them before writing them. A monitor left mid-stream (a glitch pending, an index
+        // waiting, the history full) and reconfigured must then report exactly what a new one
+        // does, edge by edge and in batches.
+        let w = kneader(0.01);
+        let p = Pattern::missing_teeth(36, 2);
+        let mut wheel = EncoderConfig::pattern(p, 10e6);
+        wheel.estimator = Estimator::Edges(4);
+        wheel.min_speed = 20.0;
+        let configs = [
+            wheel,
+            indexed(256, 32, 32, 84e6),
+            indexed(1024, 16, 24, 84e6),
+        ];
+        let streams: Vec<Vec<Ev>> = configs
+            .iter()
+            .map(|c| {
+                let (teeth, index, hz) = match c.wheel {
+                    crate::encoder::Wheel::Indexed { lines } => {
+                        (uniform(u32::from(lines)), Some(0.0), 84e6)
+                    }
+                    _ => (pattern_angles(p), None, 10e6),
+                };
+                let mask = u32::MAX >> (32 - c.counter_bits);
+                let mut evs = stream(&teeth, index, 14, hz, mask, &w);
+                // A noise pulse at 40 % of a pitch in the middle of the stream.
+                let mid = evs.len() / 2 + 1;
+                if let (Ev::Edge(a), Ev::Edge(b)) = (evs[mid], evs[mid + 1]) {
+                    let pulse = a.wrapping_add((b.wrapping_sub(a) & mask) * 2 / 5) & mask;
+                    evs.insert(mid + 1, Ev::Edge(pulse));
+                }
+                evs
+            })
+            .collect();
+        for (i, before) in configs.iter().enumerate() {
+            for (j, after) in configs.iter().enumerate() {
+                for batched in [false, true] {
+                    // Cut short just after the noise pulse (pending) or after an index pulse.
+                    let cut = &streams[i][..streams[i].len() / 2 + 2];
+                    let mut used = monitor(*before, 2);
+                    if batched {
+                        run_batched(&mut used, cut, 7);
+                    } else {
+                        run(&mut used, cut);
+                    }
+                    used.configure_from(*after, window(2), Some(AlarmConfig::new(0.06)))
+                        .unwrap();
+                    let new = monitor(*after, 2);
+                    assert_eq!(used.tracker.without_slots(), new.tracker.without_slots());
+                    assert_eq!(format!("{:?}", used.state), format!("{:?}", new.state));
+                    assert_eq!(used.diag, new.diag);
+                    assert_eq!(used.encoder, new.encoder);
+                    let mut new = new;
+                    let (a, b) = if batched {
+                        (
+                            run_batched(&mut used, &streams[j], 11),
+                            run_batched(&mut new, &streams[j], 11),
+                        )
+                    } else {
+                        (run(&mut used, &streams[j]), run(&mut new, &streams[j]))
+                    };
+                    assert!(!b.is_empty(), "{j}: {:?}", new.diagnostics());
+                    assert_eq!(a, b, "{i} then {j}, batched {batched}");
+                    assert_eq!(used.diagnostics(), new.diagnostics(), "{i} then {j}");
+                    assert_eq!(used.speed().to_bits(), new.speed().to_bits());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_narrow_counter_takes_batches_with_the_index_in_capture_order() {
+        // A 16-bit counter's period (65 536 ticks) is 17 edges here, less than a batch: an
+        // index timestamp alone cannot say which of a batch's captures it falls among, so the
+        // index is reported where it falls, between the captures before it and those after
+        // it (the batch split at it), and the results are those of edge by edge.
+        let evs = stream(&uniform(1024), Some(0.0), 14, 84e6, 0xFFFF, &kneader(0.01));
+        let mut one = monitor(indexed(1024, 16, 16, 84e6), 2);
+        let expected = run(&mut one, &evs);
+        assert!(expected.len() >= 5, "{expected:?}");
+        for batch in [17usize, 64, 150] {
+            let mut m = monitor(indexed(1024, 16, 16, 84e6), 2);
+            let mut out = Vec::new();
+            let mut chunk = Vec::new();
+            for e in &evs {
+                match *e {
+                    Ev::Index(t) => {
+                        m.on_captures(&chunk, |o| out.push(o));
+                        chunk.clear();
+                        m.on_index(t);
+                    }
+                    Ev::Edge(t) => {
+                        chunk.push(t);
+                        if chunk.len() == batch {
+                            m.on_captures(&chunk, |o| out.push(o));
+                            chunk.clear();
+                        }
+                    }
+                }
+            }
+            m.on_captures(&chunk, |o| out.push(o));
+            assert_eq!(out, expected, "batches of {batch}");
+            assert_eq!(m.diagnostics(), one.diagnostics());
+        }
     }
 
     #[test]

@@ -207,6 +207,25 @@ impl EdgeCounters {
         syncs: 0,
         sync_losses: 0,
     };
+
+    /// Back to [`EdgeCounters::ZERO`] in place, one store a counter. The zero is opaque to
+    /// the optimizer: ten stores of a constant zero would become a call of `memset` (a run of
+    /// more than 32 zero bytes is one on a Cortex-M), which configuration would then link.
+    pub(crate) fn clear(&mut self) {
+        let z = core::hint::black_box(0);
+        *self = EdgeCounters {
+            accepted: z,
+            glitches: z,
+            missing: z,
+            extra: z,
+            missing_frames: z,
+            reversals: z,
+            timeouts: z,
+            revolutions: z,
+            syncs: z,
+            sync_losses: z,
+        };
+    }
 }
 
 /// Pending raw edges awaiting judgement: the edge itself and two for lookahead.
@@ -300,6 +319,24 @@ pub struct SpeedTracker {
     counters: EdgeCounters,
 }
 
+#[cfg(test)]
+impl SpeedTracker {
+    /// Its state but for the slots [`SpeedTracker::reset`] leaves (the ring, the per-tooth
+    /// history, the pending edges, the waiting index pulses), which read as `new()`'s.
+    pub(crate) fn without_slots(&self) -> String {
+        let new = SpeedTracker::new();
+        let t = SpeedTracker {
+            ring: new.ring,
+            hist: new.hist,
+            pending: new.pending,
+            pending_seq: new.pending_seq,
+            index: new.index,
+            ..self.clone()
+        };
+        format!("{t:?}")
+    }
+}
+
 impl Default for SpeedTracker {
     fn default() -> Self {
         Self::new()
@@ -311,10 +348,14 @@ impl Default for SpeedTracker {
 /// Careful path only (f32); out of line, one copy for every term of every hypothesis.
 #[inline(never)]
 fn log_sq(a: f32, b: f32) -> f32 {
+    // Compared, not `f32::max`/`min` (which call `fmaxf`/`fminf` on this FPU): the same for
+    // tick counts, which are never NaN.
     let (a, b) = if a >= b {
-        ((a - 1.0).max(b + 1.0), b + 1.0)
+        let (x, y) = (a - 1.0, b + 1.0);
+        (if x >= y { x } else { y }, y)
     } else {
-        ((a + 1.0).min(b - 1.0), b - 1.0)
+        let (x, y) = (a + 1.0, b - 1.0);
+        (if x <= y { x } else { y }, y)
     };
     if a <= 0.0 || b <= 0.0 {
         return 0.0;
@@ -401,6 +442,61 @@ impl SpeedTracker {
             searched: 0,
             counters: EdgeCounters::ZERO,
         }
+    }
+
+    /// Back to [`SpeedTracker::new`] in place. The contents of the ring, the per-tooth
+    /// history, the pending edges and the waiting index pulses are left: nothing reads a slot
+    /// before writing it (`fill`, `pos`, `hist_teeth`, `history`, `npend` and `nidx` start at
+    /// zero). Assigning `new()` would zero some 550 bytes with a call of `memset`, which
+    /// configuration would then link; the numbers take an opaque zero for the same reason
+    /// (see [`EdgeCounters::clear`]). The list names every field, so a new one is not missed.
+    pub(crate) fn reset(&mut self) {
+        const NEW: SpeedTracker = SpeedTracker::new();
+        let z = core::hint::black_box(0u32);
+        let SpeedTracker {
+            state,
+            sync,
+            has_ref,
+            last,
+            latest,
+            prev,
+            accepted,
+            anchor,
+            lo,
+            width,
+            tooth,
+            stop,
+            faults,
+            ring: _,
+            pos,
+            fill,
+            sum,
+            span,
+            hist: _,
+            hist_teeth,
+            history,
+            held,
+            pending: _,
+            pending_seq: _,
+            npend,
+            out_of_band,
+            index: _,
+            arrivals,
+            nidx,
+            viable,
+            acq,
+            confirm,
+            seen_special,
+            searched,
+            counters,
+        } = self;
+        (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
+        (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
+        (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
+        (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
+        (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
+        (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
+        counters.clear();
     }
 
     /// The shaft state.
@@ -1582,7 +1678,13 @@ impl SpeedTracker {
         // Leave what the fast path would have left, laid out from the ring's start: the last
         // `m` times.
         let tail = i.checked_sub(m).and_then(|from| caps.get(from..i));
-        if !(lay::<LAID_SHORT>(&mut self.ring, tail) || lay::<MAX_SPAN>(&mut self.ring, tail)) {
+        if let Some(tail) = tail {
+            // In copies of 16 times, each a few block moves inline (a longer one would call
+            // `memcpy`): the first 16 to the ring's start, the next 16 (`m` = 32) after them.
+            let (lo, hi) = self.ring.split_at_mut(LAID_SHORT);
+            lay(lo, tail.first_chunk());
+            lay(hi, tail.get(LAID_SHORT..).and_then(<[u32]>::first_chunk));
+        } else {
             // A short batch (`i` < `m` ≤ 32): the older times move down, the batch's follow.
             let keep = m.saturating_sub(i);
             for j in 0..keep {
@@ -1591,8 +1693,12 @@ impl SpeedTracker {
                     *d = v;
                 }
             }
-            let rest = self.ring.get_mut(keep..).unwrap_or_default();
-            each_pair(rest, caps, |d, &c| *d = c);
+            // One masked slot at a time: a plain copy loop would become a call of `memcpy`.
+            for (j, &c) in caps.iter().take(i).enumerate() {
+                if let Some(d) = self.ring.get_mut(keep.wrapping_add(j) & (MAX_SPAN - 1)) {
+                    *d = c;
+                }
+            }
         }
         self.pos = m as u32;
         self.tooth = self.tooth.wrapping_add(i as u16);
@@ -1622,15 +1728,28 @@ impl SpeedTracker {
             self.pos = m as u32;
             return;
         }
-        let mut laid = [0u32; MAX_SPAN];
-        for (j, d) in laid.iter_mut().take(m).enumerate() {
-            *d = self
-                .ring
-                .get(first.wrapping_add(j) & (MAX_SPAN - 1))
-                .copied()
-                .unwrap_or(0);
+        // Wrapped: the whole ring turned left by `first` in place, slot `j` taking slot
+        // `j + first` (masked), one cycle of slots at a time (no copy of it, whose zeroing and
+        // copying would call `memset` and `memcpy`). `first` ≠ 0: `first + m` > 32.
+        let cycles = 1usize.wrapping_shl(first.trailing_zeros());
+        for c in 0..cycles {
+            let held = self.ring.get(c).copied().unwrap_or(0);
+            let mut j = c;
+            loop {
+                let next = j.wrapping_add(first) & (MAX_SPAN - 1);
+                if next == c {
+                    break;
+                }
+                let v = self.ring.get(next).copied().unwrap_or(0);
+                if let Some(d) = self.ring.get_mut(j) {
+                    *d = v;
+                }
+                j = next;
+            }
+            if let Some(d) = self.ring.get_mut(j) {
+                *d = held;
+            }
         }
-        self.ring = laid;
         self.pos = m as u32;
     }
 
@@ -1677,19 +1796,11 @@ impl SpeedTracker {
 /// [`MAX_SPAN`]).
 const LAID_SHORT: usize = 16;
 
-/// Copies `tail` to the start of `ring` if it holds exactly `M` times (a copy of fixed size);
-/// whether it did.
+/// Copies 16 times to the start of `to` (a copy of fixed size, inline), if there are.
 #[inline(always)]
-fn lay<const M: usize>(ring: &mut [u32; MAX_SPAN], tail: Option<&[u32]>) -> bool {
-    match (
-        ring.first_chunk_mut::<M>(),
-        tail.and_then(|t| <&[u32; M]>::try_from(t).ok()),
-    ) {
-        (Some(d), Some(t)) => {
-            *d = *t;
-            true
-        }
-        _ => false,
+fn lay(to: &mut [u32], times: Option<&[u32; LAID_SHORT]>) {
+    if let (Some(d), Some(t)) = (to.first_chunk_mut::<LAID_SHORT>(), times) {
+        *d = *t;
     }
 }
 
