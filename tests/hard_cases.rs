@@ -1496,6 +1496,13 @@ fn f64_parameters() -> Vec<(&'static str, Domain, Check)> {
         ok(Rotor::<2>::new(m, zm, za, zb, &[u], p))
     };
     let base = move || Rotor::<2>::new(10.0, 2.0, 0.0, 4.0, &[u], None).unwrap();
+    let process = move |f: fn(&mut ProcessLoad, f64)| -> Check {
+        Box::new(move |x| {
+            let mut p = pl;
+            f(&mut p, x);
+            rotor(10.0, 2.0, 0.0, 4.0, u, Some(p))
+        })
+    };
     let model = |x: f64, fly: f64| {
         ok(DriveModel::new(
             seed_motor(),
@@ -1665,61 +1672,25 @@ fn f64_parameters() -> Vec<(&'static str, Domain, Check)> {
         (
             "process_load.per_length",
             NonNegative,
-            Box::new(move |x| {
-                rotor(
-                    10.0,
-                    2.0,
-                    0.0,
-                    4.0,
-                    u,
-                    Some(ProcessLoad {
-                        per_length: x,
-                        ..pl
-                    }),
-                )
-            }),
+            process(|p, x| p.per_length = x),
         ),
         (
             "process_load.from",
             Finite,
-            Box::new(move |x| {
-                rotor(
-                    10.0,
-                    2.0,
-                    0.0,
-                    4.0,
-                    u,
-                    Some(ProcessLoad {
-                        from: x,
-                        to: 1e300,
-                        ..pl
-                    }),
-                )
+            process(|p, x| {
+                p.from = x;
+                p.to = 1e300;
             }),
         ),
         (
             "process_load.to",
             Finite,
-            Box::new(move |x| {
-                rotor(
-                    10.0,
-                    2.0,
-                    0.0,
-                    4.0,
-                    u,
-                    Some(ProcessLoad {
-                        from: -1e300,
-                        to: x,
-                        ..pl
-                    }),
-                )
+            process(|p, x| {
+                p.from = -1e300;
+                p.to = x;
             }),
         ),
-        (
-            "process_load.angle",
-            Finite,
-            Box::new(move |x| rotor(10.0, 2.0, 0.0, 4.0, u, Some(ProcessLoad { angle: x, ..pl }))),
-        ),
+        ("process_load.angle", Finite, process(|p, x| p.angle = x)),
         (
             "gravity",
             NonNegative,
@@ -1777,6 +1748,13 @@ fn f32_parameters() -> Vec<(&'static str, Domain, Check32)> {
         balancer(2),
     );
     let m2 = m;
+    let enc = |f: fn(&mut EncoderConfig, f32)| -> Check32 {
+        Box::new(move |x| {
+            let mut c = EncoderConfig::indexed(64, 1e6);
+            f(&mut c, x);
+            ok(Encoder::new(c))
+        })
+    };
     let alarm = |f: fn(&mut AlarmConfig, f32)| -> Check32 {
         Box::new(move |x| {
             let mut a = AlarmConfig::new(0.06);
@@ -1788,29 +1766,17 @@ fn f32_parameters() -> Vec<(&'static str, Domain, Check32)> {
         (
             "tolerances.glitch_fraction",
             Positive,
-            Box::new(|x| {
-                let mut c = EncoderConfig::indexed(64, 1e6);
-                c.tolerances.glitch_fraction = x;
-                ok(Encoder::new(c))
-            }),
+            enc(|c, x| c.tolerances.glitch_fraction = x),
         ),
         (
             "tolerances.accept",
             Positive,
-            Box::new(|x| {
-                let mut c = EncoderConfig::indexed(64, 1e6);
-                c.tolerances.accept = x;
-                ok(Encoder::new(c))
-            }),
+            enc(|c, x| c.tolerances.accept = x),
         ),
         (
             "tolerances.fault_margin",
             Positive,
-            Box::new(|x| {
-                let mut c = EncoderConfig::indexed(64, 1e6);
-                c.tolerances.fault_margin = x;
-                ok(Encoder::new(c))
-            }),
+            enc(|c, x| c.tolerances.fault_margin = x),
         ),
         (
             "steady_tolerance",

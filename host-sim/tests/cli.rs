@@ -1,18 +1,9 @@
 //! The `drive-sim` command line: bundled scenes, JSON contracts, errors and exit codes.
 
-use std::process::Command;
+mod cli_common;
 
-fn drive_sim(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
-        .args(args)
-        .output()
-        .expect("drive-sim runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use cli_common::drive_sim;
+use std::process::Command;
 
 fn json(args: &[&str]) -> serde_json::Value {
     let (ok, out, err) = drive_sim(args);

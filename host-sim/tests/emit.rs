@@ -1,20 +1,10 @@
 //! `drive-sim predict SCENE --emit rust`: the table the firmware example includes is what the
 //! command writes now (so it cannot go stale), and `--out` writes the same.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod cli_common;
 
-fn drive_sim(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_drive-sim"))
-        .args(args)
-        .output()
-        .expect("drive-sim runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use cli_common::drive_sim;
+use std::path::PathBuf;
 
 /// The firmware example's checked-in table.
 fn firmware_table() -> PathBuf {

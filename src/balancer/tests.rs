@@ -76,14 +76,24 @@ fn analyse(cfg: MachineConfig) -> Machine {
     m
 }
 
-/// A random machine: masses log-uniform in [1e-3, 1e3] kg (before the balancer is added),
-/// stiffness in [1e2, 1e6] N/m, couplings zero with probability 1/6, light damping.
-fn random_machine(rng: &mut Rng, n: usize, exciter_any: bool) -> MachineConfig {
+/// `n` random platforms (masses log-uniform in [1e-3, 1e3] kg, stiffness in [1e2, 1e6] N/m)
+/// and every coupling between them (zero with probability 1/6, else stiffness log-uniform in
+/// [1e1, 1e6] N/m), each damping drawn by `platform_damping(rng, k, m)` and
+/// `coupling_damping(rng, k, platforms, a, b)` right after the stiffness it goes with; then a
+/// balancer on platform `exciter(rng)` with its masses scaled by a factor log-uniform in
+/// [1e-4, 1].
+fn random_config(
+    rng: &mut Rng,
+    n: usize,
+    platform_damping: impl Fn(&mut Rng, f64, f64) -> f64,
+    coupling_damping: impl Fn(&mut Rng, f64, &[Platform], u8, u8) -> f64,
+    exciter: impl FnOnce(&mut Rng) -> u8,
+) -> MachineConfig {
     let mut ps = Vec::new();
     for _ in 0..n {
         let k = rng.log_uniform(1e2, 1e6);
         let m = rng.log_uniform(1e-3, 1e3);
-        ps.push(platform(m, k, 1e-3 * (k * m).sqrt() * rng.uniform()));
+        ps.push(platform(m, k, platform_damping(rng, k, m)));
     }
     let mut cs = Vec::new();
     for a in 1..=n as u8 {
@@ -93,21 +103,34 @@ fn random_machine(rng: &mut Rng, n: usize, exciter_any: bool) -> MachineConfig {
             } else {
                 rng.log_uniform(1e1, 1e6)
             };
-            cs.push(coupling(a, b, k, 1e-3 * k.sqrt() * rng.uniform()));
+            cs.push(coupling(a, b, k, coupling_damping(rng, k, &ps, a, b)));
         }
     }
-    let e = if exciter_any {
-        1 + rng.below(n as u64) as u8
-    } else if n == 1 {
-        1
-    } else {
-        2
-    };
-    let mut b = balancer(e);
+    let mut b = balancer(exciter(rng));
     let scale = rng.log_uniform(1e-4, 1.0);
     b.load_mass *= scale;
     b.housing_mass *= scale;
     MachineConfig::new(&ps, &cs, b).unwrap()
+}
+
+/// A random machine ([`random_config`]) with light damping, the exciter on any platform or on
+/// platform 2 (1 for one platform).
+fn random_machine(rng: &mut Rng, n: usize, exciter_any: bool) -> MachineConfig {
+    random_config(
+        rng,
+        n,
+        |rng, k, m| 1e-3 * (k * m).sqrt() * rng.uniform(),
+        |rng, k, _, _, _| 1e-3 * k.sqrt() * rng.uniform(),
+        |rng| {
+            if exciter_any {
+                1 + rng.below(n as u64) as u8
+            } else if n == 1 {
+                1
+            } else {
+                2
+            }
+        },
+    )
 }
 
 /// Determinant by Gaussian elimination with partial pivoting (test-only, any size).
@@ -501,19 +524,55 @@ fn h_tilde(m: &Machine, q: f64) -> (f64, f64) {
     (re * s, im * s)
 }
 
+/// `n` platforms of the seed cross-checks: stiffness in [1e3, 1e6] N/m, mass in [1, 1e3] kg,
+/// damping up to 0.2·√(k·m).
+fn seed_platforms(rng: &mut Rng, n: usize) -> Vec<Platform> {
+    (0..n)
+        .map(|_| {
+            let k = rng.log_uniform(1e3, 1e6);
+            let m = rng.log_uniform(1.0, 1e3);
+            platform(m, k, 0.2 * (k * m).sqrt() * rng.uniform())
+        })
+        .collect()
+}
+
+/// A coupling of the seed cross-checks: stiffness in [1e3, 1e6] N/m, damping up to 0.1·√k.
+fn seed_coupling(rng: &mut Rng, a: u8, b: u8) -> Coupling {
+    let kc = rng.log_uniform(1e3, 1e6);
+    coupling(a, b, kc, 0.1 * kc.sqrt() * rng.uniform())
+}
+
+/// Asserts that the seed's ratio `num/Δ` (`name` its numerator) equals Re H̃ at `q` within
+/// `tol`·|H̃|, Δ > 0, and that where the ratio is clearly off zero the sign of `num`
+/// (negative: balancing) agrees with the zone table.
+fn assert_seed_ratio_is_receptance(
+    m: &Machine,
+    q: f64,
+    name: &str,
+    num: f64,
+    delta: f64,
+    tol: f64,
+) {
+    assert!(delta > 0.0);
+    let (re, im) = h_tilde(m, q);
+    let scale = re.hypot(im);
+    assert!(
+        (num / delta - re).abs() < tol * scale,
+        "q {q}: {name}/Δ {} vs Re H̃ {re}",
+        num / delta
+    );
+    if (num / delta).abs() > 1e-6 * scale {
+        let kind = m.zone_kind_at(q * m.config().dimensionless().omega_ref);
+        assert_eq!(kind == ZoneKind::Balancing, num < 0.0, "q {q}");
+    }
+}
+
 #[test]
 fn seed_eq31_two_platforms_equals_receptance() {
     let mut rng = Rng(5);
     for _ in 0..200 {
-        let ps: Vec<Platform> = (0..2)
-            .map(|_| {
-                let k = rng.log_uniform(1e3, 1e6);
-                let m = rng.log_uniform(1.0, 1e3);
-                platform(m, k, 0.2 * (k * m).sqrt() * rng.uniform())
-            })
-            .collect();
-        let kc = rng.log_uniform(1e3, 1e6);
-        let cs = [coupling(1, 2, kc, 0.1 * kc.sqrt() * rng.uniform())];
+        let ps = seed_platforms(&mut rng, 2);
+        let cs = [seed_coupling(&mut rng, 1, 2)];
         let m = analyse(MachineConfig::new(&ps, &cs, balancer(2)).unwrap());
         let d = m.config().dimensionless();
         let (n1, n2, n12, rho) = (d.n_sq[0], d.n_sq[1], d.n_sq_coupling[0][1], d.rho[0]);
@@ -536,20 +595,8 @@ fn seed_eq31_two_platforms_equals_receptance() {
                 vec![rho * a13, rho * a14, a33, a34],
                 vec![-rho * a14, rho * a13, -a34, a33],
             ];
-            let delta = det(big_a);
-            assert!(delta > 0.0);
-            let (re, im) = h_tilde(&m, q);
-            let scale = re.hypot(im);
-            assert!(
-                (f / delta - re).abs() < 1e-9 * scale,
-                "q {q}: f/Δ {} vs Re H̃ {re}",
-                f / delta
-            );
-            // The criterion's sign agrees with the zone table.
-            if (f / delta).abs() > 1e-6 * scale {
-                let kind = m.zone_kind_at(q * d.omega_ref);
-                assert_eq!(kind == ZoneKind::Balancing, f < 0.0, "q {q}");
-            }
+            // f/Δ = Re H̃, and the criterion's sign agrees with the zone table.
+            assert_seed_ratio_is_receptance(&m, q, "f", f, det(big_a), 1e-9);
         }
     }
 }
@@ -558,19 +605,10 @@ fn seed_eq31_two_platforms_equals_receptance() {
 fn seed_eq53_three_platforms_equals_receptance() {
     let mut rng = Rng(6);
     for _ in 0..150 {
-        let ps: Vec<Platform> = (0..3)
-            .map(|_| {
-                let k = rng.log_uniform(1e3, 1e6);
-                let m = rng.log_uniform(1.0, 1e3);
-                platform(m, k, 0.2 * (k * m).sqrt() * rng.uniform())
-            })
-            .collect();
+        let ps = seed_platforms(&mut rng, 3);
         let cs: Vec<Coupling> = [(1, 2), (1, 3), (2, 3)]
             .iter()
-            .map(|&(a, b)| {
-                let kc = rng.log_uniform(1e3, 1e6);
-                coupling(a, b, kc, 0.1 * kc.sqrt() * rng.uniform())
-            })
+            .map(|&(a, b)| seed_coupling(&mut rng, a, b))
             .collect();
         let m = analyse(MachineConfig::new(&ps, &cs, balancer(2)).unwrap());
         let d = m.config().dimensionless();
@@ -583,20 +621,7 @@ fn seed_eq53_three_platforms_equals_receptance() {
                 .filter(|&i| i != 2)
                 .map(|i| (0..6).filter(|&j| j != 2).map(|j| a[i][j]).collect())
                 .collect();
-            let delta = det(full);
-            let delta3 = det(minor);
-            assert!(delta > 0.0);
-            let (re, im) = h_tilde(&m, q);
-            let scale = re.hypot(im);
-            assert!(
-                (delta3 / delta - re).abs() < 1e-8 * scale,
-                "q {q}: Δ3/Δ {} vs Re H̃ {re}",
-                delta3 / delta
-            );
-            if (delta3 / delta).abs() > 1e-6 * scale {
-                let kind = m.zone_kind_at(q * d.omega_ref);
-                assert_eq!(kind == ZoneKind::Balancing, delta3 < 0.0, "q {q}");
-            }
+            assert_seed_ratio_is_receptance(&m, q, "Δ3", det(minor), det(full), 1e-8);
         }
     }
 }
@@ -1184,34 +1209,16 @@ fn comparison_machine(rng: &mut Rng, n: usize, heavy: bool) -> MachineConfig {
             rng.log_uniform(1e-5, 1e-2)
         }
     };
-    let mut ps = Vec::new();
-    for _ in 0..n {
-        let k = rng.log_uniform(1e2, 1e6);
-        let m = rng.log_uniform(1e-3, 1e3);
-        ps.push(platform(m, k, 2.0 * ratio(rng) * (k * m).sqrt()));
-    }
-    let mut cs = Vec::new();
-    for a in 1..=n as u8 {
-        for b in a + 1..=n as u8 {
-            let k = if rng.below(6) == 0 {
-                0.0
-            } else {
-                rng.log_uniform(1e1, 1e6)
-            };
+    random_config(
+        rng,
+        n,
+        |rng, k, m| 2.0 * ratio(rng) * (k * m).sqrt(),
+        |rng, k, ps, a, b| {
             let m = ps[usize::from(a) - 1].mass.min(ps[usize::from(b) - 1].mass);
-            cs.push(coupling(
-                a,
-                b,
-                k,
-                2.0 * ratio(rng) * (k.max(1e1) * m).sqrt(),
-            ));
-        }
-    }
-    let mut b = balancer(1 + rng.below(n as u64) as u8);
-    let scale = rng.log_uniform(1e-4, 1.0);
-    b.load_mass *= scale;
-    b.housing_mass *= scale;
-    MachineConfig::new(&ps, &cs, b).unwrap()
+            2.0 * ratio(rng) * (k.max(1e1) * m).sqrt()
+        },
+        |rng| 1 + rng.below(n as u64) as u8,
+    )
 }
 
 /// Randomised comparison of [`Machine::new`] with the scanned reference

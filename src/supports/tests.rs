@@ -538,13 +538,16 @@ fn unbalance_far_outside_the_span() {
     assert!(f.norm() <= 1e-15 && m.norm() <= 1e-12);
 }
 
-fn auger(gravity: bool) -> (Rotor<4>, Limits) {
-    let rotor = Rotor::<4>::new(
+/// The auger's rotor: 350 kg with its centre of mass at 1.9, supports at 0 and `support_b`,
+/// an unbalance of 2e-3 kg·m at `unbalance_z` and 30°, and a process load of 400 N/m on
+/// 0.5…3.5 at 270°.
+fn auger_rotor(support_b: f64, unbalance_z: f64) -> Rotor<4> {
+    Rotor::<4>::new(
         350.0,
         1.9,
         0.0,
-        4.0,
-        &[Unbalance::new(1.2, 2.0e-3, 30f64.to_radians())],
+        support_b,
+        &[Unbalance::new(unbalance_z, 2.0e-3, 30f64.to_radians())],
         Some(ProcessLoad {
             per_length: 400.0,
             from: 0.5,
@@ -552,14 +555,24 @@ fn auger(gravity: bool) -> (Rotor<4>, Limits) {
             angle: 270f64.to_radians(),
         }),
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The auger's limits: grade G 6.3 up to 60 rad/s, 8 000 N at each support, warning at 0.8.
+fn auger_limits() -> Limits {
+    Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), 0.8).unwrap()
+}
+
+/// The bundled auger scene (supports at 0 and 4, the unbalance at 1.2), with or without
+/// gravity, and its limits.
+fn auger(gravity: bool) -> (Rotor<4>, Limits) {
+    let rotor = auger_rotor(4.0, 1.2);
     let rotor = if gravity {
         rotor
     } else {
         rotor.with_gravity(0.0, 0.0).unwrap()
     };
-    let limits = Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), 0.8).unwrap();
-    (rotor, limits)
+    (rotor, auger_limits())
 }
 
 #[test]
@@ -621,21 +634,8 @@ fn bundled_auger_scene_worked_numbers() {
 fn overhung_auger_variant_is_sensible() {
     // Supports at 0 and 1.5, the screw overhangs B up to 4.0: CoM 1.9 and the unbalance at
     // 3.5 lie beyond B, as does most of the process load.
-    let rotor = Rotor::<4>::new(
-        350.0,
-        1.9,
-        0.0,
-        1.5,
-        &[Unbalance::new(3.5, 2.0e-3, 30f64.to_radians())],
-        Some(ProcessLoad {
-            per_length: 400.0,
-            from: 0.5,
-            to: 3.5,
-            angle: 270f64.to_radians(),
-        }),
-    )
-    .unwrap();
-    let limits = Limits::new(6.3, 60.0, Some([8000.0, 8000.0]), 0.8).unwrap();
+    let rotor = auger_rotor(1.5, 3.5);
+    let limits = auger_limits();
     let an = SupportAnalysis::new(&rotor, &limits).unwrap();
     let rep = an.report();
     // Lever: D_A = D·(1.5 − 3.5)/1.5 (opposite to D), D_B = D·3.5/1.5.

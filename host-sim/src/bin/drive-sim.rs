@@ -52,44 +52,8 @@ enum Command {
         /// Its format (default: told from its first lines).
         #[arg(long, value_enum)]
         format: Option<CaptureFormat>,
-        /// The encoder channel: its name in the header, or its number among the channels
-        /// (from 0).
-        #[arg(long, default_value = "0")]
-        channel: Channel,
-        /// The index channel of an index disc (default: channel 1).
-        #[arg(long)]
-        index_channel: Option<Channel>,
-        /// The edges the capture unit takes.
-        #[arg(long, value_enum, default_value = "rising")]
-        edge: Polarity,
-        /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
-        #[arg(long)]
-        wheel: Option<String>,
-        /// A uniform disc of N lines (with --framing).
-        #[arg(long)]
-        lines: Option<u16>,
-        /// How the uniform disc of --lines is framed.
-        #[arg(long, value_enum)]
-        framing: Option<FramingArg>,
-        /// Take the wheel, the timer, the tolerances and the window from a scene's [encoder]
-        /// and [monitor] (a bundled scene's name or a file).
-        #[arg(long)]
-        scene: Option<String>,
-        /// The emulated capture timer clock, Hz (default 1e6, or the scene's).
-        #[arg(long)]
-        timer_hz: Option<f64>,
-        /// The emulated counter width, bits (16 to 32; default 32, or the scene's).
-        #[arg(long)]
-        counter_bits: Option<u8>,
-        /// Slowest speed still running, rad/s (default 1, or the scene's).
-        #[arg(long)]
-        min_speed: Option<f64>,
-        /// Edges per speed sample (default 1, or the scene's).
-        #[arg(long)]
-        estimator_edges: Option<u16>,
-        /// Revolutions per δ window (default 1, or the scene's).
-        #[arg(long)]
-        window_revolutions: Option<u16>,
+        #[command(flatten)]
+        options: AnalyzeArgs,
         /// Samples per second of a sigrok file without a samplerate comment, Hz.
         #[arg(long)]
         sample_rate: Option<f64>,
@@ -169,6 +133,74 @@ enum Command {
     Scenes,
 }
 
+/// The options of `analyze` that describe the encoder, the core's settings and the channels
+/// (`AnalyzeOptions` once `--scene` is read).
+#[derive(clap::Args)]
+struct AnalyzeArgs {
+    /// The encoder channel: its name in the header, or its number among the channels
+    /// (from 0).
+    #[arg(long, default_value = "0")]
+    channel: Channel,
+    /// The index channel of an index disc (default: channel 1).
+    #[arg(long)]
+    index_channel: Option<Channel>,
+    /// The edges the capture unit takes.
+    #[arg(long, value_enum, default_value = "rising")]
+    edge: Polarity,
+    /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
+    #[arg(long)]
+    wheel: Option<String>,
+    /// A uniform disc of N lines (with --framing).
+    #[arg(long)]
+    lines: Option<u16>,
+    /// How the uniform disc of --lines is framed.
+    #[arg(long, value_enum)]
+    framing: Option<FramingArg>,
+    /// Take the wheel, the timer, the tolerances and the window from a scene's [encoder]
+    /// and [monitor] (a bundled scene's name or a file).
+    #[arg(long)]
+    scene: Option<String>,
+    /// The emulated capture timer clock, Hz (default 1e6, or the scene's).
+    #[arg(long)]
+    timer_hz: Option<f64>,
+    /// The emulated counter width, bits (16 to 32; default 32, or the scene's).
+    #[arg(long)]
+    counter_bits: Option<u8>,
+    /// Slowest speed still running, rad/s (default 1, or the scene's).
+    #[arg(long)]
+    min_speed: Option<f64>,
+    /// Edges per speed sample (default 1, or the scene's).
+    #[arg(long)]
+    estimator_edges: Option<u16>,
+    /// Revolutions per δ window (default 1, or the scene's).
+    #[arg(long)]
+    window_revolutions: Option<u16>,
+}
+
+impl AnalyzeArgs {
+    /// The options, with `--scene` resolved and read.
+    fn resolve(self) -> Result<host_sim::app::analyze::AnalyzeOptions, Failure> {
+        let scene = match self.scene {
+            Some(name) => Some(resolve(&name)?),
+            None => None,
+        };
+        Ok(host_sim::app::analyze::AnalyzeOptions {
+            wheel: self.wheel,
+            lines: self.lines,
+            framing: self.framing,
+            scene,
+            timer_hz: self.timer_hz,
+            counter_bits: self.counter_bits,
+            min_speed: self.min_speed,
+            estimator_edges: self.estimator_edges,
+            window_revolutions: self.window_revolutions,
+            channel: Some(self.channel),
+            index_channel: self.index_channel,
+            edge: Some(self.edge),
+        })
+    }
+}
+
 /// Most speeds `sweep --steps` accepts (each is a whole simulation of the scene).
 const MAX_SWEEP_STEPS: usize = 1000;
 /// Most machines `criterion --machines` accepts (each is a grid of simulations).
@@ -236,40 +268,12 @@ fn main() -> ExitCode {
         Some(Command::Analyze {
             capture,
             format,
-            channel,
-            index_channel,
-            edge,
-            wheel,
-            lines,
-            framing,
-            scene,
-            timer_hz,
-            counter_bits,
-            min_speed,
-            estimator_edges,
-            window_revolutions,
+            options,
             sample_rate,
             json,
             plot,
         }) => (|| {
-            let scene = match scene {
-                Some(name) => Some(resolve(&name)?),
-                None => None,
-            };
-            let options = host_sim::app::analyze::AnalyzeOptions {
-                wheel,
-                lines,
-                framing,
-                scene,
-                timer_hz,
-                counter_bits,
-                min_speed,
-                estimator_edges,
-                window_revolutions,
-                channel: Some(channel),
-                index_channel,
-                edge: Some(edge),
-            };
+            let options = options.resolve()?;
             analyze_cmd(
                 &capture,
                 format,

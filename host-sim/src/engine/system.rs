@@ -81,51 +81,51 @@ pub enum SpeedLaw {
 }
 
 impl SpeedLaw {
+    /// Angle at t = 0, rad.
+    fn phi0(&self) -> f64 {
+        match *self {
+            SpeedLaw::Constant { phi0, .. }
+            | SpeedLaw::Ramp { phi0, .. }
+            | SpeedLaw::RampTo { phi0, .. } => phi0,
+        }
+    }
+
     /// Checks the parameters.
     pub fn validate(&self) -> Result<(), ConfigError> {
         match *self {
-            SpeedLaw::Constant { omega, phi0 } => {
+            SpeedLaw::Constant { omega, .. } => {
                 finite("shaft.omega", omega)?;
-                finite("shaft.phi0", phi0)?;
             }
-            SpeedLaw::Ramp {
-                omega0,
-                alpha,
-                phi0,
-            } => {
+            SpeedLaw::Ramp { omega0, alpha, .. } => {
                 finite("shaft.omega0", omega0)?;
                 finite("shaft.alpha", alpha)?;
-                finite("shaft.phi0", phi0)?;
             }
             SpeedLaw::RampTo {
                 omega0,
                 omega1,
                 ramp_time,
-                phi0,
+                ..
             } => {
                 finite("shaft.omega0", omega0)?;
                 finite("shaft.omega1", omega1)?;
                 positive("shaft.ramp_time", ramp_time)?;
-                finite("shaft.phi0", phi0)?;
             }
         }
+        finite("shaft.phi0", self.phi0())?;
         Ok(())
     }
 
     /// (φ0, ω0, α) of the piece containing t, with the piece's start time.
     fn piece(&self, t: f64) -> (f64, f64, f64, f64) {
+        let phi0 = self.phi0();
         match *self {
-            SpeedLaw::Constant { omega, phi0 } => (0.0, phi0, omega, 0.0),
-            SpeedLaw::Ramp {
-                omega0,
-                alpha,
-                phi0,
-            } => (0.0, phi0, omega0, alpha),
+            SpeedLaw::Constant { omega, .. } => (0.0, phi0, omega, 0.0),
+            SpeedLaw::Ramp { omega0, alpha, .. } => (0.0, phi0, omega0, alpha),
             SpeedLaw::RampTo {
                 omega0,
                 omega1,
                 ramp_time,
-                phi0,
+                ..
             } => {
                 let alpha = (omega1 - omega0) / ramp_time;
                 if t <= ramp_time {

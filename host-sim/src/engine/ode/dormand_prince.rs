@@ -4,7 +4,7 @@
 use std::ops::Range;
 
 use super::Buf;
-use super::{OdeSystem, Solver, Tol};
+use super::{OdeSystem, Solver, Tableau, Tol};
 
 impl Solver {
     /// Component `i` of `y + h·Σ_j w_j·k_j` over the stages `j < w.len()` (zero weights
@@ -78,39 +78,75 @@ impl Solver {
         norm(sums, n as f64)
     }
 
-    /// One attempted DOPRI5 step of length `h`: `ynew`, `fnew` and the RMS of the scaled
-    /// 5th/4th-order difference.
-    pub(super) fn attempt_dp5<S: OdeSystem + ?Sized>(
+    /// One attempted step of length `h` of tableau `tab`: `ynew`, `fnew` and the error norm,
+    /// for DOPRI5 the RMS of the scaled 5th/4th-order difference, for DOP853 Hairer's
+    /// combined 5th/3rd-order estimate.
+    pub(super) fn attempt<S: OdeSystem + ?Sized>(
         &mut self,
         sys: &mut S,
         h: f64,
         tol: Tol,
+        tab: Tableau,
     ) -> f64 {
         let n = self.n;
-        // Stage s (1-based 2..6) in block s-1; block 0 mirrors f.
+        // Stage s (1-based 2..) in block s-1; block 0 mirrors f.
         self.k[..n].copy_from_slice(&self.f);
-        self.run_stages(sys, &DP5_A, &DP5_C, 1..6, h);
-        // Every weight, the zero one included: a non-finite stage makes ynew non-finite.
-        for i in 0..n {
-            let mut acc = 0.0;
-            for (j, b) in DP5_B.iter().enumerate() {
-                acc += b * self.k[j * n + i];
-            }
-            self.ynew[i] = self.y[i] + h * acc;
-        }
-        self.finish_attempt(
-            sys,
-            h,
-            tol,
-            |s, i| {
-                let mut acc = DP5_E[6] * s.fnew[i];
-                for (j, e) in DP5_E.iter().enumerate().take(6) {
-                    acc += e * s.k[j * n + i];
+        match tab {
+            Tableau::Dp5 => {
+                self.run_stages(sys, &DP5_A, &DP5_C, 1..6, h);
+                // Every weight, the zero one included: a non-finite stage makes ynew
+                // non-finite.
+                for i in 0..n {
+                    let mut acc = 0.0;
+                    for (j, b) in DP5_B.iter().enumerate() {
+                        acc += b * self.k[j * n + i];
+                    }
+                    self.ynew[i] = self.y[i] + h * acc;
                 }
-                [h * acc]
-            },
-            |[sum], n| (sum / n).sqrt(),
-        )
+                self.finish_attempt(
+                    sys,
+                    h,
+                    tol,
+                    |s, i| {
+                        let mut acc = DP5_E[6] * s.fnew[i];
+                        for (j, e) in DP5_E.iter().enumerate().take(6) {
+                            acc += e * s.k[j * n + i];
+                        }
+                        [h * acc]
+                    },
+                    |[sum], n| (sum / n).sqrt(),
+                )
+            }
+            Tableau::Dp853 => {
+                self.run_stages(sys, &DP8_A, &DP8_C, 1..12, h);
+                // Row 12 holds the weights b.
+                for i in 0..n {
+                    self.ynew[i] = self.increment(&DP8_A[12][..12], h, i);
+                }
+                self.finish_attempt(
+                    sys,
+                    h,
+                    tol,
+                    |s, i| {
+                        let mut e5 = 0.0;
+                        let mut e3 = 0.0;
+                        for j in 0..12 {
+                            let kj = s.k[j * n + i];
+                            e5 += DP8_E5[j] * kj;
+                            e3 += (DP8_A[12][j] - DP8_BHH[j]) * kj;
+                        }
+                        [e5, e3]
+                    },
+                    |[err5, err3], n| {
+                        let mut deno = err5 + 0.01 * err3;
+                        if deno <= 0.0 {
+                            deno = 1.0;
+                        }
+                        h.abs() * err5 / (deno * n).sqrt()
+                    },
+                )
+            }
+        }
     }
 
     /// Shampine's continuous extension in Hairer's DOPRI5 form (its block 2 is the Hermite
@@ -130,45 +166,6 @@ impl Solver {
             self.nested[3 * n + i] = h * acc;
         }
         self.set_dense(t, h, 4);
-    }
-
-    /// One attempted DOP853 step of length `h`: `ynew`, `fnew` and Hairer's combined
-    /// 5th/3rd-order error estimate.
-    pub(super) fn attempt_dp853<S: OdeSystem + ?Sized>(
-        &mut self,
-        sys: &mut S,
-        h: f64,
-        tol: Tol,
-    ) -> f64 {
-        let n = self.n;
-        self.k[..n].copy_from_slice(&self.f);
-        self.run_stages(sys, &DP8_A, &DP8_C, 1..12, h);
-        // Row 12 holds the weights b.
-        for i in 0..n {
-            self.ynew[i] = self.increment(&DP8_A[12][..12], h, i);
-        }
-        self.finish_attempt(
-            sys,
-            h,
-            tol,
-            |s, i| {
-                let mut e5 = 0.0;
-                let mut e3 = 0.0;
-                for j in 0..12 {
-                    let kj = s.k[j * n + i];
-                    e5 += DP8_E5[j] * kj;
-                    e3 += (DP8_A[12][j] - DP8_BHH[j]) * kj;
-                }
-                [e5, e3]
-            },
-            |[err5, err3], n| {
-                let mut deno = err5 + 0.01 * err3;
-                if deno <= 0.0 {
-                    deno = 1.0;
-                }
-                h.abs() * err5 / (deno * n).sqrt()
-            },
-        )
     }
 
     pub(super) fn dense_dp853<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, t: f64, h: f64) {

@@ -585,10 +585,7 @@ impl Solver {
             if h <= 16.0 * f64::EPSILON * t.abs().max(1e-300) {
                 return Err(OdeError::StepSizeUnderflow { t });
             }
-            let err = match tab {
-                Tableau::Dp5 => self.attempt_dp5(sys, h, tol),
-                Tableau::Dp853 => self.attempt_dp853(sys, h, tol),
-            };
+            let err = self.attempt(sys, h, tol, tab);
             if err.is_finite() && err <= 1.0 {
                 self.accept_adaptive(sys, tab, &ctrl, h, err, clipped);
                 return Ok(());
