@@ -1196,6 +1196,56 @@ mod tests {
     }
 
     #[test]
+    fn a_disc_that_never_confirms_its_frame_counts_missing_frames() {
+        // A 1024-line disc configured with the wrong number of lines: the index never comes a
+        // configured revolution after the candidate, so the frame is never confirmed and no
+        // window is measured; that must show in the counters (a missing frame for every three
+        // failed confirmations, two a revolution here), not as silence.
+        let evs = stream(
+            &uniform(1024),
+            Some(0.0),
+            14,
+            84e6,
+            u32::MAX,
+            &kneader(0.01),
+        );
+        for lines in [1000u16, 1023] {
+            let mut m = monitor(indexed(lines, 16, 32, 84e6), 2);
+            assert!(run(&mut m, &evs).is_empty());
+            let d = m.diagnostics().edges;
+            assert_eq!(d.syncs, 0, "{lines}: {d:?}");
+            assert!(d.missing_frames >= 6, "{lines}: {d:?}");
+        }
+        let mut right = monitor(indexed(1024, 16, 32, 84e6), 2);
+        assert!(run(&mut right, &evs).len() >= 5);
+        assert_eq!(right.diagnostics().edges.missing_frames, 0);
+        // A 16-bit counter's index reported ahead of batches that span more than half its
+        // period (see `a_narrow_counter_takes_batches_with_the_index_in_capture_order`):
+        // misplaced, and counted.
+        let evs = stream(&uniform(1024), Some(0.0), 14, 84e6, 0xFFFF, &kneader(0.01));
+        let mut early = monitor(indexed(1024, 16, 16, 84e6), 2);
+        let mut out = Vec::new();
+        for chunk in evs.chunks(150) {
+            for e in chunk {
+                if let Ev::Index(t) = *e {
+                    early.on_index(t);
+                }
+            }
+            let caps: Vec<u32> = chunk
+                .iter()
+                .filter_map(|e| match *e {
+                    Ev::Edge(t) => Some(t),
+                    Ev::Index(_) => None,
+                })
+                .collect();
+            early.on_captures(&caps, |o| out.push(o));
+        }
+        let d = early.diagnostics().edges;
+        assert!(out.is_empty() && d.syncs == 0, "{d:?}");
+        assert!(d.missing_frames >= 3, "{d:?}");
+    }
+
+    #[test]
     fn a_batch_gives_the_same_results_as_edge_by_edge() {
         // Speed swinging by ±35 % three times a revolution (the band refreshed and reopened
         // often), with noise pulses and dropped edges; sample spans from 1 to 32 edges.

@@ -179,7 +179,7 @@ pub struct EdgeCounters {
     /// Extra edges counted in a revolution.
     pub extra: u32,
     /// Frame markers missed (and every three revolutions' worth of edges searched without a
-    /// frame).
+    /// confirmed frame).
     pub missing_frames: u32,
     /// Changes to reverse rotation.
     pub reversals: u32,
@@ -314,7 +314,8 @@ pub struct SpeedTracker {
     acq: [u32; 3],
     confirm: u16,
     seen_special: bool,
-    /// Edges accepted while searching (a missing frame is counted every two revolutions).
+    /// Edges accepted since the search for a frame began, while searching or confirming (a
+    /// missing frame is counted every three revolutions' worth).
     searched: u16,
     counters: EdgeCounters,
 }
@@ -1268,13 +1269,20 @@ impl SpeedTracker {
                         }
                     }
                     SyncState::Confirming => {
+                        // Counted from the candidate, the index is due at tooth 0. Where it
+                        // comes elsewhere, or tooth 0 comes without it, the confirmation
+                        // failed: a revolution's worth of edges searched without a confirmed
+                        // frame (the search's count goes on), so that a disc that never
+                        // confirms (the wrong number of lines, an index misplaced) shows as
+                        // missing frames, not as no windows and no fault.
+                        if indexed && tooth == 0 {
+                            self.sync = SyncState::Synced;
+                            self.counters.syncs = self.counters.syncs.wrapping_add(1);
+                            frame = true;
+                        } else if indexed || tooth == 0 {
+                            self.count_search(enc, enc.edges());
+                        }
                         if indexed {
-                            // Counted from the candidate, the index is due at tooth 0.
-                            if tooth == 0 {
-                                self.sync = SyncState::Synced;
-                                self.counters.syncs = self.counters.syncs.wrapping_add(1);
-                                frame = true;
-                            }
                             tooth = 0;
                         }
                     }
@@ -1284,7 +1292,7 @@ impl SpeedTracker {
                             tooth = 0;
                             self.searched = 0;
                         } else {
-                            self.count_search(enc);
+                            self.count_search(enc, 1);
                         }
                     }
                 }
@@ -1365,10 +1373,11 @@ impl SpeedTracker {
         });
     }
 
-    /// Counts a missing frame for every three revolutions' worth of edges searched without one
-    /// (finding and confirming a pattern takes up to two).
-    fn count_search(&mut self, enc: &Encoder) {
-        self.searched = self.searched.saturating_add(1);
+    /// Counts `n` edges searched, and a missing frame for every three revolutions' worth of
+    /// edges searched without one (finding and confirming a pattern takes up to two).
+    #[inline(never)]
+    fn count_search(&mut self, enc: &Encoder, n: u16) {
+        self.searched = self.searched.saturating_add(n);
         if self.searched >= enc.edges().saturating_mul(3).max(6) {
             self.searched = 0;
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
@@ -1439,7 +1448,7 @@ impl SpeedTracker {
                 }
             }
         }
-        self.count_search(enc);
+        self.count_search(enc, 1);
         // Move on to this edge.
         self.viable = rotate_left(self.viable, edges) & all;
         if self.viable.count_ones() == 1 {
