@@ -397,6 +397,45 @@ fn an_index_disc_from_two_channels() {
     assert!(frames >= 4);
 }
 
+#[test]
+fn an_index_disc_configured_with_the_wrong_lines_says_so() {
+    // A 24-line disc analyzed as 20 or 25 lines never syncs; the report counts the missing
+    // frames and says how many captures come between index pulses.
+    let file = tmp("index-wrong-lines.csv");
+    let text = "[simulation]\nduration = 3.0\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+                [encoder]\nlines = 24\nframing = \"index\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
+                [capture]\nsample_rate = 10e6\n";
+    simulate(text, CaptureFormat::Saleae, &file);
+    for lines in [20u16, 24, 25] {
+        let options = AnalyzeOptions {
+            lines: Some(lines),
+            framing: Some(host_sim::app::analyze::FramingArg::Index),
+            ..AnalyzeOptions::default()
+        };
+        let (report, _) = run_analyze(&file, options);
+        let period = report.index_period.expect("index pulses");
+        assert_eq!((period.captures, period.expected), (24, lines));
+        assert!(period.of >= 15 && period.times == period.of, "{period:?}");
+        let said = host_sim::app::analyze::text(&report);
+        if lines == 24 {
+            assert!(report.sync_acquired.is_some());
+            assert_eq!(report.missing_frames, 0);
+            assert!(!said.contains("index: "), "{said}");
+        } else {
+            assert!(report.sync_acquired.is_none());
+            assert!(report.missing_frames >= 4, "{}", report.missing_frames);
+            assert!(
+                said.contains(&format!(
+                    "index: 24 captures from one index pulse to the next ({} of {} times), \
+                     but a revolution of the configured wheel is {lines}",
+                    period.times, period.of
+                )),
+                "{said}"
+            );
+        }
+    }
+}
+
 /// Every format writes and reads back the same transitions, to its time resolution: the
 /// sample grid (sigrok, plain exactly; Saleae's nine decimals to half a nanosecond).
 #[test]

@@ -155,6 +155,65 @@ pub struct SyncOut {
     pub state: &'static str,
 }
 
+/// Encoder captures between consecutive index pulses, against the revolution the
+/// configuration expects: a disc with another number of lines than configured never syncs.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq, Eq)]
+pub struct IndexPeriod {
+    /// The most common number of captures from one index pulse to the next.
+    pub captures: u64,
+    /// How many of the intervals between index pulses had that many.
+    pub times: u64,
+    /// Intervals between index pulses.
+    pub of: u64,
+    /// Captures per revolution of the configured wheel.
+    pub expected: u16,
+}
+
+/// Counts the captures between index pulses (at most [`MAX_PERIODS`] distinct counts kept).
+#[derive(Default)]
+struct IndexPeriods {
+    since: Option<u64>,
+    counts: std::collections::BTreeMap<u64, u64>,
+    of: u64,
+}
+
+/// Most distinct capture counts between index pulses kept (memory bounded).
+const MAX_PERIODS: usize = 1024;
+
+impl IndexPeriods {
+    fn index(&mut self) {
+        if let Some(n) = self.since {
+            self.of += 1;
+            if self.counts.len() < MAX_PERIODS || self.counts.contains_key(&n) {
+                *self.counts.entry(n).or_insert(0) += 1;
+            }
+        }
+        self.since = Some(0);
+    }
+
+    fn capture(&mut self) {
+        if let Some(n) = &mut self.since {
+            *n += 1;
+        }
+    }
+
+    /// The most common count (the smallest of equally common ones).
+    fn period(&self, expected: u16) -> Option<IndexPeriod> {
+        let mut best: Option<(u64, u64)> = None;
+        for (&captures, &times) in &self.counts {
+            if best.is_none_or(|(_, t)| times > t) {
+                best = Some((captures, times));
+            }
+        }
+        best.map(|(captures, times)| IndexPeriod {
+            captures,
+            times,
+            of: self.of,
+            expected,
+        })
+    }
+}
+
 /// What the core found in a capture.
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct AnalyzeReport {
@@ -207,6 +266,9 @@ pub struct AnalyzeReport {
     pub sync_acquired: Option<f64>,
     /// The sync state at the end.
     pub sync_state: &'static str,
+    /// How many encoder captures came between consecutive index pulses (with an index
+    /// channel and at least two pulses).
+    pub index_period: Option<IndexPeriod>,
     /// Every change of the sync state (at most [`MAX_LISTED`]).
     pub sync: Vec<SyncOut>,
     /// Valid and invalid windows.
@@ -405,6 +467,7 @@ pub fn analyze<R: BufRead>(
         max_revs: usize::from(monitor.window_revolutions()),
     };
     let mut prev: Vec<Level> = Vec::new();
+    let mut periods = IndexPeriods::default();
     let mut last_event: Option<f64> = None;
     let mut last_poll = f64::NEG_INFINITY;
     let mut end = 0.0;
@@ -445,10 +508,12 @@ pub fn analyze<R: BufRead>(
         last_event = Some(t);
         if index_edge {
             report.index_pulses += 1;
+            periods.index();
             monitor.on_index(ticks);
         }
         if encoder_edge {
             report.edges += 1;
+            periods.capture();
             let o = monitor.on_edge_observed(ticks, None, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
         }
@@ -475,6 +540,7 @@ pub fn analyze<R: BufRead>(
     report.valid_windows = d.valid_windows;
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
+    report.index_period = periods.period(enc.edges());
     // Edges fed but neither accepted nor rejected: still waiting for their lookahead.
     report.unjudged_at_end = report
         .edges
@@ -671,6 +737,18 @@ pub fn text(r: &AnalyzeReport) -> String {
         None => {
             let _ = writeln!(s, "sync: never acquired ({} at the end)", r.sync_state);
         }
+    }
+    if let Some(p) = r
+        .index_period
+        .filter(|p| p.captures != u64::from(p.expected))
+    {
+        let _ = writeln!(
+            s,
+            "index: {} captures from one index pulse to the next ({} of {} times), but a \
+             revolution of the configured wheel is {}: check the number of lines (and the \
+             edge polarity)",
+            p.captures, p.times, p.of, p.expected
+        );
     }
     for e in r.sync.iter().take(20) {
         let _ = writeln!(s, "  {:>12.6} s  {}", e.time, e.state);
