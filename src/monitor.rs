@@ -1049,8 +1049,28 @@ mod tests {
     }
 
     /// Feeds `evs` in batches of pseudo-random sizes (1 to 150, every few batches a single
-    /// edge through `on_edge` instead), seeded by `seed`.
+    /// edge through `on_edge` instead), seeded by `seed`. An index pulse is reported as it
+    /// comes, ahead of the batch holding the captures before it, as a DMA firmware's index
+    /// interrupt does (see `run_batched_in_order`).
     fn run_batched(m: &mut DeltaMonitor<1024>, evs: &[Ev], seed: u64) -> Vec<WindowOutcome> {
+        feed_batched(m, evs, seed, false)
+    }
+
+    /// [`run_batched`] with each index pulse reported where it falls: the batch split at it.
+    fn run_batched_in_order(
+        m: &mut DeltaMonitor<1024>,
+        evs: &[Ev],
+        seed: u64,
+    ) -> Vec<WindowOutcome> {
+        feed_batched(m, evs, seed, true)
+    }
+
+    fn feed_batched(
+        m: &mut DeltaMonitor<1024>,
+        evs: &[Ev],
+        seed: u64,
+        in_order: bool,
+    ) -> Vec<WindowOutcome> {
         let mut rng = seed;
         let mut next = |n: u64| {
             rng = rng
@@ -1063,7 +1083,13 @@ mod tests {
         let mut size = 1 + next(150) as usize;
         for e in evs {
             match *e {
-                Ev::Index(t) => m.on_index(t),
+                Ev::Index(t) => {
+                    if in_order {
+                        m.on_captures(&chunk, |o| out.push(o));
+                        chunk.clear();
+                    }
+                    m.on_index(t);
+                }
                 Ev::Edge(t) => {
                     chunk.push(t);
                     if chunk.len() >= size {
@@ -1136,12 +1162,11 @@ mod tests {
                     }
                     used.configure_from(*after, window(2), Some(AlarmConfig::new(0.06)))
                         .unwrap();
-                    let new = monitor(*after, 2);
+                    let mut new = monitor(*after, 2);
                     assert_eq!(used.tracker.without_slots(), new.tracker.without_slots());
                     assert_eq!(format!("{:?}", used.state), format!("{:?}", new.state));
                     assert_eq!(used.diag, new.diag);
                     assert_eq!(used.encoder, new.encoder);
-                    let mut new = new;
                     let (a, b) = if batched {
                         (
                             run_batched(&mut used, &streams[j], 11),
@@ -1161,7 +1186,7 @@ mod tests {
 
     #[test]
     fn a_narrow_counter_takes_batches_with_the_index_in_capture_order() {
-        // A 16-bit counter's period (65 536 ticks) is 17 edges here, less than a batch: an
+        // A 16-bit counter's period (65 536 ticks) is 17 edges here, less than most batches: an
         // index timestamp alone cannot say which of a batch's captures it falls among, so the
         // index is reported where it falls, between the captures before it and those after
         // it (the batch split at it), and the results are those of edge by edge.
@@ -1169,28 +1194,10 @@ mod tests {
         let mut one = monitor(indexed(1024, 16, 16, 84e6), 2);
         let expected = run(&mut one, &evs);
         assert!(expected.len() >= 5, "{expected:?}");
-        for batch in [17usize, 64, 150] {
+        for seed in 1..4u64 {
             let mut m = monitor(indexed(1024, 16, 16, 84e6), 2);
-            let mut out = Vec::new();
-            let mut chunk = Vec::new();
-            for e in &evs {
-                match *e {
-                    Ev::Index(t) => {
-                        m.on_captures(&chunk, |o| out.push(o));
-                        chunk.clear();
-                        m.on_index(t);
-                    }
-                    Ev::Edge(t) => {
-                        chunk.push(t);
-                        if chunk.len() == batch {
-                            m.on_captures(&chunk, |o| out.push(o));
-                            chunk.clear();
-                        }
-                    }
-                }
-            }
-            m.on_captures(&chunk, |o| out.push(o));
-            assert_eq!(out, expected, "batches of {batch}");
+            let out = run_batched_in_order(&mut m, &evs, seed);
+            assert_eq!(out, expected, "seed {seed}");
             assert_eq!(m.diagnostics(), one.diagnostics());
         }
     }
@@ -1220,26 +1227,12 @@ mod tests {
         assert!(run(&mut right, &evs).len() >= 5);
         assert_eq!(right.diagnostics().edges.missing_frames, 0);
         // A 16-bit counter's index reported ahead of batches that span more than half its
-        // period (see `a_narrow_counter_takes_batches_with_the_index_in_capture_order`):
-        // misplaced, and counted.
+        // period (up to 150 captures; see
+        // `a_narrow_counter_takes_batches_with_the_index_in_capture_order`): misplaced, and
+        // counted.
         let evs = stream(&uniform(1024), Some(0.0), 14, 84e6, 0xFFFF, &kneader(0.01));
         let mut early = monitor(indexed(1024, 16, 16, 84e6), 2);
-        let mut out = Vec::new();
-        for chunk in evs.chunks(150) {
-            for e in chunk {
-                if let Ev::Index(t) = *e {
-                    early.on_index(t);
-                }
-            }
-            let caps: Vec<u32> = chunk
-                .iter()
-                .filter_map(|e| match *e {
-                    Ev::Edge(t) => Some(t),
-                    Ev::Index(_) => None,
-                })
-                .collect();
-            early.on_captures(&caps, |o| out.push(o));
-        }
+        let out = run_batched(&mut early, &evs, 11);
         let d = early.diagnostics().edges;
         assert!(out.is_empty() && d.syncs == 0, "{d:?}");
         assert!(d.missing_frames >= 3, "{d:?}");

@@ -369,21 +369,32 @@ fn dropped_teeth_are_counted_as_missing() {
     assert_eq!((report.glitches, report.extra), (0, 0));
 }
 
+/// A scene of a 24-line disc with an index pulse on its own channel, at 40 rad/s for
+/// `duration` s, captured at 10 MS/s.
+fn index_disc(duration: f64) -> String {
+    format!(
+        "[simulation]\nduration = {duration}\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+         [encoder]\nlines = 24\nframing = \"index\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
+         [capture]\nsample_rate = 10e6\n"
+    )
+}
+
+/// Analysis of an index disc of `lines` lines.
+fn index_lines(lines: u16) -> AnalyzeOptions {
+    AnalyzeOptions {
+        lines: Some(lines),
+        framing: Some(host_sim::app::analyze::FramingArg::Index),
+        ..AnalyzeOptions::default()
+    }
+}
+
 /// An index disc (24 lines and an index pulse on its own channel): synced by the index,
 /// every revolution counted, no fault.
 #[test]
 fn an_index_disc_from_two_channels() {
     let file = tmp("index.csv");
-    let text = "[simulation]\nduration = 1.0\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
-                [encoder]\nlines = 24\nframing = \"index\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
-                [capture]\nsample_rate = 10e6\n";
-    let run = simulate(text, CaptureFormat::Saleae, &file);
-    let options = AnalyzeOptions {
-        lines: Some(24),
-        framing: Some(host_sim::app::analyze::FramingArg::Index),
-        ..AnalyzeOptions::default()
-    };
-    let (report, seen) = run_analyze(&file, options);
+    let run = simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
+    let (report, seen) = run_analyze(&file, index_lines(24));
     assert_eq!(report.index_channel.as_deref(), Some("Channel 1"));
     assert!(seen.iter().all(|s| matches!(s, Seen::Tooth { .. })));
     let index = run.edge_list.iter().filter(|e| e.index && e.rising).count() as u64;
@@ -402,17 +413,9 @@ fn an_index_disc_configured_with_the_wrong_lines_says_so() {
     // A 24-line disc analyzed as 20 or 25 lines never syncs; the report counts the missing
     // frames and says how many captures come between index pulses.
     let file = tmp("index-wrong-lines.csv");
-    let text = "[simulation]\nduration = 3.0\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
-                [encoder]\nlines = 24\nframing = \"index\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
-                [capture]\nsample_rate = 10e6\n";
-    simulate(text, CaptureFormat::Saleae, &file);
+    simulate(&index_disc(3.0), CaptureFormat::Saleae, &file);
     for lines in [20u16, 24, 25] {
-        let options = AnalyzeOptions {
-            lines: Some(lines),
-            framing: Some(host_sim::app::analyze::FramingArg::Index),
-            ..AnalyzeOptions::default()
-        };
-        let (report, _) = run_analyze(&file, options);
+        let (report, _) = run_analyze(&file, index_lines(lines));
         let period = report.index_period.expect("index pulses");
         assert_eq!((period.captures, period.expected), (24, lines));
         assert!(period.of >= 15 && period.times == period.of, "{period:?}");
