@@ -30,6 +30,8 @@ fi
 [ "$missing" -eq 0 ] || exit 1
 
 echo "== build (release, thumbv7em-none-eabihf)"
+# The instruction counts below depend on the compiler's code generation: name it.
+echo "compiler: $(rustc --version)"
 source ../tools/firmware.sh
 elf="$(release_elf run.sh)"
 echo "ELF: $elf"

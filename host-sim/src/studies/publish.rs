@@ -93,6 +93,7 @@ fn pareto_plot(path: &Path, title: &str, rows: &[ParetoRow]) -> Result<(), Strin
 /// against f64 or exact references, on the target).
 struct TargetReport {
     benches: Vec<(String, String)>,
+    compiler: String,
     footprint: String,
     memory: Vec<String>,
     accuracy: Vec<String>,
@@ -125,6 +126,12 @@ fn target_benches() -> Result<TargetReport, String> {
         .find(|l| l.starts_with("footprint:"))
         .unwrap_or("")
         .to_string();
+    let compiler = text
+        .lines()
+        .find_map(|l| l.strip_prefix("compiler: "))
+        .ok_or("examples/qemu/run.sh printed no `compiler:` line")?
+        .trim()
+        .to_string();
     let accuracy = text
         .lines()
         .filter(|l| l.starts_with("accuracy ") || l.starts_with("delta: "))
@@ -137,6 +144,7 @@ fn target_benches() -> Result<TargetReport, String> {
         .collect();
     Ok(TargetReport {
         benches,
+        compiler,
         footprint,
         memory,
         accuracy,
@@ -165,6 +173,7 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
     if target {
         let TargetReport {
             benches,
+            compiler,
             footprint,
             memory,
             accuracy,
@@ -183,7 +192,8 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
         );
         let _ = writeln!(
             md,
-            "Instructions per call, counted with SysTick; {footprint}.\n"
+            "Instructions per call, counted with SysTick, firmware built by {compiler} (the \
+             counts depend on its code generation); {footprint}.\n"
         );
         let _ = writeln!(md, "| path | instructions per call |\n|---|---:|");
         for (name, n) in &benches {
