@@ -410,3 +410,36 @@ fn simulated_support_reactions_reach_the_rotating_peak() {
     assert_eq!(s.speed, None);
     assert_eq!(s.simulated_reaction_level, Some(["over", "warning"]));
 }
+
+/// A press whose reduced inertia swings 1 ± 0.4 kg·m² twice a revolution, with a constant
+/// load: ω ∝ 1/√J(φ) makes δ = 2(√(1.4/0.6) − 1)/(√(1.4/0.6) + 1) ≈ 0.417 with no load
+/// ripple at all. `predict` ignored `inertia_harmonics` and said δ = 0, "within the δ limit
+/// without a flywheel"; now it says it does not predict δ, and why.
+#[test]
+fn a_varying_inertia_is_not_predicted_as_a_constant_one() {
+    let scene = "[shaft]\ninertia = 1.0\ninertia_harmonics = [{ order = 2.0, amplitude = 0.4 }]\n\
+                 [motor]\nmodel = \"parabola\"\nno_load_speed = 160.0\nbreakdown_speed = 40.0\n\
+                 breakdown_torque = 300.0\n[load]\nmean = 50.0\n\
+                 [encoder]\nlines = 2048\ntimer_hz = 100e6\n[monitor]\ndelta_limit = 0.01\n\
+                 [simulation]\nduration = 5.0\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert!(p.irregularity.is_none());
+    let why = p.irregularity_not_predicted.as_deref().unwrap();
+    assert!(why.contains("shaft.inertia_harmonics"), "{why}");
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("NOT PREDICTED") && !text.contains("within the δ limit"),
+        "{text}"
+    );
+    let r = run_trial(scene);
+    assert_eq!(r.delta_predicted, None);
+    let ratio = (1.4f64 / 0.6).sqrt();
+    let energy = 2.0 * (ratio - 1.0) / (ratio + 1.0);
+    let measured = r.delta_measured.unwrap();
+    assert!(
+        (measured / energy - 1.0).abs() < 0.02,
+        "{measured} against {energy}"
+    );
+}

@@ -316,6 +316,10 @@ pub struct Prediction {
     /// Predicted irregularity (scenes with a torque motor and a load).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub irregularity: Option<IrregularityOut>,
+    /// Why a scene with a torque motor and a load has no `irregularity`
+    /// ([`irregularity_not_predicted`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub irregularity_not_predicted: Option<String>,
     /// Support unbalances and limits (scenes with a rotor).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsOut>,
@@ -327,14 +331,37 @@ pub struct Prediction {
 impl Prediction {
     /// Whether the scene gave nothing to predict (no drive model, rotor or vibration machine).
     pub fn is_empty(&self) -> bool {
-        self.irregularity.is_none() && self.supports.is_none() && self.autobalancer.is_none()
+        self.irregularity.is_none()
+            && self.irregularity_not_predicted.is_none()
+            && self.supports.is_none()
+            && self.autobalancer.is_none()
     }
+}
+
+/// Why the steady-state δ of a scene's drive is not predicted, when it is not: the closed form
+/// (seed 000, eq. 11–13) and the flywheel sizing hold for a constant inertia, and
+/// `[shaft] inertia_harmonics` makes J depend on φ (its ½·ω²·dJ/dφ term alone makes ω swing,
+/// ω ∝ 1/√J(φ) without any load ripple). `run` simulates such a drive; the prediction would
+/// silently leave the variation out.
+pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
+    let shaft = scene.shaft.as_ref()?;
+    let varying = shaft.inertia_harmonics.iter().any(|h| h.amplitude != 0.0);
+    varying.then(|| {
+        "shaft.inertia_harmonics makes J depend on φ; the closed form (seed 000 eq. 11–13) and \
+         the flywheel sizing hold for a constant J only, so no δ is predicted (`drive-sim run` \
+         simulates J(φ))"
+            .to_string()
+    })
 }
 
 /// Computes the design-time results of `scene`.
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();
-    if let Some(model) = drive_model(scene, file)? {
+    let model = drive_model(scene, file)?;
+    if model.is_some() {
+        p.irregularity_not_predicted = irregularity_not_predicted(scene);
+    }
+    if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
         let irr = model
             .irregularity(limit)

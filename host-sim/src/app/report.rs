@@ -420,6 +420,9 @@ pub fn prediction_text(p: &Prediction) -> String {
             );
         }
     }
+    if let Some(why) = &p.irregularity_not_predicted {
+        let _ = writeln!(s, "Running irregularity NOT PREDICTED: {why}");
+    }
     if let Some(u) = &p.supports {
         let _ = writeln!(s, "Support unbalance (seed 002) and limits (ISO 21940-11)");
         let _ = writeln!(

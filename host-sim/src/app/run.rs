@@ -1245,7 +1245,10 @@ pub fn run_with(
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         ..Default::default()
     };
-    if let Some(model) = &model {
+    if let Some(model) = model
+        .as_ref()
+        .filter(|_| predict::irregularity_not_predicted(scene).is_none())
+    {
         report.delta_predicted = model.predict().steady().map(|s| s.delta);
     }
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
