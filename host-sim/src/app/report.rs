@@ -1,7 +1,7 @@
 //! Readable text reports.
 
 use crate::app::plot::{write_svg, Chart, Mark, Series};
-use crate::app::predict::{self, Prediction};
+use crate::app::predict::{self, fmt_delta, Prediction};
 use crate::app::run::RunReport;
 use crate::app::scene::Scene;
 use std::fmt::Write;
@@ -63,9 +63,17 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         }
         match (r.delta_measured, r.delta_predicted) {
             (Some(m), Some(p)) => {
+                // The speed samples average away more than 1 % of the predicted δ: say what
+                // they can show (the prediction's WARNING says why).
+                let sampled = match r.delta_predicted_through_samples {
+                    Some(d) if d < 0.99 * p => {
+                        format!(" ({} through the core's speed samples)", fmt_delta(d))
+                    }
+                    _ => String::new(),
+                };
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{}, noise floor {}",
+                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{sampled}{}, noise floor {}",
                     r.settle,
                     // A drive without load ripple is predicted δ = 0: no relative difference.
                     if p > 0.0 {
@@ -418,6 +426,9 @@ pub fn prediction_text(p: &Prediction) -> String {
                 s,
                 "  ∂δ/∂J = {dj:.4e} per kg·m², ∂δ/∂M_m = {dm:.4e} per N·m"
             );
+        }
+        if let Some(w) = &i.sampling_warning {
+            let _ = writeln!(s, "  {w}");
         }
     }
     if let Some(why) = &p.irregularity_not_predicted {

@@ -117,6 +117,10 @@ pub struct RunReport {
     pub delta_measured: Option<f64>,
     /// δ predicted by the drive model.
     pub delta_predicted: Option<f64>,
+    /// The predicted δ as the core's speed samples (`encoder.estimator_edges` edges each) can
+    /// show it ([`predict::sampled_delta`]): what the measurement is to be compared with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_predicted_through_samples: Option<f64>,
     /// Windows reported by the core.
     pub windows: u32,
     /// Of which invalid.
@@ -1250,6 +1254,8 @@ pub fn run_with(
         .filter(|_| predict::irregularity_not_predicted(scene).is_none())
     {
         report.delta_predicted = model.predict().steady().map(|s| s.delta);
+        report.delta_predicted_through_samples =
+            predict::sampled_delta(scene, file, model)?.map(|s| s.delta);
     }
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
         Samples::All(v) => v,
