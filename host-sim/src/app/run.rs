@@ -111,7 +111,7 @@ pub struct RunReport {
     pub component_evaluations: BTreeMap<&'static str, u64>,
     /// Accepted and rejected integrator steps.
     pub steps: [u64; 2],
-    /// Edges generated (line, index and glitch).
+    /// Edges generated (line, index and glitch); 0 without an `[encoder]`.
     pub edges: u64,
     /// Median δ of the valid steady windows after the settling time.
     pub delta_measured: Option<f64>,
@@ -135,7 +135,7 @@ pub struct RunReport {
     pub rejected_edges: [u32; 3],
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
-    /// Why the core measured nothing, when it has an encoder and no valid window.
+    /// Why the core measured nothing: no valid window, or no `[encoder]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_measurement: Option<String>,
     /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
@@ -1239,7 +1239,12 @@ pub fn run_with(
             .map(|c| (c.name, c.evals))
             .collect(),
         steps: [stats.solver.accepted_steps, stats.solver.rejected_steps],
-        edges: stats.encoder.edges,
+        // Without an [encoder] the simulation's internal coarse encoder is no scene's.
+        edges: if scene.encoder.is_some() {
+            stats.encoder.edges
+        } else {
+            0
+        },
         settle,
         capture_file: options
             .capture
@@ -1342,6 +1347,10 @@ fn stopped(scene: &Scene, file: &Path, stop: Stop, t: f64) -> SceneError {
 /// What the core measured: windows, rejected edges, δ, and why nothing was measured.
 fn measurement(report: &mut RunReport, col: &mut Collector) {
     let Some(m) = &col.monitor else {
+        report.no_measurement = Some(
+            "the scene has no [encoder] (lines and timer_hz), so the core had no edges to measure"
+                .to_string(),
+        );
         return;
     };
     let d = m.diagnostics();
