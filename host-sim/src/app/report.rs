@@ -73,13 +73,18 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                 };
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{sampled}{}, noise floor {}",
+                    "  δ measured {} (median of steady windows after {:.1} s), predicted {}{sampled}{}, noise floor {}",
+                    fmt_delta(m),
                     r.settle,
+                    fmt_delta(p),
                     // A drive without load ripple is predicted δ = 0: no relative difference.
-                    if p > 0.0 {
-                        format!(": {:+.2} %", 100.0 * (m / p - 1.0))
-                    } else {
-                        String::new()
+                    // Both below the noise floor: the difference is the quantization's.
+                    match r.noise_floor {
+                        Some(f) if m < f && p < f => {
+                            ": both below the noise floor, not resolved".to_string()
+                        }
+                        _ if p > 0.0 => format!(": {:+.2} %", 100.0 * (m / p - 1.0)),
+                        _ => String::new(),
                     },
                     floor(r.noise_floor)
                 );
@@ -87,7 +92,8 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             (Some(m), None) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6}, noise floor {}",
+                    "  δ measured {}, noise floor {}",
+                    fmt_delta(m),
                     floor(r.noise_floor)
                 );
             }
@@ -403,8 +409,10 @@ pub fn prediction_text(p: &Prediction) -> String {
         if i.steady_state {
             let _ = writeln!(
                 s,
-                "  ω max {:.3} rad/s, ω min {:.3} rad/s, δ = {:.6}",
-                i.omega_max, i.omega_min, i.delta
+                "  ω max {:.3} rad/s, ω min {:.3} rad/s, δ = {}",
+                i.omega_max,
+                i.omega_min,
+                fmt_delta(i.delta)
             );
         } else {
             let _ = writeln!(s, "  no steady state: the motor stalls under the peak load");
