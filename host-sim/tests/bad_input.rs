@@ -251,6 +251,24 @@ fn a_run_that_measures_nothing_says_why_and_does_not_judge_the_supports_normal()
 }
 
 #[test]
+fn a_run_without_an_encoder_says_the_core_measured_nothing() {
+    // The kneader without [encoder]: the report listed 427 edges (the simulation's internal
+    // coarse encoder) and said nothing about the measurement at all.
+    let text = bundled("kneader").replacen("[encoder]\nlines = 1024\ntimer_hz = 84e6\n", "", 1);
+    assert!(!text.contains("[encoder]"));
+    let text = text
+        .replacen("duration = 30.0", "duration = 3.0", 1)
+        .replacen("settle = 10.0", "settle = 1.0", 1);
+    let s = Scene::parse(&text, Path::new("no-encoder.toml")).unwrap();
+    let r = run(&s, Path::new("no-encoder.toml"), Overrides::default()).unwrap();
+    assert_eq!(r.edges, 0);
+    let why = r.no_measurement.as_deref().unwrap();
+    assert!(why.contains("[encoder]"), "{why}");
+    let text = run_text(&s, &r);
+    assert!(text.contains("NOTHING MEASURED"), "{text}");
+}
+
+#[test]
 fn work_is_bounded_before_simulating() {
     // Finding 2: `duration = 1e308` was accepted and ran without end; `motor.speed = 1e308`
     // looped forever; memory grew with the duration.

@@ -529,3 +529,25 @@ fn run_writes_a_capture_that_analyze_reads() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn predict_says_a_prescribed_speed_gives_no_delta() {
+    // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]
+    // with [load] and [shaft], which it has.
+    let dir = scratch("prescribed");
+    let path = dir.join("prescribed.toml");
+    std::fs::write(
+        &path,
+        "[shaft]\ninertia = 0.3\n[motor]\nmodel = \"speed\"\nspeed = 100.0\n\
+         [load]\nmean = 3.0\nharmonics = [{ order = 1.0, amplitude = 2.0 }]\n",
+    )
+    .unwrap();
+    let (ok, out, err) = drive_sim(&["predict", path.to_str().unwrap()]);
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(
+        err.contains("nothing to predict")
+            && err.contains("model = \"speed\" prescribes the speed"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

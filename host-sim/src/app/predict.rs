@@ -76,6 +76,152 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
         .map_err(|e| core_error(scene, file, "shaft", e))
 }
 
+/// What the core's speed samples do to the predicted δ: each sample is the angle of
+/// `encoder.estimator_edges` edges over their time, the mean speed over that angle, so a load
+/// cycle not much longer than the samples' span is averaged away (entirely when the span is a
+/// whole number of load cycles: 16-edge samples on a 16-line disc see no order-1 ripple).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampledDelta {
+    /// Edges per speed sample (`encoder.estimator_edges`).
+    pub edges: u16,
+    /// Shaft angle one sample spans, rad.
+    pub span: f64,
+    /// δ of the predicted steady state through those samples.
+    pub delta: f64,
+    /// The most edges per sample that keep 99 % of the predicted δ (`None` when even one
+    /// edge does not).
+    pub edges_for_99_percent: Option<u16>,
+}
+
+/// Largest grid [`delta_through_samples`] evaluates the steady state on.
+const MAX_SAMPLED_POINTS: usize = 1 << 22;
+
+/// δ of `model`'s steady state as speed samples spanning `span` radians show it: the mean
+/// speed over each span (the angle over the time `∫dφ/ω`), at every shaft angle of one period
+/// of the load, on a grid of at least 16 points per span and 512 per period. `None` without a
+/// steady state, for loads without a common period ([`drive_monitor::drive::Horizon::Unbounded`])
+/// or when the grid would exceed 4 M points.
+pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
+    use drive_monitor::drive::Horizon;
+    model.predict().steady()?;
+    let period = match model.horizon() {
+        Horizon::Constant => return Some(0.0),
+        Horizon::ClosedForm => {
+            let order = model
+                .load()
+                .harmonics()
+                .iter()
+                .map(|h| h.order().abs())
+                .filter(|o| *o > 0.0)
+                .reduce(f64::min)?;
+            std::f64::consts::TAU / order
+        }
+        Horizon::Period { radians, .. } => radians,
+        Horizon::Unbounded => return None,
+    };
+    if !(span > 0.0 && period > 0.0) {
+        return None;
+    }
+    let per_span = ((512.0 * span / period).ceil() as usize).max(16);
+    let h = span / per_span as f64;
+    let steps = (period / h).ceil();
+    if !(steps.is_finite() && steps as usize + per_span <= MAX_SAMPLED_POINTS) {
+        return None;
+    }
+    let steps = steps as usize;
+    // Time per radian on the grid from −span to the period, and its running integral.
+    let mut time = Vec::with_capacity(steps + per_span + 1);
+    let mut last = 1.0 / model.steady_omega(-span)?;
+    time.push(0.0);
+    for j in 1..=steps + per_span {
+        let f = 1.0 / model.steady_omega(-span + j as f64 * h)?;
+        time.push(time[j - 1] + 0.5 * h * (last + f));
+        last = f;
+    }
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for j in per_span..time.len() {
+        let w = span / (time[j] - time[j - per_span]);
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    Some(2.0 * (hi - lo) / (hi + lo))
+}
+
+/// [`SampledDelta`] of a scene's drive through its encoder's speed samples (`None` without a
+/// prediction, an `[encoder]`, or when [`delta_through_samples`] gives none).
+pub fn sampled_delta(
+    scene: &Scene,
+    file: &Path,
+    model: &DriveModel,
+) -> Result<Option<SampledDelta>, SceneError> {
+    let Some(e) = &scene.encoder else {
+        return Ok(None);
+    };
+    let Some(predicted) = model.predict().steady().map(|s| s.delta) else {
+        return Ok(None);
+    };
+    let wheel = crate::app::check::wheel(e, &scene.checker(file))?;
+    // Edges per revolution the core sees: the wheel's teeth, one in `prescaler` captured.
+    let pitch = std::f64::consts::TAU * f64::from(e.prescaler) / wheel.teeth.len().max(1) as f64;
+    let span = |k: u16| f64::from(k) * pitch;
+    let Some(delta) = delta_through_samples(model, span(e.estimator_edges)) else {
+        return Ok(None);
+    };
+    let keeps = |d: f64| d >= 0.99 * predicted;
+    let edges_for_99_percent = if keeps(delta) {
+        Some(e.estimator_edges)
+    } else {
+        (1..e.estimator_edges)
+            .rev()
+            .find(|&k| delta_through_samples(model, span(k)).is_some_and(keeps))
+    };
+    Ok(Some(SampledDelta {
+        edges: e.estimator_edges,
+        span: span(e.estimator_edges),
+        delta,
+        edges_for_99_percent,
+    }))
+}
+
+/// The line a report adds when the speed samples average away more than 1 % of the predicted
+/// δ (`None` otherwise).
+pub fn sampled_delta_warning(predicted: f64, s: &SampledDelta) -> Option<String> {
+    if s.delta >= 0.99 * predicted {
+        return None;
+    }
+    let advice = match s.edges_for_99_percent {
+        Some(k) => format!("encoder.estimator_edges = {k} or fewer keeps 99 % of it"),
+        None => {
+            "even one edge per sample loses more than 1 % (a finer encoder would not)".to_string()
+        }
+    };
+    Some(format!(
+        "WARNING: speed samples over encoder.estimator_edges = {} edges span {:.3} revolution and \
+         average the load ripple: of the predicted δ {} they can show {} ({:+.1} %), and the δ \
+         alarm sees only that; {advice}",
+        s.edges,
+        s.span / std::f64::consts::TAU,
+        fmt_delta(predicted),
+        // Below this the samples' δ is the rounding of a ripple averaged away exactly.
+        if s.delta < 1e-9 * predicted {
+            "none".to_string()
+        } else {
+            fmt_delta(s.delta)
+        },
+        100.0 * (s.delta / predicted - 1.0)
+    ))
+}
+
+/// A δ as text: six decimals, or four significant digits below 0.001 (where six decimals
+/// would keep one digit or none).
+pub fn fmt_delta(d: f64) -> String {
+    if d != 0.0 && d.abs() < 1e-3 {
+        format!("{d:.3e}")
+    } else {
+        format!("{d:.6}")
+    }
+}
+
 /// The rotor on two supports and its limits (`None` without `[rotor]`).
 pub fn rotor(
     scene: &Scene,
@@ -289,6 +435,13 @@ pub struct IrregularityOut {
     pub d_delta_d_inertia: Option<f64>,
     /// ∂δ/∂M_m, per N·m.
     pub d_delta_d_breakdown_torque: Option<f64>,
+    /// δ of the steady state as the core's speed samples (`encoder.estimator_edges` edges
+    /// each) can show it (absent without an `[encoder]`; [`sampled_delta`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_through_samples: Option<f64>,
+    /// The report's warning when those samples lose more than 1 % of δ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampling_warning: Option<String>,
 }
 
 /// `supports` member of `predict --json`.
@@ -316,6 +469,10 @@ pub struct Prediction {
     /// Predicted irregularity (scenes with a torque motor and a load).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub irregularity: Option<IrregularityOut>,
+    /// Why a scene with a torque motor and a load has no `irregularity`
+    /// ([`irregularity_not_predicted`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub irregularity_not_predicted: Option<String>,
     /// Support unbalances and limits (scenes with a rotor).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsOut>,
@@ -327,20 +484,46 @@ pub struct Prediction {
 impl Prediction {
     /// Whether the scene gave nothing to predict (no drive model, rotor or vibration machine).
     pub fn is_empty(&self) -> bool {
-        self.irregularity.is_none() && self.supports.is_none() && self.autobalancer.is_none()
+        self.irregularity.is_none()
+            && self.irregularity_not_predicted.is_none()
+            && self.supports.is_none()
+            && self.autobalancer.is_none()
     }
+}
+
+/// Why the steady-state δ of a scene's drive is not predicted, when it is not: the closed form
+/// (seed 000, eq. 11–13) and the flywheel sizing hold for a constant inertia, and
+/// `[shaft] inertia_harmonics` makes J depend on φ (its ½·ω²·dJ/dφ term alone makes ω swing,
+/// ω ∝ 1/√J(φ) without any load ripple). `run` simulates such a drive; the prediction would
+/// silently leave the variation out.
+pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
+    let shaft = scene.shaft.as_ref()?;
+    let varying = shaft.inertia_harmonics.iter().any(|h| h.amplitude != 0.0);
+    varying.then(|| {
+        "shaft.inertia_harmonics makes J depend on φ; the closed form (seed 000 eq. 11–13) and \
+         the flywheel sizing hold for a constant J only, so no δ is predicted (`drive-sim run` \
+         simulates J(φ))"
+            .to_string()
+    })
 }
 
 /// Computes the design-time results of `scene`.
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();
-    if let Some(model) = drive_model(scene, file)? {
+    let model = drive_model(scene, file)?;
+    if model.is_some() {
+        p.irregularity_not_predicted = irregularity_not_predicted(scene);
+    }
+    if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
         let irr = model
             .irregularity(limit)
             .map_err(|e| core_error(scene, file, "monitor", e))?;
         let sens = model.sensitivity();
+        let sampled = sampled_delta(scene, file, &model)?;
         p.irregularity = Some(IrregularityOut {
+            delta_through_samples: sampled.map(|s| s.delta),
+            sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             omega_max: irr.omega_max,
             omega_min: irr.omega_min,
             delta: irr.delta,

@@ -1,7 +1,7 @@
 //! Readable text reports.
 
 use crate::app::plot::{write_svg, Chart, Mark, Series};
-use crate::app::predict::{self, Prediction};
+use crate::app::predict::{self, fmt_delta, Prediction};
 use crate::app::run::RunReport;
 use crate::app::scene::Scene;
 use std::fmt::Write;
@@ -63,15 +63,28 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         }
         match (r.delta_measured, r.delta_predicted) {
             (Some(m), Some(p)) => {
+                // The speed samples average away more than 1 % of the predicted δ: say what
+                // they can show (the prediction's WARNING says why).
+                let sampled = match r.delta_predicted_through_samples {
+                    Some(d) if d < 0.99 * p => {
+                        format!(" ({} through the core's speed samples)", fmt_delta(d))
+                    }
+                    _ => String::new(),
+                };
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6} (median of steady windows after {:.1} s), predicted {p:.6}{}, noise floor {}",
+                    "  δ measured {} (median of steady windows after {:.1} s), predicted {}{sampled}{}, noise floor {}",
+                    fmt_delta(m),
                     r.settle,
+                    fmt_delta(p),
                     // A drive without load ripple is predicted δ = 0: no relative difference.
-                    if p > 0.0 {
-                        format!(": {:+.2} %", 100.0 * (m / p - 1.0))
-                    } else {
-                        String::new()
+                    // Both below the noise floor: the difference is the quantization's.
+                    match r.noise_floor {
+                        Some(f) if m < f && p < f => {
+                            ": both below the noise floor, not resolved".to_string()
+                        }
+                        _ if p > 0.0 => format!(": {:+.2} %", 100.0 * (m / p - 1.0)),
+                        _ => String::new(),
                     },
                     floor(r.noise_floor)
                 );
@@ -79,7 +92,8 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             (Some(m), None) => {
                 let _ = writeln!(
                     s,
-                    "  δ measured {m:.6}, noise floor {}",
+                    "  δ measured {}, noise floor {}",
+                    fmt_delta(m),
                     floor(r.noise_floor)
                 );
             }
@@ -395,8 +409,10 @@ pub fn prediction_text(p: &Prediction) -> String {
         if i.steady_state {
             let _ = writeln!(
                 s,
-                "  ω max {:.3} rad/s, ω min {:.3} rad/s, δ = {:.6}",
-                i.omega_max, i.omega_min, i.delta
+                "  ω max {:.3} rad/s, ω min {:.3} rad/s, δ = {}",
+                i.omega_max,
+                i.omega_min,
+                fmt_delta(i.delta)
             );
         } else {
             let _ = writeln!(s, "  no steady state: the motor stalls under the peak load");
@@ -419,6 +435,12 @@ pub fn prediction_text(p: &Prediction) -> String {
                 "  ∂δ/∂J = {dj:.4e} per kg·m², ∂δ/∂M_m = {dm:.4e} per N·m"
             );
         }
+        if let Some(w) = &i.sampling_warning {
+            let _ = writeln!(s, "  {w}");
+        }
+    }
+    if let Some(why) = &p.irregularity_not_predicted {
+        let _ = writeln!(s, "Running irregularity NOT PREDICTED: {why}");
     }
     if let Some(u) = &p.supports {
         let _ = writeln!(s, "Support unbalance (seed 002) and limits (ISO 21940-11)");

@@ -77,7 +77,8 @@ pub struct SupportsRunOut {
     /// Peak support loads per turn from the core at that speed, N (null without a measured
     /// speed, or beyond f32).
     pub peak_load: [Option<f64>; 2],
-    /// Largest support reaction seen in the simulation over the last second, N.
+    /// Largest support reaction seen in the simulation over the last second (sampled every
+    /// [`REACTION_ANGLE`] of shaft rotation), N.
     pub simulated_peak_reaction: [f64; 2],
     /// Level of each support load: "normal" | "warning" | "over" | "unknown".
     pub load_level: [&'static str; 2],
@@ -110,12 +111,16 @@ pub struct RunReport {
     pub component_evaluations: BTreeMap<&'static str, u64>,
     /// Accepted and rejected integrator steps.
     pub steps: [u64; 2],
-    /// Edges generated (line, index and glitch).
+    /// Edges generated (line, index and glitch); 0 without an `[encoder]`.
     pub edges: u64,
     /// Median δ of the valid steady windows after the settling time.
     pub delta_measured: Option<f64>,
     /// δ predicted by the drive model.
     pub delta_predicted: Option<f64>,
+    /// The predicted δ as the core's speed samples (`encoder.estimator_edges` edges each) can
+    /// show it ([`predict::sampled_delta`]): what the measurement is to be compared with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_predicted_through_samples: Option<f64>,
     /// Windows reported by the core.
     pub windows: u32,
     /// Of which invalid.
@@ -130,7 +135,7 @@ pub struct RunReport {
     pub rejected_edges: [u32; 3],
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
-    /// Why the core measured nothing, when it has an encoder and no valid window.
+    /// Why the core measured nothing: no valid window, or no `[encoder]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_measurement: Option<String>,
     /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
@@ -463,6 +468,10 @@ fn median(v: &mut [f64]) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
+/// Shaft rotation between two samples of the simulated support reactions, rad (0.25°): a
+/// rotating load's peak is then missed by at most 1 − cos(0.125°) ≈ 2.4e-6 of it.
+pub const REACTION_ANGLE: f64 = 0.25 * std::f64::consts::PI / 180.0;
+
 /// Most encoder edges one run may produce (about a minute of work in release).
 pub const MAX_EDGES: f64 = 2e8;
 /// Most integrator steps one run may take.
@@ -776,10 +785,23 @@ impl Observer for Collector<'_> {
             }
         }
         if let Some(r) = &self.rotor {
-            if step.t1() >= self.reactions_from {
-                let f = r.reactions(step.shaft(step.t1()));
-                for (peak, v) in self.reactions.iter_mut().zip(f) {
-                    *peak = peak.max(v[0].hypot(v[1]));
+            let (t0, t1) = (step.t0().max(self.reactions_from), step.t1());
+            if t1 >= self.reactions_from {
+                // A step can span many turns (a prescribed speed takes long steps): sample
+                // the reactions every REACTION_ANGLE of shaft rotation, so that the peak of
+                // the rotating load is not missed between step ends.
+                let turned = (step.shaft(t1).phi - step.shaft(t0).phi).abs();
+                let n = (turned / REACTION_ANGLE).ceil().clamp(1.0, 1e9) as u64;
+                for i in 0..=n {
+                    let t = if i == n {
+                        t1
+                    } else {
+                        t0 + (t1 - t0) * (i as f64 / n as f64)
+                    };
+                    let f = r.reactions(step.shaft(t));
+                    for (peak, v) in self.reactions.iter_mut().zip(f) {
+                        *peak = peak.max(v[0].hypot(v[1]));
+                    }
                 }
             }
         }
@@ -1217,7 +1239,12 @@ pub fn run_with(
             .map(|c| (c.name, c.evals))
             .collect(),
         steps: [stats.solver.accepted_steps, stats.solver.rejected_steps],
-        edges: stats.encoder.edges,
+        // Without an [encoder] the simulation's internal coarse encoder is no scene's.
+        edges: if scene.encoder.is_some() {
+            stats.encoder.edges
+        } else {
+            0
+        },
         settle,
         capture_file: options
             .capture
@@ -1227,8 +1254,13 @@ pub fn run_with(
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         ..Default::default()
     };
-    if let Some(model) = &model {
+    if let Some(model) = model
+        .as_ref()
+        .filter(|_| predict::irregularity_not_predicted(scene).is_none())
+    {
         report.delta_predicted = model.predict().steady().map(|s| s.delta);
+        report.delta_predicted_through_samples =
+            predict::sampled_delta(scene, file, model)?.map(|s| s.delta);
     }
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
         Samples::All(v) => v,
@@ -1315,6 +1347,10 @@ fn stopped(scene: &Scene, file: &Path, stop: Stop, t: f64) -> SceneError {
 /// What the core measured: windows, rejected edges, δ, and why nothing was measured.
 fn measurement(report: &mut RunReport, col: &mut Collector) {
     let Some(m) = &col.monitor else {
+        report.no_measurement = Some(
+            "the scene has no [encoder] (lines and timer_hz), so the core had no edges to measure"
+                .to_string(),
+        );
         return;
     };
     let d = m.diagnostics();

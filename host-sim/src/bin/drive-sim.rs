@@ -567,9 +567,25 @@ fn predict_cmd(name: &str, json: bool) -> Result<(), Failure> {
     let (scene, path) = resolve(name)?;
     let p = predict(&scene, &path)?;
     if p.is_empty() {
+        use host_sim::app::scene::MotorSpec;
+        // A prescribed speed has no torque balance: its [load] and [shaft] give no δ.
+        let prescribed = match &scene.motor {
+            Some(MotorSpec::Speed { .. }) => Some("speed"),
+            Some(MotorSpec::Ramp { .. }) => Some("ramp"),
+            Some(MotorSpec::Profile { .. }) => Some("profile"),
+            _ => None,
+        };
+        let why = match prescribed {
+            Some(model) => format!(
+                " ([motor] model = \"{model}\" prescribes the speed, so no δ follows from a \
+                 load; a torque model, \"parabola\" or \"kloss\", does)"
+            ),
+            None => String::new(),
+        };
         return Err(Failure::Message(format!(
-            "{}: nothing to predict: the scene has no [motor] with [load] and [shaft], no \
-             [rotor] and no [[platform]] with [autobalancer]",
+            "{}: nothing to predict: the scene has no torque motor ([motor] model = \"parabola\" \
+             or \"kloss\") with [load] and [shaft], no [rotor] and no [[platform]] with \
+             [autobalancer]{why}",
             path.display()
         )));
     }
