@@ -21,7 +21,8 @@
 //! - **plain**: a header `time_s,level` (or `time_s,level,index` with an index channel), then
 //!   `time,0|1` rows at each change.
 //!
-//! Reading is streamed, one line at a time: memory does not grow with the file. Limits: a line
+//! Reading is streamed, one line at a time: memory does not grow with the file. Line ends may
+//! be LF or CRLF, and a UTF-8 byte order mark before the first line is skipped. Limits: a line
 //! is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`] channels, times must
 //! not decrease from row to row. Every error names the file, the line and what was expected.
 //!
@@ -348,7 +349,11 @@ impl<R: BufRead> CaptureReader<R> {
                 "line longer than {MAX_LINE_BYTES} bytes: not a capture row"
             )));
         }
-        let l = self.buf.trim_end_matches(['\n', '\r']);
+        let mut l = self.buf.trim_end_matches(['\n', '\r']);
+        if self.line == 1 {
+            // A UTF-8 byte order mark (Windows editors, spreadsheet exports) is not text.
+            l = l.strip_prefix('\u{feff}').unwrap_or(l);
+        }
         Ok(Some(l.to_string()))
     }
 
