@@ -16,8 +16,9 @@
 //!   with `label=channel` it is `Time,D0,D1`. The time column counts the sample period in that
 //!   unit from one period at the first sample (libsigrok writes `(i+1)·period` for sample `i`);
 //!   sample `i` is read as time `i / samplerate`, so the samplerate comment (or
-//!   `--sample-rate`) is needed when the unit cannot be told from the header. A file without
-//!   a time column (`time=false`) is read as one row per sample.
+//!   `--sample-rate`) is needed: the period in whole units alone is not exact (24 MHz is
+//!   written as 41 ns), and never guessed. A `--sample-rate` that disagrees with the comment
+//!   is an error. A file without a time column (`time=false`) is read as one row per sample.
 //! - **plain**: a header `time_s,level` (or `time_s,level,index` with an index channel), then
 //!   `time,0|1` rows at each change.
 //!
@@ -394,6 +395,16 @@ impl<R: BufRead> CaptureReader<R> {
                         clip(rest.trim())
                     ))
                 })?;
+                if let Some(given) = self.sample_rate {
+                    if (given - rate).abs() > 1e-9 * rate {
+                        return Err(self.err_here(&format!(
+                            "the file states `Samplerate: {}` ({rate} Hz) but --sample-rate is \
+                             {given} Hz: leave --sample-rate out (the file's rate is used) or \
+                             correct it",
+                            rest.trim()
+                        )));
+                    }
+                }
                 self.sample_rate = Some(rate);
             }
             line = loop {
@@ -425,6 +436,12 @@ impl<R: BufRead> CaptureReader<R> {
             }
             self.channels = names;
             self.held = Some(header);
+            if self.sample_rate.is_none() {
+                return Err(self.err_here(
+                    "the time of a sample cannot be told: the file has no `; Samplerate:` \
+                     comment and no header row naming a time unit; give --sample-rate",
+                ));
+            }
             return Ok(());
         }
         let (time, labels) = match fields.first() {
@@ -447,12 +464,19 @@ impl<R: BufRead> CaptureReader<R> {
         } else {
             labels.iter().map(|l| l.to_string()).collect()
         };
-        if (time == SigrokTime::Labelled || time == SigrokTime::None) && self.sample_rate.is_none()
-        {
-            return Err(self.err_here(
-                "the time of a sample cannot be told: the file has no `; Samplerate:` comment \
-                     and no time unit in its header; give --sample-rate",
-            ));
+        if self.sample_rate.is_none() {
+            return Err(self.err_here(&match time {
+                SigrokTime::Column { .. } => format!(
+                    "the time of a sample cannot be told exactly: the file has no `; \
+                     Samplerate:` comment, and its `{}` column counts a sample period that \
+                     libsigrok rounds down to whole units (24 MHz is written as 41 ns, not \
+                     41.67); give --sample-rate (the capture's samples per second)",
+                    fields.first().copied().unwrap_or("")
+                ),
+                _ => "the time of a sample cannot be told: the file has no `; Samplerate:` \
+                      comment and no time unit in its header; give --sample-rate"
+                    .to_string(),
+            }));
         }
 
         Ok(())

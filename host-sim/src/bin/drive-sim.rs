@@ -54,7 +54,9 @@ enum Command {
         format: Option<CaptureFormat>,
         #[command(flatten)]
         options: AnalyzeArgs,
-        /// Samples per second of a sigrok file without a samplerate comment, Hz.
+        /// Samples per second of a sigrok file without a `; Samplerate:` comment, Hz (needed
+        /// then: its time column alone is not exact); it must agree with the comment when the
+        /// file has one.
         #[arg(long)]
         sample_rate: Option<f64>,
         /// Print JSON.
