@@ -741,3 +741,46 @@ fn a_sigrok_sample_rate_is_never_guessed() {
         "{e}"
     );
 }
+
+/// `--channel 3` counts channels from 0; on an export whose channels are named by the
+/// analyzer's own numbers from another start (Channel 0 not exported) that is another
+/// channel than the one named 3: refused, naming both, instead of analyzing the wrong one.
+#[test]
+fn a_channel_number_that_another_channel_is_named_by_is_refused() {
+    let header = "Time [s],Channel 1,Channel 2,Channel 3,Channel 4\n0.0,0,0,0,0\n0.001,1,0,1,0\n";
+    let try_channel = |channel: host_sim::app::analyze::Channel, text: &str| {
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(channel),
+            ..wheel("36-2")
+        })
+        .unwrap();
+        let mut reader = CaptureReader::new(
+            std::io::Cursor::new(text.to_string()),
+            Path::new("c.csv"),
+            None,
+            None,
+        )
+        .unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {})
+            .map(|r| r.channel)
+            .map_err(|e| e.to_string())
+    };
+    use host_sim::app::analyze::Channel;
+    let e = try_channel(Channel::Column(2), header).unwrap_err();
+    assert!(
+        e.contains("--channel 2 is ambiguous")
+            && e.contains("`Channel 3`")
+            && e.contains("`Channel 2`")
+            && e.contains("--channel \"Channel 2\""),
+        "{e}"
+    );
+    let e = try_channel(Channel::Column(4), header).unwrap_err();
+    assert!(e.contains("--channel \"Channel 4\""), "{e}");
+    assert_eq!(
+        try_channel(Channel::Name("Channel 3".into()), header).unwrap(),
+        "Channel 3"
+    );
+    // Numbers and names agree (every channel exported): the number is the channel.
+    let all = "Time [s],Channel 0,Channel 1,Channel 2\n0.0,0,0,0\n0.001,1,0,1\n";
+    assert_eq!(try_channel(Channel::Column(2), all).unwrap(), "Channel 2");
+}

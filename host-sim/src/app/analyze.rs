@@ -372,9 +372,31 @@ pub fn wheel_text(e: &Encoder) -> String {
     }
 }
 
+/// The number a channel's name ends with (`Channel 3`, `D3`, `CH3`: 3).
+fn name_number(name: &str) -> Option<usize> {
+    let name = name.trim();
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    name[name.len() - digits..].parse().ok()
+}
+
 fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, String> {
+    // A channel whose name carries the number given, at another column: the number is read
+    // as a column, but the analyzer's own numbering may be what was meant.
+    let named = |n: usize| {
+        channels
+            .iter()
+            .position(|x| name_number(x) == Some(n))
+            .filter(|&k| k != n)
+    };
     match c {
-        Channel::Column(n) if *n < channels.len() => Ok(*n),
+        Channel::Column(n) if *n < channels.len() => match named(*n) {
+            None => Ok(*n),
+            Some(k) => Err(format!(
+                "{option} {n} is ambiguous: the channel {n} counted from 0 is `{}`, and \
+                 `{}` (counted {k}) has {n} in its name; give the name: {option} \"{}\"",
+                channels[*n], channels[k], channels[k]
+            )),
+        },
         Channel::Name(name) => channels.iter().position(|x| x == name).ok_or_else(|| {
             format!(
                 "{option} {name}: no such channel (the capture has {})",
@@ -382,10 +404,17 @@ fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, Strin
             )
         }),
         Channel::Column(n) => Err(format!(
-            "{option} {n}: the capture has {} channel{} ({}), numbered from 0",
+            "{option} {n}: the capture has {} channel{} ({}), numbered from 0{}",
             channels.len(),
             if channels.len() == 1 { "" } else { "s" },
-            channels.join(", ")
+            channels.join(", "),
+            match named(*n) {
+                Some(k) => format!(
+                    "; for the channel named {n} give its name: {option} \"{}\"",
+                    channels[k]
+                ),
+                None => String::new(),
+            }
         )),
     }
 }

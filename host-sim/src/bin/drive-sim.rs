@@ -140,7 +140,8 @@ enum Command {
 #[derive(clap::Args)]
 struct AnalyzeArgs {
     /// The encoder channel: its name in the header, or its number among the channels
-    /// (from 0).
+    /// (from 0; refused when another channel's name carries that number, e.g. `3` on an
+    /// export of `Channel 1` to `Channel 4`: give the name then).
     #[arg(long, default_value = "0")]
     channel: Channel,
     /// The index channel of an index disc (default: channel 1).
