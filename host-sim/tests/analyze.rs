@@ -784,3 +784,53 @@ fn a_channel_number_that_another_channel_is_named_by_is_refused() {
     let all = "Time [s],Channel 0,Channel 1,Channel 2\n0.0,0,0,0\n0.001,1,0,1\n";
     assert_eq!(try_channel(Channel::Column(2), all).unwrap(), "Channel 2");
 }
+
+/// A channel that never changes (the wrong `--channel`, a probe not connected) gives no edge:
+/// the report says so and names the channels that do change, instead of only "sync: never
+/// acquired".
+#[test]
+fn a_channel_without_edges_is_named_with_the_channels_that_change() {
+    let mut text = String::from("Time [s],Channel 0,Channel 1,Channel 2\n");
+    for k in 0..40 {
+        let _ = std::fmt::Write::write_fmt(
+            &mut text,
+            format_args!("{:.9},1,{},{}\n", f64::from(k) * 1e-3, k % 2, (k / 4) % 2),
+        );
+    }
+    let run = |options: AnalyzeOptions| {
+        let cfg = configure(&options).unwrap();
+        let mut reader = CaptureReader::new(
+            std::io::Cursor::new(text.clone()),
+            Path::new("q.csv"),
+            None,
+            None,
+        )
+        .unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {}).unwrap()
+    };
+    let r = run(wheel("36-2"));
+    assert_eq!(r.edges, 0);
+    let changes: Vec<u64> = r.channel_changes.iter().map(|c| c.changes).collect();
+    assert_eq!(changes, [0, 39, 9]);
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains(
+            "no rising edge on --channel `Channel 0` in the capture: check --channel; channels \
+             that change: Channel 1 (39 changes), Channel 2 (9 changes)"
+        ),
+        "{said}"
+    );
+    // An index disc whose index channel is the quiet one.
+    let r = run(AnalyzeOptions {
+        channel: Some(host_sim::app::analyze::Channel::Column(1)),
+        index_channel: Some(host_sim::app::analyze::Channel::Column(0)),
+        ..index_lines(24)
+    });
+    assert_eq!((r.edges, r.index_pulses), (20, 0));
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains("no rising edge on --index-channel `Channel 0`")
+            && !said.contains("on --channel"),
+        "{said}"
+    );
+}

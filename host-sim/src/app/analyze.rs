@@ -214,6 +214,15 @@ impl IndexPeriods {
     }
 }
 
+/// A channel of the capture and how often its level changed.
+#[derive(Debug, Clone, Serialize, PartialEq, Eq)]
+pub struct ChannelChanges {
+    /// The channel's name in the header.
+    pub name: String,
+    /// Level changes (0 to 1 or 1 to 0; not to or from an unknown `X`).
+    pub changes: u64,
+}
+
 /// What the core found in a capture.
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct AnalyzeReport {
@@ -282,6 +291,8 @@ pub struct AnalyzeReport {
     /// Edges pending judgement when the capture ended (the last edges, waiting for the two
     /// that would confirm them).
     pub unjudged_at_end: u64,
+    /// Every channel of the capture and how often its level changed (0 or 1 to 0 or 1).
+    pub channel_changes: Vec<ChannelChanges>,
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
@@ -500,10 +511,16 @@ pub fn analyze<R: BufRead>(
     let mut last_event: Option<f64> = None;
     let mut last_poll = f64::NEG_INFINITY;
     let mut end = 0.0;
+    let mut changes = vec![0u64; channels.len()];
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
             prev = levels.to_vec();
+        }
+        for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
+            if a != b && *a != Level::Unknown && *b != Level::Unknown {
+                *n += 1;
+            }
         }
         report.rows += 1;
         end = t;
@@ -574,6 +591,14 @@ pub fn analyze<R: BufRead>(
     report.unjudged_at_end = report
         .edges
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches));
+    report.channel_changes = channels
+        .iter()
+        .zip(changes)
+        .map(|(name, changes)| ChannelChanges {
+            name: name.clone(),
+            changes,
+        })
+        .collect();
     report.speed_trace.shrink_to_fit();
     Ok(report)
 }
@@ -750,6 +775,29 @@ pub fn text(r: &AnalyzeReport) -> String {
         },
         r.revolutions
     );
+    let quiet = |name: &str, option: &str| {
+        let others: Vec<String> = r
+            .channel_changes
+            .iter()
+            .filter(|c| c.changes > 0 && c.name != name)
+            .map(|c| format!("{} ({} changes)", c.name, c.changes))
+            .collect();
+        format!(
+            "no {} edge on {option} `{name}` in the capture: check {option}; {}",
+            r.edge,
+            if others.is_empty() {
+                "no channel of the capture changes level".to_string()
+            } else {
+                format!("channels that change: {}", others.join(", "))
+            }
+        )
+    };
+    if r.edges == 0 {
+        let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+    }
+    if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
+        let _ = writeln!(s, "{}", quiet(i, "--index-channel"));
+    }
     let _ = writeln!(
         s,
         "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts",
@@ -774,8 +822,8 @@ pub fn text(r: &AnalyzeReport) -> String {
         let _ = writeln!(
             s,
             "index: {} captures from one index pulse to the next ({} of {} times), but a \
-             revolution of the configured wheel is {}: check the number of lines (and the \
-             edge polarity)",
+             revolution of the configured wheel is {}: check the number of lines, the edge \
+             polarity and --index-channel",
             p.captures, p.times, p.of, p.expected
         );
     }
