@@ -834,3 +834,35 @@ fn a_channel_without_edges_is_named_with_the_channels_that_change() {
         "{said}"
     );
 }
+
+/// A window whose mean speed moved from the previous one's (a run-down) is valid but not
+/// steady, and the report says so: its δ includes the change of speed, not the ripple alone.
+#[test]
+fn windows_of_a_run_down_are_reported_not_steady() {
+    let file = tmp("rundown.csv");
+    let text = cranking("36-2", "sample_rate = 50e6", 4.0, "").replace(
+        "points = [[0.0, 0.0], [0.5, 25.0]]",
+        "points = [[0.0, 0.0], [0.5, 25.0], [2.5, 25.0], [3.3, 2.0]]",
+    );
+    simulate(&text, CaptureFormat::Saleae, &file);
+    let (report, _) = run_analyze(&file, wheel("36-2"));
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    let plateau: Vec<_> = valid
+        .iter()
+        .filter(|w| w.start > 0.6 && w.end < 2.5)
+        .collect();
+    let down: Vec<_> = valid.iter().filter(|w| w.end > 2.6).collect();
+    assert!(plateau.len() >= 3 && !down.is_empty(), "{valid:?}");
+    assert!(
+        plateau[1..].iter().all(|w| w.steady == Some(true)),
+        "{plateau:?}"
+    );
+    assert!(down.iter().all(|w| w.steady == Some(false)), "{down:?}");
+    let said = host_sim::app::analyze::text(&report);
+    let lines: Vec<&str> = said.lines().filter(|l| l.contains("valid")).collect();
+    assert!(
+        lines.iter().any(|l| l.ends_with("valid, not steady"))
+            && lines.iter().any(|l| l.ends_with("  valid")),
+        "{said}"
+    );
+}

@@ -135,6 +135,10 @@ pub struct WindowOut {
     pub omega_min: Option<f64>,
     /// Bound on δ's error from timer quantization.
     pub noise_floor: Option<f64>,
+    /// The mean speed was within the steady tolerance (2 % unless the scene says otherwise)
+    /// of the previous valid window's (valid windows; never the first one after sync). δ of
+    /// a window that is not steady includes the change of speed (a run-up or run-down).
+    pub steady: Option<bool>,
 }
 
 /// A fault with its time.
@@ -736,6 +740,7 @@ impl State {
             omega_max: m.and_then(|m| f(m.omega_max)),
             omega_min: m.and_then(|m| f(m.omega_min)),
             noise_floor: m.and_then(|m| f(m.noise_floor)),
+            steady: m.map(|m| m.steady),
         });
     }
 }
@@ -857,8 +862,18 @@ pub fn text(r: &AnalyzeReport) -> String {
             (Some(d), Some(m), Some(f)) => {
                 let _ = writeln!(
                     s,
-                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid",
-                    w.start, w.end, w.revolutions, d, m, f
+                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid{}",
+                    w.start,
+                    w.end,
+                    w.revolutions,
+                    d,
+                    m,
+                    f,
+                    if w.steady == Some(true) {
+                        ""
+                    } else {
+                        ", not steady"
+                    }
                 );
             }
             _ => {
