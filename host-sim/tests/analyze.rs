@@ -866,3 +866,160 @@ fn windows_of_a_run_down_are_reported_not_steady() {
         "{said}"
     );
 }
+
+/// A Saleae capture of a quadrature disc of `lines` lines (A, B a quarter pitch behind, and
+/// an index pulse Z at tooth 0) turning at `omega` rad/s through the angle `stops`: forward
+/// from 0 to `stops[0]`, back to `stops[1]`, forward to `stops[2]`... The times at which the
+/// direction changes are returned with the text and the number of A's rising edges while
+/// running backwards.
+fn quadrature(lines: u32, omega: f64, stops: &[f64]) -> (String, Vec<f64>, usize) {
+    let p = std::f64::consts::TAU / f64::from(lines);
+    // (angle, channel, level after crossing it going forward)
+    let boundaries = |lo: f64, hi: f64| {
+        let mut b = Vec::new();
+        let k0 = (lo / p).floor() as i64 - 1;
+        let k1 = (hi / p).ceil() as i64 + 1;
+        for k in k0..=k1 {
+            let x = k as f64 * p;
+            b.extend([
+                (x, 0usize, true),
+                (x + p / 2.0, 0, false),
+                (x + p / 4.0, 1, true),
+                (x + 3.0 * p / 4.0, 1, false),
+            ]);
+            if k.rem_euclid(i64::from(lines)) == 0 {
+                b.extend([(x - p / 8.0, 2, true), (x + p / 8.0, 2, false)]);
+            }
+        }
+        b.retain(|&(a, _, _)| a > lo && a <= hi);
+        b
+    };
+    let mut events: Vec<(f64, usize, bool)> = Vec::new();
+    let (mut from, mut t0) = (0.3 * p, 0.0);
+    let mut turns = Vec::new();
+    let mut backwards_rising = 0;
+    for (i, &to) in stops.iter().enumerate() {
+        let forward = i % 2 == 0;
+        let (lo, hi) = if forward { (from, to) } else { (to, from) };
+        for (a, c, up) in boundaries(lo, hi) {
+            let level = if forward { up } else { !up };
+            events.push((t0 + (a - from).abs() / omega, c, level));
+            if !forward && c == 0 && level {
+                backwards_rising += 1;
+            }
+        }
+        t0 += (to - from).abs() / omega;
+        turns.push(t0);
+        from = to;
+    }
+    events.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut levels = [false, false, false];
+    let mut text = String::from("Time [s],A,B,Z\n0.000000000,0,0,0\n");
+    for (t, c, l) in events {
+        levels[c] = l;
+        let _ = std::fmt::Write::write_fmt(
+            &mut text,
+            format_args!(
+                "{t:.9},{},{},{}\n",
+                u8::from(levels[0]),
+                u8::from(levels[1]),
+                u8::from(levels[2])
+            ),
+        );
+    }
+    turns.pop();
+    (text, turns, backwards_rising)
+}
+
+/// A reversal on a quadrature capture: with the B channel named, the core sees the direction
+/// of every edge, counts the reversal, takes no backwards edge as a tooth and no revolution
+/// run backwards; without it every edge counts as forward.
+#[test]
+fn a_reversal_is_seen_with_the_quadrature_b_channel() {
+    use host_sim::app::analyze::{Channel, Lead};
+    let rev = std::f64::consts::TAU;
+    let off = 0.37 * rev / 50.0;
+    let stops = [8.0 * rev + off, 4.0 * rev + off, 12.0 * rev + off];
+    let (text, turns, backwards) = quadrature(50, 40.0, &stops);
+    let run = |direction: Option<&str>, forward: Option<Lead>| {
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            index_channel: Some(Channel::Name("Z".into())),
+            direction_channel: direction.map(|d| Channel::Name(d.into())),
+            forward,
+            ..index_lines(50)
+        })
+        .unwrap();
+        let mut reader = CaptureReader::new(
+            std::io::Cursor::new(text.clone()),
+            Path::new("q.csv"),
+            None,
+            None,
+        )
+        .unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {}).unwrap()
+    };
+    let r = run(Some("B"), None);
+    assert_eq!(r.direction_channel.as_deref(), Some("B"));
+    assert_eq!((r.reversals, r.direction_unknown), (1, 0), "{r:?}");
+    assert_eq!(r.reverse_edges as usize, backwards);
+    assert!(r
+        .faults
+        .iter()
+        .any(|f| f.fault == "reversal" && f.time > turns[0] && f.time < turns[1]));
+    // Forward from 0 to 8 revolutions and from 4 to 12: at most 8 + 8 frames after sync.
+    assert!(
+        r.revolutions <= 15 && r.revolutions >= 12,
+        "{}",
+        r.revolutions
+    );
+    for w in r.windows.iter().filter(|w| w.valid) {
+        assert!(w.end <= turns[0] || w.start >= turns[1], "{w:?}");
+        assert!((w.omega_mean.unwrap() - 40.0).abs() < 0.1, "{w:?}");
+    }
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains("direction from B (forward: A leads)"),
+        "{said}"
+    );
+    // The other lead: the forward running is the reverse, and the reversal is where the shaft
+    // comes back.
+    let r = run(Some("B"), Some(Lead::BLeads));
+    assert_eq!(r.reversals, 1, "{:?} {turns:?}", r.faults);
+    assert!(
+        r.faults
+            .iter()
+            .any(|f| f.fault == "reversal" && f.time > turns[1]),
+        "{:?} {turns:?}",
+        r.faults
+    );
+    // The direction channel is not the encoder's own; --forward needs it.
+    let e = configure(&AnalyzeOptions {
+        direction_channel: Some(Channel::Name("A".into())),
+        ..index_lines(50)
+    })
+    .map(|cfg| {
+        let mut reader = CaptureReader::new(
+            std::io::Cursor::new(text.clone()),
+            Path::new("q.csv"),
+            None,
+            None,
+        )
+        .unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {})
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    })
+    .unwrap()
+    .unwrap_err();
+    assert!(
+        e.contains("--direction-channel is the encoder channel"),
+        "{e}"
+    );
+    assert!(configure(&AnalyzeOptions {
+        forward: Some(Lead::ALeads),
+        ..index_lines(50)
+    })
+    .unwrap_err()
+    .contains("--forward goes with --direction-channel"));
+}

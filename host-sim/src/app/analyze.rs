@@ -22,7 +22,7 @@ use serde::Serialize;
 use drive_monitor::encoder::{Encoder, EncoderConfig};
 use drive_monitor::irregularity::{WindowConfig, WindowReport};
 use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
-use drive_monitor::speed::{EdgeSink, Fault, SyncState, Tooth};
+use drive_monitor::speed::{Direction, EdgeSink, Fault, SyncState, Tooth};
 
 use crate::app::logic::{CaptureError, CaptureReader, Level};
 use crate::app::run::MAX_LINES;
@@ -77,8 +77,33 @@ pub struct AnalyzeConfig {
     pub channel: Channel,
     /// The index channel (index discs).
     pub index_channel: Option<Channel>,
+    /// The quadrature B channel that gives each edge its direction, and which of A and B
+    /// leads when running forward.
+    pub direction: Option<(Channel, Lead)>,
     /// The edges taken.
     pub edge: Polarity,
+}
+
+/// Which channel of a quadrature pair leads when the shaft runs forward.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lead {
+    /// A (the encoder channel) leads B by a quarter pitch: B is low at A's rising edge.
+    ALeads,
+    /// B leads A: B is high at A's rising edge.
+    BLeads,
+}
+
+impl Lead {
+    /// The direction of an edge of A to level `a`, with B at level `b`.
+    fn direction(self, a: bool, b: bool) -> Direction {
+        // A leading B: B still holds A's previous level when A changes.
+        if (a != b) == (self == Lead::ALeads) {
+            Direction::Forward
+        } else {
+            Direction::Reverse
+        }
+    }
 }
 
 /// A decision of the core on one edge, with its capture time.
@@ -238,6 +263,13 @@ pub struct AnalyzeReport {
     pub channel: String,
     /// The index channel, if any.
     pub index_channel: Option<String>,
+    /// The quadrature B channel giving the direction of each edge, if any.
+    pub direction_channel: Option<String>,
+    /// Which of A and B leads running forward (with a direction channel).
+    pub forward: Option<Lead>,
+    /// Edges fed without a direction: B changed in the same sample as A (the capture sampled
+    /// too slowly to resolve the quadrature) or was unknown (`X`).
+    pub direction_unknown: u64,
     /// The edges taken: `rising` or `falling`.
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
@@ -292,8 +324,11 @@ pub struct AnalyzeReport {
     pub windows: Vec<WindowOut>,
     /// The faults (at most [`MAX_LISTED`]).
     pub faults: Vec<FaultOut>,
-    /// Edges pending judgement when the capture ended (the last edges, waiting for the two
-    /// that would confirm them).
+    /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
+    pub reverse_edges: u64,
+    /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
+    /// the last edges of the capture, waiting for the two that would confirm them, and the
+    /// first edge after a standstill or a reversal (a time reference only).
     pub unjudged_at_end: u64,
     /// Every channel of the capture and how often its level changed (0 or 1 to 0 or 1).
     pub channel_changes: Vec<ChannelChanges>,
@@ -480,10 +515,25 @@ pub fn analyze<R: BufRead>(
             "--index-channel is the encoder channel itself".into(),
         ));
     }
+    let dch = match &cfg.direction {
+        Some((c, lead)) => {
+            let d = column(&channels, c, "--direction-channel").map_err(AnalyzeError::Option)?;
+            if d == ch || Some(d) == ich {
+                return Err(AnalyzeError::Option(format!(
+                    "--direction-channel is the {} channel itself: give the quadrature B channel",
+                    if d == ch { "encoder" } else { "index" }
+                )));
+            }
+            Some((d, *lead))
+        }
+        None => None,
+    };
     let mut report = AnalyzeReport {
         format: reader.format().name(),
         channel: channels[ch].clone(),
         index_channel: ich.map(|i| channels[i].clone()),
+        direction_channel: dch.map(|(d, _)| channels[d].clone()),
+        forward: dch.map(|(_, lead)| lead),
         edge: match cfg.edge {
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
@@ -537,6 +587,21 @@ pub fn analyze<R: BufRead>(
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
         let encoder_edge = edge(ch) == Some(cfg.edge);
+        // B's level as A changes; unknown when B changed in the same sample.
+        let direction = match dch {
+            Some((d, lead)) if encoder_edge && prev[d] == levels[d] => match levels[d] {
+                Level::Low => Some(lead.direction(levels[ch] == Level::High, false)),
+                Level::High => Some(lead.direction(levels[ch] == Level::High, true)),
+                Level::Unknown => None,
+            },
+            _ => None,
+        };
+        if encoder_edge && dch.is_some() && direction.is_none() {
+            report.direction_unknown += 1;
+        }
+        if direction == Some(Direction::Reverse) {
+            report.reverse_edges += 1;
+        }
         prev.copy_from_slice(levels);
         if !index_edge && !encoder_edge {
             continue;
@@ -564,7 +629,7 @@ pub fn analyze<R: BufRead>(
         if encoder_edge {
             report.edges += 1;
             periods.capture();
-            let o = monitor.on_edge_observed(ticks, None, &mut st.seen);
+            let o = monitor.on_edge_observed(ticks, direction, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
         }
     }
@@ -591,10 +656,11 @@ pub fn analyze<R: BufRead>(
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
-    // Edges fed but neither accepted nor rejected: still waiting for their lookahead.
+    // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
+    // or time references after a standstill or a reversal.
     report.unjudged_at_end = report
         .edges
-        .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches));
+        .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
     report.channel_changes = channels
         .iter()
         .zip(changes)
@@ -756,13 +822,32 @@ pub fn text(r: &AnalyzeReport) -> String {
     );
     let _ = writeln!(
         s,
-        "channel: {} ({} edges){}",
+        "channel: {} ({} edges){}{}",
         r.channel,
         r.edge,
         r.index_channel
             .as_ref()
-            .map_or(String::new(), |i| format!(", index channel {i}"))
+            .map_or(String::new(), |i| format!(", index channel {i}")),
+        match (&r.direction_channel, r.forward) {
+            (Some(d), Some(lead)) => format!(
+                ", direction from {d} (forward: {} leads)",
+                if lead == Lead::ALeads {
+                    r.channel.as_str()
+                } else {
+                    d.as_str()
+                }
+            ),
+            _ => String::new(),
+        }
     );
+    if r.direction_unknown > 0 {
+        let _ = writeln!(
+            s,
+            "{} edge(s) without a direction: the direction channel changed in the same sample \
+             (the capture's sample rate is too low for the quadrature) or had no data",
+            r.direction_unknown
+        );
+    }
     let _ = writeln!(
         s,
         "wheel: {}; timer {} Hz, {}-bit counter",
@@ -838,10 +923,18 @@ pub fn text(r: &AnalyzeReport) -> String {
     if r.sync.len() > 20 {
         let _ = writeln!(s, "  ... {} more changes (see --json)", r.sync.len() - 20);
     }
+    if r.reverse_edges > 0 {
+        let _ = writeln!(
+            s,
+            "{} edge(s) running in reverse (not taken as teeth)",
+            r.reverse_edges
+        );
+    }
     if r.unjudged_at_end > 0 {
         let _ = writeln!(
             s,
-            "{} edge(s) at the end of the capture were still waiting to be judged",
+            "{} edge(s) neither taken as teeth nor rejected: the last ones still waiting to be \
+             judged, and the first after a standstill or reversal (a time reference only)",
             r.unjudged_at_end
         );
     }
@@ -1010,6 +1103,10 @@ pub struct AnalyzeOptions {
     pub channel: Option<Channel>,
     /// `--index-channel`.
     pub index_channel: Option<Channel>,
+    /// `--direction-channel`.
+    pub direction_channel: Option<Channel>,
+    /// `--forward` (default A leads).
+    pub forward: Option<Lead>,
     /// `--edge` (default rising).
     pub edge: Option<Polarity>,
 }
@@ -1114,7 +1211,14 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     if o.index_channel.is_some() && !index {
         return Err("--index-channel goes with an index disc (--lines N --framing index, or a scene whose framing is \"index\")".into());
     }
+    if o.forward.is_some() && o.direction_channel.is_none() {
+        return Err("--forward goes with --direction-channel (the quadrature B channel)".into());
+    }
     Ok(AnalyzeConfig {
+        direction: o
+            .direction_channel
+            .clone()
+            .map(|c| (c, o.forward.unwrap_or(Lead::ALeads))),
         encoder: enc,
         window,
         channel: o.channel.clone().unwrap_or(Channel::Column(0)),

@@ -1,7 +1,7 @@
 //! `drive-sim`: run, predict and sweep scenes.
 
 use clap::{Parser, Subcommand};
-use host_sim::app::analyze::{Channel, FramingArg, Polarity};
+use host_sim::app::analyze::{Channel, FramingArg, Lead, Polarity};
 use host_sim::app::logic::CaptureFormat;
 use host_sim::app::predict::predict;
 use host_sim::app::scene::{resolve, BUNDLED, DEFAULT_SCENE};
@@ -147,6 +147,13 @@ struct AnalyzeArgs {
     /// The index channel of an index disc (default: channel 1).
     #[arg(long)]
     index_channel: Option<Channel>,
+    /// The quadrature B channel: its level at each edge of --channel gives the edge's
+    /// direction, so a reversal is seen (without it every edge counts as forward).
+    #[arg(long)]
+    direction_channel: Option<Channel>,
+    /// Which channel leads when the shaft runs forward (with --direction-channel).
+    #[arg(long, value_enum)]
+    forward: Option<Lead>,
     /// The edges the capture unit takes.
     #[arg(long, value_enum, default_value = "rising")]
     edge: Polarity,
@@ -199,6 +206,8 @@ impl AnalyzeArgs {
             window_revolutions: self.window_revolutions,
             channel: Some(self.channel),
             index_channel: self.index_channel,
+            direction_channel: self.direction_channel,
+            forward: self.forward,
             edge: Some(self.edge),
         })
     }
