@@ -1023,3 +1023,35 @@ fn a_reversal_is_seen_with_the_quadrature_b_channel() {
     .unwrap_err()
     .contains("--forward goes with --direction-channel"));
 }
+
+/// A file cut off in the middle of its last row (a recording or a copy interrupted) is an
+/// error that says so and what to do; the same row with its line end is an ordinary bad row,
+/// and a complete last row without a line end is read.
+#[test]
+fn a_file_cut_off_in_the_middle_of_a_row_says_so() {
+    let e = reader_error("Time [s],Channel 0,Channel 1\n0.000000000,0,0\n0.001000000,1");
+    assert!(
+        e.starts_with("cap.csv:3:")
+            && e.contains("expected 3 fields")
+            && e.contains("cut off")
+            && e.contains("delete that line"),
+        "{e}"
+    );
+    let e = reader_error("Time [s],Channel 0,Channel 1\n0.000000000,0,0\n0.001000000,1\n");
+    assert!(
+        e.contains("expected 3 fields") && !e.contains("cut off"),
+        "{e}"
+    );
+    let e = reader_error("time_s,level\n0,0\n0.00");
+    assert!(e.starts_with("cap.csv:3:") && e.contains("cut off"), "{e}");
+    let mut r = CaptureReader::new(
+        std::io::Cursor::new("time_s,level\n0,0\n0.001,1".to_string()),
+        Path::new("cap.csv"),
+        None,
+        None,
+    )
+    .unwrap();
+    assert!(r.next_row().unwrap().is_some());
+    assert_eq!(r.next_row().unwrap().map(|(t, _)| t), Some(0.001));
+    assert!(r.next_row().unwrap().is_none());
+}

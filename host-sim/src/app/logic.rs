@@ -201,6 +201,8 @@ pub struct CaptureReader<R> {
     sample_rate: Option<f64>,
     rows: u64,
     last_time: f64,
+    /// The line last read had no line end (the end of the file).
+    unterminated: bool,
 }
 
 impl CaptureReader<std::io::BufReader<std::fs::File>> {
@@ -241,6 +243,7 @@ impl<R: BufRead> CaptureReader<R> {
             sample_rate,
             rows: 0,
             last_time: f64::NEG_INFINITY,
+            unterminated: false,
         };
         let first = loop {
             match r.read_line()? {
@@ -318,10 +321,19 @@ impl<R: BufRead> CaptureReader<R> {
 
     /// An error at the current line.
     pub fn err_here(&self, message: &str) -> CaptureError {
+        let mut message = message.to_string();
+        if self.unterminated {
+            // The last line of the file has no line end: most likely a recording or a copy
+            // cut off in the middle of a row.
+            message.push_str(
+                "; this is the file's last line and it has no line end: the file looks cut off \
+                 in the middle of a row; delete that line to analyze the rows before it",
+            );
+        }
         CaptureError {
             file: self.file.clone(),
             line: Some(self.line.max(1)),
-            message: message.to_string(),
+            message,
         }
     }
 
@@ -345,6 +357,7 @@ impl<R: BufRead> CaptureReader<R> {
             return Ok(None);
         }
         self.line += 1;
+        self.unterminated = n <= MAX_LINE_BYTES && !self.buf.ends_with('\n');
         if n > MAX_LINE_BYTES && !self.buf.ends_with('\n') {
             return Err(self.err_here(&format!(
                 "line longer than {MAX_LINE_BYTES} bytes: not a capture row"
