@@ -1055,3 +1055,51 @@ fn a_file_cut_off_in_the_middle_of_a_row_says_so() {
     assert_eq!(r.next_row().unwrap().map(|(t, _)| t), Some(0.001));
     assert!(r.next_row().unwrap().is_none());
 }
+
+/// A capture sampled more coarsely than the emulated timer ticks (300 kS/s against 84 MHz):
+/// δ is resolved to the sampling, not to the timer, and the floor the report gives includes
+/// it; the timer's floor alone is exceeded many times over.
+#[test]
+fn a_coarsely_sampled_capture_widens_the_noise_floor() {
+    let file = tmp("coarse.csv");
+    let run = simulate(
+        &cranking("36-2", "sample_rate = 3e5\ndedup = true", 3.0, ""),
+        CaptureFormat::Sigrok,
+        &file,
+    );
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            timer_hz: Some(84e6),
+            ..wheel("36-2")
+        },
+    );
+    assert_eq!(report.sample_rate, Some(3e5));
+    let truth = teeth(&run.edge_list);
+    let mut beyond_timer = 0;
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 4, "{}", valid.len());
+    for w in &valid {
+        let (d, timer, both) = (
+            w.delta.unwrap(),
+            w.noise_floor.unwrap(),
+            w.floor_with_sampling.unwrap(),
+        );
+        assert!((both / timer - (1.0 + 84e6 / 3e5)).abs() < 1e-9);
+        let err = (d - truth_delta(&truth, 36, w.start, w.end, 3e5)).abs();
+        assert!(err <= both, "window {}: error {err}, floor {both}", w.start);
+        if err > timer {
+            beyond_timer += 1;
+        }
+    }
+    assert!(
+        beyond_timer * 2 > valid.len(),
+        "{beyond_timer} of {}",
+        valid.len()
+    );
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("sampling: 300000 Hz") && said.contains("281.000 times the timer's alone"),
+        "{said}"
+    );
+}

@@ -160,6 +160,10 @@ pub struct WindowOut {
     pub omega_min: Option<f64>,
     /// Bound on δ's error from timer quantization.
     pub noise_floor: Option<f64>,
+    /// The bound with the capture's sampling added (when its sample rate is known): each
+    /// timestamp is known to a sample period besides the timer's tick, so the floor is
+    /// `noise_floor · (1 + timer_hz / sample_rate)`.
+    pub floor_with_sampling: Option<f64>,
     /// The mean speed was within the steady tolerance (2 % unless the scene says otherwise)
     /// of the previous valid window's (valid windows; never the first one after sync). δ of
     /// a window that is not steady includes the change of speed (a run-up or run-down).
@@ -278,6 +282,8 @@ pub struct AnalyzeReport {
     pub timer_hz: f64,
     /// Emulated counter width, bits.
     pub counter_bits: u8,
+    /// The capture's sample rate, Hz, when known (a sigrok file's, or `--sample-rate`).
+    pub sample_rate: Option<f64>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s.
@@ -541,6 +547,7 @@ pub fn analyze<R: BufRead>(
         wheel: wheel_text(&enc),
         timer_hz: cfg.encoder.timer_hz,
         counter_bits: cfg.encoder.counter_bits,
+        sample_rate: reader.sample_rate(),
         sync_state: "searching",
         ..Default::default()
     };
@@ -661,6 +668,12 @@ pub fn analyze<R: BufRead>(
     report.unjudged_at_end = report
         .edges
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
+    if let Some(rate) = report.sample_rate {
+        let widen = 1.0 + cfg.encoder.timer_hz / rate;
+        for w in &mut report.windows {
+            w.floor_with_sampling = w.noise_floor.map(|f| f * widen);
+        }
+    }
     report.channel_changes = channels
         .iter()
         .zip(changes)
@@ -806,6 +819,7 @@ impl State {
             omega_max: m.and_then(|m| f(m.omega_max)),
             omega_min: m.and_then(|m| f(m.omega_min)),
             noise_floor: m.and_then(|m| f(m.noise_floor)),
+            floor_with_sampling: None,
             steady: m.map(|m| m.steady),
         });
     }
@@ -853,6 +867,25 @@ pub fn text(r: &AnalyzeReport) -> String {
         "wheel: {}; timer {} Hz, {}-bit counter",
         r.wheel, r.timer_hz, r.counter_bits
     );
+    match r.sample_rate {
+        Some(rate) => {
+            let _ = writeln!(
+                s,
+                "sampling: {rate} Hz (a time known to {:.3e} s, {:.3} timer ticks): the floor \
+                 below includes it, {:.3} times the timer's alone",
+                1.0 / rate,
+                r.timer_hz / rate,
+                1.0 + r.timer_hz / rate
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "sampling: rate not stated (give --sample-rate): the floor below is the timer's \
+                 alone, and a capture sampled slower than the timer resolves δ less finely"
+            );
+        }
+    }
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
@@ -951,7 +984,11 @@ pub fn text(r: &AnalyzeReport) -> String {
         );
     }
     for w in r.windows.iter().take(40) {
-        match (w.delta, w.omega_mean, w.noise_floor) {
+        match (
+            w.delta,
+            w.omega_mean,
+            w.floor_with_sampling.or(w.noise_floor),
+        ) {
             (Some(d), Some(m), Some(f)) => {
                 let _ = writeln!(
                     s,

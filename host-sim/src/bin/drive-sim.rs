@@ -54,9 +54,10 @@ enum Command {
         format: Option<CaptureFormat>,
         #[command(flatten)]
         options: AnalyzeArgs,
-        /// Samples per second of a sigrok file without a `; Samplerate:` comment, Hz (needed
-        /// then: its time column alone is not exact); it must agree with the comment when the
-        /// file has one.
+        /// The logic analyzer's samples per second, Hz. A sigrok file states it (needed when it
+        /// does not: its time column alone is not exact; it must agree with the comment when
+        /// there is one); for any format it widens the windows' noise floor by the sampling's
+        /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long)]
         sample_rate: Option<f64>,
         /// Print JSON.
