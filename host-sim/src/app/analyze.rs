@@ -22,7 +22,7 @@ use serde::Serialize;
 use drive_monitor::encoder::{Encoder, EncoderConfig};
 use drive_monitor::irregularity::{WindowConfig, WindowReport};
 use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
-use drive_monitor::speed::{EdgeSink, Fault, SyncState, Tooth};
+use drive_monitor::speed::{Direction, EdgeSink, Fault, SyncState, Tooth};
 
 use crate::app::logic::{CaptureError, CaptureReader, Level};
 use crate::app::run::MAX_LINES;
@@ -77,8 +77,33 @@ pub struct AnalyzeConfig {
     pub channel: Channel,
     /// The index channel (index discs).
     pub index_channel: Option<Channel>,
+    /// The quadrature B channel that gives each edge its direction, and which of A and B
+    /// leads when running forward.
+    pub direction: Option<(Channel, Lead)>,
     /// The edges taken.
     pub edge: Polarity,
+}
+
+/// Which channel of a quadrature pair leads when the shaft runs forward.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lead {
+    /// A (the encoder channel) leads B by a quarter pitch: B is low at A's rising edge.
+    ALeads,
+    /// B leads A: B is high at A's rising edge.
+    BLeads,
+}
+
+impl Lead {
+    /// The direction of an edge of A to level `a`, with B at level `b`.
+    fn direction(self, a: bool, b: bool) -> Direction {
+        // A leading B: B still holds A's previous level when A changes.
+        if (a != b) == (self == Lead::ALeads) {
+            Direction::Forward
+        } else {
+            Direction::Reverse
+        }
+    }
 }
 
 /// A decision of the core on one edge, with its capture time.
@@ -135,6 +160,14 @@ pub struct WindowOut {
     pub omega_min: Option<f64>,
     /// Bound on δ's error from timer quantization.
     pub noise_floor: Option<f64>,
+    /// The bound with the capture's sampling added (when its sample rate is known): each
+    /// timestamp is known to a sample period besides the timer's tick, so the floor is
+    /// `noise_floor · (1 + timer_hz / sample_rate)`.
+    pub floor_with_sampling: Option<f64>,
+    /// The mean speed was within the steady tolerance (2 % unless the scene says otherwise)
+    /// of the previous valid window's (valid windows; never the first one after sync). δ of
+    /// a window that is not steady includes the change of speed (a run-up or run-down).
+    pub steady: Option<bool>,
 }
 
 /// A fault with its time.
@@ -214,6 +247,15 @@ impl IndexPeriods {
     }
 }
 
+/// A channel of the capture and how often its level changed.
+#[derive(Debug, Clone, Serialize, PartialEq, Eq)]
+pub struct ChannelChanges {
+    /// The channel's name in the header.
+    pub name: String,
+    /// Level changes (0 to 1 or 1 to 0; not to or from an unknown `X`).
+    pub changes: u64,
+}
+
 /// What the core found in a capture.
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct AnalyzeReport {
@@ -225,6 +267,13 @@ pub struct AnalyzeReport {
     pub channel: String,
     /// The index channel, if any.
     pub index_channel: Option<String>,
+    /// The quadrature B channel giving the direction of each edge, if any.
+    pub direction_channel: Option<String>,
+    /// Which of A and B leads running forward (with a direction channel).
+    pub forward: Option<Lead>,
+    /// Edges fed without a direction: B changed in the same sample as A (the capture sampled
+    /// too slowly to resolve the quadrature) or was unknown (`X`).
+    pub direction_unknown: u64,
     /// The edges taken: `rising` or `falling`.
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
@@ -233,6 +282,8 @@ pub struct AnalyzeReport {
     pub timer_hz: f64,
     /// Emulated counter width, bits.
     pub counter_bits: u8,
+    /// The capture's sample rate, Hz, when known (a sigrok file's, or `--sample-rate`).
+    pub sample_rate: Option<f64>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s.
@@ -279,9 +330,14 @@ pub struct AnalyzeReport {
     pub windows: Vec<WindowOut>,
     /// The faults (at most [`MAX_LISTED`]).
     pub faults: Vec<FaultOut>,
-    /// Edges pending judgement when the capture ended (the last edges, waiting for the two
-    /// that would confirm them).
+    /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
+    pub reverse_edges: u64,
+    /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
+    /// the last edges of the capture, waiting for the two that would confirm them, and the
+    /// first edge after a standstill or a reversal (a time reference only).
     pub unjudged_at_end: u64,
+    /// Every channel of the capture and how often its level changed (0 or 1 to 0 or 1).
+    pub channel_changes: Vec<ChannelChanges>,
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
@@ -372,9 +428,31 @@ pub fn wheel_text(e: &Encoder) -> String {
     }
 }
 
+/// The number a channel's name ends with (`Channel 3`, `D3`, `CH3`: 3).
+fn name_number(name: &str) -> Option<usize> {
+    let name = name.trim();
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    name[name.len() - digits..].parse().ok()
+}
+
 fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, String> {
+    // A channel whose name carries the number given, at another column: the number is read
+    // as a column, but the analyzer's own numbering may be what was meant.
+    let named = |n: usize| {
+        channels
+            .iter()
+            .position(|x| name_number(x) == Some(n))
+            .filter(|&k| k != n)
+    };
     match c {
-        Channel::Column(n) if *n < channels.len() => Ok(*n),
+        Channel::Column(n) if *n < channels.len() => match named(*n) {
+            None => Ok(*n),
+            Some(k) => Err(format!(
+                "{option} {n} is ambiguous: the channel {n} counted from 0 is `{}`, and \
+                 `{}` (counted {k}) has {n} in its name; give the name: {option} \"{}\"",
+                channels[*n], channels[k], channels[k]
+            )),
+        },
         Channel::Name(name) => channels.iter().position(|x| x == name).ok_or_else(|| {
             format!(
                 "{option} {name}: no such channel (the capture has {})",
@@ -382,10 +460,17 @@ fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, Strin
             )
         }),
         Channel::Column(n) => Err(format!(
-            "{option} {n}: the capture has {} channel{} ({}), numbered from 0",
+            "{option} {n}: the capture has {} channel{} ({}), numbered from 0{}",
             channels.len(),
             if channels.len() == 1 { "" } else { "s" },
-            channels.join(", ")
+            channels.join(", "),
+            match named(*n) {
+                Some(k) => format!(
+                    "; for the channel named {n} give its name: {option} \"{}\"",
+                    channels[k]
+                ),
+                None => String::new(),
+            }
         )),
     }
 }
@@ -436,10 +521,25 @@ pub fn analyze<R: BufRead>(
             "--index-channel is the encoder channel itself".into(),
         ));
     }
+    let dch = match &cfg.direction {
+        Some((c, lead)) => {
+            let d = column(&channels, c, "--direction-channel").map_err(AnalyzeError::Option)?;
+            if d == ch || Some(d) == ich {
+                return Err(AnalyzeError::Option(format!(
+                    "--direction-channel is the {} channel itself: give the quadrature B channel",
+                    if d == ch { "encoder" } else { "index" }
+                )));
+            }
+            Some((d, *lead))
+        }
+        None => None,
+    };
     let mut report = AnalyzeReport {
         format: reader.format().name(),
         channel: channels[ch].clone(),
         index_channel: ich.map(|i| channels[i].clone()),
+        direction_channel: dch.map(|(d, _)| channels[d].clone()),
+        forward: dch.map(|(_, lead)| lead),
         edge: match cfg.edge {
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
@@ -447,6 +547,7 @@ pub fn analyze<R: BufRead>(
         wheel: wheel_text(&enc),
         timer_hz: cfg.encoder.timer_hz,
         counter_bits: cfg.encoder.counter_bits,
+        sample_rate: reader.sample_rate(),
         sync_state: "searching",
         ..Default::default()
     };
@@ -471,10 +572,16 @@ pub fn analyze<R: BufRead>(
     let mut last_event: Option<f64> = None;
     let mut last_poll = f64::NEG_INFINITY;
     let mut end = 0.0;
+    let mut changes = vec![0u64; channels.len()];
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
             prev = levels.to_vec();
+        }
+        for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
+            if a != b && *a != Level::Unknown && *b != Level::Unknown {
+                *n += 1;
+            }
         }
         report.rows += 1;
         end = t;
@@ -487,6 +594,21 @@ pub fn analyze<R: BufRead>(
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
         let encoder_edge = edge(ch) == Some(cfg.edge);
+        // B's level as A changes; unknown when B changed in the same sample.
+        let direction = match dch {
+            Some((d, lead)) if encoder_edge && prev[d] == levels[d] => match levels[d] {
+                Level::Low => Some(lead.direction(levels[ch] == Level::High, false)),
+                Level::High => Some(lead.direction(levels[ch] == Level::High, true)),
+                Level::Unknown => None,
+            },
+            _ => None,
+        };
+        if encoder_edge && dch.is_some() && direction.is_none() {
+            report.direction_unknown += 1;
+        }
+        if direction == Some(Direction::Reverse) {
+            report.reverse_edges += 1;
+        }
         prev.copy_from_slice(levels);
         if !index_edge && !encoder_edge {
             continue;
@@ -514,7 +636,7 @@ pub fn analyze<R: BufRead>(
         if encoder_edge {
             report.edges += 1;
             periods.capture();
-            let o = monitor.on_edge_observed(ticks, None, &mut st.seen);
+            let o = monitor.on_edge_observed(ticks, direction, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
         }
     }
@@ -541,10 +663,25 @@ pub fn analyze<R: BufRead>(
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
-    // Edges fed but neither accepted nor rejected: still waiting for their lookahead.
+    // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
+    // or time references after a standstill or a reversal.
     report.unjudged_at_end = report
         .edges
-        .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches));
+        .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
+    if let Some(rate) = report.sample_rate {
+        let widen = 1.0 + cfg.encoder.timer_hz / rate;
+        for w in &mut report.windows {
+            w.floor_with_sampling = w.noise_floor.map(|f| f * widen);
+        }
+    }
+    report.channel_changes = channels
+        .iter()
+        .zip(changes)
+        .map(|(name, changes)| ChannelChanges {
+            name: name.clone(),
+            changes,
+        })
+        .collect();
     report.speed_trace.shrink_to_fit();
     Ok(report)
 }
@@ -682,6 +819,8 @@ impl State {
             omega_max: m.and_then(|m| f(m.omega_max)),
             omega_min: m.and_then(|m| f(m.omega_min)),
             noise_floor: m.and_then(|m| f(m.noise_floor)),
+            floor_with_sampling: None,
+            steady: m.map(|m| m.steady),
         });
     }
 }
@@ -697,18 +836,56 @@ pub fn text(r: &AnalyzeReport) -> String {
     );
     let _ = writeln!(
         s,
-        "channel: {} ({} edges){}",
+        "channel: {} ({} edges){}{}",
         r.channel,
         r.edge,
         r.index_channel
             .as_ref()
-            .map_or(String::new(), |i| format!(", index channel {i}"))
+            .map_or(String::new(), |i| format!(", index channel {i}")),
+        match (&r.direction_channel, r.forward) {
+            (Some(d), Some(lead)) => format!(
+                ", direction from {d} (forward: {} leads)",
+                if lead == Lead::ALeads {
+                    r.channel.as_str()
+                } else {
+                    d.as_str()
+                }
+            ),
+            _ => String::new(),
+        }
     );
+    if r.direction_unknown > 0 {
+        let _ = writeln!(
+            s,
+            "{} edge(s) without a direction: the direction channel changed in the same sample \
+             (the capture's sample rate is too low for the quadrature) or had no data",
+            r.direction_unknown
+        );
+    }
     let _ = writeln!(
         s,
         "wheel: {}; timer {} Hz, {}-bit counter",
         r.wheel, r.timer_hz, r.counter_bits
     );
+    match r.sample_rate {
+        Some(rate) => {
+            let _ = writeln!(
+                s,
+                "sampling: {rate} Hz (a time known to {:.3e} s, {:.3} timer ticks): the floor \
+                 below includes it, {:.3} times the timer's alone",
+                1.0 / rate,
+                r.timer_hz / rate,
+                1.0 + r.timer_hz / rate
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "sampling: rate not stated (give --sample-rate): the floor below is the timer's \
+                 alone, and a capture sampled slower than the timer resolves δ less finely"
+            );
+        }
+    }
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
@@ -721,6 +898,29 @@ pub fn text(r: &AnalyzeReport) -> String {
         },
         r.revolutions
     );
+    let quiet = |name: &str, option: &str| {
+        let others: Vec<String> = r
+            .channel_changes
+            .iter()
+            .filter(|c| c.changes > 0 && c.name != name)
+            .map(|c| format!("{} ({} changes)", c.name, c.changes))
+            .collect();
+        format!(
+            "no {} edge on {option} `{name}` in the capture: check {option}; {}",
+            r.edge,
+            if others.is_empty() {
+                "no channel of the capture changes level".to_string()
+            } else {
+                format!("channels that change: {}", others.join(", "))
+            }
+        )
+    };
+    if r.edges == 0 {
+        let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+    }
+    if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
+        let _ = writeln!(s, "{}", quiet(i, "--index-channel"));
+    }
     let _ = writeln!(
         s,
         "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts",
@@ -745,8 +945,8 @@ pub fn text(r: &AnalyzeReport) -> String {
         let _ = writeln!(
             s,
             "index: {} captures from one index pulse to the next ({} of {} times), but a \
-             revolution of the configured wheel is {}: check the number of lines (and the \
-             edge polarity)",
+             revolution of the configured wheel is {}: check the number of lines, the edge \
+             polarity and --index-channel",
             p.captures, p.times, p.of, p.expected
         );
     }
@@ -756,10 +956,18 @@ pub fn text(r: &AnalyzeReport) -> String {
     if r.sync.len() > 20 {
         let _ = writeln!(s, "  ... {} more changes (see --json)", r.sync.len() - 20);
     }
+    if r.reverse_edges > 0 {
+        let _ = writeln!(
+            s,
+            "{} edge(s) running in reverse (not taken as teeth)",
+            r.reverse_edges
+        );
+    }
     if r.unjudged_at_end > 0 {
         let _ = writeln!(
             s,
-            "{} edge(s) at the end of the capture were still waiting to be judged",
+            "{} edge(s) neither taken as teeth nor rejected: the last ones still waiting to be \
+             judged, and the first after a standstill or reversal (a time reference only)",
             r.unjudged_at_end
         );
     }
@@ -776,12 +984,26 @@ pub fn text(r: &AnalyzeReport) -> String {
         );
     }
     for w in r.windows.iter().take(40) {
-        match (w.delta, w.omega_mean, w.noise_floor) {
+        match (
+            w.delta,
+            w.omega_mean,
+            w.floor_with_sampling.or(w.noise_floor),
+        ) {
             (Some(d), Some(m), Some(f)) => {
                 let _ = writeln!(
                     s,
-                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid",
-                    w.start, w.end, w.revolutions, d, m, f
+                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid{}",
+                    w.start,
+                    w.end,
+                    w.revolutions,
+                    d,
+                    m,
+                    f,
+                    if w.steady == Some(true) {
+                        ""
+                    } else {
+                        ", not steady"
+                    }
                 );
             }
             _ => {
@@ -918,6 +1140,10 @@ pub struct AnalyzeOptions {
     pub channel: Option<Channel>,
     /// `--index-channel`.
     pub index_channel: Option<Channel>,
+    /// `--direction-channel`.
+    pub direction_channel: Option<Channel>,
+    /// `--forward` (default A leads).
+    pub forward: Option<Lead>,
     /// `--edge` (default rising).
     pub edge: Option<Polarity>,
 }
@@ -1022,7 +1248,14 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     if o.index_channel.is_some() && !index {
         return Err("--index-channel goes with an index disc (--lines N --framing index, or a scene whose framing is \"index\")".into());
     }
+    if o.forward.is_some() && o.direction_channel.is_none() {
+        return Err("--forward goes with --direction-channel (the quadrature B channel)".into());
+    }
     Ok(AnalyzeConfig {
+        direction: o
+            .direction_channel
+            .clone()
+            .map(|c| (c, o.forward.unwrap_or(Lead::ALeads))),
         encoder: enc,
         window,
         channel: o.channel.clone().unwrap_or(Channel::Column(0)),

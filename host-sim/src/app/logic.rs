@@ -16,12 +16,14 @@
 //!   with `label=channel` it is `Time,D0,D1`. The time column counts the sample period in that
 //!   unit from one period at the first sample (libsigrok writes `(i+1)·period` for sample `i`);
 //!   sample `i` is read as time `i / samplerate`, so the samplerate comment (or
-//!   `--sample-rate`) is needed when the unit cannot be told from the header. A file without
-//!   a time column (`time=false`) is read as one row per sample.
+//!   `--sample-rate`) is needed: the period in whole units alone is not exact (24 MHz is
+//!   written as 41 ns), and never guessed. A `--sample-rate` that disagrees with the comment
+//!   is an error. A file without a time column (`time=false`) is read as one row per sample.
 //! - **plain**: a header `time_s,level` (or `time_s,level,index` with an index channel), then
 //!   `time,0|1` rows at each change.
 //!
-//! Reading is streamed, one line at a time: memory does not grow with the file. Limits: a line
+//! Reading is streamed, one line at a time: memory does not grow with the file. Line ends may
+//! be LF or CRLF, and a UTF-8 byte order mark before the first line is skipped. Limits: a line
 //! is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`] channels, times must
 //! not decrease from row to row. Every error names the file, the line and what was expected.
 //!
@@ -199,6 +201,8 @@ pub struct CaptureReader<R> {
     sample_rate: Option<f64>,
     rows: u64,
     last_time: f64,
+    /// The line last read had no line end (the end of the file).
+    unterminated: bool,
 }
 
 impl CaptureReader<std::io::BufReader<std::fs::File>> {
@@ -239,6 +243,7 @@ impl<R: BufRead> CaptureReader<R> {
             sample_rate,
             rows: 0,
             last_time: f64::NEG_INFINITY,
+            unterminated: false,
         };
         let first = loop {
             match r.read_line()? {
@@ -316,10 +321,19 @@ impl<R: BufRead> CaptureReader<R> {
 
     /// An error at the current line.
     pub fn err_here(&self, message: &str) -> CaptureError {
+        let mut message = message.to_string();
+        if self.unterminated {
+            // The last line of the file has no line end: most likely a recording or a copy
+            // cut off in the middle of a row.
+            message.push_str(
+                "; this is the file's last line and it has no line end: the file looks cut off \
+                 in the middle of a row; delete that line to analyze the rows before it",
+            );
+        }
         CaptureError {
             file: self.file.clone(),
             line: Some(self.line.max(1)),
-            message: message.to_string(),
+            message,
         }
     }
 
@@ -343,12 +357,17 @@ impl<R: BufRead> CaptureReader<R> {
             return Ok(None);
         }
         self.line += 1;
+        self.unterminated = n <= MAX_LINE_BYTES && !self.buf.ends_with('\n');
         if n > MAX_LINE_BYTES && !self.buf.ends_with('\n') {
             return Err(self.err_here(&format!(
                 "line longer than {MAX_LINE_BYTES} bytes: not a capture row"
             )));
         }
-        let l = self.buf.trim_end_matches(['\n', '\r']);
+        let mut l = self.buf.trim_end_matches(['\n', '\r']);
+        if self.line == 1 {
+            // A UTF-8 byte order mark (Windows editors, spreadsheet exports) is not text.
+            l = l.strip_prefix('\u{feff}').unwrap_or(l);
+        }
         Ok(Some(l.to_string()))
     }
 
@@ -389,6 +408,16 @@ impl<R: BufRead> CaptureReader<R> {
                         clip(rest.trim())
                     ))
                 })?;
+                if let Some(given) = self.sample_rate {
+                    if (given - rate).abs() > 1e-9 * rate {
+                        return Err(self.err_here(&format!(
+                            "the file states `Samplerate: {}` ({rate} Hz) but --sample-rate is \
+                             {given} Hz: leave --sample-rate out (the file's rate is used) or \
+                             correct it",
+                            rest.trim()
+                        )));
+                    }
+                }
                 self.sample_rate = Some(rate);
             }
             line = loop {
@@ -420,6 +449,12 @@ impl<R: BufRead> CaptureReader<R> {
             }
             self.channels = names;
             self.held = Some(header);
+            if self.sample_rate.is_none() {
+                return Err(self.err_here(
+                    "the time of a sample cannot be told: the file has no `; Samplerate:` \
+                     comment and no header row naming a time unit; give --sample-rate",
+                ));
+            }
             return Ok(());
         }
         let (time, labels) = match fields.first() {
@@ -442,12 +477,19 @@ impl<R: BufRead> CaptureReader<R> {
         } else {
             labels.iter().map(|l| l.to_string()).collect()
         };
-        if (time == SigrokTime::Labelled || time == SigrokTime::None) && self.sample_rate.is_none()
-        {
-            return Err(self.err_here(
-                "the time of a sample cannot be told: the file has no `; Samplerate:` comment \
-                     and no time unit in its header; give --sample-rate",
-            ));
+        if self.sample_rate.is_none() {
+            return Err(self.err_here(&match time {
+                SigrokTime::Column { .. } => format!(
+                    "the time of a sample cannot be told exactly: the file has no `; \
+                     Samplerate:` comment, and its `{}` column counts a sample period that \
+                     libsigrok rounds down to whole units (24 MHz is written as 41 ns, not \
+                     41.67); give --sample-rate (the capture's samples per second)",
+                    fields.first().copied().unwrap_or("")
+                ),
+                _ => "the time of a sample cannot be told: the file has no `; Samplerate:` \
+                      comment and no time unit in its header; give --sample-rate"
+                    .to_string(),
+            }));
         }
 
         Ok(())

@@ -1,7 +1,7 @@
 //! `drive-sim`: run, predict and sweep scenes.
 
 use clap::{Parser, Subcommand};
-use host_sim::app::analyze::{Channel, FramingArg, Polarity};
+use host_sim::app::analyze::{Channel, FramingArg, Lead, Polarity};
 use host_sim::app::logic::CaptureFormat;
 use host_sim::app::predict::predict;
 use host_sim::app::scene::{resolve, BUNDLED, DEFAULT_SCENE};
@@ -54,7 +54,10 @@ enum Command {
         format: Option<CaptureFormat>,
         #[command(flatten)]
         options: AnalyzeArgs,
-        /// Samples per second of a sigrok file without a samplerate comment, Hz.
+        /// The logic analyzer's samples per second, Hz. A sigrok file states it (needed when it
+        /// does not: its time column alone is not exact; it must agree with the comment when
+        /// there is one); for any format it widens the windows' noise floor by the sampling's
+        /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long)]
         sample_rate: Option<f64>,
         /// Print JSON.
@@ -138,12 +141,20 @@ enum Command {
 #[derive(clap::Args)]
 struct AnalyzeArgs {
     /// The encoder channel: its name in the header, or its number among the channels
-    /// (from 0).
+    /// (from 0; refused when another channel's name carries that number, e.g. `3` on an
+    /// export of `Channel 1` to `Channel 4`: give the name then).
     #[arg(long, default_value = "0")]
     channel: Channel,
     /// The index channel of an index disc (default: channel 1).
     #[arg(long)]
     index_channel: Option<Channel>,
+    /// The quadrature B channel: its level at each edge of --channel gives the edge's
+    /// direction, so a reversal is seen (without it every edge counts as forward).
+    #[arg(long)]
+    direction_channel: Option<Channel>,
+    /// Which channel leads when the shaft runs forward (with --direction-channel).
+    #[arg(long, value_enum)]
+    forward: Option<Lead>,
     /// The edges the capture unit takes.
     #[arg(long, value_enum, default_value = "rising")]
     edge: Polarity,
@@ -196,6 +207,8 @@ impl AnalyzeArgs {
             window_revolutions: self.window_revolutions,
             channel: Some(self.channel),
             index_channel: self.index_channel,
+            direction_channel: self.direction_channel,
+            forward: self.forward,
             edge: Some(self.edge),
         })
     }
