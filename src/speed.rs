@@ -16,7 +16,9 @@
 //! per-pitch intervals (the sum of squared log swings): the expected tooth; a glitch (the edge
 //! is dropped and the next one is the tooth); one or two missing teeth; and, on a pattern
 //! wheel, a count one ahead or behind (an earlier extra or missing edge). A fault must explain
-//! the intervals better than the plain tooth by [`crate::encoder::Tolerances::fault_margin`].
+//! the intervals better than the plain tooth by [`crate::encoder::Tolerances::fault_margin`]
+//! (a lost tooth after a wheel's gap, which stretches the gap by less, by a margin scaled to
+//! the evidence it leaves).
 //! A real compression swing is therefore taken as a tooth, a noise pulse between two teeth is
 //! rejected as a glitch and the real edge behind it kept, and a tooth lost mid-revolution moves
 //! the count on by one instead of re-framing the revolution there (no cascade).
@@ -917,10 +919,17 @@ impl SpeedTracker {
                     self.accept(enc, table, e1, s1, true, sink);
                     continue;
                 }
-                // Teeth lost before it (`Missing` is 1 or 2), or none: the count was one ahead.
+                // Teeth lost before it (`Missing` is 1 or 2, lost within its interval; `Ahead`
+                // one lost earlier, its interval the tooth's own), or none: the count was one
+                // ahead.
                 Verdict::Missing(n) => n,
                 Verdict::Ahead => 1,
                 Verdict::Behind => 0,
+            };
+            let within = if let Verdict::Missing(n) = verdict {
+                n
+            } else {
+                0
             };
             self.pop();
             if lost == 0 {
@@ -938,6 +947,34 @@ impl SpeedTracker {
                 self.advance_after_fault(enc, lost);
             }
             self.accept(enc, table, e1, s1, false, sink);
+            if within > 0 {
+                self.prev = self.per_base_over(enc, within);
+            }
+        }
+    }
+
+    /// The per-base interval of the tooth just accepted when its interval also spanned the
+    /// `lost` teeth before it: the interval over all their pitches, as the judgement took it
+    /// (over the tooth's own pitch alone, the next edge would be judged against an interval
+    /// `lost + 1` pitches long, and after a wheel's gap taken for a glitch).
+    fn per_base_over(&self, enc: &Encoder, lost: u16) -> u32 {
+        if enc.is_uniform() {
+            // Every pitch the base (always so without pattern wheels: no other division).
+            return self
+                .prev
+                .checked_div(u32::from(lost).wrapping_add(1))
+                .unwrap_or(self.prev);
+        }
+        let own = enc.grid_pitch(self.tooth);
+        let mut span = own;
+        for i in 1..=lost {
+            span = span.saturating_add(enc.grid_pitch(tooth_back(self.tooth, i, enc.edges())));
+        }
+        // A reference for judging, which is done in f32 anyway (no 64-bit division).
+        if span == 0 {
+            self.prev
+        } else {
+            (self.prev as f32 * (own as f32 / span as f32)) as u32
         }
     }
 
@@ -1040,15 +1077,27 @@ impl SpeedTracker {
         };
         consider(glitch, Verdict::Glitch);
         if synced {
+            // A tooth lost after a long pitch p (a gap) stretches it by a swing of (p + 1)/p
+            // only, not 2: the margin a lost tooth must win by shrinks with the evidence it
+            // leaves, by (ln((p + 1)/p)/ln 2)², so that a swing is called a lost tooth at the
+            // same fraction of the way to one as after an ordinary pitch (on a 60-2 wheel's
+            // gap a swing above 1.21, against 1.58 elsewhere, without a recorded revolution).
+            let lost_margin = if enc.framing() == Framing::Pattern && p_next > 1.0 {
+                let r = ln((p_next + 1.0) / p_next) / core::f32::consts::LN_2;
+                margin * (r * r).min(1.0)
+            } else {
+                margin
+            };
             let mut spans = p_next;
             let mut tooth = next;
             for j in 1..=2u16 {
                 tooth = tooth_after(tooth, 1, edges);
                 spans += pitch_ratio(enc, tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
+                // (`consider` adds one `margin`: a lost tooth's is `lost_margin` each.)
                 consider(
-                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3])
-                        + margin * f32::from(j.wrapping_sub(1)),
+                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3]) - margin
+                        + lost_margin * f32::from(j),
                     Verdict::Missing(j),
                 );
             }
