@@ -551,3 +551,36 @@ fn predict_says_a_prescribed_speed_gives_no_delta() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn run_says_which_tables_a_prescribed_speed_leaves_out() {
+    // A prescribed speed with [load] and [shaft]: neither moves the shaft, and the run said
+    // nothing of them (the load's ripple simply did not show).
+    let dir = scratch("prescribed-run");
+    let path = dir.join("prescribed.toml");
+    std::fs::write(
+        &path,
+        "[shaft]\ninertia = 0.3\n[motor]\nmodel = \"speed\"\nspeed = 100.0\n\
+         [load]\nmean = 3.0\nharmonics = [{ order = 1.0, amplitude = 2.0 }]\n\
+         [encoder]\nlines = 360\ntimer_hz = 1e6\n[simulation]\nduration = 0.5\n",
+    )
+    .unwrap();
+    let file = path.to_str().unwrap();
+    let (ok, out, err) = drive_sim(&["run", file]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("NOT SIMULATED [load]: the speed is prescribed ([motor] model = \"speed\")")
+            && out.contains("NOT SIMULATED [shaft]"),
+        "{out}"
+    );
+    let v = json(&["run", file, "--json"]);
+    let notes = v["not_simulated"].as_array().expect("not_simulated");
+    assert_eq!(notes.len(), 2, "{v}");
+    assert!(notes[0].as_str().unwrap().starts_with("[load]"), "{v}");
+    assert!(notes[1].as_str().unwrap().starts_with("[shaft]"), "{v}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    // A motor-driven scene leaves nothing out, and its δ limit is in the JSON as in the text.
+    let v = json(&["run", "kneader", "--json"]);
+    assert!(v.get("not_simulated").is_none(), "{v}");
+    assert_eq!(v["delta_limit"].as_f64(), Some(0.06));
+}

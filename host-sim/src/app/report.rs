@@ -32,6 +32,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         r.steps[1],
         r.edges
     );
+    for why in &r.not_simulated {
+        let _ = writeln!(s, "NOT SIMULATED {why}");
+    }
     if let Some(why) = &r.no_measurement {
         let _ = writeln!(s, "NOTHING MEASURED by the core: {why}");
     }

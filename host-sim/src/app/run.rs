@@ -138,6 +138,10 @@ pub struct RunReport {
     /// Why the core measured nothing: no valid window, or no `[encoder]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_measurement: Option<String>,
+    /// Tables of the scene that take no part in the run, each with why (e.g. `[load]` under a
+    /// prescribed speed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_simulated: Vec<String>,
     /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_predicted: Option<&'static str>,
@@ -194,8 +198,8 @@ pub struct RunReport {
     /// Settling time, s.
     #[serde(skip)]
     pub settle: f64,
-    /// δ limit.
-    #[serde(skip)]
+    /// δ limit (`[monitor] delta_limit`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_limit: Option<f64>,
 }
 
@@ -1252,6 +1256,7 @@ pub fn run_with(
             .map(|t| t.path.display().to_string()),
         capture_rows,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
+        not_simulated: not_simulated(scene, over),
         ..Default::default()
     };
     if let Some(model) = model
@@ -1276,6 +1281,46 @@ pub fn run_with(
     report.edge_list = col.edge_list.take().unwrap_or_default();
     report.wall_seconds = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// The tables a prescribed speed leaves out: the load torque and the shaft's inertia move
+/// nothing when the speed is imposed (said, not dropped in silence).
+fn not_simulated(scene: &Scene, over: Overrides) -> Vec<String> {
+    let by = match (over.speed, &scene.motor) {
+        (Some(w), _) => format!("the speed is prescribed ({w} rad/s for this run)"),
+        (None, Some(MotorSpec::Speed { .. })) => "[motor] model = \"speed\"".to_string(),
+        (None, Some(MotorSpec::Ramp { .. })) => "[motor] model = \"ramp\"".to_string(),
+        (None, Some(MotorSpec::Profile { .. })) => "[motor] model = \"profile\"".to_string(),
+        _ => return Vec::new(),
+    };
+    let by = if over.speed.is_some() {
+        by
+    } else {
+        format!("the speed is prescribed ({by})")
+    };
+    let drive = "a \"parabola\" or \"kloss\" motor simulates the drive with it";
+    let mut out = Vec::new();
+    if scene.load.is_some() {
+        let window = scene
+            .monitor
+            .as_ref()
+            .and_then(|m| m.window_revolutions)
+            .is_none();
+        out.push(format!(
+            "[load]: {by}, so its torque moves nothing{}; {drive}",
+            if window {
+                " (its lowest harmonic order still sets the δ window: one load cycle)"
+            } else {
+                ""
+            }
+        ));
+    }
+    if scene.shaft.is_some() {
+        out.push(format!(
+            "[shaft]: {by}, so its inertia moves nothing; {drive}"
+        ));
+    }
+    out
 }
 
 /// The capture writer of a run: the scene's `[capture]` settings (or their defaults).
