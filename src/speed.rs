@@ -1024,7 +1024,24 @@ impl SpeedTracker {
         };
         let x = d1 as f32;
         let tol = enc.config().tolerances;
-        if x + 1.0 < tol.glitch_fraction * (expected - 1.0) {
+        // Synced on a pattern wheel, the count may be one tooth off (an extra or lost edge
+        // taken earlier): only what is short even against the pitches of the teeth before
+        // and after the expected one is a glitch outright (a real tooth, one short of a gap
+        // the count puts one tooth early, is left for the judgement, which realigns).
+        let outright = if synced && enc.framing() == Framing::Pattern {
+            let own = enc.grid_pitch(next);
+            let near = enc
+                .grid_pitch(self.tooth)
+                .min(enc.grid_pitch(tooth_after(next, 1, edges)));
+            if near < own && own > 0 {
+                expected * (near as f32 / own as f32)
+            } else {
+                expected
+            }
+        } else {
+            expected
+        };
+        if x + 1.0 < tol.glitch_fraction * (outright - 1.0) {
             return Verdict::Glitch;
         }
         if !synced && enc.framing() == Framing::Pattern {
@@ -1058,11 +1075,28 @@ impl SpeedTracker {
         }
         let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
         let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
-        let margin = tol.fault_margin;
         let p_next = pitch_ratio(enc, next);
+        // Where the expected tooth ends a long pitch p (a gap), every fault leaves less
+        // evidence than after an ordinary pitch: a tooth lost there stretches the gap by
+        // (p + 1)/p only, not 2, and a noise pulse late in the gap, or a count one tooth off,
+        // looks like a gap a pitch shorter. The margin shrinks with it, by
+        // (ln((p + 1)/p)/ln 2)², so that a swing is called a fault at the same fraction of
+        // the way to one as after an ordinary pitch (on a 60-2 wheel's gap a swing above 1.21
+        // is a lost tooth, against 1.58 elsewhere, without a recorded revolution).
+        // There, too, an interval after the judged one that no hypothesis here explains
+        // (a tooth lost two teeth on) costs each hypothesis at most that margin: what calling
+        // it a fault when it is judged will cost (else it would outweigh the evidence on the
+        // judged edge itself).
+        let (margin, cap) = if synced && enc.framing() == Framing::Pattern && p_next > 1.0 {
+            let r = ln((p_next + 1.0) / p_next) / core::f32::consts::LN_2;
+            let m = tol.fault_margin * if r < 1.0 { r * r } else { 1.0 };
+            (m, m)
+        } else {
+            (tol.fault_margin, f32::INFINITY)
+        };
         let here = self.tooth;
         let mut best = (
-            self.chain_cost(enc, here, next, x / p_next, [d2, d3]),
+            self.chain_cost(enc, here, next, x / p_next, [d2, d3], cap),
             Verdict::Tooth,
         );
         let mut consider = |cost: f32, v: Verdict| {
@@ -1072,32 +1106,20 @@ impl SpeedTracker {
         };
         // A glitch: e1 and e2 merged are the expected tooth.
         let glitch = match d2 {
-            Some(d2) => self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, [d3, None]),
+            Some(d2) => self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, [d3, None], cap),
             None => f32::INFINITY,
         };
         consider(glitch, Verdict::Glitch);
         if synced {
-            // A tooth lost after a long pitch p (a gap) stretches it by a swing of (p + 1)/p
-            // only, not 2: the margin a lost tooth must win by shrinks with the evidence it
-            // leaves, by (ln((p + 1)/p)/ln 2)², so that a swing is called a lost tooth at the
-            // same fraction of the way to one as after an ordinary pitch (on a 60-2 wheel's
-            // gap a swing above 1.21, against 1.58 elsewhere, without a recorded revolution).
-            let lost_margin = if enc.framing() == Framing::Pattern && p_next > 1.0 {
-                let r = ln((p_next + 1.0) / p_next) / core::f32::consts::LN_2;
-                margin * (r * r).min(1.0)
-            } else {
-                margin
-            };
             let mut spans = p_next;
             let mut tooth = next;
             for j in 1..=2u16 {
                 tooth = tooth_after(tooth, 1, edges);
                 spans += pitch_ratio(enc, tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
-                // (`consider` adds one `margin`: a lost tooth's is `lost_margin` each.)
                 consider(
-                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3]) - margin
-                        + lost_margin * f32::from(j),
+                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3], cap)
+                        + margin * f32::from(j.wrapping_sub(1)),
                     Verdict::Missing(j),
                 );
             }
@@ -1111,12 +1133,13 @@ impl SpeedTracker {
                         behind,
                         x / pitch_ratio(enc, behind),
                         [d2, d3],
+                        cap,
                     ),
                     Verdict::Behind,
                 );
                 let ahead = tooth_after(next, 1, edges);
                 consider(
-                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3]),
+                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3], cap),
                     Verdict::Ahead,
                 );
             }
@@ -1128,8 +1151,8 @@ impl SpeedTracker {
     /// per-pitch interval `head`, after the last accepted edge, which was tooth `before`; the
     /// intervals `rest` that follow are the teeth after `first`. The cost is the sum of the
     /// squared log swings of the per-pitch intervals against the swings the same teeth had one
-    /// revolution earlier (against 1 without a recorded revolution). One routine, out of line,
-    /// for every hypothesis.
+    /// revolution earlier (against 1 without a recorded revolution), each after the first at
+    /// most `cap`. One routine, out of line, for every hypothesis.
     #[inline(never)]
     fn chain_cost(
         &self,
@@ -1138,13 +1161,16 @@ impl SpeedTracker {
         first: u16,
         head: f32,
         rest: [Option<u32>; 2],
+        cap: f32,
     ) -> f32 {
         let mut cost = log_sq(head, self.prev as f32 * self.recorded_swing(before, first));
         let (mut prev, mut tooth) = (head, first);
         for d in rest.iter().flatten() {
             let next = tooth_after(tooth, 1, enc.edges());
             let v = *d as f32 / pitch_ratio(enc, next);
-            cost += log_sq(v, prev * self.recorded_swing(tooth, next));
+            // A compare, not `f32::min` (a call of `fminf` on this FPU); never NaN.
+            let swing = log_sq(v, prev * self.recorded_swing(tooth, next));
+            cost += if swing > cap { cap } else { swing };
             prev = v;
             tooth = next;
         }
