@@ -224,10 +224,10 @@ pub struct Tolerances {
     /// shaft with one tooth missing scores 0.96 in favour of the fault and a noise pulse
     /// between 30 and 70 % of a tooth at least 0.96; a compression swing of 1.6 for one tooth
     /// scores 0.34 in favour of a missing tooth that is not there, so the margin keeps it a
-    /// tooth. After a long pitch of p pitches (a wheel's gap) a lost tooth stretches the
-    /// interval by (p + 1)/p only, and leaves less evidence: there the margin for a lost tooth
-    /// is this one times (ln((p + 1)/p)/ln 2)² (0.05 after a 60-2 wheel's gap, where a lost
-    /// first tooth scores 0.17). 0.05 to 2.
+    /// tooth. At a long pitch of p pitches (a wheel's gap) every fault leaves less evidence (a
+    /// lost tooth stretches the gap by (p + 1)/p only; a noise pulse late in it looks like a
+    /// gap a pitch shorter): there the margin is this one times (ln((p + 1)/p)/ln 2)² (0.05 at
+    /// a 60-2 wheel's gap, where a lost first tooth scores 0.17). 0.05 to 2.
     pub fault_margin: f32,
 }
 

@@ -17,8 +17,7 @@
 //! is dropped and the next one is the tooth); one or two missing teeth; and, on a pattern
 //! wheel, a count one ahead or behind (an earlier extra or missing edge). A fault must explain
 //! the intervals better than the plain tooth by [`crate::encoder::Tolerances::fault_margin`]
-//! (a lost tooth after a wheel's gap, which stretches the gap by less, by a margin scaled to
-//! the evidence it leaves).
+//! (at a wheel's gap, where every fault leaves less evidence, by a margin scaled to it).
 //! A real compression swing is therefore taken as a tooth, a noise pulse between two teeth is
 //! rejected as a glitch and the real edge behind it kept, and a tooth lost mid-revolution moves
 //! the count on by one instead of re-framing the revolution there (no cascade).
