@@ -927,6 +927,95 @@ mod tests {
     }
 
     #[test]
+    fn one_fault_anywhere_on_a_uniform_disc_is_seen_and_no_window_spans_it_but_at_the_frame() {
+        // Random uniform discs (index or unframed) and speed ripples, one edge lost or one
+        // noise pulse between two edges anywhere: the fault is counted, and every window
+        // reported valid measures the ripple, except where a noise pulse falls in the last
+        // pitches before an index disc's frame edge. There a pulse late in the pitch is taken
+        // at once (in the band, the index covering it) and ends the window, and the real edge
+        // after it is the glitch, counted in the next window: the window's last sample is up to
+        // a third short. Known, not yet mended: 4 of these 1 000 runs (about 0.3 % of runs
+        // with one pulse anywhere, 1/lines of pulses).
+        let mut rng = 1_u64;
+        let mut next = |n: u64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 33) % n
+        };
+        let mut at_frame = 0;
+        for case in 0..1000 {
+            let lines = [64u16, 100, 360, 500, 1024][next(5) as usize];
+            let indexed = next(3) != 0;
+            let a = 0.005 + 0.075 * next(1000) as f64 / 1000.0;
+            let z = 1.0 + next(2) as f64;
+            let ph = TAU * next(1000) as f64 / 1000.0;
+            let w = move |phi: f64| 100.0 * (1.0 + a * (z * phi + ph).sin());
+            // Events per revolution: the edges and the index (first, half a pitch ahead).
+            let per = usize::from(lines) + usize::from(indexed);
+            let k = next(per as u64) as usize;
+            let rev = 4 + next(4) as usize;
+            let drop = next(2) == 0;
+            let index = indexed.then_some(0.0);
+            let mut evs = stream(&uniform(u32::from(lines)), index, 12, 84e6, u32::MAX, &w);
+            let at = rev * per + k;
+            if drop {
+                evs.remove(at);
+            } else {
+                let time = |e: Ev| match e {
+                    Ev::Edge(t) | Ev::Index(t) => t,
+                };
+                let (t0, t1) = (time(evs[at]), time(evs[at + 1]));
+                let f = 0.3 + 0.4 * next(1000) as f64 / 1000.0;
+                evs.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+            }
+            let mut c = if indexed {
+                EncoderConfig::indexed(lines, 84e6)
+            } else {
+                EncoderConfig::unframed(lines, 84e6)
+            };
+            c.estimator = Estimator::Edges(4);
+            c.min_speed = 20.0;
+            let mut m = monitor(c, 1);
+            let out = run(&mut m, &evs);
+            let what = format!(
+                "case {case}: {lines} lines, index {indexed}, a {a:.4}, z {z}, event {k} of rev \
+                 {rev} {}",
+                if drop { "lost" } else { "doubled" }
+            );
+            let d = m.diagnostics();
+            assert!(
+                d.edges.missing + d.edges.glitches + d.edges.extra + d.edges.missing_frames >= 1,
+                "{d:?} {what}"
+            );
+            let x = z * 4.0 * TAU / f64::from(lines) / 2.0;
+            let expect = 2.0 * a * x.sin() / x;
+            let wrong = out
+                .iter()
+                .filter_map(|o| o.report.measurement())
+                .filter(|r| (f64::from(r.delta) - expect).abs() > 0.1 * expect + 2e-3)
+                .count();
+            // A pulse after the index (ahead of tooth 0), or within the last two pitches.
+            let near_frame = indexed && !drop && (k == 0 || k + 2 >= per);
+            if wrong > 0 {
+                assert!(near_frame, "{wrong} wrong windows: {what} {out:?}");
+                at_frame += 1;
+            }
+            assert!(
+                out.iter()
+                    .filter(|o| o.report.measurement().is_some())
+                    .count()
+                    >= 6,
+                "{what}"
+            );
+        }
+        assert!(
+            at_frame <= 6,
+            "{at_frame} runs with a wrong window at the frame"
+        );
+    }
+
+    #[test]
     fn a_slowdown_mid_revolution_is_not_a_gap() {
         // The re-frame cascade: 36-2 at 5000 ticks per tooth, the speed dropping once to 1/1.6
         // in the middle of a revolution (no edge missing). Nothing is a fault, and every
