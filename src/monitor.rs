@@ -175,6 +175,11 @@ pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
     diag: Diagnostics,
     /// A second window finished by the same call, returned by the next one.
     spill: Option<WindowOutcome>,
+    /// A valid window that has just ended at its frame edge, held until the edge after the
+    /// frame is judged: a glitch, missing or extra edge found there lies against the frame
+    /// (a noise pulse late in the last pitch taken for the frame edge, the real one rejected
+    /// after it) and invalidates it.
+    held: Option<WindowReport>,
 }
 
 /// Where the tracker's findings go during one call: the window, the alarm, the observer, and
@@ -193,6 +198,7 @@ struct Feed<'a, O: EdgeSink> {
     observer: &'a mut O,
     first: Option<WindowOutcome>,
     spill: &'a mut Option<WindowOutcome>,
+    held: &'a mut Option<WindowReport>,
 }
 
 impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
@@ -200,6 +206,10 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     fn tooth(&mut self, tooth: &Tooth) {
         self.observer.tooth(tooth);
         self.last_edge = tooth.index;
+        if self.held.is_some() {
+            // The edge after the frame is a tooth: the window stands.
+            self.release(None);
+        }
         let e = self.encoder;
         if let Some(r) = self.state.on_tooth(
             self.window,
@@ -209,7 +219,8 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
             e.samples_span(),
             self.uniform,
         ) {
-            finish(self.alarm, self.diag, r, &mut self.first, self.spill);
+            // Held for the edge after the frame (see `DeltaMonitor::held`).
+            *self.held = Some(r);
         }
     }
 
@@ -217,9 +228,27 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     #[inline(never)]
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
+        if self.held.is_some() {
+            self.release(Some(fault));
+        }
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
+            finish(self.alarm, self.diag, &r, &mut self.first, self.spill);
+        }
+    }
+}
+
+impl<O: EdgeSink> Feed<'_, O> {
+    /// The edge after the frame is judged: the held window stands, unless `fault` is an edge
+    /// fault, which lies against the frame (a timeout, a reversal or a missing frame does
+    /// not).
+    fn release(&mut self, fault: Option<Fault>) {
+        if let Some(r) = self.held.as_mut() {
+            if let Some(f @ (Fault::Glitch | Fault::MissingEdge | Fault::ExtraEdge)) = fault {
+                r.result = Err(f);
+            }
             finish(self.alarm, self.diag, r, &mut self.first, self.spill);
         }
+        *self.held = None;
     }
 }
 
@@ -232,7 +261,7 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
 fn finish(
     alarm: &mut Option<DeltaAlarm>,
     diag: &mut Diagnostics,
-    report: WindowReport,
+    report: &WindowReport,
     first: &mut Option<WindowOutcome>,
     spill: &mut Option<WindowOutcome>,
 ) {
@@ -243,7 +272,7 @@ fn finish(
     }
     let (verdict, event) = match alarm.as_mut() {
         Some(a) => {
-            let (v, e) = a.update(&report);
+            let (v, e) = a.update(report);
             (Some(v), e)
         }
         None => (None, None),
@@ -252,7 +281,7 @@ fn finish(
         diag.alarms_raised = diag.alarms_raised.wrapping_add(1);
     }
     let o = WindowOutcome {
-        report,
+        report: *report,
         verdict,
         event,
     };
@@ -287,6 +316,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             state: WindowState::new(),
             diag: Diagnostics::ZERO,
             spill: None,
+            held: None,
         }
     }
 
@@ -342,6 +372,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         self.state.clear();
         self.diag.clear();
         self.spill = None;
+        self.held = None;
     }
 
     /// Validates `config` into an [`Encoder`] and configures the monitor with it.
@@ -430,8 +461,10 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     }
 
     /// One encoder edge captured at `ticks` (raw counter value), with the direction if known.
-    /// Returns a window when one ends (a second window ended by the same edge, which a late
-    /// judgement can cause, is returned by the next call).
+    /// Returns a window once it has ended and the edge after its frame edge is judged: a
+    /// glitch, missing or extra edge found there lies against the frame and makes it invalid
+    /// (a second window ended by the same edge, which a late judgement can cause, is returned
+    /// by the next call; a timeout found by [`DeltaMonitor::poll`] returns a window held).
     #[inline(always)]
     pub fn on_edge(&mut self, ticks: u32, direction: Option<Direction>) -> Option<WindowOutcome> {
         self.on_edge_observed(ticks, direction, &mut ())
@@ -475,7 +508,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         let first = self.fed(observer, |tracker, encoder, table, feed| {
             tracker.careful(encoder, table, ticks, direction, feed);
         });
-        if self.spill.is_some() {
+        if self.spill.is_some() || self.held.is_some() {
             self.tracker.block_fast();
         }
         first
@@ -546,7 +579,16 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         captures.get(taken..).unwrap_or(&[])
     }
 
-    /// Checks for standstill at time `now` (ticks); returns the window cut short, if any.
+    /// At the end of a recording or a run, when no edge will follow: the window held for the
+    /// edge after its frame edge, as it is, if any (a second one waiting from the last call
+    /// comes first, this one by the next call).
+    pub fn release_held(&mut self) -> Option<WindowOutcome> {
+        self.fed(&mut (), |_, _, _, feed| feed.release(None))
+    }
+
+    /// Checks for standstill at time `now` (ticks); returns the window cut short, if any, or
+    /// one held for the edge after its frame, which a standstill releases as it is (when
+    /// both, the held one first, the other by the next call).
     pub fn poll(&mut self, now: u32) -> Option<WindowOutcome> {
         self.poll_observed(now, &mut ())
     }
@@ -582,6 +624,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             observer,
             first: self.spill.take(),
             spill: &mut self.spill,
+            held: &mut self.held,
         };
         step(&mut self.tracker, &self.encoder, &self.table, &mut feed);
         feed.first
@@ -648,6 +691,13 @@ mod tests {
             }
         }
         out
+    }
+
+    /// The time of a capture event.
+    fn time_of(e: Ev) -> u32 {
+        match e {
+            Ev::Edge(t) | Ev::Index(t) => t,
+        }
     }
 
     /// Tooth angles of a uniform disc (edges half a pitch after the index).
@@ -927,15 +977,14 @@ mod tests {
     }
 
     #[test]
-    fn one_fault_anywhere_on_a_uniform_disc_is_seen_and_no_window_spans_it_but_at_the_frame() {
+    fn one_fault_anywhere_on_a_uniform_disc_is_seen_and_no_window_spans_it() {
         // Random uniform discs (index or unframed) and speed ripples, one edge lost or one
         // noise pulse between two edges anywhere: the fault is counted, and every window
-        // reported valid measures the ripple, except where a noise pulse falls in the last
-        // pitches before an index disc's frame edge. There a pulse late in the pitch is taken
-        // at once (in the band, the index covering it) and ends the window, and the real edge
-        // after it is the glitch, counted in the next window: the window's last sample is up to
-        // a third short. Known, not yet mended: 4 of these 1 000 runs (about 0.3 % of runs
-        // with one pulse anywhere, 1/lines of pulses).
+        // reported valid measures the ripple. Before a window was held for the edge after its
+        // frame, and samples restarted after a glitch, 4 of these 1 000 runs reported a valid
+        // window with a wrong δ: a noise pulse late in the last pitch, in the band, was taken
+        // as the frame edge and the real edge after it rejected, in the next window; and the
+        // samples after that glitch started at the pulse.
         let mut rng = 1_u64;
         let mut next = |n: u64| {
             rng = rng
@@ -943,7 +992,6 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (rng >> 33) % n
         };
-        let mut at_frame = 0;
         for case in 0..1000 {
             let lines = [64u16, 100, 360, 500, 1024][next(5) as usize];
             let indexed = next(3) != 0;
@@ -988,31 +1036,88 @@ mod tests {
                 d.edges.missing + d.edges.glitches + d.edges.extra + d.edges.missing_frames >= 1,
                 "{d:?} {what}"
             );
+            // δ = 2a less what samples of four pitches average away.
             let x = z * 4.0 * TAU / f64::from(lines) / 2.0;
             let expect = 2.0 * a * x.sin() / x;
-            let wrong = out
-                .iter()
-                .filter_map(|o| o.report.measurement())
-                .filter(|r| (f64::from(r.delta) - expect).abs() > 0.1 * expect + 2e-3)
-                .count();
-            // A pulse after the index (ahead of tooth 0), or within the last two pitches.
-            let near_frame = indexed && !drop && (k == 0 || k + 2 >= per);
-            if wrong > 0 {
-                assert!(near_frame, "{wrong} wrong windows: {what} {out:?}");
-                at_frame += 1;
+            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+            for r in &valid {
+                assert!(
+                    (f64::from(r.delta) - expect).abs() <= 0.1 * expect + 2e-3,
+                    "{expect} {r:?} {what}"
+                );
             }
-            assert!(
-                out.iter()
-                    .filter(|o| o.report.measurement().is_some())
-                    .count()
-                    >= 6,
-                "{what}"
-            );
+            assert!(valid.len() >= 6, "{what}: {out:?}");
         }
+    }
+
+    #[test]
+    fn a_window_is_held_for_the_edge_after_its_frame() {
+        // 64 lines with an index, one-revolution windows: each is returned by the edge after
+        // its frame edge; a stream that ends at a frame edge gives its window by
+        // `release_held`; a noise pulse taken for the frame edge (late in the last pitch, the
+        // real edge after it rejected) makes the window invalid.
+        let evs = stream(&uniform(64), Some(0.0), 6, 1e6, u32::MAX, &kneader(0.01));
+        let edges: Vec<u32> = evs
+            .iter()
+            .filter_map(|e| if let Ev::Edge(t) = e { Some(*t) } else { None })
+            .collect();
+        let mut m = monitor(indexed(64, 4, 32, 1e6), 1);
+        let mut returned = Vec::new();
+        for (n, e) in evs.iter().enumerate() {
+            match *e {
+                Ev::Index(t) => m.on_index(t),
+                Ev::Edge(t) => {
+                    if let Some(o) = m.on_edge(t, Some(Direction::Forward)) {
+                        returned.push((n, o));
+                    }
+                }
+            }
+        }
+        assert!(returned.len() >= 3, "{returned:?}");
+        for (n, o) in &returned {
+            // Returned by the edge after the frame edge it ends at.
+            let end = edges.iter().position(|&t| t == o.report.end_ticks).unwrap();
+            let this = evs[..=*n]
+                .iter()
+                .filter(|e| matches!(e, Ev::Edge(_)))
+                .count()
+                - 1;
+            assert_eq!(this, end + 1, "{this} {end} {o:?}");
+            assert!(o.report.valid(), "{o:?}");
+        }
+        // Ending at a frame edge (the first of revolution 5: index, then the edge).
+        let cut = evs.iter().rposition(|e| matches!(e, Ev::Index(_))).unwrap() + 2;
+        let mut m = monitor(indexed(64, 4, 32, 1e6), 1);
+        let n = run(&mut m, &evs[..cut]).len();
+        let held = m.release_held().expect("the last window, held");
+        assert!(held.report.valid() && held.report.end_ticks == time_of(evs[cut - 1]));
+        // The windows before it were returned as in the whole stream, and it is the one the
+        // whole stream returns with the next edge.
+        assert_eq!(returned.get(n).map(|(_, o)| o.report), Some(held.report));
+        assert!(m.release_held().is_none());
+        // A noise pulse at 80 % of the last pitch before a frame edge.
+        let frame = evs.iter().rposition(|e| matches!(e, Ev::Index(_))).unwrap() + 1;
+        let (t0, t1) = (time_of(evs[frame - 2]), time_of(evs[frame]));
+        let mut noisy = evs.clone();
+        noisy.insert(frame - 1, Ev::Edge(t0 + (t1 - t0) * 4 / 5));
+        let mut m = monitor(indexed(64, 4, 32, 1e6), 1);
+        let out = run(&mut m, &noisy);
+        let invalid: Vec<_> = out.iter().filter(|o| !o.report.valid()).collect();
+        assert_eq!(m.diagnostics().edges.glitches, 1);
         assert!(
-            at_frame <= 6,
-            "{at_frame} runs with a wrong window at the frame"
+            invalid
+                .iter()
+                .any(|o| o.report.fault() == Some(Fault::Glitch)),
+            "{out:?}"
         );
+        // Every window still valid is the clean stream's window that ends there.
+        for o in out.iter().filter(|o| o.report.valid()) {
+            let clean = returned
+                .iter()
+                .find(|(_, c)| c.report.end_ticks == o.report.end_ticks)
+                .map(|(_, c)| c.report);
+            assert_eq!(Some(o.report), clean, "{o:?}");
+        }
     }
 
     #[test]

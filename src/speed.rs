@@ -300,6 +300,9 @@ pub struct SpeedTracker {
     npend: u8,
     /// `pending[0]` came with the fast path open and fell outside its band.
     out_of_band: bool,
+    /// An edge was rejected as a glitch since the last accepted one: the next accepted edge's
+    /// interval spans it, and forms no sample.
+    across: bool,
     /// Waiting index timestamps, each with the number of edges that had arrived when it was
     /// reported: an index belongs to an edge that arrived after it. (Modulo the counter a
     /// timestamp alone cannot say which edge it falls before once intervals approach the
@@ -374,7 +377,9 @@ fn pitch_ratio(enc: &Encoder, tooth: u16) -> f32 {
 /// Natural log, accurate to about 1e-4 (ample for judging swings): exponent from the bits, a
 /// short series on the mantissa. No `libm` call, so the careful path stays cheap.
 fn ln(x: f32) -> f32 {
-    if x.is_nan() || x <= 0.0 || x.is_infinite() {
+    // Not above 0 (or NaN): 0. (+∞ reads as 2^128: finite, and never met for a ratio of
+    // tick counts.)
+    if x.is_nan() || x <= 0.0 {
         return 0.0;
     }
     let bits = x.to_bits();
@@ -434,6 +439,7 @@ impl SpeedTracker {
             pending_seq: [0; PENDING],
             npend: 0,
             out_of_band: false,
+            across: false,
             index: [(0, 0); INDEXES],
             arrivals: 0,
             nidx: 0,
@@ -482,6 +488,7 @@ impl SpeedTracker {
             pending_seq: _,
             npend,
             out_of_band,
+            across,
             index: _,
             arrivals,
             nidx,
@@ -494,6 +501,7 @@ impl SpeedTracker {
         } = self;
         (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
         (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
+        *across = false;
         (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
@@ -1266,6 +1274,11 @@ impl SpeedTracker {
     fn reject<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
         self.counters.glitches = self.counters.glitches.wrapping_add(1);
         sink.fault(Fault::Glitch, t);
+        // Of a noise pulse and the real edge beside it, the later is the one judged: when the
+        // pulse came first and was taken, the real edge is rejected, and the interval to the
+        // next edge starts at the pulse. Samples restart at the next accepted edge, so none
+        // spans a glitch.
+        self.across = true;
     }
 
     /// A fault inside the current revolution: too many and the count is given up.
@@ -1307,6 +1320,7 @@ impl SpeedTracker {
     ) {
         let edges = enc.edges();
         let dt = t.wrapping_sub(self.last) & enc.mask();
+        let clean = clean && !core::mem::replace(&mut self.across, false);
         let mut tooth = tooth_after(self.tooth, 1, edges);
         let mut frame = false;
         let mut realigned = false;
@@ -1622,6 +1636,7 @@ impl SpeedTracker {
         self.prev = 0;
         self.npend = 0;
         self.out_of_band = false;
+        self.across = false;
         self.block_fast();
         self.acq = [0; 3];
         self.forget_history();

@@ -254,15 +254,31 @@ impl ExactTrain {
 
     fn push(&mut self, t: u64) {
         self.hist.push_back(t);
-        if self.hist.len() > self.positions * self.revs + self.k + 1 {
+        // A window and its first sample's start, and the edges after its frame (a window is
+        // returned with the edge after its frame).
+        if self.hist.len() > self.positions * self.revs + self.k + 3 {
             self.hist.pop_front();
         }
     }
 
-    fn window(&self) -> Exact {
+    /// How many edges after its frame edge (at `end_ticks`, the counter masked by `mask`) a
+    /// window was returned: it is held for the edge after the frame.
+    fn lag(&self, mask: u64, end_ticks: u32, what: &str) -> usize {
+        (0..3)
+            .find(|&l| {
+                self.hist
+                    .len()
+                    .checked_sub(1 + l)
+                    .is_some_and(|i| self.hist[i] & mask == u64::from(end_ticks))
+            })
+            .unwrap_or_else(|| panic!("{what}: no frame edge at {end_ticks} among the last 3"))
+    }
+
+    /// The window that ends `lag` edges before the newest.
+    fn window(&self, lag: usize) -> Exact {
         let n = self.positions * self.revs;
         let h = &self.hist;
-        let last = h.len() - 1;
+        let last = h.len() - 1 - lag;
         let (mut smax, mut smin) = (0u64, u64::MAX);
         for j in last + 1 - n..=last {
             let s = h[j] - h[j - self.k];
@@ -352,6 +368,8 @@ fn monitor<const N: usize>(c: EncoderConfig, revs: u16) -> DeltaMonitor<N> {
 /// integer timestamps `t(k)`, offset by `start` and masked to the counter; every valid window
 /// is checked against the exact train. Returns the reports.
 #[allow(clippy::too_many_arguments)]
+/// A window is returned with the edge after its frame edge: a stream that is to end a window
+/// feeds one edge past its frame.
 fn run_exact<const N: usize>(
     m: &mut DeltaMonitor<N>,
     k: usize,
@@ -373,7 +391,7 @@ fn run_exact<const N: usize>(
             m.on_index((tk.wrapping_sub(1) & mask) as u32);
         }
         if let Some(o) = m.on_edge((tk & mask) as u32, Some(Direction::Forward)) {
-            let x = exact.window();
+            let x = exact.window(exact.lag(mask, o.report.end_ticks, what));
             assert_matches_exact(&o.report, &x, what);
             out.push((*o.report.measurement().unwrap(), x));
         }
@@ -456,7 +474,7 @@ fn measured_tiny_delta_equals_the_exact_delta_of_the_train() {
             let out = run_exact(
                 &mut m,
                 4,
-                16 * 6 + 1,
+                16 * 6 + 2,
                 0,
                 u32::MAX as u64,
                 pattern_times(&intervals),
@@ -573,7 +591,8 @@ fn one_tick_interval_is_a_counted_glitch() {
                 if let Some(o) = m.on_edge(ticks as u32, Some(Direction::Forward)) {
                     match o.report.fault() {
                         None => {
-                            assert_matches_exact(&o.report, &exact.window(), "after glitch");
+                            let lag = exact.lag(u64::from(u32::MAX), o.report.end_ticks, "glitch");
+                            assert_matches_exact(&o.report, &exact.window(lag), "after glitch");
                             valid += 1;
                         }
                         Some(f) => faults.push(f),
@@ -683,7 +702,7 @@ fn one_rpm_and_thirty_thousand_rpm_from_1_khz_to_200_mhz() {
                 let mut m = monitor::<1024>(c, 1);
                 let mask = (1u64 << bits) - 1;
                 let t = shaft_ticks(1024, speed, 0.005, 1.0, timer_hz);
-                let out = run_exact(&mut m, 16, 1024 * 4 + 1, 0, mask, t, &case);
+                let out = run_exact(&mut m, 16, 1024 * 4 + 2, 0, mask, t, &case);
                 assert_eq!(out.len(), 3, "{case}: {:?}", m.diagnostics());
                 assert_eq!(m.diagnostics().invalid_windows, 0, "{case}");
                 for (r, _) in out {

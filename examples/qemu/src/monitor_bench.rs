@@ -204,11 +204,12 @@ fn timed_edge(m: &mut DeltaMonitor<1024>, t: u32) -> (u64, bool) {
     (icount::instructions() - start, ended)
 }
 
-/// Instructions that finishing a window adds to the edge that ends it, and the number of
+/// Instructions that finishing a window adds to the edges that end and return it (the frame
+/// edge, and the edge after it, which returns the window held for it), and the number of
 /// windows measured. The stream goes through two monitors that differ only in window length:
 /// one revolution (every frame edge once the first window has started ends one) and
-/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge is timed in
-/// both; the cost is the mean difference over the edges that ended a window.
+/// [`MAX_WINDOW_REVS`] (no frame edge of the stream ends one). Each frame edge and the edge
+/// after it are timed in both; the cost is the mean difference over the windows returned.
 #[inline(never)]
 fn window_finish(ticks: &Ticks) -> (u64, u32) {
     let (mut with, mut without, mut n) = (0u64, 0u64, 0u32);
@@ -218,13 +219,18 @@ fn window_finish(ticks: &Ticks) -> (u64, u32) {
         for (rev, edges) in ticks.chunks_exact(PER_REV).enumerate() {
             short.on_index(index_of(ticks, rev));
             long.on_index(index_of(ticks, rev));
+            // The frame edge ends the window; the edge after it returns it (a window is held
+            // until the edge after its frame is judged): both are timed.
+            let (mut at_short, mut at_long) = (0u64, 0u64);
             for (i, &t) in edges.iter().enumerate() {
-                if i == 0 {
+                if i < 2 {
                     let (a, ended) = timed_edge(&mut short, t);
                     let (b, ended_long) = timed_edge(&mut long, t);
-                    if ended && !ended_long {
-                        with += a;
-                        without += b;
+                    at_short += a;
+                    at_long += b;
+                    if i == 1 && ended && !ended_long {
+                        with += at_short;
+                        without += at_long;
                         n += 1;
                     }
                 } else {

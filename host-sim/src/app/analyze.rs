@@ -646,6 +646,9 @@ pub fn analyze<R: BufRead>(
         let ticks = clock.ticks(end);
         clock.note(ticks, end);
         st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+        // A window held for the edge after its frame, which the recording does not have.
+        let o = monitor.release_held();
+        st.after(&mut monitor, &clock, o, &mut report, on_decision);
     }
     let d = monitor.diagnostics();
     let e = d.edges;

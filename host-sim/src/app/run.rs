@@ -693,6 +693,20 @@ impl Drop for Progress {
 }
 
 impl Collector<'_> {
+    /// A window the core returned at time `t`, s, and its alarm event.
+    fn outcome(&mut self, t: f64, o: drive_monitor::monitor::WindowOutcome) {
+        self.window(t, o.report);
+        if let Some(e) = o.event {
+            self.alarms.push(AlarmOut {
+                time: t,
+                event: match e {
+                    AlarmEvent::Raised => "raised",
+                    AlarmEvent::Cleared => "cleared",
+                },
+            });
+        }
+    }
+
     fn window(&mut self, time: f64, report: WindowReport) {
         self.window_count += 1;
         let m = report.measurement().copied();
@@ -756,16 +770,7 @@ impl Observer for Collector<'_> {
         let outcome = m.on_edge(edge.ticks, Some(edge.direction));
         let speed = m.speed();
         if let Some(o) = outcome {
-            self.window(edge.true_time, o.report);
-            if let Some(e) = o.event {
-                self.alarms.push(AlarmOut {
-                    time: edge.true_time,
-                    event: match e {
-                        AlarmEvent::Raised => "raised",
-                        AlarmEvent::Cleared => "cleared",
-                    },
-                });
-            }
+            self.outcome(edge.true_time, o);
         }
         // The trace starts with the first speed sample (0 before it is "no sample yet").
         if self.edges % self.trace_every == 0 && (speed > 0.0 || !self.trace.is_empty()) {
@@ -1271,6 +1276,10 @@ pub fn run_with(
         Samples::All(v) => v,
         Samples::Stream(s) => s.samples(),
     };
+    // The end of the run: a window held for the edge after its frame is released as it is.
+    if let Some(o) = col.monitor.as_mut().and_then(|m| m.release_held()) {
+        col.outcome(stats.time, o);
+    }
     measurement(&mut report, &mut col);
     regime(scene, file, &mut report, vib_machine.as_ref(), &samples)?;
     report.capture = capture_analysis(scene, file, vib_params.as_ref(), &samples)?;
