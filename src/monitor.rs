@@ -693,6 +693,63 @@ mod tests {
         out
     }
 
+    /// Seeded draws in [0, n) (a linear congruential generator).
+    fn lcg(seed: u64) -> impl FnMut(u64) -> u64 {
+        let mut rng = seed;
+        move |n| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 33) % n
+        }
+    }
+
+    /// A speed ripple ω(φ) = 100·(1 + a·sin(zφ + φ0)) drawn by `next`: a in [0.005, 0.08], z
+    /// 1 or 2 (δ = 2a exactly).
+    fn random_ripple(next: &mut impl FnMut(u64) -> u64) -> (f64, f64, impl Fn(f64) -> f64) {
+        let a = 0.005 + 0.075 * next(1000) as f64 / 1000.0;
+        let z = 1.0 + next(2) as f64;
+        let ph = TAU * next(1000) as f64 / 1000.0;
+        (a, z, move |phi: f64| {
+            100.0 * (1.0 + a * (z * phi + ph).sin())
+        })
+    }
+
+    /// One fault at capture event `at`: the edge lost, or a noise pulse at 30–70 % (drawn by
+    /// `next`) of the interval after it.
+    fn one_fault(evs: &mut Vec<Ev>, at: usize, drop: bool, next: &mut impl FnMut(u64) -> u64) {
+        if drop {
+            evs.remove(at);
+        } else {
+            let (t0, t1) = (time_of(evs[at]), time_of(evs[at + 1]));
+            let f = 0.3 + 0.4 * next(1000) as f64 / 1000.0;
+            evs.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+        }
+    }
+
+    /// After one fault: it was counted, and every window reported valid measures `expect`
+    /// within 10 % + 0.002. The number of valid windows.
+    fn check_one_fault(
+        m: &DeltaMonitor<1024>,
+        out: &[WindowOutcome],
+        expect: f64,
+        what: &str,
+    ) -> usize {
+        let d = m.diagnostics();
+        assert!(
+            d.edges.missing + d.edges.glitches + d.edges.extra + d.edges.missing_frames >= 1,
+            "{d:?} {what}"
+        );
+        let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+        for r in &valid {
+            assert!(
+                (f64::from(r.delta) - expect).abs() <= 0.1 * expect + 2e-3,
+                "{expect} {r:?} {what}"
+            );
+        }
+        valid.len()
+    }
+
     /// The time of a capture event.
     fn time_of(e: Ev) -> u32 {
         match e {
@@ -903,23 +960,14 @@ mod tests {
         // ripple (a fault taken for a tooth puts a sample a pitch in p off, and δ far above).
         // Before the gap's margins scaled, about 250 of 4 500 such runs (three seeds) reported a
         // valid window with a wrong δ.
-        let mut rng = 0x5eed_u64;
-        let mut next = |n: u64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 33) % n
-        };
+        let mut next = lcg(0x5eed);
         let wheels = [(60u8, 2u8), (60, 1), (36, 1), (36, 2), (24, 1), (32, 2)];
         let mut few = 0;
         for case in 0..1000 {
             let (positions, missing) = wheels[next(wheels.len() as u64) as usize];
             let p = Pattern::missing_teeth(positions, missing);
             let teeth = usize::from(positions - missing);
-            let a = 0.005 + 0.075 * next(1000) as f64 / 1000.0;
-            let z = 1.0 + next(2) as f64;
-            let ph = TAU * next(1000) as f64 / 1000.0;
-            let w = move |phi: f64| 100.0 * (1.0 + a * (z * phi + ph).sin());
+            let (a, z, w) = random_ripple(&mut next);
             let k = match next(6) {
                 0 => 0,
                 1 => 1,
@@ -931,16 +979,7 @@ mod tests {
             let drop = next(2) == 0;
             let mut evs = stream(&pattern_angles(p), None, 12, 84e6, u32::MAX, &w);
             let at = rev * teeth + k;
-            if drop {
-                evs.remove(at);
-            } else {
-                let (Ev::Edge(t0), Ev::Edge(t1)) = (evs[at], evs[at + 1]) else {
-                    unreachable!()
-                };
-                let f = 0.3 + 0.4 * next(1000) as f64 / 1000.0;
-                let t = t0 + (f64::from(t1 - t0) * f) as u32;
-                evs.insert(at + 1, Ev::Edge(t));
-            }
+            one_fault(&mut evs, at, drop, &mut next);
             let mut c = EncoderConfig::pattern(p, 84e6);
             c.estimator = Estimator::Edges(2);
             c.min_speed = 20.0;
@@ -950,26 +989,14 @@ mod tests {
                 "case {case}: {positions}-{missing}, a {a:.4}, z {z}, tooth {k} of rev {rev} {}",
                 if drop { "lost" } else { "doubled" }
             );
-            let d = m.diagnostics();
-            assert!(
-                d.edges.missing + d.edges.glitches + d.edges.extra + d.edges.missing_frames >= 1,
-                "{d:?} {what}"
-            );
             // δ = 2a less what samples of two pitches average away and where they fall
             // against the ripple's peaks (at most 1 − cos(z·pitch/2) ≈ 3.4 %).
             let x = z * TAU / f64::from(positions);
-            let expect = 2.0 * a * x.sin() / x;
-            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
-            for r in &valid {
-                assert!(
-                    (f64::from(r.delta) - expect).abs() <= 0.1 * expect + 2e-3,
-                    "{expect} {r:?} {what}"
-                );
-            }
+            let valid = check_one_fault(&m, &out, 2.0 * a * x.sin() / x, &what);
             // About eight windows follow the frame, the fault's own invalid. A noise pulse
             // just before a gap sometimes slips the count for a revolution or two (windows
             // invalid, not wrong): 2 of these 1000 runs.
-            if valid.len() < 6 {
+            if valid < 6 {
                 few += 1;
             }
         }
@@ -985,20 +1012,11 @@ mod tests {
         // window with a wrong δ: a noise pulse late in the last pitch, in the band, was taken
         // as the frame edge and the real edge after it rejected, in the next window; and the
         // samples after that glitch started at the pulse.
-        let mut rng = 1_u64;
-        let mut next = |n: u64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 33) % n
-        };
+        let mut next = lcg(1);
         for case in 0..1000 {
             let lines = [64u16, 100, 360, 500, 1024][next(5) as usize];
             let indexed = next(3) != 0;
-            let a = 0.005 + 0.075 * next(1000) as f64 / 1000.0;
-            let z = 1.0 + next(2) as f64;
-            let ph = TAU * next(1000) as f64 / 1000.0;
-            let w = move |phi: f64| 100.0 * (1.0 + a * (z * phi + ph).sin());
+            let (a, z, w) = random_ripple(&mut next);
             // Events per revolution: the edges and the index (first, half a pitch ahead).
             let per = usize::from(lines) + usize::from(indexed);
             let k = next(per as u64) as usize;
@@ -1007,16 +1025,7 @@ mod tests {
             let index = indexed.then_some(0.0);
             let mut evs = stream(&uniform(u32::from(lines)), index, 12, 84e6, u32::MAX, &w);
             let at = rev * per + k;
-            if drop {
-                evs.remove(at);
-            } else {
-                let time = |e: Ev| match e {
-                    Ev::Edge(t) | Ev::Index(t) => t,
-                };
-                let (t0, t1) = (time(evs[at]), time(evs[at + 1]));
-                let f = 0.3 + 0.4 * next(1000) as f64 / 1000.0;
-                evs.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
-            }
+            one_fault(&mut evs, at, drop, &mut next);
             let mut c = if indexed {
                 EncoderConfig::indexed(lines, 84e6)
             } else {
@@ -1031,22 +1040,10 @@ mod tests {
                  {rev} {}",
                 if drop { "lost" } else { "doubled" }
             );
-            let d = m.diagnostics();
-            assert!(
-                d.edges.missing + d.edges.glitches + d.edges.extra + d.edges.missing_frames >= 1,
-                "{d:?} {what}"
-            );
             // δ = 2a less what samples of four pitches average away.
             let x = z * 4.0 * TAU / f64::from(lines) / 2.0;
-            let expect = 2.0 * a * x.sin() / x;
-            let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
-            for r in &valid {
-                assert!(
-                    (f64::from(r.delta) - expect).abs() <= 0.1 * expect + 2e-3,
-                    "{expect} {r:?} {what}"
-                );
-            }
-            assert!(valid.len() >= 6, "{what}: {out:?}");
+            let valid = check_one_fault(&m, &out, 2.0 * a * x.sin() / x, &what);
+            assert!(valid >= 6, "{what}: {out:?}");
         }
     }
 
@@ -1387,13 +1384,7 @@ mod tests {
         seed: u64,
         in_order: bool,
     ) -> Vec<WindowOutcome> {
-        let mut rng = seed;
-        let mut next = |n: u64| {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 33) % n
-        };
+        let mut next = lcg(seed);
         let mut out = Vec::new();
         let mut chunk = Vec::new();
         let mut size = 1 + next(150) as usize;
