@@ -995,7 +995,7 @@ mod tests {
             let valid = check_one_fault(&m, &out, 2.0 * a * x.sin() / x, &what);
             // About eight windows follow the frame, the fault's own invalid. A noise pulse
             // just before a gap sometimes slips the count for a revolution or two (windows
-            // invalid, not wrong): 2 of these 1000 runs.
+            // invalid, not wrong): 1 of these 1000 runs.
             if valid < 6 {
                 few += 1;
             }
