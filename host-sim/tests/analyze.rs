@@ -772,6 +772,38 @@ fn a_channel_number_that_another_channel_is_named_by_is_refused() {
     assert_eq!(try_channel(Channel::Column(2), all).unwrap(), "Channel 2");
 }
 
+/// The index channel left at its default (1) on an export of Channel 1..4: ambiguous, and the
+/// error says the default was taken, not that an `--index-channel 1` was given.
+#[test]
+fn a_default_index_channel_that_is_ambiguous_says_it_is_the_default() {
+    let text = "Time [s],Channel 1,Channel 2,Channel 3,Channel 4\n0.0,0,0,0,0\n0.001,1,0,1,0\n";
+    let run = |index_channel: Option<host_sim::app::analyze::Channel>| {
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(host_sim::app::analyze::Channel::Name("Channel 2".into())),
+            index_channel,
+            ..index_lines(50)
+        })
+        .unwrap();
+        let mut reader = text_reader(text.to_string(), "i.csv", None).unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {})
+            .map(|r| r.index_channel)
+            .map_err(|e| e.to_string())
+    };
+    let e = run(None).unwrap_err();
+    assert!(
+        e.contains("no --index-channel was given, so the default applies")
+            && e.contains("--index-channel 1 is ambiguous"),
+        "{e}"
+    );
+    let e = run(Some(host_sim::app::analyze::Channel::Column(1))).unwrap_err();
+    assert!(
+        !e.contains("default") && e.contains("--index-channel 1 is ambiguous"),
+        "{e}"
+    );
+    let named = Some(host_sim::app::analyze::Channel::Name("Channel 1".into()));
+    assert_eq!(run(named).unwrap().as_deref(), Some("Channel 1"));
+}
+
 /// A channel that never changes (the wrong `--channel`, a probe not connected) gives no edge:
 /// the report says so and names the channels that do change, instead of only "sync: never
 /// acquired".

@@ -77,6 +77,8 @@ pub struct AnalyzeConfig {
     pub channel: Channel,
     /// The index channel (index discs).
     pub index_channel: Option<Channel>,
+    /// Whether the index channel is the default (no `--index-channel` given).
+    pub index_channel_default: bool,
     /// The quadrature B channel that gives each edge its direction, and which of A and B
     /// leads when running forward.
     pub direction: Option<(Channel, Lead)>,
@@ -513,7 +515,17 @@ pub fn analyze<R: BufRead>(
     let channels = reader.channels().to_vec();
     let ch = column(&channels, &cfg.channel, "--channel").map_err(AnalyzeError::Option)?;
     let ich = match &cfg.index_channel {
-        Some(c) => Some(column(&channels, c, "--index-channel").map_err(AnalyzeError::Option)?),
+        Some(c) => Some(
+            column(&channels, c, "--index-channel")
+                .map_err(|e| {
+                    if cfg.index_channel_default {
+                        format!("no --index-channel was given, so the default applies: {e}")
+                    } else {
+                        e
+                    }
+                })
+                .map_err(AnalyzeError::Option)?,
+        ),
         None => None,
     };
     if ich == Some(ch) {
@@ -1267,6 +1279,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         } else {
             None
         },
+        index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
     })
 }
