@@ -175,7 +175,7 @@ pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
     diag: Diagnostics,
     /// A second window finished by the same call, returned by the next one.
     spill: Option<WindowOutcome>,
-    /// A valid window that has just ended at its frame edge, held until the edge after the
+    /// A window that has just ended at its frame edge, held until the edge after the
     /// frame is judged: a glitch, missing or extra edge found there lies against the frame
     /// (a noise pulse late in the last pitch taken for the frame edge, the real one rejected
     /// after it) and invalidates it.
@@ -206,10 +206,8 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     fn tooth(&mut self, tooth: &Tooth) {
         self.observer.tooth(tooth);
         self.last_edge = tooth.index;
-        if self.held.is_some() {
-            // The edge after the frame is a tooth: the window stands.
-            self.release(None);
-        }
+        // The edge after a frame is a tooth: a window held for it stands.
+        self.release(None);
         let e = self.encoder;
         if let Some(r) = self.state.on_tooth(
             self.window,
@@ -228,9 +226,7 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
     #[inline(never)]
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
-        if self.held.is_some() {
-            self.release(Some(fault));
-        }
+        self.release(Some(fault));
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
             finish(self.alarm, self.diag, &r, &mut self.first, self.spill);
         }

@@ -914,7 +914,7 @@ impl SpeedTracker {
             let verdict = self.judge(enc, flushing);
             // One tail for every verdict (a fault's bookkeeping, then one acceptance): the
             // careful path's code stays small.
-            let lost = match verdict {
+            let (lost, within) = match verdict {
                 Verdict::Wait => return,
                 Verdict::Glitch => {
                     self.pop();
@@ -926,17 +926,12 @@ impl SpeedTracker {
                     self.accept(enc, table, e1, s1, true, sink);
                     continue;
                 }
-                // Teeth lost before it (`Missing` is 1 or 2, lost within its interval; `Ahead`
-                // one lost earlier, its interval the tooth's own), or none: the count was one
-                // ahead.
-                Verdict::Missing(n) => n,
-                Verdict::Ahead => 1,
-                Verdict::Behind => 0,
-            };
-            let within = if let Verdict::Missing(n) = verdict {
-                n
-            } else {
-                0
+                // Teeth lost before it, and of them those within its interval (`Missing` is 1
+                // or 2, lost within it; `Ahead` one lost earlier, its interval the tooth's
+                // own), or none: the count was one ahead.
+                Verdict::Missing(n) => (n, n),
+                Verdict::Ahead => (1, 0),
+                Verdict::Behind => (0, 0),
             };
             self.pop();
             if lost == 0 {
