@@ -233,6 +233,7 @@ impl EdgeCounters {
 const PENDING: usize = 3;
 /// Index timestamps that may wait for their edge.
 const INDEXES: usize = 4;
+const _: () = assert!(INDEXES <= 8, "index places are bits of a byte");
 /// The band is refreshed after every tooth whose number is a multiple of this (a power of
 /// two), and whenever the fast path opens.
 pub(crate) const BAND_REFRESH: u16 = 64;
@@ -1193,44 +1194,54 @@ impl SpeedTracker {
     /// Whether a waiting index reported before the edge at `t` (arrival `seq`) lies between
     /// the last accepted edge and it.
     fn index_covers(&self, enc: &Encoder, t: u32, seq: u32) -> bool {
+        self.index_places(enc, t, seq).0 != 0
+    }
+
+    /// Where the waiting index timestamps fall against the edge at `t` (arrival `seq`), bit
+    /// `i` for timestamp `i`: those that frame the interval ending at it (reported before it
+    /// arrived, timed after the last accepted edge and not after it), and those that are a
+    /// later edge's (reported after it arrived, or timed after it). The others lost their
+    /// edge. One scan, out of line, for the judgement and the acceptance alike.
+    #[inline(never)]
+    fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8) {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
-        self.index
-            .iter()
-            .take(usize::from(self.nidx))
-            .any(|&(x, q)| {
-                let since = x.wrapping_sub(self.last) & m;
-                reported_before(q, seq) && since > 0 && since <= d
-            })
+        let (mut frames, mut later) = (0u8, 0u8);
+        for (i, &(x, q)) in self.index.iter().take(usize::from(self.nidx)).enumerate() {
+            let since = x.wrapping_sub(self.last) & m;
+            // `i` < INDEXES ≤ 8: the bit is within the byte.
+            let bit = 1u8.wrapping_shl(i as u32);
+            if !reported_before(q, seq) || (since > d && since < m / 2) {
+                later |= bit;
+            } else if since > 0 && since <= d {
+                frames |= bit;
+            }
+        }
+        (frames, later)
     }
 
     /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
     /// ending at `t`. Timestamps older than the last accepted edge lost their edge: each is
     /// counted as a missing frame.
     fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> bool {
-        let m = enc.mask();
-        let d = t.wrapping_sub(self.last) & m;
-        let mut framed = false;
+        let (frames, later) = self.index_places(enc, t, seq);
         let mut keep = 0usize;
         for i in 0..usize::from(self.nidx) {
-            let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
-            let since = x.wrapping_sub(self.last) & m;
-            let ahead = !reported_before(q, seq) || (since > d && since < m / 2);
-            if ahead {
-                // Reported after this edge arrived, or timed after it: a later edge's.
-                if let Some(slot) = self.index.get_mut(keep) {
-                    *slot = (x, q);
+            let bit = 1u8.wrapping_shl(i as u32);
+            if later & bit != 0 {
+                // A later edge's: kept, in order.
+                let slot = self.index.get(i).copied().unwrap_or((0, 0));
+                if let Some(to) = self.index.get_mut(keep) {
+                    *to = slot;
                 }
                 keep = keep.wrapping_add(1);
-            } else if since > 0 && since <= d {
-                framed = true;
-            } else if self.sync == SyncState::Synced {
+            } else if frames & bit == 0 && self.sync == SyncState::Synced {
                 // An index that framed no edge: its edge was not seen.
                 self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
             }
         }
         self.nidx = keep as u8;
-        framed
+        frames != 0
     }
 
     /// An index waiting before a new time reference `t` (within a timeout of it) makes that
