@@ -197,8 +197,9 @@ impl Default for WindowState {
 
 /// `x as f32` from the FPU's 32-bit conversions: exact rounding when `x` fits in 32 bits, and
 /// within about one unit in the last place above (high and low words converted and joined;
-/// the software 64-bit conversion would cost some 50 instructions on a 32-bit core).
-#[inline]
+/// the software 64-bit conversion would cost some 50 instructions on a 32-bit core). Once
+/// per window result: out of line, one copy for its six uses.
+#[inline(never)]
 fn u64_to_f32(x: u64) -> f32 {
     match u32::try_from(x) {
         Ok(x) => x as f32,

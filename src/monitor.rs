@@ -236,7 +236,8 @@ impl<O: EdgeSink> EdgeSink for Feed<'_, O> {
 impl<O: EdgeSink> Feed<'_, O> {
     /// The edge after the frame is judged: the held window stands, unless `fault` is an edge
     /// fault, which lies against the frame (a timeout, a reversal or a missing frame does
-    /// not).
+    /// not). Careful path: out of line, one copy for its callers (code size).
+    #[inline(never)]
     fn release(&mut self, fault: Option<Fault>) {
         if let Some(r) = self.held.as_mut() {
             if let Some(f @ (Fault::Glitch | Fault::MissingEdge | Fault::ExtraEdge)) = fault {

@@ -548,6 +548,7 @@ impl SpeedTracker {
     /// Brings the careful path's bookkeeping up to date with what the fast path did: the
     /// accepted count, and the previous interval (the ring's newest: fast teeth are ordinary
     /// teeth, so their interval is per base pitch already).
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn settle(&mut self, enc: &Encoder) {
         if self.tooth != self.anchor {
             self.accepted = self.accepted_now();
@@ -557,6 +558,7 @@ impl SpeedTracker {
     }
 
     /// The newest interval in the ring (the fast path's last interval).
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn newest(&self, enc: &Encoder) -> u32 {
         let at = |back: u32| {
             self.ring
@@ -771,7 +773,8 @@ impl SpeedTracker {
     }
 
     /// The swing tooth `to` had against tooth `from` one revolution earlier (1 without a
-    /// recorded revolution). Careful path only.
+    /// recorded revolution). Careful path only; out of line, one copy for every hypothesis.
+    #[inline(never)]
     fn recorded_swing(&self, from: u16, to: u16) -> f32 {
         if !self.history {
             return 1.0;
@@ -960,6 +963,7 @@ impl SpeedTracker {
     /// `lost` teeth before it: the interval over all their pitches, as the judgement took it
     /// (over the tooth's own pitch alone, the next edge would be judged against an interval
     /// `lost + 1` pitches long, and after a wheel's gap taken for a glitch).
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn per_base_over(&self, enc: &Encoder, lost: u16) -> u32 {
         if enc.is_uniform() {
             // Every pitch the base (always so without pattern wheels: no other division).
@@ -981,6 +985,7 @@ impl SpeedTracker {
         }
     }
 
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn pop(&mut self) {
         self.out_of_band = false;
         self.pending.copy_within(1.., 0);
@@ -1181,6 +1186,7 @@ impl SpeedTracker {
     }
 
     /// Whether `tooth` needs the careful judgement when it comes next.
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn is_special(&self, enc: &Encoder, tooth: u16) -> bool {
         tooth == 0
             || (enc.framing() == Framing::Pattern
@@ -1288,6 +1294,7 @@ impl SpeedTracker {
     }
 
     /// A fault inside the current revolution: too many and the count is given up.
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn fault_in_revolution(&mut self) {
         self.faults = self.faults.saturating_add(1);
         if self.faults >= FAULTS_TO_RESYNC && self.sync == SyncState::Synced {
@@ -1622,6 +1629,7 @@ impl SpeedTracker {
     }
 
     /// The running shaft stopped (a timeout): count it once, lose sync.
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn stop_running<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
         if self.state == ShaftState::Running {
             self.counters.timeouts = self.counters.timeouts.wrapping_add(1);
@@ -1649,6 +1657,7 @@ impl SpeedTracker {
         self.reset_ring();
     }
 
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn reset_ring(&mut self) {
         self.fill = 0;
         self.pos = 0;
