@@ -296,3 +296,79 @@ fn work_is_bounded_before_simulating() {
     assert!(r.window_list.is_empty());
     assert_eq!(r.regime_simulated, Some("balancing"));
 }
+
+/// The number after `prefix` in `e`.
+fn number_after(e: &str, prefix: &str) -> f64 {
+    let at = e
+        .find(prefix)
+        .unwrap_or_else(|| panic!("`{prefix}` not in: {e}"))
+        + prefix.len();
+    let s: String = e[at..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | '-' | '+'))
+        .collect();
+    s.parse()
+        .unwrap_or_else(|_| panic!("no number after `{prefix}` in: {e}"))
+}
+
+/// A speed range the timer cannot hold says which values would fit, each the core's own bound
+/// (the longest pitch at the minimum speed fits the counter and lasts at least 2 ticks), to
+/// three digits on the side that fits; and a scene with the suggested value is accepted.
+#[test]
+fn a_speed_range_the_timer_cannot_hold_says_what_would_fit() {
+    let pitch = std::f64::consts::TAU / 1024.0;
+    // A 16-bit counter at 84 MHz: the slowest pitch must be under 65 535 ticks.
+    let e = error(
+        "kneader",
+        "timer_hz = 84e6\n\n[monitor]\ndelta_limit = 0.06",
+        "timer_hz = 84e6\ncounter_bits = 16\n\n[monitor]\ndelta_limit = 0.06\nmin_speed = 0.1",
+    );
+    assert_names(
+        &e,
+        &[
+            "`monitor.min_speed = 0.1`",
+            "more ticks than the counter holds",
+        ],
+    );
+    let speed = number_after(&e, "`monitor.min_speed` at least ");
+    let exact = pitch * 84e6 / 65_535.0;
+    assert!(
+        speed >= exact && speed <= exact * 1.01,
+        "{speed} against {exact}: {e}"
+    );
+    let timer = number_after(&e, "`encoder.timer_hz` at most ");
+    let exact = 65_535.0 * 0.1 / pitch;
+    assert!(
+        timer <= exact && timer >= exact * 0.99,
+        "{timer} against {exact}: {e}"
+    );
+    // 84e6 / 0.1 · pitch = 5.15e6 ticks: 23 bits.
+    assert!(e.contains("`encoder.counter_bits` = 23"), "{e}");
+    // The suggestion is taken.
+    let text = bundled("kneader").replacen(
+        "timer_hz = 84e6\n\n[monitor]\ndelta_limit = 0.06",
+        &format!("timer_hz = 84e6\ncounter_bits = 16\n\n[monitor]\ndelta_limit = 0.06\nmin_speed = {speed}"),
+        1,
+    );
+    let s = Scene::parse(&text, Path::new("fixed.toml")).unwrap();
+    predict(&s, Path::new("fixed.toml")).unwrap();
+    // The other side: at 1 MHz a pitch at 5e4 rad/s lasts 0.12 ticks.
+    let e = error(
+        "kneader",
+        "timer_hz = 84e6\n\n[monitor]\ndelta_limit = 0.06",
+        "timer_hz = 1e6\n\n[monitor]\ndelta_limit = 0.06\nmin_speed = 5e4",
+    );
+    assert_names(&e, &["fewer than 2 ticks"]);
+    let timer = number_after(&e, "`encoder.timer_hz` at least ");
+    let exact = 2.0 * 5e4 / pitch;
+    assert!(
+        timer >= exact && timer <= exact * 1.01,
+        "{timer} against {exact}: {e}"
+    );
+    let speed = number_after(&e, "`monitor.min_speed` at most ");
+    let exact = 1e6 * pitch / 2.0;
+    assert!(
+        speed <= exact && speed >= exact * 0.99,
+        "{speed} against {exact}: {e}"
+    );
+}

@@ -1248,13 +1248,25 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         steady_tolerance: 0.02,
     });
     Encoder::new(enc).map_err(|e| {
-        format!(
+        let mut m = format!(
             "{} does not fit: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",
             option_of(e.parameter()),
             enc.timer_hz,
             enc.counter_bits,
             enc.min_speed
-        )
+        );
+        let hint = crate::app::check::speed_range_hint(
+            &enc,
+            e,
+            "--min-speed",
+            "--timer-hz",
+            Some("--counter-bits"),
+        );
+        if let Some(h) = hint {
+            m.push_str(": ");
+            m.push_str(&h);
+        }
+        m
     })?;
     window
         .validate()

@@ -1155,3 +1155,106 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     }
     Ok(())
 }
+
+/// What would fit, for an encoder configuration the core refused because the speed range
+/// does not fit the timer: the longest pitch at the minimum speed lasts more ticks than the
+/// counter holds (`min_speed`), a `K`-edge sample of such pitches more than 32 bits
+/// (`estimator.edges`), or fewer than 2 ticks (`timer_hz`). The bound is found by asking the
+/// core itself (doubling, then bisecting the minimum speed or the timer clock, every other
+/// field as given), so it is the core's own rule, and rounded to three significant digits on
+/// the side that fits. `min_speed` and `timer_hz` name the two knobs as the user writes them
+/// (scene keys or options), and `counter_bits` the counter's width where the user can set it.
+/// `None` for any other error, or where no value fits.
+pub fn speed_range_hint(
+    config: &drive_monitor::encoder::EncoderConfig,
+    e: ConfigError,
+    min_speed: &str,
+    timer_hz: &str,
+    counter_bits: Option<&str>,
+) -> Option<String> {
+    use drive_monitor::encoder::{Encoder, EncoderConfig};
+    let fits = |f: &dyn Fn(&mut EncoderConfig)| {
+        let mut c = *config;
+        f(&mut c);
+        Encoder::new(c).is_ok()
+    };
+    // The bound on `x` between `bad` (refused) and `good` (accepted), to 1e-6 relative, rounded
+    // to three significant digits towards `good`.
+    let bound = |bad: f64, good: f64, set: &dyn Fn(&mut EncoderConfig, f64)| {
+        let (mut bad, mut good) = (bad, good);
+        while (good - bad).abs() > 1e-6 * good.abs() {
+            let mid = 0.5 * (bad + good);
+            if fits(&|c| set(c, mid)) {
+                good = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        // Three significant digits, one step of the third towards `good` if rounding left it.
+        let digits = |x: f64| format!("{x:.2e}").parse::<f64>().unwrap_or(x);
+        let step = 10f64.powi(good.abs().log10().floor() as i32 - 2);
+        let mut r = digits(good);
+        if !fits(&|c| set(c, r)) {
+            r = digits(if good > bad { r + step } else { r - step });
+        }
+        if fits(&|c| set(c, r)) {
+            r
+        } else {
+            good
+        }
+    };
+    // Doubles (`up`) or halves `x` from `start` until the core accepts it: the first value
+    // accepted, if any within 60 steps.
+    let search = |start: f64, up: bool, set: &dyn Fn(&mut EncoderConfig, f64)| {
+        let mut x = start;
+        for _ in 0..60 {
+            let next = if up { x * 2.0 } else { x * 0.5 };
+            if fits(&|c| set(c, next)) {
+                return Some(bound(x, next, set));
+            }
+            x = next;
+        }
+        None
+    };
+    let set_speed = |c: &mut EncoderConfig, x: f64| c.min_speed = x;
+    let set_timer = |c: &mut EncoderConfig, x: f64| c.timer_hz = x;
+    match e {
+        ConfigError::Inconsistent("min_speed") | ConfigError::Inconsistent("estimator.edges") => {
+            let what = if e == ConfigError::Inconsistent("min_speed") {
+                "the longest pitch at the minimum speed lasts more ticks than the counter holds"
+            } else {
+                "a sample of the estimator's edges at the minimum speed lasts more ticks than 32 bits hold"
+            };
+            let speed = search(config.min_speed, true, &set_speed)?;
+            let mut hint = format!(
+                "{what}: `{min_speed}` at least {} rad/s would fit",
+                num(speed)
+            );
+            if let Some(t) = search(config.timer_hz, false, &set_timer) {
+                let _ = write!(hint, ", or `{timer_hz}` at most {} Hz", num(t));
+            }
+            // A wider counter, where the counter is what is short.
+            let wider = (config.counter_bits.saturating_add(1)..=32)
+                .find(|&b| fits(&|c: &mut EncoderConfig| c.counter_bits = b));
+            if let (Some(b), Some(bits)) = (wider, counter_bits) {
+                let _ = write!(hint, ", or `{bits}` = {b}");
+            }
+            Some(hint)
+        }
+        ConfigError::Inconsistent("timer_hz") => {
+            let what =
+                "the longest pitch at the minimum speed lasts fewer than 2 ticks of the timer";
+            let timer = search(config.timer_hz, true, &set_timer)?;
+            let speed = search(config.min_speed, false, &set_speed);
+            Some(match speed {
+                Some(s) => format!(
+                    "{what}: `{timer_hz}` at least {} Hz would fit, or `{min_speed}` at most {} rad/s",
+                    num(timer),
+                    num(s)
+                ),
+                None => format!("{what}: `{timer_hz}` at least {} Hz would fit", num(timer)),
+            })
+        }
+        _ => None,
+    }
+}

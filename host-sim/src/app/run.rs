@@ -367,9 +367,21 @@ pub fn core_encoder(scene: &Scene, file: &Path) -> Result<Option<Encoder>, Scene
         .as_ref()
         .and_then(|m| m.min_speed)
         .unwrap_or(1.0);
-    Encoder::new(cfg)
-        .map(Some)
-        .map_err(|er| core_error(scene, file, "encoder", er))
+    Encoder::new(cfg).map(Some).map_err(|er| {
+        let mut err = core_error(scene, file, "encoder", er);
+        let hint = crate::app::check::speed_range_hint(
+            &cfg,
+            er,
+            "monitor.min_speed",
+            "encoder.timer_hz",
+            Some("encoder.counter_bits"),
+        );
+        if let (SceneError::Core { message, .. }, Some(h)) = (&mut err, hint) {
+            message.push_str(": ");
+            message.push_str(&h);
+        }
+        err
+    })
 }
 
 /// The δ window of a scene: `[monitor] window_revolutions`, else one load cycle (the lowest
