@@ -541,3 +541,58 @@ fn a_delta_below_the_noise_floor_is_printed_as_such() {
     );
     assert!(!text.contains(" %, noise floor"), "{text}");
 }
+
+/// A Kloss motor's δ is predicted through its tangent parabola at synchronous speed, while
+/// `run` integrates the curve: the report says so, with the largest difference over the
+/// predicted speeds, which this test recomputes from the seed's formulas (Kloss
+/// `M = 2·M_m/(σ/σ_m + σ_m/σ)`, tangent `A = −M_m/(σ_m·ω_s²)`, `B = M_m/σ_m`). A parabola
+/// motor has no such note.
+#[test]
+fn a_kloss_prediction_says_it_stands_on_the_tangent_parabola() {
+    let (ws, sm, mm) = (157.08f64, 0.25f64, 158.0f64);
+    let scene = format!(
+        "[shaft]\ninertia = 0.323\n[motor]\nmodel = \"kloss\"\nsynchronous_speed = {ws}\n\
+         breakdown_slip = {sm}\nbreakdown_torque = {mm}\n[load]\nmean = 24.0\n\
+         harmonics = [{{ order = 0.125, amplitude = 12.0, phase = 0.0 }}]\n"
+    );
+    let path = std::path::Path::new("kloss.toml");
+    let s = host_sim::app::scene::Scene::parse(&scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let i = p.irregularity.as_ref().unwrap();
+    let note = i.motor_note.as_deref().unwrap();
+    assert!(
+        note.contains("tangent parabola at synchronous speed"),
+        "{note}"
+    );
+    let kloss = |w: f64| {
+        let sigma = (ws - w) / ws;
+        2.0 * mm / (sigma / sm + sm / sigma)
+    };
+    let (a, b) = (-mm / (sm * ws * ws), mm / sm);
+    let worst = (0..=64)
+        .map(|k| i.omega_min + (i.omega_max - i.omega_min) * f64::from(k) / 64.0)
+        .map(|w| a * w * w + b - kloss(w))
+        .fold(0.0f64, |m, d| if d.abs() > m.abs() { d } else { m });
+    let said: f64 = note
+        .split("by at most ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (said - worst).abs() <= 1e-4 + 1e-6 * worst.abs(),
+        "{said} against {worst}: {note}"
+    );
+    assert!(worst.abs() > 0.01, "{worst}");
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(text.contains(note), "{text}");
+    // A parabola motor: no note.
+    let scene = scene.replace(
+        &format!("model = \"kloss\"\nsynchronous_speed = {ws}\nbreakdown_slip = {sm}\n"),
+        "model = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n",
+    );
+    let s = host_sim::app::scene::Scene::parse(&scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.irregularity.unwrap().motor_note, None);
+}

@@ -442,6 +442,55 @@ pub struct IrregularityOut {
     /// The report's warning when those samples lose more than 1 % of δ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sampling_warning: Option<String>,
+    /// For a Kloss motor: the prediction's parabola against the Kloss curve over the
+    /// predicted speeds ([`kloss_note`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motor_note: Option<String>,
+}
+
+/// What a Kloss motor's prediction stands on: the closed form (seed 000 eq. 11–13) needs a
+/// parabola `A·ω² + B`, and the Kloss curve is replaced by its tangent parabola at synchronous
+/// speed (exact there, above the curve towards breakdown), while `run` integrates the curve
+/// itself. Says so, with the largest difference between the two over the predicted speeds
+/// `[omega_min, omega_max]` (65 points), in N·m and in % of the curve's torque there. `None`
+/// for a parabola motor.
+pub fn kloss_note(
+    motor: &drive_monitor::drive::Motor,
+    omega_min: f64,
+    omega_max: f64,
+) -> Option<String> {
+    let k = motor.kloss_curve()?;
+    let p = motor.model();
+    let head = format!(
+        "the Kloss motor is predicted through its tangent parabola at synchronous speed \
+         (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
+        p.a(),
+        p.b()
+    );
+    if !(omega_min > 0.0 && omega_max >= omega_min) {
+        return Some(head);
+    }
+    let (mut worst, mut at) = (0.0f64, omega_min);
+    for i in 0..=64 {
+        let w = omega_min + (omega_max - omega_min) * f64::from(i) / 64.0;
+        let d = p.torque(w) - k.torque(w);
+        if d.abs() > worst.abs() {
+            (worst, at) = (d, w);
+        }
+    }
+    let curve = k.torque(at);
+    let share = if curve != 0.0 {
+        format!(
+            " ({:+.2} % of the curve's {curve:.3} N·m)",
+            100.0 * worst / curve
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{head}: over the predicted speeds the parabola differs from the curve by at most \
+         {worst:+.4} N·m at {at:.3} rad/s{share}"
+    ))
 }
 
 /// `supports` member of `predict --json`.
@@ -524,6 +573,11 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         p.irregularity = Some(IrregularityOut {
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
+            motor_note: kloss_note(
+                model.motor(),
+                irr.omega_min,
+                if irr.steady_state { irr.omega_max } else { 0.0 },
+            ),
             omega_max: irr.omega_max,
             omega_min: irr.omega_min,
             delta: irr.delta,

@@ -441,6 +441,9 @@ pub fn prediction_text(p: &Prediction) -> String {
         if let Some(w) = &i.sampling_warning {
             let _ = writeln!(s, "  {w}");
         }
+        if let Some(n) = &i.motor_note {
+            let _ = writeln!(s, "  {n}");
+        }
     }
     if let Some(why) = &p.irregularity_not_predicted {
         let _ = writeln!(s, "Running irregularity NOT PREDICTED: {why}");
