@@ -442,6 +442,18 @@ fn an_index_disc_configured_with_the_wrong_lines_says_so() {
         } else {
             assert!(report.sync_acquired.is_none());
             assert!(report.missing_frames >= 4, "{}", report.missing_frames);
+            // Counted while searching, without a fault event of the core's: listed all the
+            // same, each with its time.
+            let listed = report
+                .faults
+                .iter()
+                .filter(|f| f.fault == "missing-frame")
+                .count();
+            assert_eq!(
+                listed, report.missing_frames as usize,
+                "{:?}",
+                report.faults
+            );
             assert!(
                 said.contains(&format!(
                     "index: 24 captures from one index pulse to the next ({} of {} times), \

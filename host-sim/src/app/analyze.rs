@@ -578,6 +578,7 @@ pub fn analyze<R: BufRead>(
         stride: 1,
         skipped: 0,
         max_revs: usize::from(monitor.window_revolutions()),
+        frames_listed: 0,
     };
     let mut prev: Vec<Level> = Vec::new();
     let mut periods = IndexPeriods::default();
@@ -711,6 +712,8 @@ struct State {
     stride: u64,
     skipped: u64,
     max_revs: usize,
+    /// Missing frames accounted for in the fault list (listed, or left out past its cap).
+    frames_listed: u32,
 }
 
 impl State {
@@ -778,6 +781,9 @@ impl State {
                     }
                 }
                 Event::Fault(f) => {
+                    if f == Fault::MissingFrame {
+                        self.frames_listed += 1;
+                    }
                     if report.faults.len() < MAX_LISTED {
                         report.faults.push(FaultOut {
                             time,
@@ -788,6 +794,25 @@ impl State {
                 }
             };
             on_decision(&Decision { time, kind });
+        }
+        // The core counts some missing frames without a fault event (a search of three
+        // revolutions' worth of edges that found no frame, an index pulse that framed no edge,
+        // one dropped when four waited): each is listed at the edge or poll after which it
+        // was counted, so that the list agrees with the count.
+        let counted = monitor.diagnostics().edges.missing_frames;
+        while self.frames_listed < counted {
+            self.frames_listed += 1;
+            let time = clock.latest.1;
+            if report.faults.len() < MAX_LISTED {
+                report.faults.push(FaultOut {
+                    time,
+                    fault: Fault::MissingFrame.name(),
+                });
+            }
+            on_decision(&Decision {
+                time,
+                kind: DecisionKind::Fault(Fault::MissingFrame),
+            });
         }
         let s = monitor.sync_state();
         if s != self.sync {
