@@ -1098,3 +1098,53 @@ fn a_coarsely_sampled_capture_widens_the_noise_floor() {
         "{said}"
     );
 }
+
+/// The rising edges of an N-M wheel turning at `omega` rad/s from t = 0 to `stop` s (teeth at
+/// grid positions 0 … N−M−1, the gap after them), drawn directly from the angle, not through
+/// the simulator's encoder model.
+fn wheel_teeth(n: u32, m: u32, omega: f64, stop: f64) -> Vec<f64> {
+    let pitch = std::f64::consts::TAU / f64::from(n);
+    (0..)
+        .map(|k: u32| (k, f64::from(k) * pitch / omega))
+        .take_while(|&(_, t)| t < stop)
+        .filter(|&(k, _)| k % n < n - m)
+        .map(|(_, t)| t)
+        .collect()
+}
+
+/// A Saleae Logic 2 export of one channel rising at `rising` (nanosecond times) and falling
+/// halfway to the next rise; the recording ends at `end`.
+fn saleae_of_rising(rising: &[f64], end: f64) -> String {
+    let mut s = String::from("Time [s],Channel 0\n0.000000000,0\n");
+    for (i, &t) in rising.iter().enumerate() {
+        let next = rising.get(i + 1).copied().unwrap_or(t + 1e-3);
+        s.push_str(&format!("{t:.9},1\n{:.9},0\n", 0.5 * (t + next)));
+    }
+    s.push_str(&format!("{end:.9},0\n"));
+    s
+}
+
+/// A shaft that stops before the recording does: the timeout is where the firmware's poll
+/// would see it (the core's timeout after the last tooth), not at the end of the file, and so
+/// is the end of the window it makes invalid.
+#[test]
+fn a_stop_before_the_end_of_the_recording_times_out_where_it_happens() {
+    let rising = wheel_teeth(36, 2, 40.0, 1.5);
+    let last = *rising.last().unwrap();
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let timeout = {
+        let e = drive_monitor::encoder::Encoder::new(cfg.encoder).unwrap();
+        f64::from(e.timeout_ticks()) / cfg.encoder.timer_hz
+    };
+    let mut reader = text_reader(saleae_of_rising(&rising, 4.0), "stop.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.timeouts, 1);
+    let at = report.faults.iter().find(|f| f.fault == "timeout").unwrap().time;
+    assert!(
+        at > last + timeout - 2e-3 && at < last + timeout + 2e-3,
+        "timeout at {at} s, last tooth {last} s, timeout {timeout} s"
+    );
+    let w = report.windows.last().unwrap();
+    assert!(!w.valid && (w.end - at).abs() < 1e-9, "{w:?}");
+    assert!(report.sync.last().is_some_and(|s| s.time == at), "{:?}", report.sync);
+}

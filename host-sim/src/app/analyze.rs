@@ -569,8 +569,10 @@ pub fn analyze<R: BufRead>(
         recent: VecDeque::new(),
         latest: (0, 0.0),
     };
-    let poll_every = poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits);
-    let timeout = f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz;
+    let polls = Polls {
+        every: poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits),
+        timeout: f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz,
+    };
     let mut st = State {
         seen: Seen::default(),
         frames: VecDeque::new(),
@@ -625,17 +627,18 @@ pub fn analyze<R: BufRead>(
         if !index_edge && !encoder_edge {
             continue;
         }
-        // The periodic task between the last event and this one. A poll finds nothing until
-        // the timeout has passed: only the ones around it are made.
+        // The periodic task between the last event and this one.
         if let Some(t0) = last_event {
-            let mut p = last_poll.max(t0 + timeout - 2.0 * poll_every).max(t0) + poll_every;
-            while p < t && p <= t0 + timeout + 2.0 * poll_every {
-                let ticks = clock.ticks(p);
-                clock.note(ticks, p);
-                st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
-                last_poll = p;
-                p += poll_every;
-            }
+            polls.between(
+                t0,
+                t,
+                &mut last_poll,
+                &mut clock,
+                &mut st,
+                &mut monitor,
+                &mut report,
+                on_decision,
+            );
         }
         let ticks = clock.ticks(t);
         clock.note(ticks, t);
@@ -653,8 +656,20 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
-    // The end of the recording: a last poll there.
-    if last_event.is_some() {
+    // The end of the recording: the periodic task up to it (a shaft that stopped before the
+    // recording did times out where a firmware's poll would see it, not at the end of the
+    // file), and a last poll there.
+    if let Some(t0) = last_event {
+        polls.between(
+            t0,
+            end,
+            &mut last_poll,
+            &mut clock,
+            &mut st,
+            &mut monitor,
+            &mut report,
+            on_decision,
+        );
         let ticks = clock.ticks(end);
         clock.note(ticks, end);
         st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
@@ -699,6 +714,40 @@ pub fn analyze<R: BufRead>(
         .collect();
     report.speed_trace.shrink_to_fit();
     Ok(report)
+}
+
+/// The firmware's periodic task between two events.
+struct Polls {
+    /// Poll interval, s.
+    every: f64,
+    /// The core's timeout, s.
+    timeout: f64,
+}
+
+impl Polls {
+    /// Polls after the event at `t0` and before `t`, every [`Polls::every`]. A poll finds
+    /// nothing until the timeout has passed: only the ones around it are made.
+    #[allow(clippy::too_many_arguments)]
+    fn between(
+        &self,
+        t0: f64,
+        t: f64,
+        last_poll: &mut f64,
+        clock: &mut Clock,
+        st: &mut State,
+        monitor: &mut DeltaMonitor<MAX_LINES>,
+        report: &mut AnalyzeReport,
+        on_decision: &mut dyn FnMut(&Decision),
+    ) {
+        let mut p = last_poll.max(t0 + self.timeout - 2.0 * self.every).max(t0) + self.every;
+        while p < t && p <= t0 + self.timeout + 2.0 * self.every {
+            let ticks = clock.ticks(p);
+            clock.note(ticks, p);
+            st.poll(monitor, clock, ticks, report, on_decision);
+            *last_poll = p;
+            p += self.every;
+        }
+    }
 }
 
 /// The analysis state between calls to the monitor.
