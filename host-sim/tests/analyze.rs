@@ -1112,13 +1112,14 @@ fn wheel_teeth(n: u32, m: u32, omega: f64, stop: f64) -> Vec<f64> {
         .collect()
 }
 
-/// A Saleae Logic 2 export of one channel rising at `rising` (nanosecond times) and falling
+/// A Saleae Logic 2 export of one channel sampled at `rate`, rising at `rising` and falling
 /// halfway to the next rise; the recording ends at `end`.
-fn saleae_of_rising(rising: &[f64], end: f64) -> String {
+fn saleae_of_rising(rising: &[f64], rate: f64, end: f64) -> String {
     let mut s = String::from("Time [s],Channel 0\n0.000000000,0\n");
     for (i, &t) in rising.iter().enumerate() {
         let next = rising.get(i + 1).copied().unwrap_or(t + 1e-3);
-        s.push_str(&format!("{t:.9},1\n{:.9},0\n", 0.5 * (t + next)));
+        let (up, down) = (sampled(t, rate), sampled(0.5 * (t + next), rate));
+        s.push_str(&format!("{up:.9},1\n{down:.9},0\n"));
     }
     s.push_str(&format!("{end:.9},0\n"));
     s
@@ -1136,15 +1137,88 @@ fn a_stop_before_the_end_of_the_recording_times_out_where_it_happens() {
         let e = drive_monitor::encoder::Encoder::new(cfg.encoder).unwrap();
         f64::from(e.timeout_ticks()) / cfg.encoder.timer_hz
     };
-    let mut reader = text_reader(saleae_of_rising(&rising, 4.0), "stop.csv", None).unwrap();
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 4.0), "stop.csv", None).unwrap();
     let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
     assert_eq!(report.timeouts, 1);
-    let at = report.faults.iter().find(|f| f.fault == "timeout").unwrap().time;
+    let at = report
+        .faults
+        .iter()
+        .find(|f| f.fault == "timeout")
+        .unwrap()
+        .time;
     assert!(
         at > last + timeout - 2e-3 && at < last + timeout + 2e-3,
         "timeout at {at} s, last tooth {last} s, timeout {timeout} s"
     );
     let w = report.windows.last().unwrap();
     assert!(!w.valid && (w.end - at).abs() < 1e-9, "{w:?}");
-    assert!(report.sync.last().is_some_and(|s| s.time == at), "{:?}", report.sync);
+    assert!(
+        report.sync.last().is_some_and(|s| s.time == at),
+        "{:?}",
+        report.sync
+    );
+}
+
+/// A Saleae export states no sample rate, but its times show the sampling: every one on a
+/// 5 µs grid (200 kS/s). A steady shaft (true δ 0) measured with an 84 MHz timer shows δ of
+/// the sampling's size, hundreds of times the timer's floor: the floor given includes the
+/// grid, and the report says the grid was taken as the sample period.
+#[test]
+fn the_time_grid_of_a_capture_without_a_rate_widens_the_floor() {
+    let rising = wheel_teeth(36, 2, 40.0, 2.0);
+    let text = saleae_of_rising(&rising, 2e5, 2.0);
+    let cfg = configure(&AnalyzeOptions {
+        timer_hz: Some(84e6),
+        ..wheel("36-2")
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "coarse.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.sample_rate, None);
+    assert!(
+        report.time_grid.is_some_and(|g| (g - 5e-6).abs() < 1e-15),
+        "{:?}",
+        report.time_grid
+    );
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 5, "{}", valid.len());
+    let mut beyond_timer = 0;
+    for w in &valid {
+        let (d, timer) = (w.delta.unwrap(), w.noise_floor.unwrap());
+        let both = w.floor_with_sampling.unwrap();
+        assert!((both / timer - (1.0 + 84e6 * 5e-6)).abs() < 1e-9);
+        assert!(
+            d <= both,
+            "window {}: δ {d} (truth 0), floor {both}",
+            w.start
+        );
+        if d > timer {
+            beyond_timer += 1;
+        }
+    }
+    assert_eq!(beyond_timer, valid.len());
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("every time lies on a 5.000e-6 s grid"),
+        "{said}"
+    );
+    // Times not on a common grid of 2 ns or more (full precision) give none.
+    let fine: String = saleae_of_rising(&rising, 2e5, 2.0)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| match (i, l.split_once(',')) {
+            (0, _) | (_, None) => format!("{l}\n"),
+            (_, Some((t, v))) => format!(
+                "{:.12},{v}\n",
+                t.parse::<f64>().unwrap() + 1.3e-10 * i as f64
+            ),
+        })
+        .collect();
+    let mut reader = text_reader(fine, "fine.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.time_grid, None);
+    assert!(report
+        .windows
+        .iter()
+        .all(|w| w.floor_with_sampling.is_none()));
 }
