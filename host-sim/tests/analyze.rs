@@ -1222,3 +1222,29 @@ fn the_time_grid_of_a_capture_without_a_rate_widens_the_floor() {
         .iter()
         .all(|w| w.floor_with_sampling.is_none()));
 }
+
+/// A steady shaft (true δ 0): what a window measures is the timer's quantization, within the
+/// noise floor. Such a window is valid but its δ is not resolved, and the report says so
+/// (`resolved` false) instead of printing it like a measured ripple.
+#[test]
+fn a_delta_within_its_noise_floor_is_not_reported_as_resolved() {
+    let rising = wheel_teeth(36, 2, 40.0, 2.0);
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 2.0), "steady.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 5, "{}", valid.len());
+    for w in &valid {
+        let floor = w.floor_with_sampling.or(w.noise_floor).unwrap();
+        assert!(w.delta.unwrap() <= floor, "{w:?}");
+        assert_eq!(w.resolved, Some(false), "{w:?}");
+    }
+    let said = host_sim::app::analyze::text(&report);
+    let rows: Vec<&str> = said.lines().filter(|l| l.contains("  valid")).collect();
+    assert_eq!(rows.len(), valid.len(), "{said}");
+    assert!(
+        rows.iter()
+            .all(|l| l.ends_with("δ within its floor: not resolved")),
+        "{said}"
+    );
+}

@@ -170,6 +170,10 @@ pub struct WindowOut {
     /// of the previous valid window's (valid windows; never the first one after sync). δ of
     /// a window that is not steady includes the change of speed (a run-up or run-down).
     pub steady: Option<bool>,
+    /// δ exceeds the floor given (`floor_with_sampling` when there is one, else
+    /// `noise_floor`; valid windows): otherwise δ is not resolved from the quantization and
+    /// its value is no measurement of the ripple, only a bound on it.
+    pub resolved: Option<bool>,
 }
 
 /// A fault with its time.
@@ -716,6 +720,11 @@ pub fn analyze<R: BufRead>(
             w.floor_with_sampling = w.noise_floor.map(|f| f * widen);
         }
     }
+    for w in &mut report.windows {
+        if let (Some(d), Some(f)) = (w.delta, w.floor_with_sampling.or(w.noise_floor)) {
+            w.resolved = Some(d > f);
+        }
+    }
     report.channel_changes = channels
         .iter()
         .zip(changes)
@@ -942,6 +951,7 @@ impl State {
             noise_floor: m.and_then(|m| f(m.noise_floor)),
             floor_with_sampling: None,
             steady: m.map(|m| m.steady),
+            resolved: None,
         });
     }
 }
@@ -1133,10 +1143,11 @@ pub fn text(r: &AnalyzeReport) -> String {
                     d,
                     m,
                     f,
-                    if w.steady == Some(true) {
-                        ""
-                    } else {
-                        ", not steady"
+                    match (w.steady == Some(true), w.resolved == Some(false)) {
+                        (true, false) => "",
+                        (false, false) => ", not steady",
+                        (true, true) => ", δ within its floor: not resolved",
+                        (false, true) => ", not steady, δ within its floor: not resolved",
                     }
                 );
             }
