@@ -1110,3 +1110,153 @@ fn a_coarsely_sampled_capture_widens_the_noise_floor() {
         "{said}"
     );
 }
+
+/// The rising edges of an N-M wheel turning at `omega` rad/s from t = 0 to `stop` s (teeth at
+/// grid positions 0 … N−M−1, the gap after them), drawn directly from the angle, not through
+/// the simulator's encoder model.
+fn wheel_teeth(n: u32, m: u32, omega: f64, stop: f64) -> Vec<f64> {
+    let pitch = std::f64::consts::TAU / f64::from(n);
+    (0..)
+        .map(|k: u32| (k, f64::from(k) * pitch / omega))
+        .take_while(|&(_, t)| t < stop)
+        .filter(|&(k, _)| k % n < n - m)
+        .map(|(_, t)| t)
+        .collect()
+}
+
+/// A Saleae Logic 2 export of one channel sampled at `rate`, rising at `rising` and falling
+/// halfway to the next rise; the recording ends at `end`.
+fn saleae_of_rising(rising: &[f64], rate: f64, end: f64) -> String {
+    let mut s = String::from("Time [s],Channel 0\n0.000000000,0\n");
+    for (i, &t) in rising.iter().enumerate() {
+        let next = rising.get(i + 1).copied().unwrap_or(t + 1e-3);
+        let (up, down) = (sampled(t, rate), sampled(0.5 * (t + next), rate));
+        s.push_str(&format!("{up:.9},1\n{down:.9},0\n"));
+    }
+    s.push_str(&format!("{end:.9},0\n"));
+    s
+}
+
+/// A shaft that stops before the recording does: the timeout is where the firmware's poll
+/// would see it (the core's timeout after the last tooth), not at the end of the file, and so
+/// is the end of the window it makes invalid.
+#[test]
+fn a_stop_before_the_end_of_the_recording_times_out_where_it_happens() {
+    let rising = wheel_teeth(36, 2, 40.0, 1.5);
+    let last = *rising.last().unwrap();
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let timeout = {
+        let e = drive_monitor::encoder::Encoder::new(cfg.encoder).unwrap();
+        f64::from(e.timeout_ticks()) / cfg.encoder.timer_hz
+    };
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 4.0), "stop.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.timeouts, 1);
+    let at = report
+        .faults
+        .iter()
+        .find(|f| f.fault == "timeout")
+        .unwrap()
+        .time;
+    assert!(
+        at > last + timeout - 2e-3 && at < last + timeout + 2e-3,
+        "timeout at {at} s, last tooth {last} s, timeout {timeout} s"
+    );
+    let w = report.windows.last().unwrap();
+    assert!(!w.valid && (w.end - at).abs() < 1e-9, "{w:?}");
+    assert!(
+        report.sync.last().is_some_and(|s| s.time == at),
+        "{:?}",
+        report.sync
+    );
+}
+
+/// A Saleae export states no sample rate, but its times show the sampling: every one on a
+/// 5 µs grid (200 kS/s). A steady shaft (true δ 0) measured with an 84 MHz timer shows δ of
+/// the sampling's size, hundreds of times the timer's floor: the floor given includes the
+/// grid, and the report says the grid was taken as the sample period.
+#[test]
+fn the_time_grid_of_a_capture_without_a_rate_widens_the_floor() {
+    let rising = wheel_teeth(36, 2, 40.0, 2.0);
+    let text = saleae_of_rising(&rising, 2e5, 2.0);
+    let cfg = configure(&AnalyzeOptions {
+        timer_hz: Some(84e6),
+        ..wheel("36-2")
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "coarse.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.sample_rate, None);
+    assert!(
+        report.time_grid.is_some_and(|g| (g - 5e-6).abs() < 1e-15),
+        "{:?}",
+        report.time_grid
+    );
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 5, "{}", valid.len());
+    let mut beyond_timer = 0;
+    for w in &valid {
+        let (d, timer) = (w.delta.unwrap(), w.noise_floor.unwrap());
+        let both = w.floor_with_sampling.unwrap();
+        assert!((both / timer - (1.0 + 84e6 * 5e-6)).abs() < 1e-9);
+        assert!(
+            d <= both,
+            "window {}: δ {d} (truth 0), floor {both}",
+            w.start
+        );
+        if d > timer {
+            beyond_timer += 1;
+        }
+    }
+    assert_eq!(beyond_timer, valid.len());
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("every time lies on a 5.000e-6 s grid"),
+        "{said}"
+    );
+    // Times not on a common grid of 2 ns or more (full precision) give none.
+    let fine: String = saleae_of_rising(&rising, 2e5, 2.0)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| match (i, l.split_once(',')) {
+            (0, _) | (_, None) => format!("{l}\n"),
+            (_, Some((t, v))) => format!(
+                "{:.12},{v}\n",
+                t.parse::<f64>().unwrap() + 1.3e-10 * i as f64
+            ),
+        })
+        .collect();
+    let mut reader = text_reader(fine, "fine.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.time_grid, None);
+    assert!(report
+        .windows
+        .iter()
+        .all(|w| w.floor_with_sampling.is_none()));
+}
+
+/// A steady shaft (true δ 0): what a window measures is the timer's quantization, within the
+/// noise floor. Such a window is valid but its δ is not resolved, and the report says so
+/// (`resolved` false) instead of printing it like a measured ripple.
+#[test]
+fn a_delta_within_its_noise_floor_is_not_reported_as_resolved() {
+    let rising = wheel_teeth(36, 2, 40.0, 2.0);
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 2.0), "steady.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 5, "{}", valid.len());
+    for w in &valid {
+        let floor = w.floor_with_sampling.or(w.noise_floor).unwrap();
+        assert!(w.delta.unwrap() <= floor, "{w:?}");
+        assert_eq!(w.resolved, Some(false), "{w:?}");
+    }
+    let said = host_sim::app::analyze::text(&report);
+    let rows: Vec<&str> = said.lines().filter(|l| l.contains("  valid")).collect();
+    assert_eq!(rows.len(), valid.len(), "{said}");
+    assert!(
+        rows.iter()
+            .all(|l| l.ends_with("δ within its floor: not resolved")),
+        "{said}"
+    );
+}

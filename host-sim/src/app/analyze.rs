@@ -162,14 +162,18 @@ pub struct WindowOut {
     pub omega_min: Option<f64>,
     /// Bound on δ's error from timer quantization.
     pub noise_floor: Option<f64>,
-    /// The bound with the capture's sampling added (when its sample rate is known): each
-    /// timestamp is known to a sample period besides the timer's tick, so the floor is
-    /// `noise_floor · (1 + timer_hz / sample_rate)`.
+    /// The bound with the capture's sampling added (when its sample rate is known, or the
+    /// grid its times lie on): each timestamp is known to a sample period besides the timer's
+    /// tick, so the floor is `noise_floor · (1 + timer_hz / sample_rate)`.
     pub floor_with_sampling: Option<f64>,
     /// The mean speed was within the steady tolerance (2 % unless the scene says otherwise)
     /// of the previous valid window's (valid windows; never the first one after sync). δ of
     /// a window that is not steady includes the change of speed (a run-up or run-down).
     pub steady: Option<bool>,
+    /// δ exceeds the floor given (`floor_with_sampling` when there is one, else
+    /// `noise_floor`; valid windows): otherwise δ is not resolved from the quantization and
+    /// its value is no measurement of the ripple, only a bound on it.
+    pub resolved: Option<bool>,
 }
 
 /// A fault with its time.
@@ -286,6 +290,10 @@ pub struct AnalyzeReport {
     pub counter_bits: u8,
     /// The capture's sample rate, Hz, when known (a sigrok file's, or `--sample-rate`).
     pub sample_rate: Option<f64>,
+    /// Without a known sample rate: the step, s, that every row's time lies on from the first
+    /// row's (in whole nanoseconds, when 2 ns or more: the analyzer's sample period, as a
+    /// Saleae export's nine decimals show it), taken as the sampling for the floor.
+    pub time_grid: Option<f64>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s.
@@ -569,8 +577,10 @@ pub fn analyze<R: BufRead>(
         recent: VecDeque::new(),
         latest: (0, 0.0),
     };
-    let poll_every = poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits);
-    let timeout = f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz;
+    let polls = Polls {
+        every: poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits),
+        timeout: f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz,
+    };
     let mut st = State {
         seen: Seen::default(),
         frames: VecDeque::new(),
@@ -586,11 +596,13 @@ pub fn analyze<R: BufRead>(
     let mut last_poll = f64::NEG_INFINITY;
     let mut end = 0.0;
     let mut changes = vec![0u64; channels.len()];
+    let mut grid = TimeGrid::default();
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
             prev = levels.to_vec();
         }
+        grid.row(t);
         for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
                 *n += 1;
@@ -626,17 +638,18 @@ pub fn analyze<R: BufRead>(
         if !index_edge && !encoder_edge {
             continue;
         }
-        // The periodic task between the last event and this one. A poll finds nothing until
-        // the timeout has passed: only the ones around it are made.
+        // The periodic task between the last event and this one.
         if let Some(t0) = last_event {
-            let mut p = last_poll.max(t0 + timeout - 2.0 * poll_every).max(t0) + poll_every;
-            while p < t && p <= t0 + timeout + 2.0 * poll_every {
-                let ticks = clock.ticks(p);
-                clock.note(ticks, p);
-                st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
-                last_poll = p;
-                p += poll_every;
-            }
+            polls.between(
+                t0,
+                t,
+                &mut last_poll,
+                &mut clock,
+                &mut st,
+                &mut monitor,
+                &mut report,
+                on_decision,
+            );
         }
         let ticks = clock.ticks(t);
         clock.note(ticks, t);
@@ -654,8 +667,20 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
-    // The end of the recording: a last poll there.
-    if last_event.is_some() {
+    // The end of the recording: the periodic task up to it (a shaft that stopped before the
+    // recording did times out where a firmware's poll would see it, not at the end of the
+    // file), and a last poll there.
+    if let Some(t0) = last_event {
+        polls.between(
+            t0,
+            end,
+            &mut last_poll,
+            &mut clock,
+            &mut st,
+            &mut monitor,
+            &mut report,
+            on_decision,
+        );
         let ticks = clock.ticks(end);
         clock.note(ticks, end);
         st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
@@ -684,10 +709,21 @@ pub fn analyze<R: BufRead>(
     report.unjudged_at_end = report
         .edges
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
-    if let Some(rate) = report.sample_rate {
+    if report.sample_rate.is_none() {
+        report.time_grid = grid.step();
+    }
+    if let Some(rate) = report
+        .sample_rate
+        .or_else(|| report.time_grid.map(|g| 1.0 / g))
+    {
         let widen = 1.0 + cfg.encoder.timer_hz / rate;
         for w in &mut report.windows {
             w.floor_with_sampling = w.noise_floor.map(|f| f * widen);
+        }
+    }
+    for w in &mut report.windows {
+        if let (Some(d), Some(f)) = (w.delta, w.floor_with_sampling.or(w.noise_floor)) {
+            w.resolved = Some(d > f);
         }
     }
     report.channel_changes = channels
@@ -700,6 +736,85 @@ pub fn analyze<R: BufRead>(
         .collect();
     report.speed_trace.shrink_to_fit();
     Ok(report)
+}
+
+/// The step every row's time lies on, from the first row's, in whole nanoseconds (the
+/// greatest common divisor of the offsets): a capture's sample period when the file does not
+/// state its rate (Saleae Logic 2 writes nine decimals).
+#[derive(Default)]
+struct TimeGrid {
+    first: Option<i64>,
+    /// The divisor so far (0: no offset yet); `None` once a time is not whole nanoseconds.
+    gcd: Option<u64>,
+}
+
+impl TimeGrid {
+    fn row(&mut self, t: f64) {
+        let ns = t * 1e9;
+        let whole = ns.round();
+        // Not whole nanoseconds (to the rounding of the decimal time), or beyond 1e5 s where
+        // f64 no longer tells them: no grid.
+        if !(whole.abs() < 1e14 && (ns - whole).abs() <= 1e-2 + 1e-15 * whole.abs()) {
+            self.gcd = None;
+            self.first = Some(0);
+            return;
+        }
+        let n = whole as i64;
+        match self.first {
+            None => {
+                self.first = Some(n);
+                self.gcd = Some(0);
+            }
+            Some(f) => {
+                if let Some(g) = self.gcd {
+                    let (mut a, mut b) = (g, n.abs_diff(f));
+                    while b != 0 {
+                        (a, b) = (b, a % b);
+                    }
+                    self.gcd = Some(a);
+                }
+            }
+        }
+    }
+
+    /// The step, s, when it is at least 2 ns.
+    fn step(&self) -> Option<f64> {
+        self.gcd.filter(|&g| g >= 2).map(|g| g as f64 * 1e-9)
+    }
+}
+
+/// The firmware's periodic task between two events.
+struct Polls {
+    /// Poll interval, s.
+    every: f64,
+    /// The core's timeout, s.
+    timeout: f64,
+}
+
+impl Polls {
+    /// Polls after the event at `t0` and before `t`, every [`Polls::every`]. A poll finds
+    /// nothing until the timeout has passed: only the ones around it are made.
+    #[allow(clippy::too_many_arguments)]
+    fn between(
+        &self,
+        t0: f64,
+        t: f64,
+        last_poll: &mut f64,
+        clock: &mut Clock,
+        st: &mut State,
+        monitor: &mut DeltaMonitor<MAX_LINES>,
+        report: &mut AnalyzeReport,
+        on_decision: &mut dyn FnMut(&Decision),
+    ) {
+        let mut p = last_poll.max(t0 + self.timeout - 2.0 * self.every).max(t0) + self.every;
+        while p < t && p <= t0 + self.timeout + 2.0 * self.every {
+            let ticks = clock.ticks(p);
+            clock.note(ticks, p);
+            st.poll(monitor, clock, ticks, report, on_decision);
+            *last_poll = p;
+            p += self.every;
+        }
+    }
 }
 
 /// The analysis state between calls to the monitor.
@@ -861,6 +976,7 @@ impl State {
             noise_floor: m.and_then(|m| f(m.noise_floor)),
             floor_with_sampling: None,
             steady: m.map(|m| m.steady),
+            resolved: None,
         });
     }
 }
@@ -918,13 +1034,26 @@ pub fn text(r: &AnalyzeReport) -> String {
                 1.0 + r.timer_hz / rate
             );
         }
-        None => {
-            let _ = writeln!(
-                s,
-                "sampling: rate not stated (give --sample-rate): the floor below is the timer's \
-                 alone, and a capture sampled slower than the timer resolves δ less finely"
-            );
-        }
+        None => match r.time_grid {
+            Some(g) => {
+                let _ = writeln!(
+                    s,
+                    "sampling: rate not stated; every time lies on a {g:.3e} s grid ({:.3} timer \
+                     ticks), taken as the sample period: the floor below includes it, {:.3} \
+                     times the timer's alone (give --sample-rate to state the rate)",
+                    r.timer_hz * g,
+                    1.0 + r.timer_hz * g
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "sampling: rate not stated (give --sample-rate): the floor below is the \
+                     timer's alone, and a capture sampled slower than the timer resolves δ less \
+                     finely"
+                );
+            }
+        },
     }
     let _ = writeln!(
         s,
@@ -1039,10 +1168,11 @@ pub fn text(r: &AnalyzeReport) -> String {
                     d,
                     m,
                     f,
-                    if w.steady == Some(true) {
-                        ""
-                    } else {
-                        ", not steady"
+                    match (w.steady == Some(true), w.resolved == Some(false)) {
+                        (true, false) => "",
+                        (false, false) => ", not steady",
+                        (true, true) => ", δ within its floor: not resolved",
+                        (false, true) => ", not steady, δ within its floor: not resolved",
                     }
                 );
             }
