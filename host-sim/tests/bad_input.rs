@@ -372,3 +372,65 @@ fn a_speed_range_the_timer_cannot_hold_says_what_would_fit() {
         "{speed} against {exact}: {e}"
     );
 }
+
+#[test]
+fn a_pendulum_inertia_on_balls_or_rollers_is_refused_not_ignored() {
+    // `pendulum_inertia = 0.01` beside `kind = "ball"` was checked for its range, then ignored:
+    // `predict` gave the same 61.430 rad/s resonance and zones as without it.
+    for kind in ["ball", "roller"] {
+        let e = error(
+            "one-mass",
+            "kind = \"ball\"",
+            &format!("kind = \"{kind}\"\npendulum_inertia = 0.01"),
+        );
+        assert_names(
+            &e,
+            &[
+                "`autobalancer.pendulum_inertia = 0.01`",
+                "kind = \"pendulum\" only",
+                kind,
+            ],
+        );
+    }
+    // With a pendulum it is read (and required).
+    let text = bundled("one-mass").replacen(
+        "kind = \"ball\"",
+        "kind = \"pendulum\"\npendulum_inertia = 0.01",
+        1,
+    );
+    assert!(Scene::parse(&text, Path::new("ok.toml")).is_ok());
+}
+
+#[test]
+fn refusals_quote_arrays_as_written_and_say_what_would_be_valid() {
+    // `between = [1, 1]` was quoted as "`coupling[1].between = [1, 1] (the default)`":
+    // written arrays are kept element by element, and the whole array was not found.
+    let e = error("two-mass", "between = [1, 2]", "between = [1, 1]");
+    assert_names(
+        &e,
+        &["`coupling[1].between = [1, 1]`", "two different platforms"],
+    );
+    assert!(!e.contains("the default"), "{e}");
+    // Two tables coupling the same pair: "`coupling`: contradict each other", no hint.
+    let e = error(
+        "two-mass",
+        "[autobalancer]",
+        "[[coupling]]\nbetween = [2, 1]\nstiffness = 1.0e5\n\n[autobalancer]",
+    );
+    assert_names(
+        &e,
+        &["coupling", "same two platforms", "one table per pair"],
+    );
+    // Supports in one plane: "`rotor.support_b = 0.0`, `rotor.support_a = 0.0`: contradict
+    // each other", without saying what separation is needed.
+    let e = error("auger", "support_b = 4.0", "support_b = 0.0");
+    assert_names(
+        &e,
+        &[
+            "`rotor.support_b = 0.0`",
+            "`rotor.support_a = 0.0`",
+            "two distinct planes",
+            "1e-6",
+        ],
+    );
+}

@@ -584,3 +584,47 @@ fn run_says_which_tables_a_prescribed_speed_leaves_out() {
     assert!(v.get("not_simulated").is_none(), "{v}");
     assert_eq!(v["delta_limit"].as_f64(), Some(0.06));
 }
+
+/// A 50 g rotor (supports 30 mm apart, centre of mass 20 mm from A, 1e-7 kg·m at 10 mm, 1000
+/// rad/s): the statics give static loads 0.05·9.80665·(1/3, 2/3) = 0.16344, 0.32689 N and
+/// peaks 0.16344 + 6.6667e-8·1e6 = 0.23011 N, 0.32689 + 3.3333e-8·1e6 = 0.36022 N. Printed to
+/// 0.1 N they read "static loads A 0.2 N, B 0.3 N; peak at service speed A 0.2 N, B 0.4 N":
+/// 22 % off, and A's rotating part (0.067 N) vanished. Small loads keep four digits now.
+#[test]
+fn a_small_rotors_support_loads_keep_their_digits() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-small-rotor-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("small.toml");
+    std::fs::write(
+        &scene,
+        "[rotor]\nmass = 0.05\ncentre_of_mass = 0.02\nsupport_a = 0.0\nsupport_b = 0.03\n\
+         grade = 2.5\nservice_speed = 1000.0\nsupport_load_limit = [0.6, 0.6]\n\
+         [[unbalance]]\nz = 0.01\namount = 1e-7\nangle = 45.0\n\
+         [motor]\nmodel = \"speed\"\nspeed = 1000.0\n[simulation]\nduration = 0.5\n",
+    )
+    .unwrap();
+    let path = scene.to_str().unwrap();
+    let (ok, out, err) = drive_sim(&["predict", path]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains(
+            "static loads A 0.1634 N, B 0.3269 N; peak at service speed A 0.2301 N, B 0.3602 N"
+        ),
+        "{out}"
+    );
+    let (ok, out, err) = drive_sim(&["run", path]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains(
+            "simulated peak reactions A 0.2301 N (normal against the load limit), B 0.3602 N"
+        ),
+        "{out}"
+    );
+    // Large loads print as before.
+    let (ok, out, _) = drive_sim(&["predict", "auger"]);
+    assert!(
+        ok && out.contains("static loads A 2402.0 N, B 2230.4 N"),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

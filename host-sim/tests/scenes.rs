@@ -411,6 +411,32 @@ fn simulated_support_reactions_reach_the_rotating_peak() {
     assert_eq!(s.simulated_reaction_level, Some(["over", "warning"]));
 }
 
+/// The auger with its supports written the other way round (`support_a = 4.0`, `support_b =
+/// 0.0`): `predict` took it (the core's rotor takes either order) and gave A and B exchanged,
+/// but `run` refused it as "`rotor.support_b = 0.0`, `rotor.support_a = 4.0`: contradict each
+/// other". Now `run` simulates it too, with the same loads, exchanged: at 60 rad/s the support
+/// at z = 0 carries 2402.0 + 1.4e-3·3600 = 2407.0 N, the one at z = 4 2230.4 + 2.16 = 2232.5 N.
+#[test]
+fn run_takes_the_supports_in_either_order_as_predict_does() {
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    let swapped = auger
+        .replacen("support_a = 0.0", "support_a = 4.0", 1)
+        .replacen("support_b = 4.0", "support_b = 0.0", 1);
+    assert_ne!(swapped, auger);
+    let (straight, turned) = (run_trial(auger), run_trial(&swapped));
+    let (s, t) = (straight.supports.unwrap(), turned.supports.unwrap());
+    for k in 0..2 {
+        let (a, b) = (
+            s.simulated_peak_reaction[k],
+            t.simulated_peak_reaction[1 - k],
+        );
+        assert!((a / b - 1.0).abs() < 1e-9, "{a} against {b}");
+        assert_eq!(s.load_level[k], t.load_level[1 - k]);
+    }
+    assert!((s.simulated_peak_reaction[0] - 2407.012).abs() < 0.01);
+    assert!((s.simulated_peak_reaction[1] - 2232.516).abs() < 0.01);
+}
+
 /// A press whose reduced inertia swings 1 ± 0.4 kg·m² twice a revolution, with a constant
 /// load: ω ∝ 1/√J(φ) makes δ = 2(√(1.4/0.6) − 1)/(√(1.4/0.6) + 1) ≈ 0.417 with no load
 /// ripple at all. `predict` ignored `inertia_harmonics` and said δ = 0, "within the δ limit

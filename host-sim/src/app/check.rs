@@ -9,7 +9,8 @@
 //! ranges (values that contradict each other) are turned into scene keys by [`core_keys`].
 
 use crate::app::scene::{
-    parse_wheel, AutobalancerSpec, EncoderSpec, FramingSpec, Harmonic, MotorSpec, Scene, SceneError,
+    parse_wheel, AutobalancerSpec, BalancerKindSpec, EncoderSpec, FramingSpec, Harmonic, MotorSpec,
+    Scene, SceneError,
 };
 use drive_monitor::ConfigError;
 use std::collections::BTreeMap;
@@ -158,11 +159,19 @@ impl<'a> Checker<'a> {
         Checker { file, written }
     }
 
-    /// `key`'s value as written, or `x` marked as the default.
+    /// `key`'s value as written (an array of numbers from its elements, which [`Written`]
+    /// keeps one by one), or `x` marked as the default.
     pub fn shown(&self, key: &str, x: impl std::fmt::Display) -> String {
-        match self.written.get(key) {
-            Some(v) => v.to_string(),
-            None => format!("{x} (the default)"),
+        if let Some(v) = self.written.get(key) {
+            return v.to_string();
+        }
+        let elements: Vec<&str> = (1..)
+            .map_while(|i| self.written.get(&format!("{key}[{i}]")))
+            .collect();
+        if elements.is_empty() {
+            format!("{x} (the default)")
+        } else {
+            format!("[{}]", elements.join(", "))
         }
     }
 
@@ -283,6 +292,17 @@ fn core_message(e: &ConfigError, several: bool) -> String {
         ConfigError::OutOfRange(_) => "out of range".into(),
         ConfigError::Capacity(_) => "more than the fixed capacity holds".into(),
         ConfigError::Unsupported(_) => "not supported by this build of the core".into(),
+        // What would be valid, where the core's parameter alone does not say it.
+        ConfigError::Inconsistent("support_b") => format!(
+            "contradict each other (the supports must be two distinct planes, at least {:e} of \
+             the largest axial coordinate apart, in either order)",
+            drive_monitor::supports::MIN_PLANE_SEPARATION
+        ),
+        ConfigError::Inconsistent("duplicate coupling") => {
+            "contradict each other (two [[coupling]] tables join the same two platforms: give \
+             one table per pair, with the sum of the stiffnesses and of the dampings)"
+                .into()
+        }
         // The core names what contradicts in parentheses: "pattern (rotationally symmetric)".
         ConfigError::Inconsistent(p) => match p.split_once(" (") {
             Some((_, why)) => format!("contradict each other ({}", why),
@@ -1022,6 +1042,23 @@ fn autobalancer(ab: &AutobalancerSpec, platforms: u64, c: &Checker) -> Result<()
     // Checked for every kind: a value given for a key the kind does not use is still read.
     if let Some(j) = ab.pendulum_inertia {
         c.non_negative("autobalancer.pendulum_inertia", j, MAX_INERTIA, "kg·m²")?;
+        // Balls and rollers take their own inertia from the kind (κ = 7/5, 3/2): a pendulum
+        // inertia given with them would be read and silently ignored.
+        let kind = match ab.kind {
+            BalancerKindSpec::Ball => Some("ball"),
+            BalancerKindSpec::Roller => Some("roller"),
+            BalancerKindSpec::Pendulum => None,
+        };
+        if let Some(kind) = kind {
+            return Err(c.bad(
+                "autobalancer.pendulum_inertia",
+                j,
+                format!(
+                    "belongs to kind = \"pendulum\" only: a {kind}'s inertia is given by its kind \
+                     (κ = 7/5 for balls, 3/2 for rollers); remove the key, or set kind = \"pendulum\""
+                ),
+            ));
+        }
     }
     c.count(
         "autobalancer.platform",

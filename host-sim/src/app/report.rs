@@ -143,29 +143,45 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     s
 }
 
+/// A support load in N: one decimal from 100 N up (`2407.0`), four significant digits below
+/// (`0.1634`, `52.18`), so that a small rotor's loads keep their digits (a 50 g rotor's
+/// 0.163 N was printed `0.2`), and `1.234e-5` under a millinewton.
+pub fn fmt_force(f: f64) -> String {
+    let a = f.abs();
+    if a == 0.0 || a >= 100.0 || !a.is_finite() {
+        format!("{f:.1}")
+    } else if a < 1e-3 {
+        format!("{f:.3e}")
+    } else {
+        // 1e-3 ≤ |f| < 100: 4 significant digits.
+        let decimals = (3 - a.log10().floor() as i32).max(1) as usize;
+        format!("{f:.decimals$}")
+    }
+}
+
 /// The supports line of a run: the core's judgement at the measured speed, or, without one,
 /// the simulated reactions against the load limits.
 fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
-    let load = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.1}"));
+    let load = |v: Option<f64>| v.map_or("–".to_string(), fmt_force);
     match (u.speed, u.simulated_reaction_level) {
         (Some(speed), _) => format!(
-            "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {:.1} N, B {:.1} N; unbalance A {}, B {}\n",
+            "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {} N, B {} N; unbalance A {}, B {}\n",
             load(u.peak_load[0]),
             u.load_level[0],
             load(u.peak_load[1]),
             u.load_level[1],
-            u.simulated_peak_reaction[0],
-            u.simulated_peak_reaction[1],
+            fmt_force(u.simulated_peak_reaction[0]),
+            fmt_force(u.simulated_peak_reaction[1]),
             u.unbalance_level[0],
             u.unbalance_level[1]
         ),
         (None, levels) => {
             let levels = levels.unwrap_or(["unknown"; 2]);
             format!(
-                "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {:.1} N ({} against the load limit), B {:.1} N ({}); unbalance A {}, B {}\n",
-                u.simulated_peak_reaction[0],
+                "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {} N ({} against the load limit), B {} N ({}); unbalance A {}, B {}\n",
+                fmt_force(u.simulated_peak_reaction[0]),
                 levels[0],
-                u.simulated_peak_reaction[1],
+                fmt_force(u.simulated_peak_reaction[1]),
                 levels[1],
                 u.unbalance_level[0],
                 u.unbalance_level[1]
@@ -457,11 +473,11 @@ pub fn prediction_text(p: &Prediction) -> String {
         );
         let _ = writeln!(
             s,
-            "  static loads A {:.1} N, B {:.1} N; peak at service speed A {:.1} N, B {:.1} N",
-            u.static_load[0],
-            u.static_load[1],
-            u.peak_load_at_service_speed[0],
-            u.peak_load_at_service_speed[1]
+            "  static loads A {} N, B {} N; peak at service speed A {} N, B {} N",
+            fmt_force(u.static_load[0]),
+            fmt_force(u.static_load[1]),
+            fmt_force(u.peak_load_at_service_speed[0]),
+            fmt_force(u.peak_load_at_service_speed[1])
         );
         match u.max_speed {
             Some(w) => {

@@ -2,7 +2,8 @@
 //!
 //! # Model
 //!
-//! The rotor axis is `z`; supports A and B sit at `z_A < z_B`, span `L = z_B − z_A`.
+//! The rotor axis is `z`; supports A and B sit at `z_A` and `z_B` (either order, as in the core's
+//! `drive_monitor::supports::Rotor`), signed span `L = z_B − z_A`.
 //! Unbalance `i` (amount `D_i` = mass·eccentricity, kg·m) sits at axial position `z_i` and at
 //! angle `α_i` on the rotor, so in the fixed frame its vector is
 //! `D_i·e^{i(φ+α_i)}` (x, y components, the plane normal to the axis). Turning at speed `ω`
@@ -79,7 +80,7 @@ pub enum StaticLoadParams {
 pub struct RotorLoadsParams {
     /// Axial position of support A, m.
     pub support_a: f64,
-    /// Axial position of support B, m (greater than `support_a`).
+    /// Axial position of support B, m (not `support_a`; either side of it).
     pub support_b: f64,
     /// The unbalances.
     #[serde(default)]
@@ -112,11 +113,12 @@ fn add(acc: &mut [[f64; 2]; 2], s: [[f64; 2]; 2]) {
 }
 
 impl RotorLoads {
-    /// Validates `p`: finite values, `support_b > support_a`, non-negative amounts, `to ≥ from`.
+    /// Validates `p`: finite values, `support_b ≠ support_a` (either order: the split below uses
+    /// the signed span, as the core's `Rotor` does), non-negative amounts, `to ≥ from`.
     pub fn new(p: &RotorLoadsParams) -> Result<Self, ConfigError> {
         let za = finite("support_a", p.support_a)?;
         let zb = finite("support_b", p.support_b)?;
-        if zb <= za {
+        if zb == za {
             return Err(ConfigError::Inconsistent("support_b"));
         }
         let mut support_unbalance = [[0.0; 2]; 2];
@@ -340,6 +342,24 @@ mod tests {
                 assert!((d[0][k] - (dst[k] * lb / l - md[k] / l)).abs() < 1e-15);
                 assert!((d[1][k] - (dst[k] * la / l + md[k] / l)).abs() < 1e-15);
             }
+        }
+    }
+
+    #[test]
+    fn supports_in_either_order() {
+        // The core's Rotor (and so `predict`) takes the supports in either order; so does the
+        // simulation: swapping the positions swaps the supports' loads.
+        let p = params();
+        let mut q = params();
+        (q.support_a, q.support_b) = (p.support_b, p.support_a);
+        let (r, s) = (RotorLoads::new(&p).unwrap(), RotorLoads::new(&q).unwrap());
+        let shaft = Shaft {
+            phi: 0.7,
+            omega: 80.0,
+        };
+        let (f, g) = (r.reactions(shaft), s.reactions(shaft));
+        for k in 0..2 {
+            assert!((f[0][k] - g[1][k]).abs() < 1e-9 && (f[1][k] - g[0][k]).abs() < 1e-9);
         }
     }
 
