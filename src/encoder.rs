@@ -350,6 +350,11 @@ pub struct Encoder {
     short: u64,
     /// Span of `k` nominal pitches on a uniform disc, units.
     uniform_span: u32,
+    /// `R⁹`, `R` the wheel's pitch ratio nearest 1 among its long and short pitches (the
+    /// smallest long pitch over the base, or the base over the largest short one); +∞ on a
+    /// uniform disc. A swing of `R^0.9` or more (`s¹⁰ ≥ R⁹`) is nearly as large as the
+    /// pattern itself.
+    pattern_swing: f32,
     /// Whether every tooth has the same nominal pitch.
     uniform: bool,
 }
@@ -376,6 +381,7 @@ impl Encoder {
             long,
             short,
             uniform_span,
+            pattern_swing,
             uniform,
         } = self;
         *config = other.config;
@@ -385,7 +391,8 @@ impl Encoder {
         (*band_sum_max, *bulk_max, *timer_hz) =
             (other.band_sum_max, other.bulk_max, other.timer_hz);
         (*unit_rad, *base, *long, *short) = (other.unit_rad, other.base, other.long, other.short);
-        (*uniform_span, *uniform) = (other.uniform_span, other.uniform);
+        (*uniform_span, *pattern_swing, *uniform) =
+            (other.uniform_span, other.pattern_swing, other.uniform);
         *pattern = other.pattern;
     }
 
@@ -417,6 +424,7 @@ impl Encoder {
         long: 0,
         short: 0,
         uniform_span: 0,
+        pattern_swing: f32::INFINITY,
         uniform: true,
     };
 
@@ -553,6 +561,13 @@ impl Encoder {
             uniform_span: (k as u32)
                 .wrapping_mul(base as u32)
                 .wrapping_mul(PITCH_UNITS),
+            pattern_swing: if uniform || !matches!(framing, Framing::Pattern) {
+                f32::INFINITY
+            } else {
+                let r = nearest_ratio(&pattern, edges, base);
+                let r3 = r * r * r;
+                (r3 * r3 * r3) as f32
+            },
             uniform,
         })
     }
@@ -630,6 +645,15 @@ impl Encoder {
     /// Grid positions of the most common pitch.
     pub(crate) fn base_pitch(&self) -> u32 {
         u32::from(self.base)
+    }
+    /// `R⁹` for the wheel's pitch ratio `R` nearest 1 (+∞ on a uniform disc): see
+    /// [`crate::speed`]'s recorded swings.
+    pub(crate) fn pattern_swing(&self) -> f32 {
+        if PATTERNS {
+            self.pattern_swing
+        } else {
+            f32::INFINITY
+        }
     }
     /// Teeth whose pitch is longer than the base (bit k = tooth k; pattern wheels).
     pub(crate) fn long_teeth(&self) -> u64 {
@@ -730,6 +754,40 @@ const fn longest_pitch(table: &[u8; MAX_PATTERN_TEETH], edges: u16) -> u8 {
         rest = tail;
     }
     longest
+}
+
+/// The pitch ratio nearest 1 of a pattern of `edges` teeth with base pitch `base`: the
+/// smallest long pitch over the base, or the base over the largest short pitch, whichever is
+/// smaller (+∞ without either).
+// Configuration only. `i` stays under `MAX_PATTERN_TEETH`, the array's length: nothing can
+// fail. A `while` loop: this is a `const fn`.
+#[allow(clippy::indexing_slicing)]
+const fn nearest_ratio(pattern: &[u8; MAX_PATTERN_TEETH], edges: u16, base: u8) -> f64 {
+    let (mut min_long, mut max_short, mut i) = (u8::MAX, 0u8, 0usize);
+    while i < edges as usize && i < MAX_PATTERN_TEETH {
+        let p = pattern[i];
+        if p > base && p < min_long {
+            min_long = p;
+        } else if p < base && p > max_short {
+            max_short = p;
+        }
+        i = i.wrapping_add(1);
+    }
+    let r_long = if min_long < u8::MAX {
+        min_long as f64 / base as f64
+    } else {
+        f64::INFINITY
+    };
+    let r_short = if max_short > 0 {
+        base as f64 / max_short as f64
+    } else {
+        f64::INFINITY
+    };
+    if r_long < r_short {
+        r_long
+    } else {
+        r_short
+    }
 }
 
 /// Validates a pattern and writes the grid pitch of every tooth, tooth 0 first, into `table`.

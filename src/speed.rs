@@ -773,18 +773,34 @@ impl SpeedTracker {
     }
 
     /// The swing tooth `to` had against tooth `from` one revolution earlier (1 without a
-    /// recorded revolution). Careful path only; out of line, one copy for every hypothesis.
+    /// recorded revolution). A recorded swing nearly as large as the wheel's own pitch ratio
+    /// nearest 1, `R^0.9` or more (or its inverse), cannot be told from the pattern: a count
+    /// one tooth off records its misplaced gap as such a swing, which would then explain the
+    /// gap away revolution after revolution. It informs nothing: 1. (`R^0.75`, the
+    /// acquisition's evidence of a long pitch, is too low here: on an 8-1 wheel cranking at
+    /// ±40 %, two strokes a revolution, neighbouring teeth differ by up to 1/0.6 = 1.67,
+    /// against 2^0.75 = 1.68, and ignoring those swings made clean cranking show faults;
+    /// 2^0.9 = 1.87.)
+    /// Careful path only; out of line, one copy for every hypothesis.
     #[inline(never)]
-    fn recorded_swing(&self, from: u16, to: u16) -> f32 {
+    fn recorded_swing(&self, enc: &Encoder, from: u16, to: u16) -> f32 {
         if !self.history {
             return 1.0;
         }
         let a = self.hist.get(usize::from(from)).copied().unwrap_or(0);
         let b = self.hist.get(usize::from(to)).copied().unwrap_or(0);
         if a == 0 || b == 0 {
+            return 1.0;
+        }
+        let s = b as f32 / a as f32;
+        let s2 = s * s;
+        let s10 = (s2 * s2) * (s2 * s2) * s2;
+        // (`s¹⁰ ≥ R⁹` and `s¹⁰·R⁹ ≤ 1` compared, no root taken; +∞ for a uniform disc: never.)
+        let limit = enc.pattern_swing();
+        if s10 >= limit || s10 * limit <= 1.0 {
             1.0
         } else {
-            b as f32 / a as f32
+            s
         }
     }
 
@@ -934,8 +950,16 @@ impl SpeedTracker {
                 // or 2, lost within it; `Ahead` one lost earlier, its interval the tooth's
                 // own), or none: the count was one ahead.
                 Verdict::Missing(n) => (n, n),
-                Verdict::Ahead => (1, 0),
-                Verdict::Behind => (0, 0),
+                // The count was off since some earlier edge: the swings recorded since were
+                // recorded against the wrong teeth, and would mislead the next judgements.
+                Verdict::Ahead => {
+                    self.forget_history();
+                    (1, 0)
+                }
+                Verdict::Behind => {
+                    self.forget_history();
+                    (0, 0)
+                }
             };
             self.pop();
             if lost == 0 {
@@ -1019,7 +1043,7 @@ impl SpeedTracker {
         let expected = if synced || enc.framing() != Framing::Pattern {
             r as f32 * enc.grid_pitch(if synced { next } else { 0 }) as f32 / base as f32
                 * if synced {
-                    self.recorded_swing(self.tooth, next)
+                    self.recorded_swing(enc, self.tooth, next)
                 } else {
                     1.0
                 }
@@ -1103,12 +1127,15 @@ impl SpeedTracker {
             (tol.fault_margin, f32::INFINITY)
         };
         let here = self.tooth;
-        let mut best = (
-            self.chain_cost(enc, here, next, x / p_next, [d2, d3], cap),
-            Verdict::Tooth,
-        );
+        let expected_cost = self.chain_cost(enc, here, next, x / p_next, [d2, d3], cap);
+        // The fault hypotheses compete on their costs alone, the first of equals kept; the
+        // best of them must then beat the expected tooth by the margin. (Each compared with
+        // the best so far plus the margin, the first fault considered that beat the tooth
+        // could not be displaced by a later one that explains the edges better: a count one
+        // tooth off, met at a gap as a lost tooth, stayed off for good.)
+        let mut best = (f32::INFINITY, Verdict::Tooth);
         let mut consider = |cost: f32, v: Verdict| {
-            if cost + margin < best.0 {
+            if cost < best.0 {
                 best = (cost, v);
             }
         };
@@ -1132,6 +1159,9 @@ impl SpeedTracker {
                 );
             }
             if enc.framing() == Framing::Pattern {
+                // A count one tooth off needs a fault earlier that went unseen: it must explain
+                // the edges better than a fault here by the margin (a tooth lost next to a gap
+                // also fits a count one ahead, and the loss is the likelier).
                 let behind = tooth_back(next, 1, edges);
                 let before_behind = tooth_back(behind, 1, edges);
                 consider(
@@ -1142,17 +1172,22 @@ impl SpeedTracker {
                         x / pitch_ratio(enc, behind),
                         [d2, d3],
                         cap,
-                    ),
+                    ) + margin,
                     Verdict::Behind,
                 );
                 let ahead = tooth_after(next, 1, edges);
                 consider(
-                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3], cap),
+                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3], cap)
+                        + margin,
                     Verdict::Ahead,
                 );
             }
         }
-        best.1
+        if best.0 + margin < expected_cost {
+            best.1
+        } else {
+            Verdict::Tooth
+        }
     }
 
     /// The cost of a hypothesis on the pending edges: the first is tooth `first` with the
@@ -1171,13 +1206,16 @@ impl SpeedTracker {
         rest: [Option<u32>; 2],
         cap: f32,
     ) -> f32 {
-        let mut cost = log_sq(head, self.prev as f32 * self.recorded_swing(before, first));
+        let mut cost = log_sq(
+            head,
+            self.prev as f32 * self.recorded_swing(enc, before, first),
+        );
         let (mut prev, mut tooth) = (head, first);
         for d in rest.iter().flatten() {
             let next = tooth_after(tooth, 1, enc.edges());
             let v = *d as f32 / pitch_ratio(enc, next);
             // A compare, not `f32::min` (a call of `fminf` on this FPU); never NaN.
-            let swing = log_sq(v, prev * self.recorded_swing(tooth, next));
+            let swing = log_sq(v, prev * self.recorded_swing(enc, tooth, next));
             cost += if swing > cap { cap } else { swing };
             prev = v;
             tooth = next;
