@@ -434,3 +434,25 @@ fn refusals_quote_arrays_as_written_and_say_what_would_be_valid() {
         ],
     );
 }
+
+/// A rotor unbalance the scene leaves out is half the capacity, and the report says it was
+/// assumed (it printed D like a value of the scene's).
+#[test]
+fn an_assumed_rotor_unbalance_is_said_to_be_assumed() {
+    let line = "rotor_unbalance = 0.05  # kg·m, the unbalance the loads balance\n";
+    let with = bundled("one-mass");
+    assert!(with.contains(line));
+    let without = with.replacen(line, "", 1);
+    let path = Path::new("one-mass.toml");
+    let said = |text: &str| {
+        let p = predict(&Scene::parse(text, path).unwrap(), path).unwrap();
+        let a = p.autobalancer.as_ref().unwrap();
+        (a.capacity, a.rotor_unbalance, prediction_text(&p))
+    };
+    let (cap, d, text) = said(&without);
+    assert_eq!(d, 0.5 * cap);
+    assert!(text.contains("half the capacity assumed"), "{text}");
+    let (_, d, text) = said(with);
+    assert_eq!(d, 0.05);
+    assert!(!text.contains("assumed"), "{text}");
+}

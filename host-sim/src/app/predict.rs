@@ -395,6 +395,8 @@ pub struct AutobalancerOut {
     /// The rotor unbalance the loads are to balance (`[autobalancer] rotor_unbalance`, default
     /// half the capacity), kg·m.
     pub rotor_unbalance: f64,
+    /// Whether the scene left `rotor_unbalance` out (half the capacity assumed).
+    pub rotor_unbalance_assumed: bool,
     /// `max(0, D − N·m·R)`: the least residual unbalance the loads can leave, kg·m (non-zero:
     /// the balancer is too small for its rotor; the loads at their limit, all opposite the
     /// unbalance, leave this much).
@@ -636,6 +638,10 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         p.autobalancer = Some(AutobalancerOut {
             capacity: design.capacity,
             rotor_unbalance: design.rotor_unbalance,
+            rotor_unbalance_assumed: scene
+                .autobalancer
+                .as_ref()
+                .is_some_and(|a| a.rotor_unbalance.is_none()),
             residual_floor: design.residual_floor,
             stability,
             regime_table,

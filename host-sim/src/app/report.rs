@@ -527,8 +527,14 @@ pub fn prediction_text(p: &Prediction) -> String {
         }
         let _ = writeln!(
             s,
-            "  capacity N·m·R = {:.4e} kg·m, rotor unbalance D = {:.4e} kg·m",
-            a.capacity, a.rotor_unbalance
+            "  capacity N·m·R = {:.4e} kg·m, rotor unbalance D = {:.4e} kg·m{}",
+            a.capacity,
+            a.rotor_unbalance,
+            if a.rotor_unbalance_assumed {
+                " (no `autobalancer.rotor_unbalance` in the scene: half the capacity assumed)"
+            } else {
+                ""
+            }
         );
         if a.residual_floor > 0.0 {
             let _ = writeln!(
