@@ -456,3 +456,26 @@ fn an_assumed_rotor_unbalance_is_said_to_be_assumed() {
     assert_eq!(d, 0.05);
     assert!(!text.contains("assumed"), "{text}");
 }
+
+/// A shaft measured above the rotor's service speed: the permissible unbalance was allotted for
+/// the service speed (U_per ∝ 1/ω), so the run says the levels are judged too leniently, with
+/// the share the grade allows there (60/80 = 75 %); at the service speed it says nothing.
+#[test]
+fn a_run_above_the_service_speed_says_the_unbalance_limit_was_allotted_lower() {
+    let path = Path::new("auger.toml");
+    let prescribed = "speed = 60.0              # rad/s, prescribed";
+    let report = |text: &str| {
+        let s = Scene::parse(text, path).unwrap();
+        let r = run(&s, path, Overrides::default()).unwrap();
+        let text = run_text(&s, &r);
+        (r.supports.unwrap().above_service_speed, text)
+    };
+    let (w, text) = report(&bundled("auger").replacen(prescribed, "speed = 80.0", 1));
+    let w = w.unwrap();
+    assert!(
+        w.contains("service speed 60") && w.contains("75.0 %"),
+        "{w}"
+    );
+    assert!(text.contains(&w), "{text}");
+    assert_eq!(report(bundled("auger")).0, None);
+}

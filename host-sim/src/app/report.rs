@@ -163,7 +163,7 @@ pub fn fmt_force(f: f64) -> String {
 /// the simulated reactions against the load limits.
 fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
     let load = |v: Option<f64>| v.map_or("–".to_string(), fmt_force);
-    match (u.speed, u.simulated_reaction_level) {
+    let mut text = match (u.speed, u.simulated_reaction_level) {
         (Some(speed), _) => format!(
             "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {} N, B {} N; unbalance A {}, B {}\n",
             load(u.peak_load[0]),
@@ -187,7 +187,13 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
                 u.unbalance_level[1]
             )
         }
+    };
+    if let Some(w) = &u.above_service_speed {
+        text.push_str("  ");
+        text.push_str(w);
+        text.push('\n');
     }
+    text
 }
 
 /// Writes the plots a run calls for into `dir`; returns the files written.

@@ -90,6 +90,10 @@ pub struct SupportsRunOut {
     /// limits ("normal" | "warning" | "over" | "unknown" without limits).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulated_reaction_level: Option<[&'static str; 2]>,
+    /// When the measured speed is above the service speed the permissible unbalance was
+    /// allotted for: the warning the report prints.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub above_service_speed: Option<String>,
 }
 
 /// What a run produced.
@@ -1510,6 +1514,21 @@ fn regime(
     Ok(())
 }
 
+/// The warning for a shaft measured above the service speed: the permissible residual
+/// unbalance (ISO 21940-11, `U_per = 1000·G·m/ω`) was allotted for the service speed, and at a
+/// higher speed the grade allows proportionally less, which the unbalance levels do not show.
+pub fn above_service_speed(speed: f64, service: f64) -> Option<String> {
+    (speed > service * 1.001).then(|| {
+        format!(
+            "WARNING: the shaft runs at {speed:.2} rad/s, above the service speed {service} rad/s \
+             the permissible unbalance was allotted for (rotor.service_speed); at {speed:.2} \
+             rad/s the grade allows {:.1} % of it, so the unbalance levels are judged too \
+             leniently",
+            100.0 * service / speed
+        )
+    })
+}
+
 /// The supports judged by the core at the measured speed, beside the simulated reactions.
 /// Without a measured speed the core's levels are unknown: the reactions are then judged
 /// against the scene's load limits directly.
@@ -1538,6 +1557,7 @@ fn supports(
                 unbalance_level: status.unbalance.map(level),
                 max_safe_speed: status.max_safe_speed.and_then(finite),
                 simulated_reaction_level: None,
+                above_service_speed: above_service_speed(speed, limits.service_speed()),
             }
         }
         None => {
@@ -1563,6 +1583,7 @@ fn supports(
                 unbalance_level: status.unbalance.map(level),
                 max_safe_speed: status.max_safe_speed.and_then(finite),
                 simulated_reaction_level: Some(judged.unwrap_or(["unknown"; 2])),
+                above_service_speed: None,
             }
         }
     };
