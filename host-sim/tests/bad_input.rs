@@ -479,3 +479,22 @@ fn a_run_above_the_service_speed_says_the_unbalance_limit_was_allotted_lower() {
     assert!(text.contains(&w), "{text}");
     assert_eq!(report(bundled("auger")).0, None);
 }
+
+/// A balancer whose loads move far faster than the rotor turns (0.1 mg loads at 10 N·s/m on
+/// a 1 mg platform): the stability scan ran for minutes with nothing printed; now it stops at
+/// its step budget with an error naming what to check.
+#[test]
+fn a_stability_scan_that_would_run_for_minutes_stops_naming_the_loads() {
+    let text = "[[platform]]\nmass = 1e-6\nstiffness = 4e5\n[autobalancer]\nkind = \"ball\"\n\
+                platform = 1\nloads = 2\nload_mass = 1e-7\nradius = 0.1\nhousing_mass = 5.0\n\
+                viscosity = 10.0\nrotor_unbalance = 1e-9\n";
+    let path = Path::new("fast-loads.toml");
+    let e = predict(&Scene::parse(text, path).unwrap(), path)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("integration steps") && e.contains("autobalancer.load_mass"),
+        "{e}"
+    );
+}

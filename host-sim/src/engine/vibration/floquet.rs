@@ -64,6 +64,7 @@ use super::{balancing_fan, VibrationMachine, MAX_LOADS, MAX_PLATFORMS};
 use crate::engine::ode::{Integrator, OdeSystem, Solver};
 use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
+use std::cell::Cell;
 use std::f64::consts::TAU;
 
 /// Why the balanced motion cannot be analysed.
@@ -250,6 +251,16 @@ fn orthonormal_remainder(basis: &[Vec<f64>], v: &[f64]) -> Option<Vec<f64>> {
     (norm > RANK_TOL).then(|| r.iter().map(|x| x / norm).collect())
 }
 
+thread_local! {
+    /// Integration steps taken by `monodromy` on this thread.
+    static STEPS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Most integration steps one stability scan may take: 50 times what the largest of the
+/// criterion study's 120 random machines takes (about 20 000); a machine beyond it (loads that
+/// move far faster than the rotor turns) ran for minutes with nothing said.
+const SCAN_STEPS: u64 = 1_000_000;
+
 impl Floquet {
     /// The balanced motion with the loads at the equally spaced fan
     /// ([`super::balancing_fan`]) for a shaft at angle `ωt`.
@@ -407,6 +418,7 @@ impl Floquet {
                     speed: omega,
                     message: e.to_string(),
                 })?;
+            STEPS.with(|c| c.set(c.get() + 1));
             if solver.stats().accepted_steps > 1_000_000 {
                 return Err(StabilityError::Numerical {
                     speed: omega,
@@ -494,8 +506,21 @@ impl Floquet {
         }
         let mut evaluations = 0usize;
         let mut drift = 0.0f64;
+        let start = STEPS.with(Cell::get);
         let mut eval = |w: f64| -> Result<f64, StabilityError> {
             let m = self.multipliers(w, rtol)?;
+            if STEPS.with(Cell::get) - start > SCAN_STEPS {
+                return Err(StabilityError::Numerical {
+                    speed: w,
+                    message: format!(
+                        "the scan has taken more than {SCAN_STEPS} integration steps (the \
+                         largest of the criterion study's 120 random machines takes 20 000): the \
+                         loads move far faster than the rotor turns; check \
+                         `autobalancer.load_mass` against `autobalancer.viscosity` (their \
+                         relaxation time m/b) and the platform masses"
+                    ),
+                });
+            }
             evaluations += 1;
             drift = drift.max(m.neutral_drift);
             Ok(m.radius.ln())
