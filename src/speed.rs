@@ -1546,7 +1546,15 @@ impl SpeedTracker {
             let m = middle as f32;
             let mut allowed = all;
             if enc.long_teeth() != 0 {
-                if m >= long_thr * hi as f32 {
+                // Long against both neighbours, or, on a wheel without short pitches, against
+                // their geometric mean, which cancels a steady speed trend: cranking at ±40 %
+                // on a 24-1 wheel leaves its gap only 1.55 times the pitch before it (2.76
+                // times the one after, 2.07 their geometric mean), and ordinary teeth there
+                // reach 1.2 against the mean (compared squared: m² against long² times the
+                // neighbours' product, no root).
+                let around = before as f32 * dt as f32;
+                let trend_long = enc.short_teeth() == 0 && m * m >= long_thr * long_thr * around;
+                if m >= long_thr * hi as f32 || trend_long {
                     allowed &= enc.long_teeth();
                 } else if m <= not_long_thr * lo as f32 {
                     allowed &= !enc.long_teeth();
