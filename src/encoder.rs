@@ -655,6 +655,15 @@ impl Encoder {
             f32::INFINITY
         }
     }
+    /// The smallest long pitch and the largest short one, in grid positions (`u8::MAX` and 0
+    /// without such a pitch; always so without a pattern).
+    pub(crate) fn extreme_pitches(&self) -> (u8, u8) {
+        if PATTERNS && matches!(self.framing, Framing::Pattern) {
+            extreme_pitches(&self.pattern, self.edges, self.base)
+        } else {
+            (u8::MAX, 0)
+        }
+    }
     /// Teeth whose pitch is longer than the base (bit k = tooth k; pattern wheels).
     pub(crate) fn long_teeth(&self) -> u64 {
         if PATTERNS {
@@ -759,20 +768,8 @@ const fn longest_pitch(table: &[u8; MAX_PATTERN_TEETH], edges: u16) -> u8 {
 /// The pitch ratio nearest 1 of a pattern of `edges` teeth with base pitch `base`: the
 /// smallest long pitch over the base, or the base over the largest short pitch, whichever is
 /// smaller (+∞ without either).
-// Configuration only. `i` stays under `MAX_PATTERN_TEETH`, the array's length: nothing can
-// fail. A `while` loop: this is a `const fn`.
-#[allow(clippy::indexing_slicing)]
 const fn nearest_ratio(pattern: &[u8; MAX_PATTERN_TEETH], edges: u16, base: u8) -> f64 {
-    let (mut min_long, mut max_short, mut i) = (u8::MAX, 0u8, 0usize);
-    while i < edges as usize && i < MAX_PATTERN_TEETH {
-        let p = pattern[i];
-        if p > base && p < min_long {
-            min_long = p;
-        } else if p < base && p > max_short {
-            max_short = p;
-        }
-        i = i.wrapping_add(1);
-    }
+    let (min_long, max_short) = extreme_pitches(pattern, edges, base);
     let r_long = if min_long < u8::MAX {
         min_long as f64 / base as f64
     } else {
@@ -788,6 +785,25 @@ const fn nearest_ratio(pattern: &[u8; MAX_PATTERN_TEETH], edges: u16, base: u8) 
     } else {
         r_short
     }
+}
+
+/// The smallest pitch longer than `base` and the largest shorter one among the first `edges`
+/// of `pattern`, in grid positions (`u8::MAX` and 0 without such a pitch).
+// `i` stays under `MAX_PATTERN_TEETH`, the array's length: nothing can fail. A `while` loop:
+// this is a `const fn`.
+#[allow(clippy::indexing_slicing)]
+const fn extreme_pitches(pattern: &[u8; MAX_PATTERN_TEETH], edges: u16, base: u8) -> (u8, u8) {
+    let (mut min_long, mut max_short, mut i) = (u8::MAX, 0u8, 0usize);
+    while i < edges as usize && i < MAX_PATTERN_TEETH {
+        let p = pattern[i];
+        if p > base && p < min_long {
+            min_long = p;
+        } else if p < base && p > max_short {
+            max_short = p;
+        }
+        i = i.wrapping_add(1);
+    }
+    (min_long, max_short)
 }
 
 /// Validates a pattern and writes the grid pitch of every tooth, tooth 0 first, into `table`.

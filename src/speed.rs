@@ -952,13 +952,9 @@ impl SpeedTracker {
                 Verdict::Missing(n) => (n, n),
                 // The count was off since some earlier edge: the swings recorded since were
                 // recorded against the wrong teeth, and would mislead the next judgements.
-                Verdict::Ahead => {
+                Verdict::Ahead | Verdict::Behind => {
                     self.forget_history();
-                    (1, 0)
-                }
-                Verdict::Behind => {
-                    self.forget_history();
-                    (0, 0)
+                    (u16::from(verdict == Verdict::Ahead), 0)
                 }
             };
             self.pop();
@@ -2166,15 +2162,13 @@ const NOT_A_PAIR_SQ: f32 = 2.828_427;
 /// extra tooth halving a pitch, below the 0.63 of a 1.6 swing).
 fn acquisition_thresholds(enc: &Encoder) -> (f32, f32, f32) {
     let base = enc.base_pitch() as f32;
-    let (mut r_long, mut r_short) = (f32::INFINITY, 0.0f32);
-    for k in 0..enc.edges() {
-        let p = enc.grid_pitch(k) as f32 / base;
-        if p > 1.0 {
-            r_long = r_long.min(p);
-        } else if p < 1.0 {
-            r_short = r_short.max(p);
-        }
-    }
+    let (long, short) = enc.extreme_pitches();
+    let r_long = if long < u8::MAX {
+        f32::from(long) / base
+    } else {
+        f32::INFINITY
+    };
+    let r_short = f32::from(short) / base;
     let pow = |x: f32, e: f32| {
         if x > 0.0 && x.is_finite() {
             exp(e * ln(x))

@@ -611,6 +611,11 @@ fn a_kloss_prediction_says_it_stands_on_the_tangent_parabola() {
         "{said} against {worst}: {note}"
     );
     assert!(worst.abs() > 0.01, "{worst}");
+    // The figures README quotes for this motor.
+    assert!(
+        note.contains("-0.0927 N·m") && note.contains("(-0.35 %"),
+        "{note}"
+    );
     let text = host_sim::app::report::prediction_text(&p);
     assert!(text.contains(note), "{text}");
     // A parabola motor: no note.

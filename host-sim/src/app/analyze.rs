@@ -577,9 +577,10 @@ pub fn analyze<R: BufRead>(
         recent: VecDeque::new(),
         latest: (0, 0.0),
     };
-    let polls = Polls {
+    let mut polls = Polls {
         every: poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits),
         timeout: f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz,
+        last: f64::NEG_INFINITY,
     };
     let mut st = State {
         seen: Seen::default(),
@@ -593,7 +594,6 @@ pub fn analyze<R: BufRead>(
     let mut prev: Vec<Level> = Vec::new();
     let mut periods = IndexPeriods::default();
     let mut last_event: Option<f64> = None;
-    let mut last_poll = f64::NEG_INFINITY;
     let mut end = 0.0;
     let mut changes = vec![0u64; channels.len()];
     let mut grid = TimeGrid::default();
@@ -643,7 +643,6 @@ pub fn analyze<R: BufRead>(
             polls.between(
                 t0,
                 t,
-                &mut last_poll,
                 &mut clock,
                 &mut st,
                 &mut monitor,
@@ -674,7 +673,6 @@ pub fn analyze<R: BufRead>(
         polls.between(
             t0,
             end,
-            &mut last_poll,
             &mut clock,
             &mut st,
             &mut monitor,
@@ -789,6 +787,8 @@ struct Polls {
     every: f64,
     /// The core's timeout, s.
     timeout: f64,
+    /// When the last poll was made, s.
+    last: f64,
 }
 
 impl Polls {
@@ -796,22 +796,21 @@ impl Polls {
     /// nothing until the timeout has passed: only the ones around it are made.
     #[allow(clippy::too_many_arguments)]
     fn between(
-        &self,
+        &mut self,
         t0: f64,
         t: f64,
-        last_poll: &mut f64,
         clock: &mut Clock,
         st: &mut State,
         monitor: &mut DeltaMonitor<MAX_LINES>,
         report: &mut AnalyzeReport,
         on_decision: &mut dyn FnMut(&Decision),
     ) {
-        let mut p = last_poll.max(t0 + self.timeout - 2.0 * self.every).max(t0) + self.every;
+        let mut p = self.last.max(t0 + self.timeout - 2.0 * self.every).max(t0) + self.every;
         while p < t && p <= t0 + self.timeout + 2.0 * self.every {
             let ticks = clock.ticks(p);
             clock.note(ticks, p);
             st.poll(monitor, clock, ticks, report, on_decision);
-            *last_poll = p;
+            self.last = p;
             p += self.every;
         }
     }
@@ -1415,7 +1414,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
             e,
             "--min-speed",
             "--timer-hz",
-            Some("--counter-bits"),
+            "--counter-bits",
         );
         if let Some(h) = hint {
             m.push_str(": ");

@@ -1200,14 +1200,14 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
 /// core itself (doubling, then bisecting the minimum speed or the timer clock, every other
 /// field as given), so it is the core's own rule, and rounded to three significant digits on
 /// the side that fits. `min_speed` and `timer_hz` name the two knobs as the user writes them
-/// (scene keys or options), and `counter_bits` the counter's width where the user can set it.
-/// `None` for any other error, or where no value fits.
+/// (scene keys or options), and `counter_bits` the counter's width. `None` for any other
+/// error, or where no value fits.
 pub fn speed_range_hint(
     config: &drive_monitor::encoder::EncoderConfig,
     e: ConfigError,
     min_speed: &str,
     timer_hz: &str,
-    counter_bits: Option<&str>,
+    counter_bits: &str,
 ) -> Option<String> {
     use drive_monitor::encoder::{Encoder, EncoderConfig};
     let fits = |f: &dyn Fn(&mut EncoderConfig)| {
@@ -1273,8 +1273,8 @@ pub fn speed_range_hint(
             // A wider counter, where the counter is what is short.
             let wider = (config.counter_bits.saturating_add(1)..=32)
                 .find(|&b| fits(&|c: &mut EncoderConfig| c.counter_bits = b));
-            if let (Some(b), Some(bits)) = (wider, counter_bits) {
-                let _ = write!(hint, ", or `{bits}` = {b}");
+            if let Some(b) = wider {
+                let _ = write!(hint, ", or `{counter_bits}` = {b}");
             }
             Some(hint)
         }

@@ -322,6 +322,7 @@ mod tests {
                 })
                 .collect(),
             evaluations: 0,
+            steps: 0,
             neutral_drift: 0.0,
         }
     }

@@ -378,7 +378,7 @@ pub fn core_encoder(scene: &Scene, file: &Path) -> Result<Option<Encoder>, Scene
             er,
             "monitor.min_speed",
             "encoder.timer_hz",
-            Some("encoder.counter_bits"),
+            "encoder.counter_bits",
         );
         if let (SceneError::Core { message, .. }, Some(h)) = (&mut err, hint) {
             message.push_str(": ");

@@ -1277,6 +1277,13 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         .filter_map(|m| m.design.exact.as_ref())
         .map(|e| e.map.evaluations as f64)
         .collect();
+    let most_steps = s
+        .machines
+        .iter()
+        .filter_map(|m| m.design.exact.as_ref())
+        .map(|e| e.map.steps)
+        .max()
+        .unwrap_or(0);
     let neutral_text = if neutral == 0 {
         "Every machine has a rotor unbalance (D > 0), so none has a neutral direction to remove."
             .to_string()
@@ -1295,7 +1302,9 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
          (rtol 1e-14), the spectral radius at the ends of each final bracket keeps its side of \
          1 at **{tight_ok} of {}** (the bracket is 1e-7 wide: the boundary is placed to better \
          than 1e-6). {neutral_text} The analysis integrated {:.0} monodromy matrices per \
-         machine at the median ({:.0} at most), in {:.2} s (median; {:.2} s at most) of wall \
+         machine at the median ({:.0} at most; a scan took at most {most_steps} integration \
+         steps, against the million `floquet::SCAN_STEPS` allows), in {:.2} s (median; {:.2} s \
+         at most) of wall \
          time per machine, release build, the machines two at a time on this machine's two \
          cores. `host-sim/tests/vibration.rs` checks the analysis against a Floquet analysis of \
          seed eq. 4 written independently (boundaries to 1e-6) and against the growth rate of a \

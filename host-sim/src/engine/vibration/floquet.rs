@@ -64,7 +64,6 @@ use super::{balancing_fan, VibrationMachine, MAX_LOADS, MAX_PLATFORMS};
 use crate::engine::ode::{Integrator, OdeSystem, Solver};
 use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
-use std::cell::Cell;
 use std::f64::consts::TAU;
 
 /// Why the balanced motion cannot be analysed.
@@ -191,6 +190,8 @@ pub struct StabilityMap {
     pub boundaries: Vec<Boundary>,
     /// Monodromy matrices integrated.
     pub evaluations: usize,
+    /// Integration steps they took.
+    pub steps: u64,
     /// Largest neutral drift met (see [`Multipliers::neutral_drift`]).
     pub neutral_drift: f64,
 }
@@ -251,14 +252,10 @@ fn orthonormal_remainder(basis: &[Vec<f64>], v: &[f64]) -> Option<Vec<f64>> {
     (norm > RANK_TOL).then(|| r.iter().map(|x| x / norm).collect())
 }
 
-thread_local! {
-    /// Integration steps taken by `monodromy` on this thread.
-    static STEPS: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Most integration steps one stability scan may take: 50 times what the largest of the
-/// criterion study's 120 random machines takes (about 20 000); a machine beyond it (loads that
-/// move far faster than the rotor turns) ran for minutes with nothing said.
+/// Most integration steps one stability scan may take: far more than any of the criterion
+/// study's random machines takes (`docs/criterion.md` states their largest, `steps` of
+/// [`StabilityMap`]); a machine beyond it (loads that move far faster than the rotor turns)
+/// ran for minutes with nothing said.
 const SCAN_STEPS: u64 = 1_000_000;
 
 impl Floquet {
@@ -386,6 +383,15 @@ impl Floquet {
     /// (`[δY/R, δẎ/(Rω), δφ, δφ̇/ω]`), integrated with DOP853 at relative and absolute
     /// tolerance `rtol`.
     pub fn monodromy(&self, omega: f64, rtol: f64) -> Result<DMatrix<f64>, StabilityError> {
+        self.monodromy_counted(omega, rtol).map(|(phi, _)| phi)
+    }
+
+    /// [`Floquet::monodromy`] with the integration steps it took.
+    fn monodromy_counted(
+        &self,
+        omega: f64,
+        rtol: f64,
+    ) -> Result<(DMatrix<f64>, u64), StabilityError> {
         if !(omega.is_finite() && omega > 0.0) {
             return Err(StabilityError::Input(format!(
                 "the rotor speed must be positive and finite, got {omega}"
@@ -418,7 +424,6 @@ impl Floquet {
                     speed: omega,
                     message: e.to_string(),
                 })?;
-            STEPS.with(|c| c.set(c.get() + 1));
             if solver.stats().accepted_steps > 1_000_000 {
                 return Err(StabilityError::Numerical {
                     speed: omega,
@@ -427,7 +432,8 @@ impl Floquet {
             }
         }
         // Column k of Φ(T) is the state at T started from the k-th unit vector.
-        Ok(DMatrix::from_fn(n, n, |i, k| solver.y()[k * n + i]))
+        let steps = solver.stats().accepted_steps;
+        Ok((DMatrix::from_fn(n, n, |i, k| solver.y()[k * n + i]), steps))
     }
 
     /// `Wᵀ·Φ·W`: the monodromy matrix with the neutral directions removed (see the module
@@ -463,7 +469,16 @@ impl Floquet {
 
     /// The Floquet multipliers at speed `omega` rad/s, the monodromy integrated to `rtol`.
     pub fn multipliers(&self, omega: f64, rtol: f64) -> Result<Multipliers, StabilityError> {
-        let phi = self.monodromy(omega, rtol)?;
+        self.multipliers_counted(omega, rtol).map(|(m, _)| m)
+    }
+
+    /// [`Floquet::multipliers`] with the integration steps of its monodromy matrix.
+    fn multipliers_counted(
+        &self,
+        omega: f64,
+        rtol: f64,
+    ) -> Result<(Multipliers, u64), StabilityError> {
+        let (phi, steps) = self.monodromy_counted(omega, rtol)?;
         let (reduced, neutral_drift) = self.reduce(&phi);
         let schur = nalgebra::Schur::try_new(reduced, f64::EPSILON, 100_000).ok_or_else(|| {
             StabilityError::Numerical {
@@ -474,13 +489,14 @@ impl Floquet {
         let mut values: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
         values.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
         let radius = values.first().map_or(0.0, |z| z.norm());
-        Ok(Multipliers {
+        let m = Multipliers {
             speed: omega,
             values: values.iter().map(|z| [z.re, z.im]).collect(),
             radius,
             neutral: self.neutral.len(),
             neutral_drift,
-        })
+        };
+        Ok((m, steps))
     }
 
     /// Scans `[opts.from, opts.to]` for changes of stability and bisects each.
@@ -506,18 +522,19 @@ impl Floquet {
         }
         let mut evaluations = 0usize;
         let mut drift = 0.0f64;
-        let start = STEPS.with(Cell::get);
+        let mut steps = 0u64;
         let mut eval = |w: f64| -> Result<f64, StabilityError> {
-            let m = self.multipliers(w, rtol)?;
-            if STEPS.with(Cell::get) - start > SCAN_STEPS {
+            let (m, n) = self.multipliers_counted(w, rtol)?;
+            steps += n;
+            if steps > SCAN_STEPS {
                 return Err(StabilityError::Numerical {
                     speed: w,
                     message: format!(
-                        "the scan has taken more than {SCAN_STEPS} integration steps (the \
-                         largest of the criterion study's 120 random machines takes 20 000): the \
-                         loads move far faster than the rotor turns; check \
-                         `autobalancer.load_mass` against `autobalancer.viscosity` (their \
-                         relaxation time m/b) and the platform masses"
+                        "the scan has taken more than {SCAN_STEPS} integration steps (far more \
+                         than any machine of the criterion study, docs/criterion.md): the loads \
+                         move far faster than the rotor turns; check `autobalancer.load_mass` \
+                         against `autobalancer.viscosity` (their relaxation time m/b) and the \
+                         platform masses"
                     ),
                 });
             }
@@ -579,6 +596,7 @@ impl Floquet {
             stable_at_from: pts[0].1 < 0.0,
             boundaries,
             evaluations,
+            steps,
             neutral_drift: drift,
         })
     }
