@@ -76,6 +76,8 @@ fn predict_json_has_the_contracted_members() {
 #[test]
 fn run_json_reports_measurement_prediction_and_cost() {
     let v = json(&["run", "kneader", "--json"]);
+    // The integrator as kneader.toml names it (`integrator = "dp5"`).
+    assert_eq!(v["integrator"], "dp5");
     let m = v["delta_measured"].as_f64().unwrap();
     let p = v["delta_predicted"].as_f64().unwrap();
     assert!((m / p - 1.0).abs() < 0.01);

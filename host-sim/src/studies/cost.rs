@@ -30,7 +30,7 @@ use std::time::Instant;
 pub struct ParetoRow {
     /// Scene.
     pub scene: &'static str,
-    /// Integrator and setting, e.g. `dopri5 rtol=1e-9`.
+    /// Integrator and setting, e.g. `dp5 rtol=1e-9`.
     pub setting: String,
     /// Right-hand-side evaluations.
     pub rhs_evals: u64,
@@ -51,7 +51,7 @@ fn settings(fine_step: f64) -> Vec<(String, Integrator)> {
     }
     for rtol in [1e-6, 1e-8, 1e-10, 1e-12] {
         v.push((
-            format!("dopri5 rtol={rtol:.0e}"),
+            format!("dp5 rtol={rtol:.0e}"),
             Integrator::Dopri5 {
                 rtol,
                 atol: rtol * 1e-2,
@@ -445,9 +445,9 @@ pub fn crate_comparison() -> Result<Vec<CrateRow>, String> {
                 .map_err(|e| e.to_string())?;
             Ok(obs.worst)
         })
-        .map_err(|e| format!("own dopri5 at rtol {rtol}: {e}"))?;
+        .map_err(|e| format!("own dp5 at rtol {rtol}: {e}"))?;
         rows.push(CrateRow {
-            stepper: "host-sim dopri5",
+            stepper: "host-sim dp5",
             rtol,
             wall_ms,
             error,

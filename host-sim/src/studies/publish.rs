@@ -64,7 +64,7 @@ fn scaling_table(s: &mut String, rows: &[ScalingRow]) {
 
 fn pareto_plot(path: &Path, title: &str, rows: &[ParetoRow]) -> Result<(), String> {
     let mut series = Vec::new();
-    for family in ["rk4", "dopri5", "dop853"] {
+    for family in ["rk4", "dp5", "dop853"] {
         let points: Vec<(f64, f64)> = rows
             .iter()
             .filter(|r| r.setting.starts_with(family) && r.error > 0.0 && r.error.is_finite())

@@ -113,11 +113,12 @@ impl Integrator {
         }
     }
 
-    /// Short name of the method ("rk4", "dopri5", "dop853").
+    /// Short name of the method, as scenes write it (`[simulation] integrator`: "rk4", "dp5",
+    /// "dop853").
     pub fn name(&self) -> &'static str {
         match self {
             Integrator::Rk4 { .. } => "rk4",
-            Integrator::Dopri5 { .. } => "dopri5",
+            Integrator::Dopri5 { .. } => "dp5",
             Integrator::Dop853 { .. } => "dop853",
         }
     }
@@ -827,7 +828,7 @@ mod tests {
         let i: Integrator =
             toml::from_str("method = \"dopri5\"\nrtol = 1e-9\natol = 1e-9").unwrap();
         assert!(i.validate().is_ok());
-        assert_eq!(i.name(), "dopri5");
+        assert_eq!(i.name(), "dp5");
         let bad: Result<Integrator, _> = toml::from_str("method = \"rk4\"\nstep = 1e-3\nrtol = 1");
         assert!(bad.is_err());
         let i: Integrator = toml::from_str("method = \"rk4\"\nstep = -1.0").unwrap();
