@@ -423,6 +423,46 @@ fn an_index_disc_from_two_channels() {
     assert!(frames >= 4);
 }
 
+/// A capture whose times are Unix times (1.76e9 s: an f64 resolves only 0.24 µs there) reads
+/// as exactly as the same capture from 0: the same decisions at the same times (counted from
+/// the first time's whole seconds, which the report names) and the same δ in every window.
+/// (Read as plain f64, every interval was off by up to 240 ticks of the 1 GHz timer.)
+#[test]
+fn unix_times_read_as_exactly_as_times_from_zero() {
+    let file = tmp("index-from-zero.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Plain, &file);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut shifted = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let (time, rest) = line.split_once(',').unwrap();
+        if i == 0 {
+            shifted.push_str(line);
+        } else {
+            // Whole seconds added as text: the file says exactly the same instants, later.
+            let (whole, fraction) = time.split_once('.').unwrap_or((time, "0"));
+            let whole: u64 = whole.parse().unwrap();
+            shifted.push_str(&format!("{}.{fraction},{rest}", whole + 1_764_130_000));
+        }
+        shifted.push('\n');
+    }
+    let epoch = tmp("index-unix-times.csv");
+    std::fs::write(&epoch, shifted).unwrap();
+    let options = AnalyzeOptions {
+        timer_hz: Some(1e9),
+        ..index_lines(24)
+    };
+    let (a, seen_a) = run_analyze(&file, options.clone());
+    let (b, seen_b) = run_analyze(&epoch, options);
+    assert_eq!((a.time_origin, b.time_origin), (0, 1_764_130_000));
+    assert_eq!(seen_a.len(), seen_b.len());
+    for (x, y) in seen_a.iter().zip(&seen_b) {
+        assert_eq!(format!("{x:?}"), format!("{y:?}"));
+    }
+    let deltas = |r: &AnalyzeReport| r.windows.iter().map(|w| w.delta).collect::<Vec<_>>();
+    assert!(a.valid_windows >= 3, "{}", a.valid_windows);
+    assert_eq!(deltas(&a), deltas(&b));
+}
+
 #[test]
 fn an_index_disc_configured_with_the_wrong_lines_says_so() {
     // A 24-line disc analyzed as 20 or 25 lines never syncs; the report counts the missing

@@ -296,8 +296,12 @@ pub struct AnalyzeReport {
     pub time_grid: Option<f64>,
     /// Rows read.
     pub rows: u64,
-    /// First and last time in the capture, s.
+    /// First and last time in the capture, s, counted from `time_origin`.
     pub span: [f64; 2],
+    /// Whole seconds subtracted, exactly, from every time the file writes (the first time's,
+    /// when it is 10 000 s or more, such as a Unix time; else 0): every time reported is
+    /// counted from it.
+    pub time_origin: i64,
     /// Edges of the chosen polarity on the encoder channel (fed to the core).
     pub edges: u64,
     /// Edges on the index channel (fed to the core).
@@ -666,6 +670,7 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
+    report.time_origin = reader.time_origin();
     // The end of the recording: the periodic task up to it (a shaft that stopped before the
     // recording did times out where a firmware's poll would see it, not at the end of the
     // file), and a last poll there.
@@ -989,6 +994,13 @@ pub fn text(r: &AnalyzeReport) -> String {
         "capture: {} ({} format, {} rows, {:.6} s to {:.6} s)",
         r.file, r.format, r.rows, r.span[0], r.span[1]
     );
+    if r.time_origin != 0 {
+        let _ = writeln!(
+            s,
+            "times: counted from {} s, the whole seconds of the file's first time (read exactly)",
+            r.time_origin
+        );
+    }
     let _ = writeln!(
         s,
         "channel: {} ({} edges){}{}",

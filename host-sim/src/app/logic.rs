@@ -201,8 +201,73 @@ pub struct CaptureReader<R> {
     sample_rate: Option<f64>,
     rows: u64,
     last_time: f64,
+    /// Whole seconds subtracted, exactly, from every time written in decimal seconds: those of
+    /// the first row's time when it is large (see [`ORIGIN_FROM`]), else 0.
+    origin: Option<i64>,
     /// The line last read had no line end (the end of the file).
     unterminated: bool,
+}
+
+/// A first time of this magnitude or more (s) is read relative to its whole seconds: an f64
+/// near 1.7e9 s (a Unix time) resolves only 0.24 µs, 20 ticks of an 84 MHz timer; below 1e4 s
+/// it resolves 1.8 ps.
+const ORIGIN_FROM: i128 = 10_000;
+
+/// Attoseconds per second: decimal times are read exactly in these units.
+const ATTO: i128 = 1_000_000_000_000_000_000;
+
+/// `text` (decimal seconds, `[+-]digits[.digits][(e|E)[+-]digits]`) exactly in attoseconds,
+/// digits past the 18th decimal dropped; `None` when it is not of that form or out of range.
+fn decimal_attoseconds(text: &str) -> Option<i128> {
+    let (negative, body) = match text.as_bytes().first()? {
+        b'-' => (true, &text[1..]),
+        b'+' => (false, &text[1..]),
+        _ => (false, text),
+    };
+    let (number, exponent) = match body.find(['e', 'E']) {
+        Some(k) => (&body[..k], body[k + 1..].parse::<i32>().ok()?),
+        None => (body, 0),
+    };
+    let (whole, fraction) = number.split_once('.').unwrap_or((number, ""));
+    if whole.is_empty() && fraction.is_empty()
+        || !whole
+            .bytes()
+            .chain(fraction.bytes())
+            .all(|b| b.is_ascii_digit())
+    {
+        return None;
+    }
+    // The digits as one integer times 10^scale; at most 36 significant digits kept (the
+    // integer stays within i128), the rest of the fraction dropped.
+    let mut mantissa: i128 = 0;
+    let mut scale: i32 = exponent;
+    let mut significant = 0;
+    for b in whole.bytes() {
+        if significant < 36 {
+            mantissa = mantissa * 10 + i128::from(b - b'0');
+            significant += usize::from(mantissa != 0);
+        } else {
+            scale = scale.checked_add(1)?;
+        }
+    }
+    for b in fraction.bytes() {
+        if significant < 36 {
+            mantissa = mantissa * 10 + i128::from(b - b'0');
+            significant += usize::from(mantissa != 0);
+            scale = scale.checked_sub(1)?;
+        }
+    }
+    let shift = scale.checked_add(18)?;
+    let atto = if shift >= 0 {
+        mantissa.checked_mul(10i128.checked_pow(u32::try_from(shift).ok()?)?)?
+    } else {
+        match 10i128.checked_pow(shift.unsigned_abs()) {
+            Some(d) => mantissa / d,
+            // Below an attosecond.
+            None => 0,
+        }
+    };
+    Some(if negative { -atto } else { atto })
 }
 
 impl CaptureReader<std::io::BufReader<std::fs::File>> {
@@ -243,6 +308,7 @@ impl<R: BufRead> CaptureReader<R> {
             sample_rate,
             rows: 0,
             last_time: f64::NEG_INFINITY,
+            origin: None,
             unterminated: false,
         };
         let first = loop {
@@ -317,6 +383,13 @@ impl<R: BufRead> CaptureReader<R> {
     /// The file's sample rate, when it states one (sigrok), Hz.
     pub fn sample_rate(&self) -> Option<f64> {
         self.sample_rate
+    }
+
+    /// The whole seconds subtracted from every time the file writes (its first time's, when
+    /// that is 10 000 s or more, such as a Unix time: read as it is, an f64 would lose the
+    /// ticks); 0 when times are as written. Known once the first row is read.
+    pub fn time_origin(&self) -> i64 {
+        self.origin.unwrap_or(0)
     }
 
     /// An error at the current line.
@@ -570,7 +643,7 @@ impl<R: BufRead> CaptureReader<R> {
     }
 
     /// The time of a row's first field, s.
-    fn time_of(&self, f: &str) -> Result<f64, CaptureError> {
+    fn time_of(&mut self, f: &str) -> Result<f64, CaptureError> {
         let bad = |what: &str| self.err_here(&format!("`{}` is not {what}", clip(f)));
         match (self.format, self.sigrok_time) {
             (CaptureFormat::Sigrok, SigrokTime::Column { unit, unit_rate }) => {
@@ -592,11 +665,25 @@ impl<R: BufRead> CaptureReader<R> {
                 Ok((v / period).saturating_sub(1) as f64 / rate)
             }
             _ => {
-                let t: f64 = f.parse().map_err(|_| bad("a time in seconds"))?;
-                if !t.is_finite() {
-                    return Err(bad("a finite time in seconds"));
-                }
-                Ok(t)
+                let Some(atto) = decimal_attoseconds(f) else {
+                    // Not a plain decimal: `inf`, `NaN`, or no number at all.
+                    return Err(match f.parse::<f64>() {
+                        Ok(x) if x.is_finite() => bad("a time within ±1e20 s"),
+                        Ok(_) => bad("a finite time in seconds"),
+                        Err(_) => bad("a time in seconds"),
+                    });
+                };
+                let origin = *self.origin.get_or_insert_with(|| {
+                    let whole = atto / ATTO;
+                    if whole.abs() >= ORIGIN_FROM {
+                        i64::try_from(whole).unwrap_or(0)
+                    } else {
+                        0
+                    }
+                });
+                // The difference taken exactly, then rounded once: a time far from 0 keeps its
+                // resolution.
+                Ok(atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64)
             }
         }
     }
@@ -882,5 +969,40 @@ mod tests {
         assert_eq!(parse_rate(" 12.5 MHz"), Some(12.5e6));
         assert_eq!(parse_rate("500 kHz"), Some(5e5));
         assert_eq!(parse_rate("fast"), None);
+    }
+
+    /// Decimal seconds read exactly, against the same instants written as integers.
+    #[test]
+    fn decimal_times_are_read_exactly() {
+        let cases: [(&str, i128); 12] = [
+            ("0", 0),
+            (
+                "1764130000.000490633",
+                1_764_130_000_000_490_633_000_000_000,
+            ),
+            ("-0.5", -500_000_000_000_000_000),
+            ("+.25", 250_000_000_000_000_000),
+            ("3.", 3 * ATTO),
+            ("1.5e-3", 1_500_000_000_000_000),
+            ("2E+2", 200 * ATTO),
+            ("12.5e-1", 1_250_000_000_000_000_000),
+            // Past the 18th decimal: dropped.
+            ("0.0000000000000000019", 1),
+            ("1e-30", 0),
+            // 40 digits: those past 36 significant ones dropped from the fraction.
+            (
+                "1234567890.123456789012345678901234567890",
+                1_234_567_890_123_456_789_012_345_678,
+            ),
+            ("1e20", 100_000_000_000_000_000_000 * ATTO),
+        ];
+        for (text, atto) in cases {
+            assert_eq!(decimal_attoseconds(text), Some(atto), "{text}");
+        }
+        for bad in [
+            "", ".", "-", "1.2.3", "1e", "e5", "inf", "NaN", "0x10", "1 2", "1e400", "--1",
+        ] {
+            assert_eq!(decimal_attoseconds(bad), None, "{bad}");
+        }
     }
 }
