@@ -159,6 +159,32 @@ fn values_that_gave_nan_or_inf_results_are_refused_by_key() {
     }
 }
 
+/// A δ limit is allowed in [f64's epsilon, 2), and the error says that range whatever the
+/// bad value (2 was refused as "out of range" with no range, from deep in the design).
+#[test]
+fn a_delta_limit_of_two_or_below_epsilon_names_the_range() {
+    for (bad, why) in [
+        ("2", "reaches 2 only when the shaft stops"),
+        ("3", "reaches 2 only when the shaft stops"),
+        ("2.2e-16", "finer than f64 resolves the speed"),
+        ("-1", "allowed"),
+    ] {
+        let e = error(
+            "kneader",
+            "delta_limit = 0.06",
+            &format!("delta_limit = {bad}"),
+        );
+        assert_names(
+            &e,
+            &[
+                &format!("`monitor.delta_limit = {bad}`"),
+                "allowed [2.220446049250313e-16, 2)",
+                why,
+            ],
+        );
+    }
+}
+
 #[test]
 fn keys_a_scene_does_not_use_are_still_checked() {
     // Finding 6: accepted because nothing read them.

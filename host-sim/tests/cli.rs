@@ -160,6 +160,38 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An alarm that cannot judge a window for its noise floor says so: the kneader (δ 0.033)
+/// with a 4 MHz timer and one-edge samples has a floor of 0.011, above 0.2 of a 0.02 limit,
+/// so the core's alarm counts no window; "no alarm" alone would read as a drive within it.
+#[test]
+fn an_alarm_that_judged_no_window_says_why() {
+    let dir = std::env::temp_dir().join(format!("drive-sim-blind-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kneader.toml");
+    let text = std::fs::read_to_string(scene).unwrap();
+    let text = text
+        .replace("duration = 30.0", "duration = 15.0")
+        .replace("settle = 10.0", "settle = 5.0")
+        .replace("timer_hz = 84e6", "timer_hz = 4e6\nestimator_edges = 1")
+        .replace("delta_limit = 0.06", "delta_limit = 0.02");
+    assert!(text.contains("timer_hz = 4e6") && text.contains("delta_limit = 0.02"));
+    let path = dir.join("blind-alarm.toml");
+    std::fs::write(&path, text).unwrap();
+    let v = json(&["run", path.to_str().unwrap(), "--json"]);
+    assert!(v["delta_measured"].as_f64().unwrap() > 0.03);
+    assert_eq!(v["alarms"].as_array().unwrap().len(), 0);
+    let j = &v["alarm_judged"];
+    assert_eq!(j["counted"], 0);
+    assert!(j["floor_near_limit"].as_u64().unwrap() > 10, "{j}");
+    let (ok, out, err) = drive_sim(&["run", path.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("no alarm — the alarm judged none of the") && out.contains("timer_hz"),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn runup_reports_the_capture_and_out_needs_loads_together() {
     let dir = std::env::temp_dir().join(format!("drive-sim-capture-{}", std::process::id()));

@@ -966,15 +966,24 @@ fn monitor(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     };
     if let Some(l) = m.delta_limit {
         // A limit finer than f64 resolves the speed can be neither designed for
-        // (`DriveModel::flywheel_for`) nor monitored: one check for every command.
-        c.range(
-            "monitor.delta_limit",
-            l,
-            drive_monitor::drive::MIN_DELTA_TARGET,
-            false,
-            2.0,
-            "",
-        )?;
+        // (`DriveModel::flywheel_for`) nor monitored: one check for every command. δ reaches 2
+        // only when the shaft stops once a cycle: a limit of 2 could never be exceeded (the
+        // core's design refuses it).
+        let lo = drive_monitor::drive::MIN_DELTA_TARGET;
+        if !(l.is_finite() && (lo..2.0).contains(&l)) {
+            let why = if l >= 2.0 {
+                ": δ = 2(ω max − ω min)/(ω max + ω min) reaches 2 only when the shaft stops"
+            } else if l > 0.0 && l < lo {
+                ": a smaller δ is finer than f64 resolves the speed"
+            } else {
+                ""
+            };
+            return Err(c.bad(
+                "monitor.delta_limit",
+                l,
+                format!("allowed [{}, 2){why}", num(lo)),
+            ));
+        }
     }
     if let Some(n) = m.window_revolutions {
         let max = drive_monitor::irregularity::MAX_WINDOW_REVS;

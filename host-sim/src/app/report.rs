@@ -12,6 +12,32 @@ fn floor(x: Option<f64>) -> String {
     x.map_or("–".to_string(), |x| format!("{x:.1e}"))
 }
 
+/// After "no alarm": how many windows the alarm could judge, when it could not judge them
+/// all for their noise floor (a silent "no alarm" from an alarm that judged nothing would read
+/// as a drive within its limit).
+fn alarm_judged(r: &RunReport) -> String {
+    let Some(j) = r.alarm_judged.filter(|j| j.floor_near_limit > 0) else {
+        return String::new();
+    };
+    let why = format!(
+        "{} had a noise floor above {} of the limit, which δ cannot be told from",
+        j.floor_near_limit, j.floor_fraction
+    );
+    if j.counted == 0 {
+        format!(
+            " — the alarm judged none of the {} windows: {why}; a faster capture timer \
+             (`encoder.timer_hz`) or more estimator edges (`encoder.estimator_edges`) lower the \
+             floor",
+            r.windows
+        )
+    } else {
+        format!(
+            " (judged {} of the {} windows; {why})",
+            j.counted, r.windows
+        )
+    }
+}
+
 /// A run as text.
 pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     let mut s = String::new();
@@ -104,7 +130,7 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         }
         if let Some(l) = r.delta_limit {
             if r.alarms.is_empty() {
-                let _ = writeln!(s, "  δ limit {l}: no alarm");
+                let _ = writeln!(s, "  δ limit {l}: no alarm{}", alarm_judged(r));
             }
             for a in &r.alarms {
                 let _ = writeln!(s, "  δ limit {l}: alarm {} at {:.2} s", a.event, a.time);

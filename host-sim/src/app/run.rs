@@ -24,7 +24,7 @@ use crate::engine::vibration::{
     PlatformParams, RegimeCriteria, RegimeReport, RegimeSample, VibrationMachine,
     VibrationMachineParams,
 };
-use drive_monitor::alarm::{AlarmConfig, AlarmEvent};
+use drive_monitor::alarm::{AlarmConfig, AlarmEvent, Verdict};
 #[cfg(doc)]
 use drive_monitor::balancer::DEFAULT_MARGIN;
 use drive_monitor::balancer::{Classifier, Machine};
@@ -58,6 +58,24 @@ pub struct WindowOut {
     pub steady: bool,
     /// Fault name when invalid.
     pub fault: Option<&'static str>,
+}
+
+/// How the alarm judged the windows: only those it counts can raise or clear it.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct AlarmJudged {
+    /// Counted (valid, steady, floor well below the limit), of which `over` over the limit.
+    pub counted: u32,
+    /// Counted windows whose δ was over the limit.
+    pub over: u32,
+    /// Not counted: the noise floor above `floor_fraction` of the limit (δ cannot be told
+    /// from the limit).
+    pub floor_near_limit: u32,
+    /// Not counted: the speed was not steady.
+    pub unsteady: u32,
+    /// Not counted: the window was invalid.
+    pub invalid: u32,
+    /// The fraction of the limit the floor must stay below (the core's default).
+    pub floor_fraction: f32,
 }
 
 /// An alarm transition.
@@ -135,6 +153,9 @@ pub struct RunReport {
     pub noise_floor: Option<f64>,
     /// Alarm transitions.
     pub alarms: Vec<AlarmOut>,
+    /// How the alarm judged the windows (with a δ limit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alarm_judged: Option<AlarmJudged>,
     /// Edges the core rejected or found missing: glitches, missing edges, extra edges.
     pub rejected_edges: [u32; 3],
     /// Mean speed measured by the core over the last window, rad/s.
@@ -646,6 +667,7 @@ struct Collector<'a> {
     window_count: u32,
     invalid_reasons: BTreeMap<&'static str, u32>,
     alarms: Vec<AlarmOut>,
+    judged: AlarmJudged,
     trace: Vec<(f64, f64)>,
     trace_every: u64,
     edges: u64,
@@ -712,6 +734,18 @@ impl Collector<'_> {
     /// A window the core returned at time `t`, s, and its alarm event.
     fn outcome(&mut self, t: f64, o: drive_monitor::monitor::WindowOutcome) {
         self.window(t, o.report);
+        let j = &mut self.judged;
+        match o.verdict {
+            Some(Verdict::Over) => {
+                j.counted += 1;
+                j.over += 1;
+            }
+            Some(Verdict::Within) => j.counted += 1,
+            Some(Verdict::FloorNearLimit) => j.floor_near_limit += 1,
+            Some(Verdict::Unsteady) => j.unsteady += 1,
+            Some(Verdict::Invalid) => j.invalid += 1,
+            None => {}
+        }
         if let Some(e) = o.event {
             self.alarms.push(AlarmOut {
                 time: t,
@@ -1190,6 +1224,7 @@ pub fn run_with(
         window_count: 0,
         invalid_reasons: BTreeMap::new(),
         alarms: Vec::new(),
+        judged: AlarmJudged::default(),
         trace: Vec::new(),
         trace_every: ((expected_edges / 4000.0) as u64).max(1),
         edges: 0,
@@ -1301,6 +1336,10 @@ pub fn run_with(
     report.capture = capture_analysis(scene, file, vib_params.as_ref(), &samples)?;
     supports(scene, file, &mut report, col.reactions)?;
     report.alarms = col.alarms;
+    report.alarm_judged = report.delta_limit.map(|l| AlarmJudged {
+        floor_fraction: AlarmConfig::new(l as f32).floor_fraction,
+        ..col.judged
+    });
     report.window_list = col.windows;
     report.speed_trace = col.trace;
     report.edge_list = col.edge_list.take().unwrap_or_default();
