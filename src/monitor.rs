@@ -864,6 +864,42 @@ mod tests {
         }
     }
 
+    /// The accepted count never runs ahead of the edges fed: a standstill found by a poll,
+    /// then an index before the next start's reference edge, puts the count back to tooth 0;
+    /// it was set back without the careful path's anchor, so the next careful edge added
+    /// `0 − anchor` modulo 2¹⁶ (65 000 edges too many each time).
+    #[test]
+    fn an_index_at_a_restart_leaves_the_accepted_count_right() {
+        let mut m = monitor(indexed(64, 4, 32, 1e6), 2);
+        let evs = stream(&uniform(64), Some(0.0), 3, 1e6, u32::MAX, &kneader(0.01));
+        let gap = m.encoder().timeout_ticks() * 2;
+        let mut fed = 0u32;
+        let mut offset = 0u32;
+        for start in 0..3 {
+            for e in &evs {
+                match *e {
+                    Ev::Index(t) => m.on_index(t.wrapping_add(offset)),
+                    Ev::Edge(t) => {
+                        fed += 1;
+                        let _ = m.on_edge(t.wrapping_add(offset), Some(Direction::Forward));
+                        let accepted = m.diagnostics().edges.accepted;
+                        assert!(accepted <= fed, "start {start}: {accepted} of {fed}");
+                    }
+                }
+            }
+            let Some(&Ev::Edge(last) | &Ev::Index(last)) = evs.last() else {
+                unreachable!()
+            };
+            // Stopped: the poll finds the timeout, and the next start comes after it.
+            let _ = m.poll(last.wrapping_add(offset).wrapping_add(gap));
+            offset = offset.wrapping_add(last).wrapping_add(2 * gap);
+        }
+        let d = m.diagnostics();
+        assert_eq!(d.edges.timeouts, 3, "{d:?}");
+        // Every edge but each start's reference edge is a tooth.
+        assert_eq!(d.edges.accepted, fed - 3, "{d:?}");
+    }
+
     #[test]
     fn windows_say_where_they_lie() {
         let mut m = monitor(indexed(64, 4, 32, 1e6), 2);

@@ -1311,7 +1311,10 @@ impl SpeedTracker {
         self.nidx = keep as u8;
         if framed {
             self.sync = SyncState::Confirming;
+            // The anchor with it: the careful path settled the count on entry (anchor = tooth),
+            // and `tooth − anchor` is what the fast path has counted since.
             self.tooth = 0;
+            self.anchor = 0;
             self.searched = 0;
         }
     }
