@@ -463,6 +463,29 @@ fn unix_times_read_as_exactly_as_times_from_zero() {
     assert_eq!(deltas(&a), deltas(&b));
 }
 
+/// A capture shorter than one window says so, with both lengths, rather than "0 valid, 0
+/// invalid" alone.
+#[test]
+fn a_capture_shorter_than_a_window_says_so() {
+    let file = tmp("index-short.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
+    let options = AnalyzeOptions {
+        window_revolutions: Some(100),
+        ..index_lines(24)
+    };
+    let (report, _) = run_analyze(&file, options);
+    assert!(report.revolutions >= 4, "{}", report.revolutions);
+    let text = host_sim::app::analyze::text(&report);
+    assert!(
+        text.contains(&format!(
+            "windows: 0 valid, 0 invalid (a window is 100 revolution(s) and the capture has {} \
+             in sync)",
+            report.revolutions
+        )),
+        "{text}"
+    );
+}
+
 #[test]
 fn an_index_disc_configured_with_the_wrong_lines_says_so() {
     // A 24-line disc analyzed as 20 or 25 lines never syncs; the report counts the missing

@@ -119,6 +119,18 @@ fn sweep_json_keeps_its_contract() {
     assert_eq!(v["agreeing"], 3);
 }
 
+/// A sweep above the speed range every scene speed has is refused at once, naming `--to`
+/// (it ran for minutes, then blamed `simulation.duration` for too many integrator steps).
+#[test]
+fn a_sweep_beyond_the_speed_range_names_to() {
+    let (ok, _, err) = drive_sim(&["sweep", "two-mass", "--from", "1e6", "--to", "2e6"]);
+    assert!(!ok);
+    assert!(
+        err.contains("`--to`") && err.contains("allowed up to 1e5 rad/s"),
+        "{err}"
+    );
+}
+
 #[test]
 fn plots_are_written() {
     let dir = std::env::temp_dir().join(format!("drive-sim-plots-{}", std::process::id()));

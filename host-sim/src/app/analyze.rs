@@ -310,6 +310,8 @@ pub struct AnalyzeReport {
     pub accepted: u32,
     /// Revolutions counted in sync.
     pub revolutions: u32,
+    /// Revolutions a window spans (`--window-revolutions`, or the scene's).
+    pub window_revolutions: u16,
     /// Faults by kind: glitches, missing edges, extra edges, missing frames, reversals,
     /// timeouts.
     pub glitches: u32,
@@ -695,6 +697,7 @@ pub fn analyze<R: BufRead>(
     let e = d.edges;
     report.accepted = e.accepted;
     report.revolutions = e.revolutions;
+    report.window_revolutions = monitor.window_revolutions();
     report.glitches = e.glitches;
     report.missing = e.missing;
     report.extra = e.extra;
@@ -1153,8 +1156,18 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     let _ = writeln!(
         s,
-        "windows: {} valid, {} invalid",
-        r.valid_windows, r.invalid_windows
+        "windows: {} valid, {} invalid{}",
+        r.valid_windows,
+        r.invalid_windows,
+        // In sync, but too short a capture for one window: said, not left to be guessed.
+        if r.valid_windows + r.invalid_windows == 0 && r.revolutions > 0 {
+            format!(
+                " (a window is {} revolution(s) and the capture has {} in sync)",
+                r.window_revolutions, r.revolutions
+            )
+        } else {
+            String::new()
+        }
     );
     if !r.windows.is_empty() {
         let _ = writeln!(

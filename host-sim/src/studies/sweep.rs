@@ -227,6 +227,13 @@ pub fn sweep(
             format!("need 0 < from < to, got {from} and {to}"),
         ));
     }
+    let max = crate::app::check::MAX_SPEED;
+    if to > max {
+        return Err(bad(
+            "--to",
+            format!("{to} rad/s: allowed up to {max:e} rad/s, as every speed of a scene is"),
+        ));
+    }
     if steps < 2 {
         return Err(bad(
             "--steps",
