@@ -94,11 +94,15 @@ pub enum Allocation {
     /// Centre of mass outside the span (overhung rotor). This product's rule, not an ISO
     /// factor: each plane is allowed the magnitude of the plane equivalent of `U_per` placed
     /// at the centre of mass, `U_perA = U_per·|L_B|/L`, `U_perB = U_per·|L_A|/L` (static
-    /// split, no clamp). A rotor whose whole residual unbalance is `U_per` at its centre of
-    /// mass then sits exactly on both limits, as an unclamped inboard rotor does; the plane
-    /// nearer the overhang is allowed more than `U_per` because it carries the lever.
-    /// The allocation is discontinuous where the centre of mass crosses a support (the ISO
-    /// clamp applies on the inboard side only). Narrow rotors are not treated separately.
+    /// split), the far plane (the one away from the overhang) held at least at
+    /// [`ISO_SHARE_MIN`]·U_per as ISO holds an inboard rotor's planes. A rotor whose whole
+    /// residual unbalance is `U_per` at its centre of mass then sits exactly on the near
+    /// plane's limit and within the far one's; the near plane is allowed more than `U_per`
+    /// because it carries the lever. Where the centre of mass crosses a support the far
+    /// plane's limit is continuous (30 % on both sides; without the floor it fell to
+    /// `U_per·|L_A|/L` → 0, and a rotor 1 mm overhung on a 4 m span was allowed 1/1200 of its
+    /// inboard limit there) and the near plane's rises from 70 % to 100 % of `U_per`.
+    /// Narrow rotors are not treated separately.
     Overhung,
 }
 
@@ -131,10 +135,11 @@ pub fn allocate(u_per: f64, support_a: f64, support_b: f64, centre_of_mass: f64)
             allocation: Allocation::Inboard,
         }
     } else {
+        // The near plane's share is above 1: only the far plane's floor can bind.
         Permissible {
             total: u_per,
-            a: u_per * share_a.abs(),
-            b: u_per * share_b.abs(),
+            a: u_per * share_a.abs().max(ISO_SHARE_MIN),
+            b: u_per * share_b.abs().max(ISO_SHARE_MIN),
             allocation: Allocation::Overhung,
         }
     }

@@ -398,17 +398,43 @@ fn iso_allocation_on_worked_numbers() {
     assert_eq!(s.allocation, Allocation::Inboard);
     assert_close(s.a, 0.025_725, 1e-16, "on support A");
     assert_close(s.b, 0.011_025, 1e-16, "on support A, B");
-    // Overhung, CoM at 5 on 0…4: |L_B|/L = 0.25 and L_A/L = 1.25, no clamp.
+    // Overhung, CoM at 5 on 0…4: |L_B|/L = 0.25, held at the floor 0.3, and L_A/L = 1.25.
     let o = allocate(u, 0.0, 4.0, 5.0);
     assert_eq!(o.allocation, Allocation::Overhung);
-    assert_close(o.a, 0.25 * 0.03675, 1e-17, "overhung A = 0.0091875");
+    assert_close(o.a, 0.3 * 0.03675, 1e-17, "overhung A = 0.011025");
     assert_close(o.b, 1.25 * 0.03675, 1e-17, "overhung B = 0.0459375");
     // The overhung rule's defining property: U_per placed at the centre of mass sits exactly
-    // on both plane limits.
+    // on the near plane's limit and within the far one's.
     let r = Rotor::<1>::new(350.0, 5.0, 0.0, 4.0, &[Unbalance::new(5.0, u, 1.0)], None).unwrap();
     let [da, db] = r.support_unbalance();
-    assert_close(da.norm(), o.a, 1e-17, "U_per at CoM → plane A");
+    assert_close(da.norm(), 0.25 * 0.03675, 1e-17, "U_per at CoM → plane A");
+    assert!(da.norm() < o.a);
     assert_close(db.norm(), o.b, 1e-17, "U_per at CoM → plane B");
+    // Far out the floor does not bind: CoM at 6, |L_B|/L = 0.5, L_A/L = 1.5.
+    let f = allocate(u, 0.0, 4.0, 6.0);
+    assert_close(f.a, 0.5 * 0.03675, 1e-17, "far overhung A");
+    assert_close(f.b, 1.5 * 0.03675, 1e-17, "far overhung B");
+}
+
+/// Where the centre of mass crosses a support the far plane's limit stays at 30 % of U_per
+/// on both sides (it fell to U_per·|L_A|/L → 0 outside: 1 mm overhung on a 4 m span allowed
+/// 9.19e-6 kg·m at B against 1.10e-2 inboard, and a well-balanced rotor read "over"), and the
+/// near plane's never falls.
+#[test]
+fn the_far_plane_limit_is_continuous_where_the_centre_of_mass_crosses_a_support() {
+    let u = permissible_residual_unbalance(6.3, 350.0, 60.0);
+    for (a, b) in [(0.0, 4.0), (4.0, 0.0)] {
+        for eps in [1e-3, 1e-6, 0.0] {
+            // Just inside and just outside support A (at 0).
+            let inside = allocate(u, a, b, eps);
+            let outside = allocate(u, a, b, -eps);
+            let far = |p: &Permissible| if a == 0.0 { p.b } else { p.a };
+            let near = |p: &Permissible| if a == 0.0 { p.a } else { p.b };
+            assert_close(far(&inside), 0.3 * u, 1e-17, "far, inside");
+            assert_close(far(&outside), 0.3 * u, 1e-17, "far, outside");
+            assert!(near(&outside) >= near(&inside), "{eps}");
+        }
+    }
 }
 
 #[test]
@@ -657,11 +683,11 @@ fn overhung_auger_variant_is_sensible() {
         da.x * dv.x + da.y * dv.y < 0.0,
         "A is pushed opposite to the unbalance"
     );
-    // Permissible, overhung rule: |L_B|/L = 0.4/1.5, L_A/L = 1.9/1.5.
+    // Permissible, overhung rule: |L_B|/L = 0.4/1.5 held at the floor 0.3, L_A/L = 1.9/1.5.
     assert_eq!(an.permissible.allocation, Allocation::Overhung);
     assert_close(
         rep.permissible_a,
-        0.03675 * 0.4 / 1.5,
+        0.03675 * 0.3,
         1e-16,
         "overhung permissible_a",
     );
