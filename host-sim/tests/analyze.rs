@@ -463,6 +463,30 @@ fn unix_times_read_as_exactly_as_times_from_zero() {
     assert_eq!(deltas(&a), deltas(&b));
 }
 
+/// A sample rate that could not have recorded the file (rows closer than one sample period)
+/// is an error naming the row, not a floor widened by the wrong factor.
+#[test]
+fn a_sample_rate_too_slow_for_the_rows_is_refused() {
+    let file = tmp("index-rate.csv");
+    simulate(&index_disc(0.2), CaptureFormat::Saleae, &file);
+    let cfg = configure(&index_lines(24)).unwrap();
+    for (rate, ok) in [(1e3, false), (10e6, true)] {
+        let mut reader = CaptureReader::open(&file, None, Some(rate)).unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {});
+        match r {
+            Ok(_) => assert!(ok, "{rate}"),
+            Err(e) => {
+                assert!(!ok, "{rate}: {e}");
+                let e = e.to_string();
+                assert!(
+                    e.contains("index-rate.csv:") && e.contains("less than one period"),
+                    "{e}"
+                );
+            }
+        }
+    }
+}
+
 /// A capture shorter than one window says so, with both lengths, rather than "0 valid, 0
 /// invalid" alone.
 #[test]

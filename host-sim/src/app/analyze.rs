@@ -603,6 +603,10 @@ pub fn analyze<R: BufRead>(
     let mut end = 0.0;
     let mut changes = vec![0u64; channels.len()];
     let mut grid = TimeGrid::default();
+    // A stated sample rate (a sigrok file's, or --sample-rate) cannot have recorded two rows
+    // less than a sample period apart: the rate or the file is wrong.
+    let period = reader.sample_rate().map(|r| 1.0 / r);
+    let mut previous_time: Option<f64> = None;
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
@@ -641,6 +645,21 @@ pub fn analyze<R: BufRead>(
             report.reverse_edges += 1;
         }
         prev.copy_from_slice(levels);
+        if let (Some(p), Some(t0)) = (period, previous_time) {
+            // (Rows at one time are allowed: a level shown twice. 1e-9 of slack for the
+            // decimal times' rounding.)
+            if t > t0 && t - t0 < p * (1.0 - 1e-9) {
+                return Err(AnalyzeError::Capture(reader.err_here(&format!(
+                    "this row is {:.3e} s after the previous one, less than one period \
+                     ({:.3e} s) of the sample rate {} Hz: the rate is wrong, or the file was \
+                     not sampled at it",
+                    t - t0,
+                    p,
+                    1.0 / p,
+                ))));
+            }
+        }
+        previous_time = Some(t);
         if !index_edge && !encoder_edge {
             continue;
         }
