@@ -1,5 +1,6 @@
 //! Predicted running irregularity δ of a drive (seed 000): motor characteristic, load torque,
-//! reduced inertia plus flywheel; the steady state in closed form, δ without cancellation,
+//! reduced inertia plus flywheel (constant, or J(φ) with harmonics); the steady state in closed
+//! form (by the trapezoid rule on one period for J(φ)), δ without cancellation,
 //! the stall case, flywheel sizing and sensitivities.
 //!
 //! Everything here runs at configuration time in f64, allocation-free. The motor and load
@@ -11,10 +12,12 @@ mod model;
 mod motor;
 #[cfg(test)]
 mod tests;
+mod varying;
 
 pub use load::{Harmonic, Load, MAX_HARMONICS, MAX_ORDER};
 pub use model::{
-    DesignError, DriveModel, Horizon, Irregularity, Prediction, Sensitivity, Stall, SteadyState,
-    MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET, SAMPLES_PER_CYCLE,
+    DesignError, DriveModel, Horizon, Irregularity, Prediction, Sensitivity, Stall, SteadyCurve,
+    SteadyState, MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET, SAMPLES_PER_CYCLE,
 };
 pub use motor::{Kloss, KlossFit, Motor, Parabola};
+pub use varying::{InertiaHarmonic, MAX_INERTIA_HARMONICS, MAX_NODES};

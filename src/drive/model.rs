@@ -1,5 +1,7 @@
 //! Steady state of the drive (seed 000, eq. 11–13), its irregularity δ, flywheel sizing and
-//! sensitivities.
+//! sensitivities. A reduced inertia that depends on φ ([`DriveModel::with_inertia_harmonics`])
+//! takes the path of the `varying` module (eq. 1 solved exactly in `w = J·ω²` over one
+//! period); what follows is the constant-inertia form, which that path reproduces.
 //!
 //! ## Derivation
 //! With constant reduced inertia `J` (machine plus flywheel), eq. 1 reads
@@ -29,6 +31,7 @@
 
 use super::load::{Harmonic, Load, MAX_HARMONICS};
 use super::motor::Motor;
+use super::varying::{self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS};
 use crate::error::{non_negative, positive, ConfigError};
 use core::f64::consts::PI;
 
@@ -51,6 +54,9 @@ pub const MIN_DELTA_TARGET: f64 = f64::EPSILON;
 const MAX_CONFIRM_DOUBLINGS: u32 = 8;
 /// Bisection steps in [`DriveModel::flywheel_for`] at most.
 const MAX_BISECTIONS: u32 = 200;
+/// Doublings of the added flywheel in [`DriveModel::flywheel_for`] on the J(φ) path at most:
+/// from any inertia, 1100 doublings pass the f64 range.
+const MAX_VARYING_DOUBLINGS: u32 = 1100;
 
 /// Over which range of φ the extrema of ω were taken.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,6 +80,17 @@ pub enum Horizon {
     /// supremum over an unbounded horizon for rationally independent orders (Kronecker), and a
     /// conservative bound (δ too large, flywheel too big) for commensurate ones.
     Unbounded,
+    /// The inertia depends on φ ([`DriveModel::with_inertia_harmonics`]): the periodic
+    /// solution of eq. 1 in `w = J·ω²` over one common period of the load and inertia orders,
+    /// by the trapezoid rule on `nodes` nodes (see the `varying` module docs), its extrema
+    /// found on the nodes and refined by golden section on the series.
+    Varying {
+        /// Common period of all load and inertia harmonics, rad.
+        radians: f64,
+        /// Trapezoid nodes over that period (a power of two, at most
+        /// [`MAX_NODES`](crate::drive::MAX_NODES)).
+        nodes: u32,
+    },
 }
 
 /// A periodic steady state.
@@ -245,6 +262,8 @@ pub struct DriveModel {
     mean_load: f64,
     components: heapless::Vec<Component, MAX_HARMONICS>,
     horizon: Horizon,
+    /// The harmonics of J(φ) with a non-zero amplitude (empty: constant inertia).
+    inertia_harmonics: heapless::Vec<InertiaHarmonic, MAX_INERTIA_HARMONICS>,
 }
 
 impl DriveModel {
@@ -252,6 +271,83 @@ impl DriveModel {
     /// (kg·m², ≥ 0). Rejects parameter combinations whose steady-state coefficients
     /// overflow f64.
     pub fn new(motor: Motor, load: Load, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
+        Self::build(motor, load, inertia, flywheel, &[], false)
+    }
+
+    /// The same drive with a reduced inertia that depends on the shaft angle,
+    /// `J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase)` (a crank mechanism),
+    /// replacing any harmonics given before. Harmonics of amplitude 0 are dropped; with none
+    /// left the drive is the constant-inertia one.
+    ///
+    /// Rejected: more than [`MAX_INERTIA_HARMONICS`] harmonics (`Capacity`); amplitudes whose
+    /// magnitudes add up to `inertia + flywheel` or more, so that J(φ) could reach 0
+    /// (`Inconsistent("inertia_harmonic.amplitude")`: the simulator's own condition);
+    /// orders with no common period with each other and with the load's
+    /// (`Inconsistent("inertia_harmonic.order")`: rationals with denominators up to
+    /// [`MAX_DENOMINATOR`] and a period of at most [`MAX_SAMPLES`]/32 cycles of the fastest
+    /// order are accepted); and a drive whose periodic solution needs more than
+    /// [`MAX_NODES`](crate::drive::MAX_NODES) trapezoid nodes or overflows f64 (`OutOfRange("inertia_harmonics")`:
+    /// J(φ) nearly reaching 0, or a motor so stiff against the inertia that `e^{∫2A/J}` swings
+    /// by many orders of magnitude over the period).
+    pub fn with_inertia_harmonics(
+        &self,
+        harmonics: &[InertiaHarmonic],
+    ) -> Result<Self, ConfigError> {
+        Self::build(
+            self.motor,
+            self.load.clone(),
+            self.inertia,
+            self.flywheel,
+            harmonics,
+            false,
+        )
+    }
+
+    /// The harmonics of J(φ) (empty for a constant inertia).
+    pub fn inertia_harmonics(&self) -> &[InertiaHarmonic] {
+        &self.inertia_harmonics
+    }
+
+    /// The same drive on the J(φ) path even with a constant inertia, for the tests that check
+    /// it against the closed form.
+    #[cfg(test)]
+    pub(super) fn on_varying_path(&self) -> Result<Self, ConfigError> {
+        let h = self.inertia_harmonics.clone();
+        Self::build(
+            self.motor,
+            self.load.clone(),
+            self.inertia,
+            self.flywheel,
+            &h,
+            true,
+        )
+    }
+
+    fn is_varying(&self) -> bool {
+        matches!(self.horizon, Horizon::Varying { .. })
+    }
+
+    /// Rebuilds with other motor and inertias, keeping the inertia harmonics and the path.
+    fn rebuilt(&self, motor: Motor, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
+        let h = self.inertia_harmonics.clone();
+        Self::build(
+            motor,
+            self.load.clone(),
+            inertia,
+            flywheel,
+            &h,
+            self.is_varying(),
+        )
+    }
+
+    fn build(
+        motor: Motor,
+        load: Load,
+        inertia: f64,
+        flywheel: f64,
+        inertia_harmonics: &[InertiaHarmonic],
+        force_varying: bool,
+    ) -> Result<Self, ConfigError> {
         let inertia = positive("inertia", inertia)?;
         let flywheel = non_negative("flywheel", flywheel)?;
         let j = inertia + flywheel;
@@ -290,8 +386,18 @@ impl DriveModel {
         if !(total.is_finite() && (u_mean + total).is_finite()) {
             return Err(ConfigError::OutOfRange("harmonic.amplitude"));
         }
-        let horizon = horizon(&components);
-        Ok(Self {
+        let mut kept: heapless::Vec<InertiaHarmonic, MAX_INERTIA_HARMONICS> = heapless::Vec::new();
+        let mut swing = 0.0;
+        for h in inertia_harmonics.iter().filter(|h| h.amplitude() != 0.0) {
+            swing += libm::fabs(h.amplitude());
+            kept.push(*h)
+                .map_err(|_| ConfigError::Capacity("inertia_harmonics"))?;
+        }
+        // An overflowed `swing` (+∞) is rejected here too; `j` is finite.
+        if swing >= j {
+            return Err(ConfigError::Inconsistent("inertia_harmonic.amplitude"));
+        }
+        let mut model = Self {
             motor,
             load,
             inertia,
@@ -299,18 +405,79 @@ impl DriveModel {
             u_mean,
             mean_load,
             components,
-            horizon,
+            horizon: Horizon::Constant,
+            inertia_harmonics: kept,
+        };
+        model.horizon = if model.inertia_harmonics.is_empty() && !force_varying {
+            horizon(&model.components)
+        } else {
+            model.varying_horizon()?
+        };
+        Ok(model)
+    }
+
+    /// The common period of the load and inertia orders and the trapezoid nodes that resolve
+    /// the periodic solution over it (out of line: see [`Self::varying_state`]).
+    #[inline(never)]
+    fn varying_horizon(&self) -> Result<Horizon, ConfigError> {
+        let orders = self
+            .load
+            .harmonics()
+            .iter()
+            .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
+            .map(Harmonic::order)
+            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order));
+        let bad_order = ConfigError::Inconsistent("inertia_harmonic.order");
+        let (radians, cycles) = common_period(orders).ok_or(bad_order)?;
+        let start = varying::initial_nodes(cycles).ok_or(bad_order)?;
+        let out_of_range = ConfigError::OutOfRange("inertia_harmonics");
+        let solution =
+            Solution::solve(self.varying_drive(radians), start, true).map_err(|_| out_of_range)?;
+        Ok(Horizon::Varying {
+            radians,
+            nodes: solution.nodes() as u32,
         })
+    }
+
+    fn varying_drive(&self, period: f64) -> varying::Drive<'_> {
+        varying::Drive {
+            a: -self.motor.model().a(),
+            q_mean: 2.0 * (self.motor.model().b() - self.mean_load),
+            j0: self.total_inertia(),
+            inertia: &self.inertia_harmonics,
+            load: self.load.harmonics(),
+            period,
+        }
+    }
+
+    /// The J(φ) solution on the model's nodes (`None` on the constant-inertia path; the
+    /// constructor computed the same solution, so it does not fail here).
+    fn varying_solution(&self) -> Option<Solution<'_>> {
+        match self.horizon {
+            Horizon::Varying { radians, nodes } => {
+                Solution::solve(self.varying_drive(radians), nodes as usize, false).ok()
+            }
+            _ => None,
+        }
+    }
+
+    /// The steady-state curve, for evaluating ω at many angles: on the J(φ) path it holds the
+    /// solution's spectrum (about 64 KiB), each evaluation `O(nodes)`.
+    pub fn steady_curve(&self) -> SteadyCurve<'_> {
+        SteadyCurve {
+            model: self,
+            solution: self.varying_solution(),
+        }
     }
 
     /// The same drive with a different added flywheel inertia.
     pub fn with_flywheel(&self, flywheel: f64) -> Result<Self, ConfigError> {
-        Self::new(self.motor, self.load.clone(), self.inertia, flywheel)
+        self.rebuilt(self.motor, self.inertia, flywheel)
     }
 
     /// The same drive with a different motor.
     pub fn with_motor(&self, motor: Motor) -> Result<Self, ConfigError> {
-        Self::new(motor, self.load.clone(), self.inertia, self.flywheel)
+        self.rebuilt(motor, self.inertia, self.flywheel)
     }
 
     /// The motor.
@@ -343,20 +510,33 @@ impl DriveModel {
         self.horizon
     }
 
-    /// Mean of ω² over the steady period, `ū = (B − M1)/a`, s⁻².
+    /// Mean of ω² over the steady period (over the shaft angle), `ū = (B − M1)/a`, s⁻²;
+    /// with J(φ) too (the mean of eq. 1 in `w = J·ω²` over the period).
     pub fn u_mean(&self) -> f64 {
         self.u_mean
     }
 
     /// ω² of the periodic solution at shaft angle `phi`, s⁻² (may be ≤ 0 where the drive
-    /// would stall). NaN in, NaN out.
+    /// would stall). NaN in, NaN out. On the J(φ) path each call solves the drive anew: use
+    /// [`Self::steady_curve`] for many angles.
     pub fn omega_squared(&self, phi: f64) -> f64 {
-        self.u_mean + self.oscillation(phi)
+        if self.is_varying() {
+            self.varying_omega_squared(phi)
+        } else {
+            self.u_mean + self.oscillation(phi)
+        }
+    }
+
+    /// Out of line, so that the solution's 64 KiB of stack stay off the constant-inertia path.
+    #[inline(never)]
+    fn varying_omega_squared(&self, phi: f64) -> f64 {
+        self.steady_curve().omega_squared(phi)
     }
 
     /// Steady-state speed at shaft angle `phi`, rad/s, for plots and for comparison with a
     /// simulation; `None` where the periodic solution has `ω² ≤ 0` (check [`Self::predict`]
-    /// for whether the steady state exists at all) or for non-finite `phi`.
+    /// for whether the steady state exists at all) or for non-finite `phi`. On the J(φ) path
+    /// each call solves the drive anew: use [`Self::steady_curve`] for many angles.
     pub fn steady_omega(&self, phi: f64) -> Option<f64> {
         let u = self.omega_squared(phi);
         if u > 0.0 && u.is_finite() {
@@ -366,17 +546,57 @@ impl DriveModel {
         }
     }
 
+    /// `ω² = centre + s` and the extrema of `s`: `ū` and the closed-form oscillation for a
+    /// constant inertia, `w̄/J0` and the J(φ) swing otherwise.
+    fn state(&self) -> (f64, Extremes) {
+        if self.is_varying() {
+            self.varying_state()
+        } else {
+            (self.u_mean, self.extremes())
+        }
+    }
+
+    /// [`Self::state`] on the J(φ) path; out of line, so that the solution's 64 KiB of stack
+    /// stay off the constant-inertia path.
+    #[inline(never)]
+    fn varying_state(&self) -> (f64, Extremes) {
+        match self.varying_solution() {
+            Some(mut sol) => {
+                let e = sol.extremes();
+                (
+                    e.centre,
+                    Extremes {
+                        s_max: e.s_max,
+                        s_min: e.s_min,
+                        phi_max: Some(e.phi_max),
+                        phi_min: Some(e.phi_min),
+                    },
+                )
+            }
+            // Not reached (the constructor solved the same drive); NaN reads as a stall.
+            None => (
+                f64::NAN,
+                Extremes {
+                    s_max: f64::NAN,
+                    s_min: f64::NAN,
+                    phi_max: None,
+                    phi_min: None,
+                },
+            ),
+        }
+    }
+
     /// The steady state and its δ, or the stall.
     pub fn predict(&self) -> Prediction {
-        let ex = self.extremes();
-        let u_min = self.u_mean + ex.s_min;
+        let (centre, ex) = self.state();
+        let u_min = centre + ex.s_min;
         if !exceeds(u_min, 0.0) {
             return Prediction::Stalls(Stall {
                 u_mean: self.u_mean,
                 u_min,
             });
         }
-        let w_max = libm::sqrt(self.u_mean + ex.s_max);
+        let w_max = libm::sqrt(centre + ex.s_max);
         let w_min = libm::sqrt(u_min);
         let w = w_max + w_min;
         // δ from the difference of squares: (ωmax − ωmin) = (smax − smin)/(ωmax + ωmin).
@@ -396,7 +616,15 @@ impl DriveModel {
     /// ∂δ/∂J and ∂δ/∂M_m at the current design, analytic (envelope theorem: the derivative of
     /// an extremum is the partial derivative at the extremal angle). `None` without a steady
     /// state, or when the parameters are so extreme that the derivatives overflow f64.
+    ///
+    /// With J(φ) the phases of the extrema move with the parameters in no closed form: both
+    /// derivatives are central differences of the computed δ with a relative step of 1e-4
+    /// (about 8 significant digits), the inertia step taken on the constant part of J;
+    /// `None` also when a stepped drive cannot be built or stalls.
     pub fn sensitivity(&self) -> Option<Sensitivity> {
+        if self.is_varying() {
+            return self.varying_sensitivity();
+        }
         let ex = self.extremes();
         let (x2, y2) = (self.u_mean + ex.s_max, self.u_mean + ex.s_min);
         if !exceeds(y2, 0.0) {
@@ -492,6 +720,13 @@ impl DriveModel {
     /// answer except where δ barely depends on J, so 200 steps are reached only when the
     /// answer is below about 2⁻¹⁶⁶ of the upper end, and then the returned flywheel still
     /// meets the target, a little oversized.
+    ///
+    /// With J(φ) no closed-form bound exists: the upper end is found by doubling an added
+    /// flywheel from the current total inertia (at most 1100 doublings, past the f64 range),
+    /// then bisected as above. δ falls with the flywheel (both the load's and the inertia's
+    /// share of the swing shrink like 1/J for a large flywheel; the randomised tests check
+    /// monotonicity on a grid), and where it might not, the answer is the first crossing the
+    /// bracket finds, which meets the target.
     pub fn flywheel_for(&self, delta_target: f64) -> Result<f64, DesignError> {
         if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
             return Err(DesignError::InvalidTarget);
@@ -510,6 +745,31 @@ impl DriveModel {
             return Ok(0.0);
         }
         let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
+        if self.is_varying() {
+            let mut hi = self.total_inertia();
+            let mut lo = 0.0;
+            let mut found = false;
+            for _ in 0..MAX_VARYING_DOUBLINGS {
+                match at(hi) {
+                    Some(m) if meets(&m) => {
+                        found = true;
+                        break;
+                    }
+                    Some(_) => {
+                        lo = hi;
+                        hi *= 2.0;
+                        if !(self.flywheel + hi).is_finite() {
+                            break;
+                        }
+                    }
+                    None => break,
+                }
+            }
+            if !found {
+                return Err(DesignError::Unreachable);
+            }
+            return bisect(lo, hi, |x| at(x).map(|m| meets(&m)));
+        }
         let j = self.total_inertia();
         let a = -self.motor.model().a();
         // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
@@ -582,18 +842,48 @@ impl DriveModel {
                 _ => return Err(DesignError::Unreachable),
             }
         }
-        for _ in 0..MAX_BISECTIONS {
-            let mid = lo + (hi - lo) / 2.0;
-            if hi - lo <= 1e-10 * hi || mid <= lo || mid >= hi {
-                break;
-            }
-            match at(mid) {
-                Some(m) if meets(&m) => hi = mid,
-                Some(_) => lo = mid,
-                None => return Err(DesignError::Unreachable),
-            }
+        bisect(lo, hi, |x| at(x).map(|m| meets(&m)))
+    }
+
+    /// ∂δ/∂J and ∂δ/∂M_m by central differences (J(φ) path).
+    fn varying_sensitivity(&self) -> Option<Sensitivity> {
+        const STEP: f64 = 1e-4;
+        let delta = |m: Result<DriveModel, ConfigError>| -> Option<f64> {
+            m.ok()?.predict().steady().map(|s| s.delta)
+        };
+        self.predict().steady()?;
+        let h = STEP * self.total_inertia();
+        let (up, down) = if self.flywheel >= h {
+            (
+                self.rebuilt(self.motor, self.inertia, self.flywheel + h),
+                self.rebuilt(self.motor, self.inertia, self.flywheel - h),
+            )
+        } else {
+            (
+                self.rebuilt(self.motor, self.inertia + h, self.flywheel),
+                self.rebuilt(self.motor, self.inertia - h, self.flywheel),
+            )
+        };
+        let d_inertia = (delta(up)? - delta(down)?) / (2.0 * h);
+        // The whole characteristic scaled by 1 ± STEP: M_m moves by ±STEP·M_m.
+        let scaled = |f: f64| {
+            self.motor
+                .model()
+                .scaled(f)
+                .map(Motor::parabola)
+                .ok_or(ConfigError::OutOfRange("breakdown_torque"))
+                .and_then(|m| self.rebuilt(m, self.inertia, self.flywheel))
+        };
+        let mm = self.motor.model().breakdown_torque();
+        let d_torque =
+            (delta(scaled(1.0 + STEP))? - delta(scaled(1.0 - STEP))?) / (2.0 * STEP * mm);
+        if !(d_inertia.is_finite() && d_torque.is_finite()) {
+            return None;
         }
-        Ok(hi)
+        Some(Sensitivity {
+            d_delta_d_inertia: d_inertia,
+            d_delta_d_breakdown_torque: d_torque,
+        })
     }
 
     /// The `irregularity` summary the host prints, with the flywheel for `delta_limit` when
@@ -615,7 +905,8 @@ impl DriveModel {
                 flywheel_for_limit,
             },
             Prediction::Stalls(_) => {
-                let u_max = self.u_mean + self.extremes().s_max;
+                let (centre, ex) = self.state();
+                let u_max = centre + ex.s_max;
                 Irregularity {
                     omega_max: if u_max > 0.0 { libm::sqrt(u_max) } else { 0.0 },
                     omega_min: 0.0,
@@ -737,6 +1028,54 @@ impl DriveModel {
     }
 }
 
+/// The steady state as a curve over φ ([`DriveModel::steady_curve`]).
+pub struct SteadyCurve<'a> {
+    model: &'a DriveModel,
+    solution: Option<Solution<'a>>,
+}
+
+impl SteadyCurve<'_> {
+    /// ω² of the periodic solution at `phi`, s⁻² (as [`DriveModel::omega_squared`]).
+    pub fn omega_squared(&self, phi: f64) -> f64 {
+        match (&self.solution, self.model.is_varying()) {
+            (Some(s), _) => s.omega_squared(phi),
+            (None, false) => self.model.u_mean + self.model.oscillation(phi),
+            (None, true) => f64::NAN,
+        }
+    }
+
+    /// Steady speed at `phi`, rad/s (as [`DriveModel::steady_omega`]).
+    pub fn steady_omega(&self, phi: f64) -> Option<f64> {
+        let u = self.omega_squared(phi);
+        if u > 0.0 && u.is_finite() {
+            Some(libm::sqrt(u))
+        } else {
+            None
+        }
+    }
+}
+
+/// Bisection between `lo` (target missed) and `hi` (met): the upper end once the bracket is
+/// within 1e-10 relative, after at most [`MAX_BISECTIONS`] steps.
+fn bisect(
+    mut lo: f64,
+    mut hi: f64,
+    meets: impl Fn(f64) -> Option<bool>,
+) -> Result<f64, DesignError> {
+    for _ in 0..MAX_BISECTIONS {
+        let mid = lo + (hi - lo) / 2.0;
+        if hi - lo <= 1e-10 * hi || mid <= lo || mid >= hi {
+            break;
+        }
+        match meets(mid) {
+            Some(true) => hi = mid,
+            Some(false) => lo = mid,
+            None => return Err(DesignError::Unreachable),
+        }
+    }
+    Ok(hi)
+}
+
 struct Extremes {
     s_max: f64,
     s_min: f64,
@@ -749,7 +1088,7 @@ fn exceeds(x: f64, y: f64) -> bool {
     x > y
 }
 
-fn wrap(phi: f64, period: f64) -> f64 {
+pub(super) fn wrap(phi: f64, period: f64) -> f64 {
     if phi < 0.0 {
         phi + period
     } else if phi >= period {
@@ -761,7 +1100,7 @@ fn wrap(phi: f64, period: f64) -> f64 {
 
 /// Golden-section search for the maximum of `sign·f` on `[lo, hi]`; returns the best point
 /// seen and `f` there.
-fn golden(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, sign: f64) -> (f64, f64) {
+pub(super) fn golden(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, sign: f64) -> (f64, f64) {
     const R: f64 = 0.618_033_988_749_894_8;
     let mut x1 = hi - R * (hi - lo);
     let mut x2 = lo + R * (hi - lo);
@@ -895,4 +1234,31 @@ fn horizon(components: &[Component]) -> Horizon {
         },
         _ => Horizon::Unbounded,
     }
+}
+
+/// The common period of `orders` (each a rational with denominator ≤ [`MAX_DENOMINATOR`]) and
+/// how many cycles of the fastest one it holds; `None` without one, or when it holds more than
+/// `MAX_SAMPLES/SAMPLES_PER_CYCLE` cycles, or with no orders at all.
+fn common_period(orders: impl Iterator<Item = f64> + Clone) -> Option<(f64, u64)> {
+    let mut q_all: u64 = 1;
+    let mut any = false;
+    for o in orders.clone() {
+        let (_, q) = rational(o)?;
+        q_all = (q_all / gcd(q_all, q)).checked_mul(q)?;
+        any = true;
+    }
+    if !any {
+        return None;
+    }
+    let (mut g, mut m_max) = (0u64, 0u64);
+    for o in orders {
+        let (p, q) = rational(o)?;
+        let m = p.checked_mul(q_all / q)?;
+        g = gcd(g, m);
+        m_max = m_max.max(m);
+    }
+    if g == 0 || m_max / g > MAX_SAMPLES / SAMPLES_PER_CYCLE {
+        return None;
+    }
+    Some((2.0 * PI * q_all as f64 / g as f64, m_max / g))
 }

@@ -369,6 +369,12 @@ pub fn core_keys(section: &str, parameter: &str) -> Vec<String> {
         ("shaft", "inertia") => &["shaft.inertia"],
         ("shaft", "flywheel") => &["shaft.flywheel"],
         ("shaft", "shaft.harmonics") => &["shaft.inertia_harmonics", "shaft.inertia"],
+        ("shaft", "inertia_harmonic.order" | "inertia_harmonic.phase" | "inertia_harmonics") => {
+            &["shaft.inertia_harmonics"]
+        }
+        ("shaft", "inertia_harmonic.amplitude") => {
+            &["shaft.inertia_harmonics", "shaft.inertia", "shaft.flywheel"]
+        }
         ("shaft", "shaft.omega" | "shaft.omega0") => &["motor.speed", "shaft.initial_speed"],
         ("load.harmonics", "order") => &["load.harmonics"],
         // drive_monitor::balancer::MachineConfig, from [[platform]], [[coupling]] and

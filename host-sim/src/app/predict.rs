@@ -5,7 +5,9 @@ use crate::app::scene::{BalancerKindSpec, MotorSpec, Scene, SceneError};
 use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, Coupling, Machine, MachineConfig, Platform, SearchOptions,
 };
-use drive_monitor::drive::{DriveModel, Harmonic, Kloss, KlossFit, Load, Motor, Parabola};
+use drive_monitor::drive::{
+    DriveModel, Harmonic, InertiaHarmonic, Kloss, KlossFit, Load, Motor, Parabola,
+};
 use drive_monitor::supports::{Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance};
 use drive_monitor::ConfigError;
 use serde::Serialize;
@@ -28,8 +30,62 @@ pub fn core_error(scene: &Scene, file: &Path, section: &str, e: ConfigError) -> 
 }
 
 /// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
-/// or without a `[load]`).
+/// or without a `[load]`), with J(φ) from `[shaft] inertia_harmonics`. Where the core does
+/// not predict that J(φ) ([`irregularity_not_predicted`] says why) the model has the constant
+/// inertia, for what does not depend on it (the motor, the mean of ω²).
 pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
+    let Some(base) = constant_inertia_model(scene, file)? else {
+        return Ok(None);
+    };
+    match with_inertia(scene, &base) {
+        Ok(m) => Ok(Some(m)),
+        Err(e) if not_covered(e).is_some() => Ok(Some(base)),
+        Err(e) => Err(core_error(scene, file, "shaft", e)),
+    }
+}
+
+/// The scene's inertia harmonics on `base` (`base` itself without any).
+fn with_inertia(scene: &Scene, base: &DriveModel) -> Result<DriveModel, ConfigError> {
+    let Some(shaft) = &scene.shaft else {
+        return Ok(base.clone());
+    };
+    if shaft.inertia_harmonics.iter().all(|h| h.amplitude == 0.0) {
+        return Ok(base.clone());
+    }
+    let harmonics = shaft
+        .inertia_harmonics
+        .iter()
+        .map(|h| InertiaHarmonic::new(h.order, h.amplitude, h.phase))
+        .collect::<Result<Vec<_>, _>>()?;
+    base.with_inertia_harmonics(&harmonics)
+}
+
+/// Why the core does not predict a J(φ) it rejected with `e`, if `e` is such a limit of the
+/// core's J(φ) path rather than an invalid scene.
+fn not_covered(e: ConfigError) -> Option<String> {
+    match e {
+        ConfigError::Inconsistent("inertia_harmonic.order") => Some(format!(
+            "shaft.inertia_harmonics: its orders and the load's have no common period the core \
+             handles (each a fraction with denominator ≤ {}, the period at most {} cycles of \
+             the fastest order)",
+            drive_monitor::drive::MAX_DENOMINATOR,
+            drive_monitor::drive::MAX_SAMPLES / drive_monitor::drive::SAMPLES_PER_CYCLE
+        )),
+        ConfigError::OutOfRange("inertia_harmonics") => Some(format!(
+            "shaft.inertia_harmonics: J(φ) comes so close to 0, or the common period holds so \
+             many of its cycles, that the periodic solution needs more than {} trapezoid nodes",
+            drive_monitor::drive::MAX_NODES
+        )),
+        ConfigError::Capacity("inertia_harmonics") => Some(format!(
+            "shaft.inertia_harmonics: more than {} harmonics",
+            drive_monitor::drive::MAX_INERTIA_HARMONICS
+        )),
+        _ => None,
+    }
+}
+
+/// The drive model with the constant part of the inertia only.
+fn constant_inertia_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
     let (Some(motor), Some(load)) = (&scene.motor, &scene.load) else {
         return Ok(None);
     };
@@ -116,7 +172,7 @@ pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
                 .reduce(f64::min)?;
             std::f64::consts::TAU / order
         }
-        Horizon::Period { radians, .. } => radians,
+        Horizon::Period { radians, .. } | Horizon::Varying { radians, .. } => radians,
         Horizon::Unbounded => return None,
     };
     if !(span > 0.0 && period > 0.0) {
@@ -131,10 +187,11 @@ pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
     let steps = steps as usize;
     // Time per radian on the grid from −span to the period, and its running integral.
     let mut time = Vec::with_capacity(steps + per_span + 1);
-    let mut last = 1.0 / model.steady_omega(-span)?;
+    let curve = model.steady_curve();
+    let mut last = 1.0 / curve.steady_omega(-span)?;
     time.push(0.0);
     for j in 1..=steps + per_span {
-        let f = 1.0 / model.steady_omega(-span + j as f64 * h)?;
+        let f = 1.0 / curve.steady_omega(-span + j as f64 * h)?;
         time.push(time[j - 1] + 0.5 * h * (last + f));
         last = f;
     }
@@ -448,6 +505,29 @@ pub struct IrregularityOut {
     /// predicted speeds ([`kloss_note`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motor_note: Option<String>,
+    /// With `[shaft] inertia_harmonics`: how the J(φ) steady state was computed (absent for a
+    /// constant inertia).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inertia_note: Option<String>,
+}
+
+/// How a J(φ) steady state was computed (`None` for a constant inertia).
+pub fn inertia_note(model: &DriveModel) -> Option<String> {
+    let drive_monitor::drive::Horizon::Varying { radians, nodes } = model.horizon() else {
+        return None;
+    };
+    Some(format!(
+        "J(φ) from shaft.inertia_harmonics ({} harmonic{}): eq. 1, linear in w = J·ω², solved \
+         over its period of {:.4} rad by the trapezoid rule on {nodes} nodes; ∂δ/∂J and \
+         ∂δ/∂M_m by central differences",
+        model.inertia_harmonics().len(),
+        if model.inertia_harmonics().len() == 1 {
+            ""
+        } else {
+            "s"
+        },
+        radians
+    ))
 }
 
 /// What a Kloss motor's prediction stands on: the closed form (seed 000 eq. 11–13) needs a
@@ -542,20 +622,18 @@ impl Prediction {
     }
 }
 
-/// Why the steady-state δ of a scene's drive is not predicted, when it is not: the closed form
-/// (seed 000, eq. 11–13) and the flywheel sizing hold for a constant inertia, and
-/// `[shaft] inertia_harmonics` makes J depend on φ (its ½·ω²·dJ/dφ term alone makes ω swing,
-/// ω ∝ 1/√J(φ) without any load ripple). `run` simulates such a drive; the prediction would
-/// silently leave the variation out.
+/// Why the steady-state δ of a scene's drive is not predicted, when it is not. A J(φ) from
+/// `[shaft] inertia_harmonics` is predicted by the core (eq. 1 solved in `w = J·ω²` over one
+/// common period); what its J(φ) path does not cover is named here: orders without a common
+/// period, a J(φ) so close to 0 that the solution needs more nodes than the core holds, more
+/// harmonics than it holds. A constant-inertia prediction would silently leave the variation
+/// out (its ½·ω²·dJ/dφ term alone makes ω swing), so none is given; `run` simulates the drive.
 pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
-    let shaft = scene.shaft.as_ref()?;
-    let varying = shaft.inertia_harmonics.iter().any(|h| h.amplitude != 0.0);
-    varying.then(|| {
-        "shaft.inertia_harmonics makes J depend on φ; the closed form (seed 000 eq. 11–13) and \
-         the flywheel sizing hold for a constant J only, so no δ is predicted (`drive-sim run` \
-         simulates J(φ))"
-            .to_string()
-    })
+    let base = constant_inertia_model(scene, Path::new("scene")).ok()??;
+    let why = not_covered(with_inertia(scene, &base).err()?)?;
+    Some(format!(
+        "{why}; δ is not predicted for this J(φ) (`drive-sim run` simulates it)"
+    ))
 }
 
 /// Computes the design-time results of `scene`.
@@ -575,6 +653,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         p.irregularity = Some(IrregularityOut {
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
+            inertia_note: inertia_note(&model),
             motor_note: kloss_note(
                 model.motor(),
                 irr.omega_min,

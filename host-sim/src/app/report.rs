@@ -455,7 +455,12 @@ pub fn prediction_text(p: &Prediction) -> String {
     if let Some(i) = &p.irregularity {
         let _ = writeln!(
             s,
-            "Predicted running irregularity (steady state, seed 000 eq. 11–13)"
+            "Predicted running irregularity (steady state, {})",
+            if i.inertia_note.is_some() {
+                "seed 000 eq. 1 with J(φ)"
+            } else {
+                "seed 000 eq. 11–13"
+            }
         );
         if i.steady_state {
             let _ = writeln!(
@@ -490,6 +495,9 @@ pub fn prediction_text(p: &Prediction) -> String {
             let _ = writeln!(s, "  {w}");
         }
         if let Some(n) = &i.motor_note {
+            let _ = writeln!(s, "  {n}");
+        }
+        if let Some(n) = &i.inertia_note {
             let _ = writeln!(s, "  {n}");
         }
     }
