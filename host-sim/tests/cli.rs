@@ -119,6 +119,81 @@ fn sweep_json_keeps_its_contract() {
     assert_eq!(v["agreeing"], 3);
 }
 
+/// A bundled scene with some text replaced, written to a file of its own.
+fn variant(scene: &str, name: &str, edits: &[(&str, &str)]) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("drive-sim-variant-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/").to_string() + scene + ".toml";
+    let mut text = std::fs::read_to_string(path).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{scene}: {from}");
+        text = text.replace(from, to);
+    }
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// `predict` never gives numbers that look like a result where there is none: a stalled
+/// drive's δ, speeds are null (they were δ 2 and ω max 18.7) with the reason; a flywheel beyond
+/// any scene's range is "none within range" with the figure (1.06e10 kg·m² was printed as the
+/// design); a speed below the breakdown speed is warned of; an unbalance over its permissible
+/// is flagged (only `run` did), and the allocation rule is named.
+#[test]
+fn predict_says_what_its_numbers_are() {
+    let stall = variant("kneader", "stall.toml", &[("mean = 24.0", "mean = 170.0")]);
+    let v = json(&["predict", stall.to_str().unwrap(), "--json"]);
+    let i = &v["irregularity"];
+    assert_eq!(i["steady_state"], false);
+    for k in ["delta", "omega_max", "omega_min"] {
+        assert!(i[k].is_null(), "{k}: {i}");
+    }
+    assert!(i["stall"].as_str().unwrap().contains("mean load"), "{i}");
+
+    let tiny = variant(
+        "kneader",
+        "tiny.toml",
+        &[("delta_limit = 0.06", "delta_limit = 1e-12")],
+    );
+    let v = json(&["predict", tiny.to_str().unwrap(), "--json"]);
+    let i = &v["irregularity"];
+    assert!(i["flywheel_for_limit"].is_null(), "{i}");
+    assert!(i["flywheel_beyond_range"].as_f64().unwrap() > 1e9, "{i}");
+    let (_, out, _) = drive_sim(&["predict", tiny.to_str().unwrap()]);
+    assert!(
+        out.contains("no flywheel within `shaft.flywheel`'s range"),
+        "{out}"
+    );
+
+    let low = variant(
+        "kneader",
+        "low.toml",
+        &[
+            ("mean = 24.0", "mean = 150.0"),
+            ("amplitude = 12.0", "amplitude = 40.0"),
+        ],
+    );
+    let v = json(&["predict", low.to_str().unwrap(), "--json"]);
+    let w = v["irregularity"]["working_branch_warning"]
+        .as_str()
+        .unwrap();
+    assert!(w.contains("below the motor's breakdown speed"), "{w}");
+
+    let heavy = variant(
+        "auger",
+        "heavy.toml",
+        &[("amount = 2.0e-3", "amount = 0.2")],
+    );
+    let v = json(&["predict", heavy.to_str().unwrap(), "--json"]);
+    let s = &v["supports"];
+    assert_eq!(s["unbalance_level"][0], "over", "{s}");
+    assert_eq!(s["allocation"], "inboard");
+    let v = json(&["predict", "auger", "--json"]);
+    assert_eq!(v["supports"]["unbalance_level"][0], "normal");
+    let v = json(&["predict", "auger-overhung", "--json"]);
+    assert_eq!(v["supports"]["allocation"], "overhung");
+}
+
 /// A sweep above the speed range every scene speed has is refused at once, naming `--to`
 /// (it ran for minutes, then blamed `simulation.duration` for too many integrator steps).
 #[test]

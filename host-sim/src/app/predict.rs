@@ -478,18 +478,30 @@ pub struct AutobalancerOut {
 /// `irregularity` member of `predict --json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct IrregularityOut {
-    /// Largest steady-state speed, rad/s.
-    pub omega_max: f64,
-    /// Smallest steady-state speed, rad/s (0 when the drive stalls).
-    pub omega_min: f64,
-    /// δ = 2(ωmax − ωmin)/(ωmax + ωmin).
-    pub delta: f64,
+    /// Largest steady-state speed, rad/s (null without a steady state).
+    pub omega_max: Option<f64>,
+    /// Smallest steady-state speed, rad/s (null without a steady state).
+    pub omega_min: Option<f64>,
+    /// δ = 2(ωmax − ωmin)/(ωmax + ωmin) (null without a steady state: the drive stalls).
+    pub delta: Option<f64>,
     /// Whether a steady state exists (false: the motor stalls under the peak load).
     pub steady_state: bool,
     /// Extra flywheel for `[monitor] delta_limit`, kg·m² (0 if already within; absent
-    /// without a limit; null when no flywheel can reach it).
+    /// without a limit; null when no flywheel within `shaft.flywheel`'s range reaches it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub flywheel_for_limit: Option<Option<f64>>,
+    /// Without a steady state, why: the mean load alone exceeds the motor's stall torque (no
+    /// flywheel helps), or the peak load stalls it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stall: Option<&'static str>,
+    /// ω min below the motor's breakdown speed: off the working branch the characteristic
+    /// stands for (a real motor's torque falls past its breakdown point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub working_branch_warning: Option<String>,
+    /// The flywheel the limit would need when it is beyond `shaft.flywheel`'s range (up to
+    /// 1e9 kg·m²), kg·m².
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flywheel_beyond_range: Option<f64>,
     /// ∂δ/∂J, per kg·m².
     pub d_delta_d_inertia: Option<f64>,
     /// ∂δ/∂M_m, per N·m.
@@ -592,6 +604,27 @@ pub struct SupportsOut {
     pub static_load: [f64; 2],
     /// Peak support loads over one turn at the service speed, N.
     pub peak_load_at_service_speed: [f64; 2],
+    /// Each plane's unbalance against its permissible share: "normal" | "warning" | "over"
+    /// (warning above `rotor.warning_fraction` of it).
+    pub unbalance_level: [&'static str; 2],
+    /// Each peak load at the service speed against `support_load_limit` (null without).
+    pub load_level: Option<[&'static str; 2]>,
+    /// How the permissible unbalance was allotted to the planes: "inboard" (ISO 21940-11's
+    /// lever rule, shares held within 30–70 %) or "overhung" (this product's rule:
+    /// `supports::Allocation::Overhung`).
+    pub allocation: &'static str,
+}
+
+/// "normal" up to `fraction·limit`, "warning" up to `limit`, "over" above (in f64, as the
+/// design computes them).
+fn level_of(value: f64, fraction: f64, limit: f64) -> &'static str {
+    if value > limit {
+        "over"
+    } else if value > fraction * limit {
+        "warning"
+    } else {
+        "normal"
+    }
 }
 
 /// All design-time results of a scene.
@@ -650,7 +683,33 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             .map_err(|e| core_error(scene, file, "monitor", e))?;
         let sens = model.sensitivity();
         let sampled = sampled_delta(scene, file, &model)?;
+        let prediction = model.predict();
+        let stall = match prediction {
+            drive_monitor::drive::Prediction::Stalls(s) if s.u_mean <= 0.0 => Some(
+                "the mean load exceeds the motor's torque at standstill: no speed and no \
+                 flywheel carry it",
+            ),
+            drive_monitor::drive::Prediction::Stalls(_) => Some(
+                "the motor stalls under the peak load (it carries the mean load: more \
+                 flywheel can help)",
+            ),
+            _ => None,
+        };
+        let working_branch_warning = prediction
+            .steady()
+            .filter(|s| !s.within_working_branch)
+            .map(|s| {
+                format!(
+                    "WARNING: ω min {:.3} rad/s is below the motor's breakdown speed {:.3} rad/s: \
+                     the characteristic stands for a real motor only above it (past its \
+                     breakdown point a real motor's torque falls, and it may stall)",
+                    s.omega_min,
+                    model.motor().model().working_min_speed()
+                )
+            });
         p.irregularity = Some(IrregularityOut {
+            stall,
+            working_branch_warning,
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
@@ -659,11 +718,19 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 irr.omega_min,
                 if irr.steady_state { irr.omega_max } else { 0.0 },
             ),
-            omega_max: irr.omega_max,
-            omega_min: irr.omega_min,
-            delta: irr.delta,
+            // Without a steady state the core's numbers describe the stall, not a δ.
+            omega_max: irr.steady_state.then_some(irr.omega_max),
+            omega_min: irr.steady_state.then_some(irr.omega_min),
+            delta: irr.steady_state.then_some(irr.delta),
             steady_state: irr.steady_state,
-            flywheel_for_limit: limit.map(|_| irr.flywheel_for_limit),
+            // A flywheel no scene may hold is no design: "none within range", and how much.
+            flywheel_for_limit: limit.map(|_| {
+                irr.flywheel_for_limit
+                    .filter(|&j| j <= crate::app::check::MAX_INERTIA)
+            }),
+            flywheel_beyond_range: irr
+                .flywheel_for_limit
+                .filter(|&j| limit.is_some() && j > crate::app::check::MAX_INERTIA),
             d_delta_d_inertia: sens.map(|s| s.d_delta_d_inertia),
             d_delta_d_breakdown_torque: sens.map(|s| s.d_delta_d_breakdown_torque),
         });
@@ -680,6 +747,17 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             max_speed: r.max_speed.filter(|v| v.is_finite()),
             static_load: [a.static_load[0].norm(), a.static_load[1].norm()],
             peak_load_at_service_speed: [loads[0].peak, loads[1].peak],
+            unbalance_level: [
+                level_of(r.unbalance_a, limits.warning_fraction(), r.permissible_a),
+                level_of(r.unbalance_b, limits.warning_fraction(), r.permissible_b),
+            ],
+            load_level: limits
+                .support_load_limit()
+                .map(|l| [0, 1].map(|i| level_of(loads[i].peak, limits.warning_fraction(), l[i]))),
+            allocation: match a.permissible.allocation {
+                drive_monitor::supports::Allocation::Inboard => "inboard",
+                drive_monitor::supports::Allocation::Overhung => "overhung",
+            },
         });
     }
     if let Some(m) = machine(scene, file)? {

@@ -462,16 +462,21 @@ pub fn prediction_text(p: &Prediction) -> String {
                 "seed 000 eq. 11–13"
             }
         );
-        if i.steady_state {
+        if let (Some(max), Some(min), Some(d)) = (i.omega_max, i.omega_min, i.delta) {
             let _ = writeln!(
                 s,
-                "  ω max {:.3} rad/s, ω min {:.3} rad/s, δ = {}",
-                i.omega_max,
-                i.omega_min,
-                fmt_delta(i.delta)
+                "  ω max {max:.3} rad/s, ω min {min:.3} rad/s, δ = {}",
+                fmt_delta(d)
             );
+            if let Some(w) = &i.working_branch_warning {
+                let _ = writeln!(s, "  {w}");
+            }
         } else {
-            let _ = writeln!(s, "  no steady state: the motor stalls under the peak load");
+            let _ = writeln!(
+                s,
+                "  no steady state: {}",
+                i.stall.unwrap_or("the motor stalls under the peak load")
+            );
         }
         match i.flywheel_for_limit {
             Some(Some(j)) if j > 0.0 => {
@@ -480,9 +485,19 @@ pub fn prediction_text(p: &Prediction) -> String {
             Some(Some(_)) => {
                 let _ = writeln!(s, "  within the δ limit without a flywheel");
             }
-            Some(None) => {
-                let _ = writeln!(s, "  no flywheel reaches the δ limit");
-            }
+            Some(None) => match i.flywheel_beyond_range {
+                Some(j) => {
+                    let _ = writeln!(
+                        s,
+                        "  no flywheel within `shaft.flywheel`'s range (at most {:e} kg·m²) \
+                         reaches the δ limit: it would take {j:.4e} kg·m²",
+                        crate::app::check::MAX_INERTIA
+                    );
+                }
+                None => {
+                    let _ = writeln!(s, "  no flywheel reaches the δ limit");
+                }
+            },
             None => {}
         }
         if let (Some(dj), Some(dm)) = (i.d_delta_d_inertia, i.d_delta_d_breakdown_torque) {
@@ -508,16 +523,33 @@ pub fn prediction_text(p: &Prediction) -> String {
         let _ = writeln!(s, "Support unbalance (seed 002) and limits (ISO 21940-11)");
         let _ = writeln!(
             s,
-            "  equivalent unbalance: A {:.4e} kg·m (permissible {:.4e}), B {:.4e} kg·m (permissible {:.4e})",
-            u.unbalance_a, u.permissible_a, u.unbalance_b, u.permissible_b
+            "  equivalent unbalance: A {:.4e} kg·m (permissible {:.4e}: {}), B {:.4e} kg·m (permissible {:.4e}: {})",
+            u.unbalance_a,
+            u.permissible_a,
+            u.unbalance_level[0],
+            u.unbalance_b,
+            u.permissible_b,
+            u.unbalance_level[1]
         );
         let _ = writeln!(
             s,
-            "  static loads A {} N, B {} N; peak at service speed A {} N, B {} N",
+            "  permissible allotted {}",
+            if u.allocation == "inboard" {
+                "by the lever, each plane within 30–70 % of U_per (ISO 21940-11, inboard rotor)"
+            } else {
+                "by the lever of U_per at the centre of mass, the far plane at least 30 % of \
+                 U_per (overhung rotor: this product's rule)"
+            }
+        );
+        let _ = writeln!(
+            s,
+            "  static loads A {} N, B {} N; peak at service speed A {} N, B {} N{}",
             fmt_force(u.static_load[0]),
             fmt_force(u.static_load[1]),
             fmt_force(u.peak_load_at_service_speed[0]),
-            fmt_force(u.peak_load_at_service_speed[1])
+            fmt_force(u.peak_load_at_service_speed[1]),
+            u.load_level
+                .map_or(String::new(), |l| format!(" ({}, {})", l[0], l[1]))
         );
         match u.max_speed {
             Some(w) => {
