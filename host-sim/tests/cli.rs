@@ -264,6 +264,15 @@ fn an_alarm_that_judged_no_window_says_why() {
     assert!(text.contains("timer_hz = 4e6") && text.contains("delta_limit = 0.02"));
     let path = dir.join("blind-alarm.toml");
     std::fs::write(&path, text).unwrap();
+    // predict foresees it from the predicted speed: 2·ω̄/(K·timer_hz·pitch) = 1.09e-2.
+    let v = json(&["predict", path.to_str().unwrap(), "--json"]);
+    let w = v["irregularity"]["alarm_floor_warning"].as_str().unwrap();
+    assert!(
+        w.contains("1.09e-2") && w.contains("above 0.2 of the δ limit 0.02"),
+        "{w}"
+    );
+    let v = json(&["predict", "kneader", "--json"]);
+    assert!(v["irregularity"]["alarm_floor_warning"].is_null());
     let v = json(&["run", path.to_str().unwrap(), "--json"]);
     assert!(v["delta_measured"].as_f64().unwrap() > 0.03);
     assert_eq!(v["alarms"].as_array().unwrap().len(), 0);

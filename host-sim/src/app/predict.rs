@@ -498,6 +498,10 @@ pub struct IrregularityOut {
     /// stands for (a real motor's torque falls past its breakdown point).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub working_branch_warning: Option<String>,
+    /// The δ alarm could judge no window: the noise floor at the predicted speed is above the
+    /// fraction of `delta_limit` the core's alarm requires (its `floor_fraction`, 0.2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alarm_floor_warning: Option<String>,
     /// The flywheel the limit would need when it is beyond `shaft.flywheel`'s range (up to
     /// 1e9 kg·m²), kg·m².
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -615,6 +619,33 @@ pub struct SupportsOut {
     pub allocation: &'static str,
 }
 
+/// The warning when the δ alarm of `scene` could judge no window at the predicted speed: a
+/// window's noise floor is 2/(K·ticks per interval) (`irregularity`'s), that is
+/// 2·ω̄/(K·timer_hz·pitch) for `K = encoder.estimator_edges` edges of `pitch` rad each, and
+/// the core's alarm counts a window only when it is at most `floor_fraction` (0.2) of the
+/// limit.
+fn alarm_floor_warning(
+    scene: &Scene,
+    file: &Path,
+    limit: Option<f64>,
+    prediction: &drive_monitor::drive::Prediction,
+) -> Result<Option<String>, SceneError> {
+    let (Some(e), Some(limit), Some(steady)) = (&scene.encoder, limit, prediction.steady()) else {
+        return Ok(None);
+    };
+    let wheel = crate::app::check::wheel(e, &scene.checker(file))?;
+    let pitch = std::f64::consts::TAU * f64::from(e.prescaler) / wheel.teeth.len().max(1) as f64;
+    let floor = 2.0 * steady.omega_rms / (f64::from(e.estimator_edges) * e.timer_hz * pitch);
+    let fraction = drive_monitor::alarm::AlarmConfig::new(limit as f32).floor_fraction;
+    Ok((floor > f64::from(fraction) * limit).then(|| {
+        format!(
+            "WARNING: at the predicted mean speed a window's noise floor is {floor:.2e}, above \
+             {fraction} of the δ limit {limit}: the core's alarm would judge no window (a \
+             faster `encoder.timer_hz` or more `encoder.estimator_edges` lower the floor)"
+        )
+    }))
+}
+
 /// "normal" up to `fraction·limit`, "warning" up to `limit`, "over" above (in f64, as the
 /// design computes them).
 fn level_of(value: f64, fraction: f64, limit: f64) -> &'static str {
@@ -707,7 +738,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                     model.motor().model().working_min_speed()
                 )
             });
+        let alarm_floor_warning = alarm_floor_warning(scene, file, limit, &prediction)?;
         p.irregularity = Some(IrregularityOut {
+            alarm_floor_warning,
             stall,
             working_branch_warning,
             delta_through_samples: sampled.map(|s| s.delta),

@@ -468,7 +468,10 @@ pub fn prediction_text(p: &Prediction) -> String {
                 "  ω max {max:.3} rad/s, ω min {min:.3} rad/s, δ = {}",
                 fmt_delta(d)
             );
-            if let Some(w) = &i.working_branch_warning {
+            for w in [&i.working_branch_warning, &i.alarm_floor_warning]
+                .into_iter()
+                .flatten()
+            {
                 let _ = writeln!(s, "  {w}");
             }
         } else {
