@@ -313,7 +313,7 @@ pub struct AnalyzeReport {
     /// Revolutions a window spans (`--window-revolutions`, or the scene's).
     pub window_revolutions: u16,
     /// Faults by kind: glitches, missing edges, extra edges, missing frames, reversals,
-    /// timeouts.
+    /// timeouts, unexplained edges.
     pub glitches: u32,
     /// Missing edges.
     pub missing: u32,
@@ -325,6 +325,9 @@ pub struct AnalyzeReport {
     pub reversals: u32,
     /// Timeouts.
     pub timeouts: u32,
+    /// Edges taken as teeth that no judgement explained (two faults close together, most
+    /// likely).
+    pub unexplained: u32,
     /// Times the frame was found and confirmed, and lost.
     pub syncs: u32,
     /// Times sync was lost.
@@ -723,6 +726,7 @@ pub fn analyze<R: BufRead>(
     report.missing_frames = e.missing_frames;
     report.reversals = e.reversals;
     report.timeouts = e.timeouts;
+    report.unexplained = e.unexplained;
     report.syncs = e.syncs;
     report.sync_losses = e.sync_losses;
     report.valid_windows = d.valid_windows;
@@ -1125,8 +1129,8 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     let _ = writeln!(
         s,
-        "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts",
-        r.glitches, r.missing, r.extra, r.missing_frames, r.reversals, r.timeouts
+        "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts, {} unexplained edges",
+        r.glitches, r.missing, r.extra, r.missing_frames, r.reversals, r.timeouts, r.unexplained
     );
     match r.sync_acquired {
         Some(t) => {
