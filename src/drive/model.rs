@@ -1,7 +1,10 @@
 //! Steady state of the drive (seed 000, eq. 11–13), its irregularity δ, flywheel sizing and
 //! sensitivities. A reduced inertia that depends on φ ([`DriveModel::with_inertia_harmonics`])
 //! takes the path of the `varying` module (eq. 1 solved exactly in `w = J·ω²` over one
-//! period); what follows is the constant-inertia form, which that path reproduces.
+//! period); a Kloss motor, with a constant inertia or J(φ), the path of the `shooting` module
+//! (eq. 1 with the Kloss curve itself, integrated over one period by a sixth-order Runge–Kutta
+//! method, Newton on the periodic start: [`Horizon::Shooting`]); what follows is the
+//! constant-inertia parabola form, which both paths reproduce.
 //!
 //! ## Derivation
 //! With constant reduced inertia `J` (machine plus flywheel), eq. 1 reads
@@ -31,8 +34,10 @@
 
 use super::load::{Harmonic, Load, MAX_HARMONICS};
 use super::motor::Motor;
+use super::shooting::{Characteristic, Failure, Shooter, Shot};
 use super::varying::{self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS};
 use crate::error::{non_negative, positive, ConfigError};
+use core::cell::Cell;
 use core::f64::consts::PI;
 
 /// Samples per period of the fastest harmonic when the extrema are searched numerically.
@@ -91,6 +96,17 @@ pub enum Horizon {
         /// [`MAX_NODES`](crate::drive::MAX_NODES)).
         nodes: u32,
     },
+    /// A Kloss motor: the periodic solution of eq. 1 with the Kloss curve itself, by shooting
+    /// over one common period of the load (and inertia) orders with a sixth-order Runge–Kutta
+    /// method on `steps` equal steps and Newton's method on the start (see the `shooting`
+    /// module docs); its extrema found on the steps and refined by golden section.
+    Shooting {
+        /// Common period of all load and inertia harmonics, rad.
+        radians: f64,
+        /// Runge–Kutta steps over that period (at most
+        /// [`MAX_STEPS`](crate::drive::MAX_STEPS)).
+        steps: u32,
+    },
 }
 
 /// A periodic steady state.
@@ -114,7 +130,8 @@ pub struct SteadyState {
     /// How the extrema were found.
     pub horizon: Horizon,
     /// `ωmin ≥` the motor's breakdown speed: the speed stays on the motor's stable working
-    /// branch, where the parabola stands for the real characteristic (see the motor module).
+    /// branch, where the parabola stands for the real characteristic (see the motor module)
+    /// and a Kloss motor's period map contracts.
     pub within_working_branch: bool,
 }
 
@@ -247,6 +264,28 @@ impl Component {
     }
 }
 
+/// Which way the steady state is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Path {
+    /// Closed form for a parabola motor with constant inertia, the J(φ) solution for a parabola
+    /// with inertia harmonics, shooting for a Kloss motor.
+    Auto,
+    /// The J(φ) solution even for a constant inertia (tests).
+    Varying,
+    /// Shooting with the parabola (tests).
+    #[cfg_attr(not(test), allow(dead_code))]
+    ShootingParabola,
+}
+
+/// The shooting's outcome, computed when the model is built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Exact {
+    Steady(Shot),
+    Stalls(Stall),
+}
+
 /// The validated drive: motor, load, reduced inertia and flywheel, with the steady-state
 /// coefficients computed once.
 #[derive(Debug, Clone, PartialEq)]
@@ -264,6 +303,9 @@ pub struct DriveModel {
     horizon: Horizon,
     /// The harmonics of J(φ) with a non-zero amplitude (empty: constant inertia).
     inertia_harmonics: heapless::Vec<InertiaHarmonic, MAX_INERTIA_HARMONICS>,
+    path: Path,
+    /// The periodic solution by shooting ([`Horizon::Shooting`]; a Kloss motor).
+    exact: Option<Exact>,
 }
 
 impl DriveModel {
@@ -271,7 +313,7 @@ impl DriveModel {
     /// (kg·m², ≥ 0). Rejects parameter combinations whose steady-state coefficients
     /// overflow f64.
     pub fn new(motor: Motor, load: Load, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
-        Self::build(motor, load, inertia, flywheel, &[], false)
+        Self::build(motor, load, inertia, flywheel, &[], Path::Auto)
     }
 
     /// The same drive with a reduced inertia that depends on the shaft angle,
@@ -299,7 +341,7 @@ impl DriveModel {
             self.inertia,
             self.flywheel,
             harmonics,
-            false,
+            self.path,
         )
     }
 
@@ -319,7 +361,22 @@ impl DriveModel {
             self.inertia,
             self.flywheel,
             &h,
-            true,
+            Path::Varying,
+        )
+    }
+
+    /// The same drive by shooting with its parabola, for the tests that check the shooting
+    /// against the closed form.
+    #[cfg(test)]
+    pub(super) fn on_shooting_path(&self) -> Result<Self, ConfigError> {
+        let h = self.inertia_harmonics.clone();
+        Self::build(
+            self.motor,
+            self.load.clone(),
+            self.inertia,
+            self.flywheel,
+            &h,
+            Path::ShootingParabola,
         )
     }
 
@@ -330,14 +387,7 @@ impl DriveModel {
     /// Rebuilds with other motor and inertias, keeping the inertia harmonics and the path.
     fn rebuilt(&self, motor: Motor, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
         let h = self.inertia_harmonics.clone();
-        Self::build(
-            motor,
-            self.load.clone(),
-            inertia,
-            flywheel,
-            &h,
-            self.is_varying(),
-        )
+        Self::build(motor, self.load.clone(), inertia, flywheel, &h, self.path)
     }
 
     fn build(
@@ -346,7 +396,7 @@ impl DriveModel {
         inertia: f64,
         flywheel: f64,
         inertia_harmonics: &[InertiaHarmonic],
-        force_varying: bool,
+        path: Path,
     ) -> Result<Self, ConfigError> {
         let inertia = positive("inertia", inertia)?;
         let flywheel = non_negative("flywheel", flywheel)?;
@@ -407,13 +457,141 @@ impl DriveModel {
             components,
             horizon: Horizon::Constant,
             inertia_harmonics: kept,
+            path,
+            exact: None,
         };
-        model.horizon = if model.inertia_harmonics.is_empty() && !force_varying {
+        let curve = match path {
+            Path::Auto => model.motor.kloss_curve().map(|k| Characteristic::Kloss(*k)),
+            Path::ShootingParabola => Some(Characteristic::Parabola(*model.motor.model())),
+            Path::Varying => None,
+        };
+        if let Some(curve) = curve {
+            if model.shoot(curve)? {
+                return Ok(model);
+            }
+        }
+        model.horizon = if model.inertia_harmonics.is_empty() && path != Path::Varying {
             horizon(&model.components)
         } else {
             model.varying_horizon()?
         };
         Ok(model)
+    }
+
+    /// The steady state by shooting with `curve`; `Ok(false)` (the closed form stands in) for
+    /// a constant inertia and load orders with no common period, where no periodic solution
+    /// exists: the tangent parabola's [`Horizon::Unbounded`] bound is used then. Out of line:
+    /// design-time code, off the parabola's path.
+    #[inline(never)]
+    fn shoot(&mut self, curve: Characteristic) -> Result<bool, ConfigError> {
+        let orders = self
+            .load
+            .harmonics()
+            .iter()
+            .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
+            .map(Harmonic::order)
+            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order));
+        let any = orders.clone().next().is_some();
+        let Some((radians, cycles)) = common_period(orders).filter(|_| any) else {
+            if !self.inertia_harmonics.is_empty() {
+                return Err(ConfigError::Inconsistent("inertia_harmonic.order"));
+            }
+            if any {
+                return Ok(false);
+            }
+            // No oscillation at all: ω is the speed that carries the mean load.
+            self.horizon = Horizon::Constant;
+            self.u_mean = match Shooter::new(
+                curve,
+                self.total_inertia(),
+                &[],
+                &[],
+                self.mean_load,
+                2.0 * PI,
+                1,
+            ) {
+                Ok(s) => s.omega_ref() * s.omega_ref(),
+                Err(_) => 0.0,
+            };
+            return Ok(true);
+        };
+        let shooter = Shooter::new(
+            curve,
+            self.total_inertia(),
+            &self.inertia_harmonics,
+            self.load.harmonics(),
+            self.mean_load,
+            radians,
+            cycles,
+        );
+        let shooter = match shooter {
+            Ok(s) => s,
+            Err(Failure::Steps) => return Err(ConfigError::OutOfRange("inertia")),
+            Err(_) => {
+                // No speed carries the mean load: no inertia helps.
+                self.u_mean = 0.0;
+                self.horizon = Horizon::Shooting { radians, steps: 0 };
+                self.exact = Some(Exact::Stalls(Stall {
+                    u_mean: 0.0,
+                    u_min: 0.0,
+                }));
+                return Ok(true);
+            }
+        };
+        // The start: the tangent parabola's oscillation at φ = 0 about the shooting's
+        // reference speed (for a constant inertia; with J(φ), the reference itself).
+        let guess = if self.inertia_harmonics.is_empty() {
+            self.total_inertia() * self.oscillation(0.0)
+        } else {
+            0.0
+        };
+        let omega_ref = shooter.omega_ref();
+        match shooter.solve(guess) {
+            Ok(shot) => {
+                self.u_mean = shot.centre() + shot.s_mean;
+                self.horizon = Horizon::Shooting {
+                    radians,
+                    steps: shooter.steps(),
+                };
+                self.exact = Some(Exact::Steady(shot));
+            }
+            Err(Failure::Stalls) => {
+                self.u_mean = omega_ref * omega_ref;
+                self.horizon = Horizon::Shooting { radians, steps: 0 };
+                self.exact = Some(Exact::Stalls(Stall {
+                    u_mean: self.u_mean,
+                    u_min: 0.0,
+                }));
+            }
+            Err(Failure::Steps) => return Err(ConfigError::OutOfRange("inertia")),
+            Err(Failure::MeanLoad | Failure::NoAttractingState) => {
+                return Err(ConfigError::OutOfRange("load.harmonics"))
+            }
+        }
+        Ok(true)
+    }
+
+    /// The shooting setup of the converged solution (`None` unless there is one).
+    fn shooter(&self) -> Option<(Shooter<'_>, Shot)> {
+        let (Some(Exact::Steady(shot)), Horizon::Shooting { radians, steps }) =
+            (self.exact, self.horizon)
+        else {
+            return None;
+        };
+        let curve = match (self.path, self.motor.kloss_curve()) {
+            (Path::Auto, Some(k)) => Characteristic::Kloss(*k),
+            _ => Characteristic::Parabola(*self.motor.model()),
+        };
+        let shooter = Shooter::again(
+            curve,
+            &shot,
+            self.total_inertia(),
+            &self.inertia_harmonics,
+            self.load.harmonics(),
+            radians,
+            steps,
+        );
+        Some((shooter, shot))
     }
 
     /// The common period of the load and inertia orders and the trapezoid nodes that resolve
@@ -467,6 +645,8 @@ impl DriveModel {
         SteadyCurve {
             model: self,
             solution: self.varying_solution(),
+            shooter: self.shooter(),
+            from: Cell::new((0.0, f64::NAN)),
         }
     }
 
@@ -522,6 +702,8 @@ impl DriveModel {
     pub fn omega_squared(&self, phi: f64) -> f64 {
         if self.is_varying() {
             self.varying_omega_squared(phi)
+        } else if self.exact.is_some() {
+            self.steady_curve().omega_squared(phi)
         } else {
             self.u_mean + self.oscillation(phi)
         }
@@ -551,6 +733,27 @@ impl DriveModel {
     fn state(&self) -> (f64, Extremes) {
         if self.is_varying() {
             self.varying_state()
+        } else if let Some(e) = self.exact {
+            match e {
+                Exact::Steady(s) => (
+                    s.centre(),
+                    Extremes {
+                        s_max: s.s_max,
+                        s_min: s.s_min,
+                        phi_max: Some(s.phi_max),
+                        phi_min: Some(s.phi_min),
+                    },
+                ),
+                Exact::Stalls(st) => (
+                    st.u_mean,
+                    Extremes {
+                        s_max: 0.0,
+                        s_min: st.u_min - st.u_mean,
+                        phi_max: None,
+                        phi_min: None,
+                    },
+                ),
+            }
         } else {
             (self.u_mean, self.extremes())
         }
@@ -588,6 +791,9 @@ impl DriveModel {
 
     /// The steady state and its δ, or the stall.
     pub fn predict(&self) -> Prediction {
+        if let Some(Exact::Stalls(st)) = self.exact {
+            return Prediction::Stalls(st);
+        }
         let (centre, ex) = self.state();
         let u_min = centre + ex.s_min;
         if !exceeds(u_min, 0.0) {
@@ -617,12 +823,13 @@ impl DriveModel {
     /// an extremum is the partial derivative at the extremal angle). `None` without a steady
     /// state, or when the parameters are so extreme that the derivatives overflow f64.
     ///
-    /// With J(φ) the phases of the extrema move with the parameters in no closed form: both
-    /// derivatives are central differences of the computed δ with a relative step of 1e-4
-    /// (about 8 significant digits), the inertia step taken on the constant part of J;
+    /// With J(φ) or a Kloss motor the phases of the extrema move with the parameters in no
+    /// closed form: both derivatives are central differences of the computed δ with a relative
+    /// step of 1e-4 (about 8 significant digits), the inertia step taken on the constant part
+    /// of J, the torque step scaling the whole characteristic (the Kloss curve's `M_m`);
     /// `None` also when a stepped drive cannot be built or stalls.
     pub fn sensitivity(&self) -> Option<Sensitivity> {
-        if self.is_varying() {
+        if self.is_varying() || self.exact.is_some() {
             return self.varying_sensitivity();
         }
         let ex = self.extremes();
@@ -721,12 +928,12 @@ impl DriveModel {
     /// answer is below about 2⁻¹⁶⁶ of the upper end, and then the returned flywheel still
     /// meets the target, a little oversized.
     ///
-    /// With J(φ) no closed-form bound exists: the upper end is found by doubling an added
-    /// flywheel from the current total inertia (at most 1100 doublings, past the f64 range),
-    /// then bisected as above. δ falls with the flywheel (both the load's and the inertia's
-    /// share of the swing shrink like 1/J for a large flywheel; the randomised tests check
-    /// monotonicity on a grid), and where it might not, the answer is the first crossing the
-    /// bracket finds, which meets the target.
+    /// With J(φ) or a Kloss motor no closed-form bound exists: the upper end is found by
+    /// doubling an added flywheel from the current total inertia (at most 1100 doublings, past
+    /// the f64 range), then bisected as above. δ falls with the flywheel (both the load's and
+    /// the inertia's share of the swing shrink like 1/J for a large flywheel; the randomised
+    /// tests check monotonicity on a grid, for J(φ) and for Kloss drives), and where it might
+    /// not, the answer is the first crossing the bracket finds, which meets the target.
     pub fn flywheel_for(&self, delta_target: f64) -> Result<f64, DesignError> {
         if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
             return Err(DesignError::InvalidTarget);
@@ -745,7 +952,7 @@ impl DriveModel {
             return Ok(0.0);
         }
         let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
-        if self.is_varying() {
+        if self.is_varying() || self.exact.is_some() {
             let mut hi = self.total_inertia();
             let mut lo = 0.0;
             let mut found = false;
@@ -868,9 +1075,7 @@ impl DriveModel {
         // The whole characteristic scaled by 1 ± STEP: M_m moves by ±STEP·M_m.
         let scaled = |f: f64| {
             self.motor
-                .model()
                 .scaled(f)
-                .map(Motor::parabola)
                 .ok_or(ConfigError::OutOfRange("breakdown_torque"))
                 .and_then(|m| self.rebuilt(m, self.inertia, self.flywheel))
         };
@@ -1032,11 +1237,34 @@ impl DriveModel {
 pub struct SteadyCurve<'a> {
     model: &'a DriveModel,
     solution: Option<Solution<'a>>,
+    shooter: Option<(Shooter<'a>, Shot)>,
+    /// The last shooting point evaluated, `(φ within the period, y)`: evaluations at rising
+    /// angles continue from it.
+    from: Cell<(f64, f64)>,
 }
 
 impl SteadyCurve<'_> {
-    /// ω² of the periodic solution at `phi`, s⁻² (as [`DriveModel::omega_squared`]).
+    /// ω² of the periodic solution at `phi`, s⁻² (as [`DriveModel::omega_squared`]). For a
+    /// Kloss motor each evaluation integrates from the previous one when `phi` (within the
+    /// period) lies after it, else from the period's start: `O(steps)` at most, and no more
+    /// over a sweep of rising angles than one period.
     pub fn omega_squared(&self, phi: f64) -> f64 {
+        if let Some((shooter, shot)) = &self.shooter {
+            let period = shooter.period();
+            let p = phi - period * libm::floor(phi / period);
+            if !(p.is_finite() && (0.0..=period).contains(&p)) {
+                return f64::NAN;
+            }
+            let last = self.from.get();
+            let start = if last.0 <= p && last.1.is_finite() {
+                last
+            } else {
+                (0.0, shot.y0)
+            };
+            let (s, y) = shooter.swing_from(start, p);
+            self.from.set((p, y));
+            return shot.centre() + s;
+        }
         match (&self.solution, self.model.is_varying()) {
             (Some(s), _) => s.omega_squared(phi),
             (None, false) => self.model.u_mean + self.model.oscillation(phi),

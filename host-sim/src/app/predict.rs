@@ -172,7 +172,9 @@ pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
                 .reduce(f64::min)?;
             std::f64::consts::TAU / order
         }
-        Horizon::Period { radians, .. } | Horizon::Varying { radians, .. } => radians,
+        Horizon::Period { radians, .. }
+        | Horizon::Varying { radians, .. }
+        | Horizon::Shooting { radians, .. } => radians,
         Horizon::Unbounded => return None,
     };
     if !(span > 0.0 && period > 0.0) {
@@ -517,6 +519,9 @@ pub struct IrregularityOut {
     /// predicted speeds ([`kloss_note`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motor_note: Option<String>,
+    /// The steady state integrates the Kloss curve itself ([`kloss_note`]; text only).
+    #[serde(skip)]
+    pub kloss_curve: bool,
     /// With `[shaft] inertia_harmonics`: how the J(φ) steady state was computed (absent for a
     /// constant inertia).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -525,8 +530,19 @@ pub struct IrregularityOut {
 
 /// How a J(φ) steady state was computed (`None` for a constant inertia).
 pub fn inertia_note(model: &DriveModel) -> Option<String> {
-    let drive_monitor::drive::Horizon::Varying { radians, nodes } = model.horizon() else {
-        return None;
+    use drive_monitor::drive::Horizon;
+    let (radians, nodes) = match model.horizon() {
+        Horizon::Varying { radians, nodes } => (radians, nodes),
+        Horizon::Shooting { radians, .. } if !model.inertia_harmonics().is_empty() => {
+            let n = model.inertia_harmonics().len();
+            return Some(format!(
+                "J(φ) from shaft.inertia_harmonics ({n} harmonic{}): eq. 1 in w = J·ω² with \
+                 the Kloss curve, integrated over its period of {radians:.4} rad (see the \
+                 motor line); ∂δ/∂J and ∂δ/∂M_m by central differences",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
+        _ => return None,
     };
     Some(format!(
         "J(φ) from shaft.inertia_harmonics ({} harmonic{}): eq. 1, linear in w = J·ω², solved \
@@ -542,22 +558,42 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
     ))
 }
 
-/// What a Kloss motor's prediction stands on: the closed form (seed 000 eq. 11–13) needs a
-/// parabola `A·ω² + B`, and the Kloss curve is replaced by its tangent parabola at synchronous
-/// speed (exact there, above the curve towards breakdown), while `run` integrates the curve
-/// itself. Says so, with the largest difference between the two over the predicted speeds
-/// `[omega_min, omega_max]` (65 points), in N·m and in % of the curve's torque there. `None`
-/// for a parabola motor.
-pub fn kloss_note(
-    motor: &drive_monitor::drive::Motor,
-    omega_min: f64,
-    omega_max: f64,
-) -> Option<String> {
+/// What a Kloss motor's prediction stands on. With a common period of the load (and
+/// inertia) orders the core integrates the Kloss curve itself over one period
+/// ([`drive_monitor::drive::Horizon::Shooting`]: eq. 1 in `w = J·ω²`, sixth-order Runge–Kutta,
+/// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
+/// step count. Without one (no periodic solution exists: `Horizon::Unbounded`) the Kloss curve
+/// is replaced by its tangent parabola at synchronous speed (exact there, above the curve
+/// towards breakdown) for the conservative bound, and the note says that, with the largest
+/// difference between the two over the predicted speeds `[omega_min, omega_max]` (65 points),
+/// in N·m and in % of the curve's torque there. `None` for a parabola motor.
+pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
+    use drive_monitor::drive::Horizon;
+    let motor = model.motor();
     let k = motor.kloss_curve()?;
+    match model.horizon() {
+        Horizon::Shooting { radians, steps } if steps > 0 => {
+            return Some(format!(
+                "the Kloss motor is predicted with its curve itself (eq. 1 in w = J·ω² \
+                 integrated over the period of {radians:.4} rad, sixth-order Runge–Kutta on \
+                 {steps} steps, Newton on the periodic start; `run` integrates the same \
+                 curve; ∂δ/∂J and ∂δ/∂M_m by central differences)"
+            ))
+        }
+        Horizon::Shooting { .. } | Horizon::Constant => {
+            return Some(
+                "the Kloss motor is predicted with its curve itself (`run` integrates the same \
+                 curve)"
+                    .to_string(),
+            )
+        }
+        _ => {}
+    }
     let p = motor.model();
     let head = format!(
-        "the Kloss motor is predicted through its tangent parabola at synchronous speed \
-         (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
+        "the load's orders have no common period, so no periodic steady state exists to \
+         integrate: the Kloss motor is predicted through its tangent parabola at synchronous \
+         speed (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
         p.a(),
         p.b()
     );
@@ -685,6 +721,14 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let sampled = sampled_delta(scene, file, &model)?;
         let prediction = model.predict();
         let stall = match prediction {
+            drive_monitor::drive::Prediction::Stalls(s)
+                if s.u_mean <= 0.0 && model.motor().kloss_curve().is_some() =>
+            {
+                Some(
+                    "the mean load is beyond the motor's breakdown torque M_m (or below −M_m): \
+                     no speed and no flywheel carry it",
+                )
+            }
             drive_monitor::drive::Prediction::Stalls(s) if s.u_mean <= 0.0 => Some(
                 "the mean load exceeds the motor's torque at standstill: no speed and no \
                  flywheel carry it",
@@ -713,8 +757,14 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
+            kloss_curve: model.motor().kloss_curve().is_some()
+                && matches!(
+                    model.horizon(),
+                    drive_monitor::drive::Horizon::Shooting { .. }
+                        | drive_monitor::drive::Horizon::Constant
+                ),
             motor_note: kloss_note(
-                model.motor(),
+                &model,
                 irr.omega_min,
                 if irr.steady_state { irr.omega_max } else { 0.0 },
             ),
