@@ -39,6 +39,7 @@ use super::varying::{self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS};
 use crate::error::{non_negative, positive, ConfigError};
 use core::cell::Cell;
 use core::f64::consts::PI;
+use core::num::NonZeroU16;
 
 /// Samples per period of the fastest harmonic when the extrema are searched numerically.
 pub const SAMPLES_PER_CYCLE: u64 = 32;
@@ -240,7 +241,8 @@ pub struct Irregularity {
 struct Component {
     order: f64,
     /// `(p, q)` with `order = p/q`, if the order is such a rational.
-    ratio: Option<(u64, u64)>,
+    /// (The denominator as a `NonZeroU16`, at most [`MAX_DENOMINATOR`]: 16 bytes, not 24.)
+    ratio: Option<(u64, NonZeroU16)>,
     c: f64,
     d: f64,
     dc_dj: f64,
@@ -274,16 +276,29 @@ enum Path {
     /// The J(φ) solution even for a constant inertia (tests).
     Varying,
     /// Shooting with the parabola (tests).
-    #[cfg_attr(not(test), allow(dead_code))]
     ShootingParabola,
 }
 
 /// The shooting's outcome, computed when the model is built.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-enum Exact {
-    Steady(Shot),
-    Stalls(Stall),
+struct Exact {
+    /// Shot with the motor's parabola (tests) rather than its Kloss curve.
+    parabola: bool,
+    /// The periodic solution; `None`: the drive stalls (`Stall { u_mean, u_min: 0 }`).
+    shot: Option<Shot>,
+}
+
+/// What the steady state is computed from: the closed form's oscillating orders, or the
+/// shooting's outcome (one or the other, in the same storage, so that the parabola's model
+/// does not grow by the shooting's results: it is moved by value).
+// Sharing the storage is the point (no allocation to box the larger variant into).
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Body {
+    Closed(heapless::Vec<Component, MAX_HARMONICS>),
+    Exact(Exact),
 }
 
 /// The validated drive: motor, load, reduced inertia and flywheel, with the steady-state
@@ -299,13 +314,12 @@ pub struct DriveModel {
     u_mean: f64,
     /// The mean load including order-0 harmonics, N·m.
     mean_load: f64,
-    components: heapless::Vec<Component, MAX_HARMONICS>,
+    /// The closed form's orders, or the periodic solution by shooting ([`Horizon::Shooting`];
+    /// a Kloss motor).
+    body: Body,
     horizon: Horizon,
     /// The harmonics of J(φ) with a non-zero amplitude (empty: constant inertia).
     inertia_harmonics: heapless::Vec<InertiaHarmonic, MAX_INERTIA_HARMONICS>,
-    path: Path,
-    /// The periodic solution by shooting ([`Horizon::Shooting`]; a Kloss motor).
-    exact: Option<Exact>,
 }
 
 impl DriveModel {
@@ -341,7 +355,7 @@ impl DriveModel {
             self.inertia,
             self.flywheel,
             harmonics,
-            self.path,
+            self.path(),
         )
     }
 
@@ -387,7 +401,7 @@ impl DriveModel {
     /// Rebuilds with other motor and inertias, keeping the inertia harmonics and the path.
     fn rebuilt(&self, motor: Motor, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
         let h = self.inertia_harmonics.clone();
-        Self::build(motor, self.load.clone(), inertia, flywheel, &h, self.path)
+        Self::build(motor, self.load.clone(), inertia, flywheel, &h, self.path())
     }
 
     fn build(
@@ -454,11 +468,9 @@ impl DriveModel {
             flywheel,
             u_mean,
             mean_load,
-            components,
+            body: Body::Closed(components),
             horizon: Horizon::Constant,
             inertia_harmonics: kept,
-            path,
-            exact: None,
         };
         let curve = match path {
             Path::Auto => model.motor.kloss_curve().map(|k| Characteristic::Kloss(*k)),
@@ -471,7 +483,7 @@ impl DriveModel {
             }
         }
         model.horizon = if model.inertia_harmonics.is_empty() && path != Path::Varying {
-            horizon(&model.components)
+            horizon(model.components())
         } else {
             model.varying_horizon()?
         };
@@ -484,6 +496,7 @@ impl DriveModel {
     /// design-time code, off the parabola's path.
     #[inline(never)]
     fn shoot(&mut self, curve: Characteristic) -> Result<bool, ConfigError> {
+        let parabola = matches!(curve, Characteristic::Parabola(_));
         let orders = self
             .load
             .harmonics()
@@ -531,10 +544,10 @@ impl DriveModel {
                 // No speed carries the mean load: no inertia helps.
                 self.u_mean = 0.0;
                 self.horizon = Horizon::Shooting { radians, steps: 0 };
-                self.exact = Some(Exact::Stalls(Stall {
-                    u_mean: 0.0,
-                    u_min: 0.0,
-                }));
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: None,
+                });
                 return Ok(true);
             }
         };
@@ -553,15 +566,18 @@ impl DriveModel {
                     radians,
                     steps: shooter.steps(),
                 };
-                self.exact = Some(Exact::Steady(shot));
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: Some(shot),
+                });
             }
             Err(Failure::Stalls) => {
                 self.u_mean = omega_ref * omega_ref;
                 self.horizon = Horizon::Shooting { radians, steps: 0 };
-                self.exact = Some(Exact::Stalls(Stall {
-                    u_mean: self.u_mean,
-                    u_min: 0.0,
-                }));
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: None,
+                });
             }
             Err(Failure::Steps) => return Err(ConfigError::OutOfRange("inertia")),
             Err(Failure::MeanLoad | Failure::NoAttractingState) => {
@@ -571,15 +587,47 @@ impl DriveModel {
         Ok(true)
     }
 
+    /// The closed form's oscillating orders (none on the shooting path).
+    fn components(&self) -> &[Component] {
+        match &self.body {
+            Body::Closed(c) => c,
+            Body::Exact(_) => &[],
+        }
+    }
+
+    /// The shooting's outcome, on its path.
+    fn exact(&self) -> Option<&Exact> {
+        match &self.body {
+            Body::Exact(e) => Some(e),
+            Body::Closed(_) => None,
+        }
+    }
+
+    /// The path a rebuilt drive takes: this one's.
+    fn path(&self) -> Path {
+        if self.is_varying() {
+            Path::Varying
+        } else if self.exact().is_some_and(|e| e.parabola) {
+            Path::ShootingParabola
+        } else {
+            Path::Auto
+        }
+    }
+
     /// The shooting setup of the converged solution (`None` unless there is one).
     fn shooter(&self) -> Option<(Shooter<'_>, Shot)> {
-        let (Some(Exact::Steady(shot)), Horizon::Shooting { radians, steps }) =
-            (self.exact, self.horizon)
+        let (
+            Some(Exact {
+                shot: Some(shot),
+                parabola,
+            }),
+            Horizon::Shooting { radians, steps },
+        ) = (self.exact().copied(), self.horizon)
         else {
             return None;
         };
-        let curve = match (self.path, self.motor.kloss_curve()) {
-            (Path::Auto, Some(k)) => Characteristic::Kloss(*k),
+        let curve = match (parabola, self.motor.kloss_curve()) {
+            (false, Some(k)) => Characteristic::Kloss(*k),
             _ => Characteristic::Parabola(*self.motor.model()),
         };
         let shooter = Shooter::again(
@@ -702,7 +750,7 @@ impl DriveModel {
     pub fn omega_squared(&self, phi: f64) -> f64 {
         if self.is_varying() {
             self.varying_omega_squared(phi)
-        } else if self.exact.is_some() {
+        } else if self.exact().is_some() {
             self.steady_curve().omega_squared(phi)
         } else {
             self.u_mean + self.oscillation(phi)
@@ -733,9 +781,9 @@ impl DriveModel {
     fn state(&self) -> (f64, Extremes) {
         if self.is_varying() {
             self.varying_state()
-        } else if let Some(e) = self.exact {
-            match e {
-                Exact::Steady(s) => (
+        } else if let Some(e) = self.exact() {
+            match e.shot {
+                Some(s) => (
                     s.centre(),
                     Extremes {
                         s_max: s.s_max,
@@ -744,11 +792,11 @@ impl DriveModel {
                         phi_min: Some(s.phi_min),
                     },
                 ),
-                Exact::Stalls(st) => (
-                    st.u_mean,
+                None => (
+                    self.u_mean,
                     Extremes {
                         s_max: 0.0,
-                        s_min: st.u_min - st.u_mean,
+                        s_min: -self.u_mean,
                         phi_max: None,
                         phi_min: None,
                     },
@@ -791,10 +839,16 @@ impl DriveModel {
 
     /// The steady state and its δ, or the stall.
     pub fn predict(&self) -> Prediction {
-        if let Some(Exact::Stalls(st)) = self.exact {
-            return Prediction::Stalls(st);
-        }
-        let (centre, ex) = self.state();
+        let (centre, ex) = match &self.body {
+            Body::Closed(_) if !self.is_varying() => (self.u_mean, self.extremes()),
+            Body::Exact(Exact { shot: None, .. }) => {
+                return Prediction::Stalls(Stall {
+                    u_mean: self.u_mean,
+                    u_min: 0.0,
+                })
+            }
+            _ => self.state(),
+        };
         let u_min = centre + ex.s_min;
         if !exceeds(u_min, 0.0) {
             return Prediction::Stalls(Stall {
@@ -829,7 +883,7 @@ impl DriveModel {
     /// of J, the torque step scaling the whole characteristic (the Kloss curve's `M_m`);
     /// `None` also when a stepped drive cannot be built or stalls.
     pub fn sensitivity(&self) -> Option<Sensitivity> {
-        if self.is_varying() || self.exact.is_some() {
+        if self.is_varying() || self.exact().is_some() {
             return self.varying_sensitivity();
         }
         let ex = self.extremes();
@@ -848,7 +902,7 @@ impl DriveModel {
             (Some(pmax), Some(pmin)) => {
                 // ∂s/∂J or ∂s/∂a at φ, from each component's pair of derivatives.
                 let slope = |phi: f64, pair: fn(&Component) -> (f64, f64)| {
-                    self.components
+                    self.components()
                         .iter()
                         .map(|c| {
                             let (x, y) = pair(c);
@@ -868,7 +922,7 @@ impl DriveModel {
             _ => {
                 // smax = Σ R_k, smin = −Σ R_k (or both 0): derivative of each |(c, d)|.
                 let (mut rj, mut ra) = (0.0, 0.0);
-                for c in &self.components {
+                for c in self.components() {
                     let r = c.amplitude();
                     // A vanishing (or underflowed) amplitude has no direction to differentiate.
                     if r.is_nan() || r <= 0.0 {
@@ -952,7 +1006,33 @@ impl DriveModel {
             return Ok(0.0);
         }
         let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
-        if self.is_varying() || self.exact.is_some() {
+        let j = self.total_inertia();
+        let a = -self.motor.model().a();
+        // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
+        let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
+        if let ([c], Horizon::ClosedForm) = (self.components(), self.horizon) {
+            let n = c.order;
+            let h = libm::hypot(2.0 * a, n * j);
+            // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
+            let m2 = c.amplitude() * h / 2.0;
+            let h_needed = 2.0 * m2 / (r * self.u_mean);
+            if !exceeds(h_needed, 2.0 * a) {
+                return Ok(0.0);
+            }
+            // As two roots: the product overflows beyond 1.3e154.
+            let j_needed = libm::sqrt(h_needed - 2.0 * a) * libm::sqrt(h_needed + 2.0 * a) / n;
+            let extra = j_needed - j;
+            // n·J stays below h_needed, so the model holds this inertia if it is finite.
+            return if !(self.inertia + (self.flywheel + extra)).is_finite() {
+                Err(DesignError::Unreachable)
+            } else if extra <= 0.0 {
+                Ok(0.0)
+            } else {
+                Ok(extra)
+            };
+        }
+        // J(φ) and the shooting (after the closed form, which neither takes).
+        if self.is_varying() || self.exact().is_some() {
             let mut hi = self.total_inertia();
             let mut lo = 0.0;
             let mut found = false;
@@ -977,44 +1057,19 @@ impl DriveModel {
             }
             return bisect(lo, hi, |x| at(x).map(|m| meets(&m)));
         }
-        let j = self.total_inertia();
-        let a = -self.motor.model().a();
-        // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
-        let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
-        if let ([c], Horizon::ClosedForm) = (self.components.as_slice(), self.horizon) {
-            let n = c.order;
-            let h = libm::hypot(2.0 * a, n * j);
-            // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
-            let m2 = c.amplitude() * h / 2.0;
-            let h_needed = 2.0 * m2 / (r * self.u_mean);
-            if !exceeds(h_needed, 2.0 * a) {
-                return Ok(0.0);
-            }
-            // As two roots: the product overflows beyond 1.3e154.
-            let j_needed = libm::sqrt(h_needed - 2.0 * a) * libm::sqrt(h_needed + 2.0 * a) / n;
-            let extra = j_needed - j;
-            // n·J stays below h_needed, so the model holds this inertia if it is finite.
-            return if !(self.inertia + (self.flywheel + extra)).is_finite() {
-                Err(DesignError::Unreachable)
-            } else if extra <= 0.0 {
-                Ok(0.0)
-            } else {
-                Ok(extra)
-            };
-        }
         // Upper end of the bracket: with `S = Σ 2|M2k|/n_k` and the budget `B = r·ū`, order k
         // gets the share `(2|M2k|/n_k)/S` of B, reached where `√(4a² + n_k²J²) = n_k·S/B`,
         // i.e. at `J_k = √((S/B)² − (2a/n_k)²)`; at `max_k J_k` every share holds, so
         // `Σ R_k ≤ B`. `2|M2k| = R_k·h_k` at the current inertia.
         let budget = r * self.u_mean * (1.0 - 1e-6);
         let s: f64 = self
-            .components
+            .components()
             .iter()
             .map(|c| c.amplitude() * (libm::hypot(2.0 * a, c.order * j) / c.order))
             .sum();
         let x = s / budget;
         let j_bound = self
-            .components
+            .components()
             .iter()
             .map(|c| {
                 let y = 2.0 * a / c.order;
@@ -1027,7 +1082,11 @@ impl DriveModel {
             .fold(0.0, f64::max);
         // Beyond f64: start from the largest flywheel the model can hold (n·J must stay
         // finite); no larger than J through rounding: from J itself.
-        let n_max = self.components.iter().map(|c| c.order).fold(1.0, f64::max);
+        let n_max = self
+            .components()
+            .iter()
+            .map(|c| c.order)
+            .fold(1.0, f64::max);
         let cap = f64::MAX / 4.0 / n_max;
         let mut hi = if !j_bound.is_finite() || j_bound > cap {
             cap
@@ -1124,11 +1183,11 @@ impl DriveModel {
     }
 
     fn oscillation(&self, phi: f64) -> f64 {
-        self.components.iter().map(|c| c.value(phi)).sum()
+        self.components().iter().map(|c| c.value(phi)).sum()
     }
 
     fn extremes(&self) -> Extremes {
-        match (self.horizon, self.components.as_slice()) {
+        match (self.horizon, self.components()) {
             (Horizon::ClosedForm, [c]) => {
                 // c·cos(nφ) + d·sin(nφ) = R·cos(nφ − α).
                 let r = c.amplitude();
@@ -1156,7 +1215,7 @@ impl DriveModel {
             }
             (Horizon::Period { radians, samples }, _) => self.search(radians, samples),
             (Horizon::Unbounded, _) => {
-                let r: f64 = self.components.iter().map(Component::amplitude).sum();
+                let r: f64 = self.components().iter().map(Component::amplitude).sum();
                 Extremes {
                     s_max: r,
                     s_min: -r,
@@ -1196,11 +1255,11 @@ impl DriveModel {
             }
         }
         let curvature: f64 = self
-            .components
+            .components()
             .iter()
             .map(|c| c.amplitude() * c.order * c.order)
             .sum();
-        let amplitude: f64 = self.components.iter().map(Component::amplitude).sum();
+        let amplitude: f64 = self.components().iter().map(Component::amplitude).sum();
         let margin = 0.5 * curvature * h * h + 8.0 * f64::EPSILON * amplitude;
         let mut out = Extremes {
             s_max: best_max,
@@ -1379,7 +1438,7 @@ fn component(h: &Harmonic, a: f64, j: f64) -> Option<Component> {
     if all.iter().all(|x| x.is_finite()) {
         Some(Component {
             order: n,
-            ratio: rational(n),
+            ratio: rational(n).and_then(|(p, q)| Some((p, NonZeroU16::new(q as u16)?))),
             c,
             d,
             dc_dj,
@@ -1436,6 +1495,7 @@ fn horizon(components: &[Component]) -> Horizon {
         let Some((_, q)) = c.ratio else {
             return Horizon::Unbounded;
         };
+        let q = u64::from(q.get());
         match (q_all / gcd(q_all, q)).checked_mul(q) {
             Some(l) => q_all = l,
             None => return Horizon::Unbounded,
@@ -1446,6 +1506,7 @@ fn horizon(components: &[Component]) -> Horizon {
         let Some((p, q)) = c.ratio else {
             return Horizon::Unbounded;
         };
+        let q = u64::from(q.get());
         let Some(m) = p.checked_mul(q_all / q) else {
             return Horizon::Unbounded;
         };
