@@ -729,3 +729,45 @@ fn a_heavily_loaded_kloss_drive_is_predicted_as_measured() {
     );
     assert!((m / p - 1.0).abs() < 0.003, "{m} {p}");
 }
+
+/// A Kloss drive the core's shooting refuses (inertia 1e-6 kg·m²: one period would need more
+/// than 2¹⁸ Runge–Kutta steps) gets no predicted δ, with the reason, and `predict` and `run`
+/// still succeed; a Kloss drive whose speed dips past the breakdown point gets the Kloss-specific
+/// WARNING.
+#[test]
+fn a_refused_kloss_drive_is_not_predicted_with_the_reason() {
+    let scene = "[shaft]\ninertia = 1e-6\n[motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+                 breakdown_slip = 0.25\nbreakdown_torque = 158.0\n[load]\nmean = 100.0\n\
+                 harmonics = [{ order = 1.0, amplitude = 10.0, phase = 0.0 }]\n";
+    let path = std::path::Path::new("kloss.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert!(p.irregularity.is_none());
+    let why = p.irregularity_not_predicted.as_deref().unwrap();
+    assert!(
+        why.contains("shaft.inertia") && why.contains("262144 Runge–Kutta steps"),
+        "{why}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("Running irregularity NOT PREDICTED"),
+        "{text}"
+    );
+    // `run` simulates it all the same.
+    let r = run_trial(&format!(
+        "[simulation]\nduration = 0.02\n{scene}[encoder]\nlines = 64\ntimer_hz = 84e6\n"
+    ));
+    assert_eq!(r.delta_predicted, None);
+    // Past the breakdown point for part of the period.
+    let scene = scene
+        .replace("inertia = 1e-6", "inertia = 0.05")
+        .replace("mean = 100.0", "mean = 140.0")
+        .replace("amplitude = 10.0", "amplitude = 120.0");
+    let s = host_sim::app::scene::Scene::parse(&scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let w = p.irregularity.unwrap().working_branch_warning.unwrap();
+    assert!(
+        w.contains("runs past the Kloss curve's breakdown point"),
+        "{w}"
+    );
+}

@@ -38,10 +38,16 @@
 //! whose trajectory reaches `ω² ≤ 0` is halved.
 //!
 //! On the working branch `M_d' < 0`, so `L < 0`: the map contracts, its fixed point is unique
-//! and attracting, and the simulation converges to it. A converged fixed point with `L ≥ 0`
-//! (repelling: no simulation settles on it) or no convergence is refused
-//! ([`Failure::NoAttractingState`]); trajectories that reach `ω² ≤ 0` from the starting point
-//! and from a start above synchronous speed alike are a stall.
+//! and attracting, and the simulation converges to it. Where Newton stalls, does not converge
+//! or converges to a repelling fixed point (`L ≥ 0`: no simulation settles on it), the highest
+//! fixed point is approached from above instead, from a start past the Kloss curve's
+//! generating breakdown point: the map is increasing, so its own step from above a fixed point
+//! stays above it; Newton steps are taken where they are no lower than that, and bisection once
+//! a start below the fixed point brackets it. A trajectory that stalls from the map's own step
+//! means that no periodic solution exists: a stall (the unit test
+//! `stall_boundary_agrees_with_time_integration` checks the boundary against a time
+//! integration). No convergence there within 400 steps, or a repelling limit, is refused
+//! ([`Failure::NoAttractingState`]), never reported as a δ.
 //!
 //! ## Extrema
 //! The converged period is integrated once more; the node values of `s = y/J` are scanned and
@@ -66,6 +72,8 @@ pub const MAX_STEPS: u64 = 1 << 18;
 const MAX_STEP_RATE: f64 = 0.25;
 /// Newton (or map) iterations at most.
 const MAX_ITERATIONS: u32 = 60;
+/// Steps of the descent from above at most (each one or two period maps).
+const MAX_DESCENT: u32 = 400;
 /// Halvings of a step whose trajectory stalls.
 const MAX_HALVINGS: u32 = 60;
 /// Extremum candidates refined per direction, at most.
@@ -398,39 +406,38 @@ impl<'a> Shooter<'a> {
         }
     }
 
-    /// `y(0)` of the attracting periodic solution, from `guess`, and `ln μ` there.
+    /// `y(0)` of the attracting periodic solution, from `guess`, and `ln μ` there: Newton from
+    /// `guess`; where that fails, the descent from above ([`Self::descend`]).
     fn fixed_point(&self, guess: f64) -> Result<(f64, f64), Failure> {
-        let (j_at_0, _) = self.inertia_at(0.0);
-        let top = self.curve.top_speed();
-        let y_top = j_at_0 * ((top - self.omega_ref) * (top + self.omega_ref));
-        let mut y = guess;
-        let mut r = self.map(y);
-        for start in [0.0, y_top] {
-            if r.is_ok() {
-                break;
-            }
-            y = start;
-            r = self.map(y);
+        match self.newton(guess) {
+            Some(found) => Ok(found),
+            None => self.descend(),
         }
-        let Ok((mut yt, mut l, mut big)) = r else {
-            return Err(Failure::Stalls);
-        };
-        let tol = (8.0 * f64::EPSILON * libm::sqrt(f64::from(self.steps))).max(1e-13);
+    }
+
+    /// The map's residual `|y(T) − y(0)|` at which a start counts as periodic: the rounding
+    /// floor of a period's integration, relative to the largest `|y|` on it. The remaining
+    /// error of `y(0)` moves the swing by about the residual (by `(1 − μ)·Δ`), even where a
+    /// weak damping makes the Newton step `Δ` itself larger.
+    fn tolerance(&self) -> f64 {
+        (8.0 * f64::EPSILON * libm::sqrt(f64::from(self.steps))).max(1e-13)
+    }
+
+    /// Newton's method from `guess` (the map's own step where `μ ≥ 1`, a step halved while its
+    /// trajectory stalls); `None` if it stalls at the start, does not converge, or converges
+    /// to a repelling periodic solution.
+    fn newton(&self, guess: f64) -> Option<(f64, f64)> {
+        let mut y = guess;
+        let (mut yt, mut l, mut big) = self.map(y).ok()?;
+        let tol = self.tolerance();
         for _ in 0..MAX_ITERATIONS {
             let g = yt - y;
             let mut delta = if l < 0.0 { g / -libm::expm1(l) } else { g };
             if !delta.is_finite() {
-                return Err(Failure::NoAttractingState);
+                return None;
             }
-            // Converged once the map's residual is at the rounding floor of a period's
-            // integration: the remaining error of y(0) moves the swing by about the residual
-            // (by `(1 − μ)·Δ`), even where a weak damping makes Δ itself larger.
             if libm::fabs(g) <= tol * big || delta == 0.0 {
-                return if l < 0.0 {
-                    Ok((y + delta, l))
-                } else {
-                    Err(Failure::NoAttractingState)
-                };
+                return (l < 0.0).then_some((y + delta, l));
             }
             let mut next = None;
             for _ in 0..MAX_HALVINGS {
@@ -440,11 +447,67 @@ impl<'a> Shooter<'a> {
                 }
                 delta *= 0.5;
             }
-            let Some(n) = next else {
-                return Err(Failure::NoAttractingState);
-            };
             y += delta;
-            (yt, l, big) = n;
+            (yt, l, big) = next?;
+        }
+        None
+    }
+
+    /// The highest periodic solution, approached from above: from a start above synchronous
+    /// speed (the Kloss curve's generating breakdown point), where the map's residual
+    /// `g = y(T) − y(0)` is negative. The map is increasing (solutions of a scalar equation do
+    /// not cross), so from any `y` above the highest fixed point `y*` the map's own step
+    /// `P(y)` stays above it; a Newton step is taken where it is no lower than that, and once
+    /// a trial start has `g > 0` (below `y*`) the two bracket `y*` and the steps stay inside
+    /// the bracket (bisection where Newton leaves it). A trajectory that stalls from `P(y)`,
+    /// which lies above every periodic solution, means there is none: a stall.
+    fn descend(&self) -> Result<(f64, f64), Failure> {
+        let (j_at_0, _) = self.inertia_at(0.0);
+        let top = self.curve.top_speed();
+        let mut hi = j_at_0 * ((top - self.omega_ref) * (top + self.omega_ref));
+        let (mut pt, mut l, mut big) = self.map(hi).map_err(|_| Failure::Stalls)?;
+        if pt >= hi {
+            // A periodic solution at or above the top start: not a drive this model serves.
+            return Err(Failure::NoAttractingState);
+        }
+        let tol = self.tolerance();
+        let mut lo: Option<f64> = None;
+        for _ in 0..MAX_DESCENT {
+            let g = pt - hi;
+            let newton = if l < 0.0 {
+                hi + g / -libm::expm1(l)
+            } else {
+                pt
+            };
+            if libm::fabs(g) <= tol * big || lo.is_some_and(|lo| hi - lo <= tol * big) {
+                let inside = lo.map_or(newton <= hi, |lo| (lo..=hi).contains(&newton));
+                return if l < 0.0 && newton.is_finite() {
+                    Ok((if inside { newton } else { hi }, l))
+                } else {
+                    Err(Failure::NoAttractingState)
+                };
+            }
+            let trial = match lo {
+                Some(lo) if !(newton > lo && newton < hi) => lo + (hi - lo) / 2.0,
+                Some(_) => newton,
+                None if newton >= pt && newton.is_finite() => newton,
+                None => pt,
+            };
+            match self.map(trial) {
+                Ok((t, _, _)) if t - trial > 0.0 => lo = Some(trial),
+                Ok((t, lt, bt)) => {
+                    (hi, pt, l, big) = (trial, t, lt, bt);
+                    continue;
+                }
+                Err(Stalled) if trial != pt && lo.is_none() => {
+                    // Newton overshot into the stall region: the map's own step instead.
+                    let (t, lt, bt) = self.map(pt).map_err(|_| Failure::Stalls)?;
+                    (hi, pt, l, big) = (pt, t, lt, bt);
+                    continue;
+                }
+                Err(Stalled) if lo.is_none() => return Err(Failure::Stalls),
+                Err(Stalled) => return Err(Failure::NoAttractingState),
+            }
         }
         Err(Failure::NoAttractingState)
     }

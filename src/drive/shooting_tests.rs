@@ -281,7 +281,7 @@ fn kloss_flywheel_sizing_stalls_and_sensitivity() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(ProptestConfig::with_cases(256))]
 
     /// Arbitrary Kloss drives: either a typed error or a prediction with finite numbers,
     /// finite sensitivities and a flywheel that meets the limit.
@@ -328,4 +328,59 @@ proptest! {
         }
         prop_assert!(!m.omega_squared(1.0).is_nan() || m.predict().steady().is_none());
     }
+}
+
+/// Near the boundary between stalling and running (a ripple of 120 N·m on a mean load of 140
+/// N·m, M_m = 158 N·m): the prediction says stall or steady as a direct RK4 integration in
+/// time from synchronous speed shows it (20 s, dt = 1e-5 s), and where it runs, ω min agrees
+/// within 1e-6 relative (the time integration's minimum over its steps after 10 s). Newton from
+/// the tangent parabola fails on the drive with 0.0203 kg·m² of flywheel; the descent from above
+/// finds the stall. A flywheel for δ ≤ 0.06 is found from the stalled drive.
+#[test]
+fn stall_boundary_agrees_with_time_integration() {
+    let base = kloss_drive(157.08, 0.25, 158.0, &[h(1.0, 120.0, 0.0)], 140.0, 0.005);
+    for (f, runs) in [(0.0203, false), (0.025, false), (0.03, true), (0.033, true)] {
+        let m = base.with_flywheel(f).unwrap();
+        let (motor, load, j) = (m.motor(), m.load(), m.total_inertia());
+        let acc = |phi: f64, w: f64| (motor.torque(w) - load.torque(phi)) / j;
+        let (mut phi, mut w, dt) = (0.0f64, 157.08f64, 1e-5);
+        let (mut t, mut w_min) = (0.0, f64::INFINITY);
+        while t < 20.0 && w > 1.0 {
+            let k1 = (w, acc(phi, w));
+            let k2 = (
+                w + 0.5 * dt * k1.1,
+                acc(phi + 0.5 * dt * k1.0, w + 0.5 * dt * k1.1),
+            );
+            let k3 = (
+                w + 0.5 * dt * k2.1,
+                acc(phi + 0.5 * dt * k2.0, w + 0.5 * dt * k2.1),
+            );
+            let k4 = (w + dt * k3.1, acc(phi + dt * k3.0, w + dt * k3.1));
+            phi += dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+            w += dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+            t += dt;
+            if t > 10.0 {
+                w_min = w_min.min(w);
+            }
+        }
+        match m.predict() {
+            Prediction::Steady(s) => {
+                assert!(
+                    runs && w > 1.0,
+                    "{f}: predicted steady, integration stalled"
+                );
+                assert!(
+                    rel(w_min, s.omega_min) < 1e-6,
+                    "{f}: {w_min} {}",
+                    s.omega_min
+                );
+            }
+            Prediction::Stalls(st) => {
+                assert!(!runs && w <= 1.0, "{f}: predicted stall, integration runs");
+                assert!(st.u_mean > 0.0 && st.u_min == 0.0);
+            }
+        }
+    }
+    let extra = base.flywheel_for(0.06).unwrap();
+    assert!(steady(&base.with_flywheel(extra).unwrap()).delta <= 0.06);
 }

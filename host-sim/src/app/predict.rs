@@ -76,6 +76,16 @@ fn not_covered(e: ConfigError) -> Option<String> {
              many of its cycles, that the periodic solution needs more than {} trapezoid nodes",
             drive_monitor::drive::MAX_NODES
         )),
+        ConfigError::OutOfRange("inertia") => Some(format!(
+            "shaft.inertia: the Kloss drive is so stiff against its inertia that one period \
+             needs more than {} Runge–Kutta steps",
+            drive_monitor::drive::MAX_STEPS
+        )),
+        ConfigError::OutOfRange("load.harmonics") => Some(
+            "load.harmonics: no attracting periodic steady state was found for the Kloss drive \
+             (its speed swings far past the breakdown point)"
+                .to_string(),
+        ),
         ConfigError::Capacity("inertia_harmonics") => Some(format!(
             "shaft.inertia_harmonics: more than {} harmonics",
             drive_monitor::drive::MAX_INERTIA_HARMONICS
@@ -85,7 +95,72 @@ fn not_covered(e: ConfigError) -> Option<String> {
 }
 
 /// The drive model with the constant part of the inertia only.
+/// `None` where the core does not predict the drive (a Kloss drive it refuses:
+/// [`irregularity_not_predicted`] says why).
 fn constant_inertia_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
+    match constant_inertia_build(scene, file)? {
+        None => Ok(None),
+        Some(Ok(m)) => Ok(Some(m)),
+        Some(Err(e)) if not_covered(e).is_some() => Ok(None),
+        Some(Err(e)) => Err(core_error(scene, file, "shaft", e)),
+    }
+}
+
+/// The drive model with the constant part of the inertia only, and the core's error when it
+/// refuses the drive as a whole.
+#[allow(clippy::type_complexity)]
+fn constant_inertia_build(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<Result<DriveModel, ConfigError>>, SceneError> {
+    Ok(drive_parts_of(scene, file)?
+        .map(|(motor, load, inertia, flywheel)| DriveModel::new(motor, load, inertia, flywheel)))
+}
+
+/// What a simulation of a scene's motor-driven shaft needs: the motor, the load and the square
+/// of a start speed (the predicted mean of ω²).
+#[derive(Debug, Clone)]
+pub struct DriveParts {
+    /// The motor.
+    pub motor: Motor,
+    /// The load torque.
+    pub load: Load,
+    /// ω² to start from, s⁻².
+    pub u_start: f64,
+}
+
+/// The motor and load of a scene for simulation: those of its drive model, or, for a Kloss
+/// drive whose steady state the core refuses to predict ([`irregularity_not_predicted`]),
+/// the scene's own, started at the tangent parabola's mean speed. `None` without a torque motor
+/// and a load.
+pub fn drive_parts(
+    scene: &Scene,
+    file: &Path,
+    model: Option<&DriveModel>,
+) -> Result<Option<DriveParts>, SceneError> {
+    if let Some(m) = model {
+        return Ok(Some(DriveParts {
+            motor: *m.motor(),
+            load: m.load().clone(),
+            u_start: m.u_mean(),
+        }));
+    }
+    Ok(drive_parts_of(scene, file)?.map(|(motor, load, ..)| {
+        let p = motor.model();
+        let u_start = (p.b() - load.mean()) / -p.a();
+        DriveParts {
+            motor,
+            load,
+            u_start,
+        }
+    }))
+}
+
+/// The scene's motor, load, inertia and flywheel as the core validates them.
+fn drive_parts_of(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<(Motor, Load, f64, f64)>, SceneError> {
     let (Some(motor), Some(load)) = (&scene.motor, &scene.load) else {
         return Ok(None);
     };
@@ -127,9 +202,7 @@ fn constant_inertia_model(scene: &Scene, file: &Path) -> Result<Option<DriveMode
             "missing: a motor-driven scene needs [shaft] inertia",
         ));
     };
-    DriveModel::new(motor, load, shaft.inertia, shaft.flywheel)
-        .map(Some)
-        .map_err(|e| core_error(scene, file, "shaft", e))
+    Ok(Some((motor, load, shaft.inertia, shaft.flywheel)))
 }
 
 /// What the core's speed samples do to the predicted δ: each sample is the angle of
@@ -697,8 +770,19 @@ impl Prediction {
 /// period, a J(φ) so close to 0 that the solution needs more nodes than the core holds, more
 /// harmonics than it holds. A constant-inertia prediction would silently leave the variation
 /// out (its ½·ω²·dJ/dφ term alone makes ω swing), so none is given; `run` simulates the drive.
+/// A Kloss drive the core refuses is named here too: one so stiff against its inertia that a
+/// period needs more than [`drive_monitor::drive::MAX_STEPS`] steps, or one with no attracting
+/// periodic steady state found.
 pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
-    let base = constant_inertia_model(scene, Path::new("scene")).ok()??;
+    let base = match constant_inertia_build(scene, Path::new("scene")).ok()?? {
+        Ok(base) => base,
+        Err(e) => {
+            let why = not_covered(e)?;
+            return Some(format!(
+                "{why}; δ is not predicted for this drive (`drive-sim run` simulates it)"
+            ));
+        }
+    };
     let why = not_covered(with_inertia(scene, &base).err()?)?;
     Some(format!(
         "{why}; δ is not predicted for this J(φ) (`drive-sim run` simulates it)"
@@ -709,7 +793,7 @@ pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();
     let model = drive_model(scene, file)?;
-    if model.is_some() {
+    if model.is_some() || scene.motor.is_some() {
         p.irregularity_not_predicted = irregularity_not_predicted(scene);
     }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
@@ -739,14 +823,28 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             ),
             _ => None,
         };
+        let kloss_curve = model.motor().kloss_curve().is_some()
+            && matches!(
+                model.horizon(),
+                drive_monitor::drive::Horizon::Shooting { .. }
+                    | drive_monitor::drive::Horizon::Constant
+            );
         let working_branch_warning = prediction
             .steady()
             .filter(|s| !s.within_working_branch)
             .map(|s| {
+                let why = if kloss_curve {
+                    "for part of the period the drive runs past the Kloss curve's breakdown \
+                     point, where its torque falls with the speed (the prediction integrates the \
+                     curve and its periodic state attracts; a little more load or less inertia \
+                     can tip it into a stall)"
+                } else {
+                    "the characteristic stands for a real motor only above it (past its \
+                     breakdown point a real motor's torque falls, and it may stall)"
+                };
                 format!(
                     "WARNING: ω min {:.3} rad/s is below the motor's breakdown speed {:.3} rad/s: \
-                     the characteristic stands for a real motor only above it (past its \
-                     breakdown point a real motor's torque falls, and it may stall)",
+                     {why}",
                     s.omega_min,
                     model.motor().model().working_min_speed()
                 )
@@ -757,12 +855,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
-            kloss_curve: model.motor().kloss_curve().is_some()
-                && matches!(
-                    model.horizon(),
-                    drive_monitor::drive::Horizon::Shooting { .. }
-                        | drive_monitor::drive::Horizon::Constant
-                ),
+            kloss_curve,
             motor_note: kloss_note(
                 &model,
                 irr.omega_min,
