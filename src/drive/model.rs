@@ -141,9 +141,12 @@ pub struct SteadyState {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Stall {
     /// Mean of ω² over the period, `ū = (B − M1)/a`, s⁻²; `≤ 0` means the mean load alone
-    /// exceeds the motor's stall torque `B` and no flywheel can help.
+    /// exceeds the motor's stall torque `B` and no flywheel can help. For a Kloss motor, the
+    /// square of the speed that carries the mean load, or 0 when the mean load is at or beyond
+    /// the breakdown torque `M_m` (or at or below `−M_m`).
     pub u_mean: f64,
-    /// The minimum of the periodic ω², s⁻² (`≤ 0`).
+    /// The minimum of the periodic ω², s⁻² (`≤ 0`); 0 for a Kloss motor, whose speed falls
+    /// to 0 with no periodic solution to take a minimum of.
     pub u_min: f64,
 }
 
@@ -325,7 +328,11 @@ pub struct DriveModel {
 impl DriveModel {
     /// A drive with reduced machine `inertia` (kg·m², > 0) and an added `flywheel`
     /// (kg·m², ≥ 0). Rejects parameter combinations whose steady-state coefficients
-    /// overflow f64.
+    /// overflow f64. A Kloss motor's steady state is computed here (by shooting, see
+    /// [`Horizon::Shooting`]); rejected are a Kloss drive so stiff against its inertia that one
+    /// period needs more than [`MAX_STEPS`](crate::drive::MAX_STEPS) steps
+    /// (`OutOfRange("inertia")`) and one with no attracting periodic solution found
+    /// (`OutOfRange("load.harmonics")`).
     pub fn new(motor: Motor, load: Load, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
         Self::build(motor, load, inertia, flywheel, &[], Path::Auto)
     }
