@@ -10,6 +10,9 @@
 mod load;
 mod model;
 mod motor;
+mod shooting;
+#[cfg(test)]
+mod shooting_tests;
 #[cfg(test)]
 mod tests;
 mod varying;
@@ -20,4 +23,5 @@ pub use model::{
     SteadyState, MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET, SAMPLES_PER_CYCLE,
 };
 pub use motor::{Kloss, KlossFit, Motor, Parabola};
+pub use shooting::MAX_STEPS;
 pub use varying::{InertiaHarmonic, MAX_INERTIA_HARMONICS, MAX_NODES};

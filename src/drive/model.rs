@@ -1,7 +1,10 @@
 //! Steady state of the drive (seed 000, eq. 11–13), its irregularity δ, flywheel sizing and
 //! sensitivities. A reduced inertia that depends on φ ([`DriveModel::with_inertia_harmonics`])
 //! takes the path of the `varying` module (eq. 1 solved exactly in `w = J·ω²` over one
-//! period); what follows is the constant-inertia form, which that path reproduces.
+//! period); a Kloss motor, with a constant inertia or J(φ), the path of the `shooting` module
+//! (eq. 1 with the Kloss curve itself, integrated over one period by a sixth-order Runge–Kutta
+//! method, Newton on the periodic start: [`Horizon::Shooting`]); what follows is the
+//! constant-inertia parabola form, which both paths reproduce.
 //!
 //! ## Derivation
 //! With constant reduced inertia `J` (machine plus flywheel), eq. 1 reads
@@ -31,9 +34,12 @@
 
 use super::load::{Harmonic, Load, MAX_HARMONICS};
 use super::motor::Motor;
+use super::shooting::{Characteristic, Failure, Shooter, Shot};
 use super::varying::{self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS};
 use crate::error::{non_negative, positive, ConfigError};
+use core::cell::Cell;
 use core::f64::consts::PI;
+use core::num::NonZeroU16;
 
 /// Samples per period of the fastest harmonic when the extrema are searched numerically.
 pub const SAMPLES_PER_CYCLE: u64 = 32;
@@ -91,6 +97,17 @@ pub enum Horizon {
         /// [`MAX_NODES`](crate::drive::MAX_NODES)).
         nodes: u32,
     },
+    /// A Kloss motor: the periodic solution of eq. 1 with the Kloss curve itself, by shooting
+    /// over one common period of the load (and inertia) orders with a sixth-order Runge–Kutta
+    /// method on `steps` equal steps and Newton's method on the start (see the `shooting`
+    /// module docs); its extrema found on the steps and refined by golden section.
+    Shooting {
+        /// Common period of all load and inertia harmonics, rad.
+        radians: f64,
+        /// Runge–Kutta steps over that period (at most
+        /// [`MAX_STEPS`](crate::drive::MAX_STEPS)).
+        steps: u32,
+    },
 }
 
 /// A periodic steady state.
@@ -114,7 +131,8 @@ pub struct SteadyState {
     /// How the extrema were found.
     pub horizon: Horizon,
     /// `ωmin ≥` the motor's breakdown speed: the speed stays on the motor's stable working
-    /// branch, where the parabola stands for the real characteristic (see the motor module).
+    /// branch, where the parabola stands for the real characteristic (see the motor module)
+    /// and a Kloss motor's period map contracts.
     pub within_working_branch: bool,
 }
 
@@ -123,9 +141,12 @@ pub struct SteadyState {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Stall {
     /// Mean of ω² over the period, `ū = (B − M1)/a`, s⁻²; `≤ 0` means the mean load alone
-    /// exceeds the motor's stall torque `B` and no flywheel can help.
+    /// exceeds the motor's stall torque `B` and no flywheel can help. For a Kloss motor, the
+    /// square of the speed that carries the mean load, or 0 when the mean load is at or beyond
+    /// the breakdown torque `M_m` (or at or below `−M_m`).
     pub u_mean: f64,
-    /// The minimum of the periodic ω², s⁻² (`≤ 0`).
+    /// The minimum of the periodic ω², s⁻² (`≤ 0`); 0 for a Kloss motor, whose speed falls
+    /// to 0 with no periodic solution to take a minimum of.
     pub u_min: f64,
 }
 
@@ -223,7 +244,8 @@ pub struct Irregularity {
 struct Component {
     order: f64,
     /// `(p, q)` with `order = p/q`, if the order is such a rational.
-    ratio: Option<(u64, u64)>,
+    /// (The denominator as a `NonZeroU16`, at most [`MAX_DENOMINATOR`]: 16 bytes, not 24.)
+    ratio: Option<(u64, NonZeroU16)>,
     c: f64,
     d: f64,
     dc_dj: f64,
@@ -247,6 +269,41 @@ impl Component {
     }
 }
 
+/// Which way the steady state is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Path {
+    /// Closed form for a parabola motor with constant inertia, the J(φ) solution for a parabola
+    /// with inertia harmonics, shooting for a Kloss motor.
+    Auto,
+    /// The J(φ) solution even for a constant inertia (tests).
+    Varying,
+    /// Shooting with the parabola (tests).
+    ShootingParabola,
+}
+
+/// The shooting's outcome, computed when the model is built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Exact {
+    /// Shot with the motor's parabola (tests) rather than its Kloss curve.
+    parabola: bool,
+    /// The periodic solution; `None`: the drive stalls (`Stall { u_mean, u_min: 0 }`).
+    shot: Option<Shot>,
+}
+
+/// What the steady state is computed from: the closed form's oscillating orders, or the
+/// shooting's outcome (one or the other, in the same storage, so that the parabola's model
+/// does not grow by the shooting's results: it is moved by value).
+// Sharing the storage is the point (no allocation to box the larger variant into).
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Body {
+    Closed(heapless::Vec<Component, MAX_HARMONICS>),
+    Exact(Exact),
+}
+
 /// The validated drive: motor, load, reduced inertia and flywheel, with the steady-state
 /// coefficients computed once.
 #[derive(Debug, Clone, PartialEq)]
@@ -260,7 +317,9 @@ pub struct DriveModel {
     u_mean: f64,
     /// The mean load including order-0 harmonics, N·m.
     mean_load: f64,
-    components: heapless::Vec<Component, MAX_HARMONICS>,
+    /// The closed form's orders, or the periodic solution by shooting ([`Horizon::Shooting`];
+    /// a Kloss motor).
+    body: Body,
     horizon: Horizon,
     /// The harmonics of J(φ) with a non-zero amplitude (empty: constant inertia).
     inertia_harmonics: heapless::Vec<InertiaHarmonic, MAX_INERTIA_HARMONICS>,
@@ -269,9 +328,13 @@ pub struct DriveModel {
 impl DriveModel {
     /// A drive with reduced machine `inertia` (kg·m², > 0) and an added `flywheel`
     /// (kg·m², ≥ 0). Rejects parameter combinations whose steady-state coefficients
-    /// overflow f64.
+    /// overflow f64. A Kloss motor's steady state is computed here (by shooting, see
+    /// [`Horizon::Shooting`]); rejected are a Kloss drive so stiff against its inertia that one
+    /// period needs more than [`MAX_STEPS`](crate::drive::MAX_STEPS) steps
+    /// (`OutOfRange("inertia")`) and one with no attracting periodic solution found
+    /// (`OutOfRange("load.harmonics")`).
     pub fn new(motor: Motor, load: Load, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
-        Self::build(motor, load, inertia, flywheel, &[], false)
+        Self::build(motor, load, inertia, flywheel, &[], Path::Auto)
     }
 
     /// The same drive with a reduced inertia that depends on the shaft angle,
@@ -299,7 +362,7 @@ impl DriveModel {
             self.inertia,
             self.flywheel,
             harmonics,
-            false,
+            self.path(),
         )
     }
 
@@ -319,7 +382,22 @@ impl DriveModel {
             self.inertia,
             self.flywheel,
             &h,
-            true,
+            Path::Varying,
+        )
+    }
+
+    /// The same drive by shooting with its parabola, for the tests that check the shooting
+    /// against the closed form.
+    #[cfg(test)]
+    pub(super) fn on_shooting_path(&self) -> Result<Self, ConfigError> {
+        let h = self.inertia_harmonics.clone();
+        Self::build(
+            self.motor,
+            self.load.clone(),
+            self.inertia,
+            self.flywheel,
+            &h,
+            Path::ShootingParabola,
         )
     }
 
@@ -330,14 +408,7 @@ impl DriveModel {
     /// Rebuilds with other motor and inertias, keeping the inertia harmonics and the path.
     fn rebuilt(&self, motor: Motor, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
         let h = self.inertia_harmonics.clone();
-        Self::build(
-            motor,
-            self.load.clone(),
-            inertia,
-            flywheel,
-            &h,
-            self.is_varying(),
-        )
+        Self::build(motor, self.load.clone(), inertia, flywheel, &h, self.path())
     }
 
     fn build(
@@ -346,7 +417,7 @@ impl DriveModel {
         inertia: f64,
         flywheel: f64,
         inertia_harmonics: &[InertiaHarmonic],
-        force_varying: bool,
+        path: Path,
     ) -> Result<Self, ConfigError> {
         let inertia = positive("inertia", inertia)?;
         let flywheel = non_negative("flywheel", flywheel)?;
@@ -404,16 +475,178 @@ impl DriveModel {
             flywheel,
             u_mean,
             mean_load,
-            components,
+            body: Body::Closed(components),
             horizon: Horizon::Constant,
             inertia_harmonics: kept,
         };
-        model.horizon = if model.inertia_harmonics.is_empty() && !force_varying {
-            horizon(&model.components)
+        let curve = match path {
+            Path::Auto => model.motor.kloss_curve().map(|k| Characteristic::Kloss(*k)),
+            Path::ShootingParabola => Some(Characteristic::Parabola(*model.motor.model())),
+            Path::Varying => None,
+        };
+        if let Some(curve) = curve {
+            if model.shoot(curve)? {
+                return Ok(model);
+            }
+        }
+        model.horizon = if model.inertia_harmonics.is_empty() && path != Path::Varying {
+            horizon(model.components())
         } else {
             model.varying_horizon()?
         };
         Ok(model)
+    }
+
+    /// The steady state by shooting with `curve`; `Ok(false)` (the closed form stands in) for
+    /// a constant inertia and load orders with no common period, where no periodic solution
+    /// exists: the tangent parabola's [`Horizon::Unbounded`] bound is used then. Out of line:
+    /// design-time code, off the parabola's path.
+    #[inline(never)]
+    fn shoot(&mut self, curve: Characteristic) -> Result<bool, ConfigError> {
+        let parabola = matches!(curve, Characteristic::Parabola(_));
+        let orders = self
+            .load
+            .harmonics()
+            .iter()
+            .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
+            .map(Harmonic::order)
+            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order));
+        let any = orders.clone().next().is_some();
+        let Some((radians, cycles)) = common_period(orders).filter(|_| any) else {
+            if !self.inertia_harmonics.is_empty() {
+                return Err(ConfigError::Inconsistent("inertia_harmonic.order"));
+            }
+            if any {
+                return Ok(false);
+            }
+            // No oscillation at all: ω is the speed that carries the mean load.
+            self.horizon = Horizon::Constant;
+            self.u_mean = match Shooter::new(
+                curve,
+                self.total_inertia(),
+                &[],
+                &[],
+                self.mean_load,
+                2.0 * PI,
+                1,
+            ) {
+                Ok(s) => s.omega_ref() * s.omega_ref(),
+                Err(_) => 0.0,
+            };
+            return Ok(true);
+        };
+        let shooter = Shooter::new(
+            curve,
+            self.total_inertia(),
+            &self.inertia_harmonics,
+            self.load.harmonics(),
+            self.mean_load,
+            radians,
+            cycles,
+        );
+        let shooter = match shooter {
+            Ok(s) => s,
+            Err(Failure::Steps) => return Err(ConfigError::OutOfRange("inertia")),
+            Err(_) => {
+                // No speed carries the mean load: no inertia helps.
+                self.u_mean = 0.0;
+                self.horizon = Horizon::Shooting { radians, steps: 0 };
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: None,
+                });
+                return Ok(true);
+            }
+        };
+        // The start: the tangent parabola's oscillation at φ = 0 about the shooting's
+        // reference speed (for a constant inertia; with J(φ), the reference itself).
+        let guess = if self.inertia_harmonics.is_empty() {
+            self.total_inertia() * self.oscillation(0.0)
+        } else {
+            0.0
+        };
+        let omega_ref = shooter.omega_ref();
+        match shooter.solve(guess) {
+            Ok(shot) => {
+                self.u_mean = shot.centre() + shot.s_mean;
+                self.horizon = Horizon::Shooting {
+                    radians,
+                    steps: shooter.steps(),
+                };
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: Some(shot),
+                });
+            }
+            Err(Failure::Stalls) => {
+                self.u_mean = omega_ref * omega_ref;
+                self.horizon = Horizon::Shooting { radians, steps: 0 };
+                self.body = Body::Exact(Exact {
+                    parabola,
+                    shot: None,
+                });
+            }
+            Err(Failure::Steps) => return Err(ConfigError::OutOfRange("inertia")),
+            Err(Failure::MeanLoad | Failure::NoAttractingState) => {
+                return Err(ConfigError::OutOfRange("load.harmonics"))
+            }
+        }
+        Ok(true)
+    }
+
+    /// The closed form's oscillating orders (none on the shooting path).
+    fn components(&self) -> &[Component] {
+        match &self.body {
+            Body::Closed(c) => c,
+            Body::Exact(_) => &[],
+        }
+    }
+
+    /// The shooting's outcome, on its path.
+    fn exact(&self) -> Option<&Exact> {
+        match &self.body {
+            Body::Exact(e) => Some(e),
+            Body::Closed(_) => None,
+        }
+    }
+
+    /// The path a rebuilt drive takes: this one's.
+    fn path(&self) -> Path {
+        if self.is_varying() {
+            Path::Varying
+        } else if self.exact().is_some_and(|e| e.parabola) {
+            Path::ShootingParabola
+        } else {
+            Path::Auto
+        }
+    }
+
+    /// The shooting setup of the converged solution (`None` unless there is one).
+    fn shooter(&self) -> Option<(Shooter<'_>, Shot)> {
+        let (
+            Some(Exact {
+                shot: Some(shot),
+                parabola,
+            }),
+            Horizon::Shooting { radians, steps },
+        ) = (self.exact().copied(), self.horizon)
+        else {
+            return None;
+        };
+        let curve = match (parabola, self.motor.kloss_curve()) {
+            (false, Some(k)) => Characteristic::Kloss(*k),
+            _ => Characteristic::Parabola(*self.motor.model()),
+        };
+        let shooter = Shooter::again(
+            curve,
+            &shot,
+            self.total_inertia(),
+            &self.inertia_harmonics,
+            self.load.harmonics(),
+            radians,
+            steps,
+        );
+        Some((shooter, shot))
     }
 
     /// The common period of the load and inertia orders and the trapezoid nodes that resolve
@@ -467,6 +700,8 @@ impl DriveModel {
         SteadyCurve {
             model: self,
             solution: self.varying_solution(),
+            shooter: self.shooter(),
+            from: Cell::new((0.0, f64::NAN)),
         }
     }
 
@@ -522,6 +757,8 @@ impl DriveModel {
     pub fn omega_squared(&self, phi: f64) -> f64 {
         if self.is_varying() {
             self.varying_omega_squared(phi)
+        } else if self.exact().is_some() {
+            self.steady_curve().omega_squared(phi)
         } else {
             self.u_mean + self.oscillation(phi)
         }
@@ -551,6 +788,27 @@ impl DriveModel {
     fn state(&self) -> (f64, Extremes) {
         if self.is_varying() {
             self.varying_state()
+        } else if let Some(e) = self.exact() {
+            match e.shot {
+                Some(s) => (
+                    s.centre(),
+                    Extremes {
+                        s_max: s.s_max,
+                        s_min: s.s_min,
+                        phi_max: Some(s.phi_max),
+                        phi_min: Some(s.phi_min),
+                    },
+                ),
+                None => (
+                    self.u_mean,
+                    Extremes {
+                        s_max: 0.0,
+                        s_min: -self.u_mean,
+                        phi_max: None,
+                        phi_min: None,
+                    },
+                ),
+            }
         } else {
             (self.u_mean, self.extremes())
         }
@@ -588,7 +846,16 @@ impl DriveModel {
 
     /// The steady state and its δ, or the stall.
     pub fn predict(&self) -> Prediction {
-        let (centre, ex) = self.state();
+        let (centre, ex) = match &self.body {
+            Body::Closed(_) if !self.is_varying() => (self.u_mean, self.extremes()),
+            Body::Exact(Exact { shot: None, .. }) => {
+                return Prediction::Stalls(Stall {
+                    u_mean: self.u_mean,
+                    u_min: 0.0,
+                })
+            }
+            _ => self.state(),
+        };
         let u_min = centre + ex.s_min;
         if !exceeds(u_min, 0.0) {
             return Prediction::Stalls(Stall {
@@ -617,12 +884,13 @@ impl DriveModel {
     /// an extremum is the partial derivative at the extremal angle). `None` without a steady
     /// state, or when the parameters are so extreme that the derivatives overflow f64.
     ///
-    /// With J(φ) the phases of the extrema move with the parameters in no closed form: both
-    /// derivatives are central differences of the computed δ with a relative step of 1e-4
-    /// (about 8 significant digits), the inertia step taken on the constant part of J;
+    /// With J(φ) or a Kloss motor the phases of the extrema move with the parameters in no
+    /// closed form: both derivatives are central differences of the computed δ with a relative
+    /// step of 1e-4 (about 8 significant digits), the inertia step taken on the constant part
+    /// of J, the torque step scaling the whole characteristic (the Kloss curve's `M_m`);
     /// `None` also when a stepped drive cannot be built or stalls.
     pub fn sensitivity(&self) -> Option<Sensitivity> {
-        if self.is_varying() {
+        if self.is_varying() || self.exact().is_some() {
             return self.varying_sensitivity();
         }
         let ex = self.extremes();
@@ -641,7 +909,7 @@ impl DriveModel {
             (Some(pmax), Some(pmin)) => {
                 // ∂s/∂J or ∂s/∂a at φ, from each component's pair of derivatives.
                 let slope = |phi: f64, pair: fn(&Component) -> (f64, f64)| {
-                    self.components
+                    self.components()
                         .iter()
                         .map(|c| {
                             let (x, y) = pair(c);
@@ -661,7 +929,7 @@ impl DriveModel {
             _ => {
                 // smax = Σ R_k, smin = −Σ R_k (or both 0): derivative of each |(c, d)|.
                 let (mut rj, mut ra) = (0.0, 0.0);
-                for c in &self.components {
+                for c in self.components() {
                     let r = c.amplitude();
                     // A vanishing (or underflowed) amplitude has no direction to differentiate.
                     if r.is_nan() || r <= 0.0 {
@@ -721,12 +989,12 @@ impl DriveModel {
     /// answer is below about 2⁻¹⁶⁶ of the upper end, and then the returned flywheel still
     /// meets the target, a little oversized.
     ///
-    /// With J(φ) no closed-form bound exists: the upper end is found by doubling an added
-    /// flywheel from the current total inertia (at most 1100 doublings, past the f64 range),
-    /// then bisected as above. δ falls with the flywheel (both the load's and the inertia's
-    /// share of the swing shrink like 1/J for a large flywheel; the randomised tests check
-    /// monotonicity on a grid), and where it might not, the answer is the first crossing the
-    /// bracket finds, which meets the target.
+    /// With J(φ) or a Kloss motor no closed-form bound exists: the upper end is found by
+    /// doubling an added flywheel from the current total inertia (at most 1100 doublings, past
+    /// the f64 range), then bisected as above. δ falls with the flywheel (both the load's and
+    /// the inertia's share of the swing shrink like 1/J for a large flywheel; the randomised
+    /// tests check monotonicity on a grid, for J(φ) and for Kloss drives), and where it might
+    /// not, the answer is the first crossing the bracket finds, which meets the target.
     pub fn flywheel_for(&self, delta_target: f64) -> Result<f64, DesignError> {
         if !(delta_target.is_finite() && delta_target > 0.0 && delta_target < 2.0) {
             return Err(DesignError::InvalidTarget);
@@ -745,7 +1013,33 @@ impl DriveModel {
             return Ok(0.0);
         }
         let at = |extra: f64| self.with_flywheel(self.flywheel + extra).ok();
-        if self.is_varying() {
+        let j = self.total_inertia();
+        let a = -self.motor.model().a();
+        // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
+        let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
+        if let ([c], Horizon::ClosedForm) = (self.components(), self.horizon) {
+            let n = c.order;
+            let h = libm::hypot(2.0 * a, n * j);
+            // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
+            let m2 = c.amplitude() * h / 2.0;
+            let h_needed = 2.0 * m2 / (r * self.u_mean);
+            if !exceeds(h_needed, 2.0 * a) {
+                return Ok(0.0);
+            }
+            // As two roots: the product overflows beyond 1.3e154.
+            let j_needed = libm::sqrt(h_needed - 2.0 * a) * libm::sqrt(h_needed + 2.0 * a) / n;
+            let extra = j_needed - j;
+            // n·J stays below h_needed, so the model holds this inertia if it is finite.
+            return if !(self.inertia + (self.flywheel + extra)).is_finite() {
+                Err(DesignError::Unreachable)
+            } else if extra <= 0.0 {
+                Ok(0.0)
+            } else {
+                Ok(extra)
+            };
+        }
+        // J(φ) and the shooting (after the closed form, which neither takes).
+        if self.is_varying() || self.exact().is_some() {
             let mut hi = self.total_inertia();
             let mut lo = 0.0;
             let mut found = false;
@@ -770,44 +1064,19 @@ impl DriveModel {
             }
             return bisect(lo, hi, |x| at(x).map(|m| meets(&m)));
         }
-        let j = self.total_inertia();
-        let a = -self.motor.model().a();
-        // The oscillation amplitude that gives δ = target with symmetric extrema ū ± R.
-        let r = delta_target / (1.0 + delta_target * delta_target / 4.0);
-        if let ([c], Horizon::ClosedForm) = (self.components.as_slice(), self.horizon) {
-            let n = c.order;
-            let h = libm::hypot(2.0 * a, n * j);
-            // |Σ M2k·e^{iψk}| of the harmonics of this order: R·h/2.
-            let m2 = c.amplitude() * h / 2.0;
-            let h_needed = 2.0 * m2 / (r * self.u_mean);
-            if !exceeds(h_needed, 2.0 * a) {
-                return Ok(0.0);
-            }
-            // As two roots: the product overflows beyond 1.3e154.
-            let j_needed = libm::sqrt(h_needed - 2.0 * a) * libm::sqrt(h_needed + 2.0 * a) / n;
-            let extra = j_needed - j;
-            // n·J stays below h_needed, so the model holds this inertia if it is finite.
-            return if !(self.inertia + (self.flywheel + extra)).is_finite() {
-                Err(DesignError::Unreachable)
-            } else if extra <= 0.0 {
-                Ok(0.0)
-            } else {
-                Ok(extra)
-            };
-        }
         // Upper end of the bracket: with `S = Σ 2|M2k|/n_k` and the budget `B = r·ū`, order k
         // gets the share `(2|M2k|/n_k)/S` of B, reached where `√(4a² + n_k²J²) = n_k·S/B`,
         // i.e. at `J_k = √((S/B)² − (2a/n_k)²)`; at `max_k J_k` every share holds, so
         // `Σ R_k ≤ B`. `2|M2k| = R_k·h_k` at the current inertia.
         let budget = r * self.u_mean * (1.0 - 1e-6);
         let s: f64 = self
-            .components
+            .components()
             .iter()
             .map(|c| c.amplitude() * (libm::hypot(2.0 * a, c.order * j) / c.order))
             .sum();
         let x = s / budget;
         let j_bound = self
-            .components
+            .components()
             .iter()
             .map(|c| {
                 let y = 2.0 * a / c.order;
@@ -820,7 +1089,11 @@ impl DriveModel {
             .fold(0.0, f64::max);
         // Beyond f64: start from the largest flywheel the model can hold (n·J must stay
         // finite); no larger than J through rounding: from J itself.
-        let n_max = self.components.iter().map(|c| c.order).fold(1.0, f64::max);
+        let n_max = self
+            .components()
+            .iter()
+            .map(|c| c.order)
+            .fold(1.0, f64::max);
         let cap = f64::MAX / 4.0 / n_max;
         let mut hi = if !j_bound.is_finite() || j_bound > cap {
             cap
@@ -868,9 +1141,7 @@ impl DriveModel {
         // The whole characteristic scaled by 1 ± STEP: M_m moves by ±STEP·M_m.
         let scaled = |f: f64| {
             self.motor
-                .model()
                 .scaled(f)
-                .map(Motor::parabola)
                 .ok_or(ConfigError::OutOfRange("breakdown_torque"))
                 .and_then(|m| self.rebuilt(m, self.inertia, self.flywheel))
         };
@@ -919,11 +1190,11 @@ impl DriveModel {
     }
 
     fn oscillation(&self, phi: f64) -> f64 {
-        self.components.iter().map(|c| c.value(phi)).sum()
+        self.components().iter().map(|c| c.value(phi)).sum()
     }
 
     fn extremes(&self) -> Extremes {
-        match (self.horizon, self.components.as_slice()) {
+        match (self.horizon, self.components()) {
             (Horizon::ClosedForm, [c]) => {
                 // c·cos(nφ) + d·sin(nφ) = R·cos(nφ − α).
                 let r = c.amplitude();
@@ -951,7 +1222,7 @@ impl DriveModel {
             }
             (Horizon::Period { radians, samples }, _) => self.search(radians, samples),
             (Horizon::Unbounded, _) => {
-                let r: f64 = self.components.iter().map(Component::amplitude).sum();
+                let r: f64 = self.components().iter().map(Component::amplitude).sum();
                 Extremes {
                     s_max: r,
                     s_min: -r,
@@ -991,11 +1262,11 @@ impl DriveModel {
             }
         }
         let curvature: f64 = self
-            .components
+            .components()
             .iter()
             .map(|c| c.amplitude() * c.order * c.order)
             .sum();
-        let amplitude: f64 = self.components.iter().map(Component::amplitude).sum();
+        let amplitude: f64 = self.components().iter().map(Component::amplitude).sum();
         let margin = 0.5 * curvature * h * h + 8.0 * f64::EPSILON * amplitude;
         let mut out = Extremes {
             s_max: best_max,
@@ -1032,11 +1303,34 @@ impl DriveModel {
 pub struct SteadyCurve<'a> {
     model: &'a DriveModel,
     solution: Option<Solution<'a>>,
+    shooter: Option<(Shooter<'a>, Shot)>,
+    /// The last shooting point evaluated, `(φ within the period, y)`: evaluations at rising
+    /// angles continue from it.
+    from: Cell<(f64, f64)>,
 }
 
 impl SteadyCurve<'_> {
-    /// ω² of the periodic solution at `phi`, s⁻² (as [`DriveModel::omega_squared`]).
+    /// ω² of the periodic solution at `phi`, s⁻² (as [`DriveModel::omega_squared`]). For a
+    /// Kloss motor each evaluation integrates from the previous one when `phi` (within the
+    /// period) lies after it, else from the period's start: `O(steps)` at most, and no more
+    /// over a sweep of rising angles than one period.
     pub fn omega_squared(&self, phi: f64) -> f64 {
+        if let Some((shooter, shot)) = &self.shooter {
+            let period = shooter.period();
+            let p = phi - period * libm::floor(phi / period);
+            if !(p.is_finite() && (0.0..=period).contains(&p)) {
+                return f64::NAN;
+            }
+            let last = self.from.get();
+            let start = if last.0 <= p && last.1.is_finite() {
+                last
+            } else {
+                (0.0, shot.y0)
+            };
+            let (s, y) = shooter.swing_from(start, p);
+            self.from.set((p, y));
+            return shot.centre() + s;
+        }
         match (&self.solution, self.model.is_varying()) {
             (Some(s), _) => s.omega_squared(phi),
             (None, false) => self.model.u_mean + self.model.oscillation(phi),
@@ -1151,7 +1445,7 @@ fn component(h: &Harmonic, a: f64, j: f64) -> Option<Component> {
     if all.iter().all(|x| x.is_finite()) {
         Some(Component {
             order: n,
-            ratio: rational(n),
+            ratio: rational(n).and_then(|(p, q)| Some((p, NonZeroU16::new(q as u16)?))),
             c,
             d,
             dc_dj,
@@ -1208,6 +1502,7 @@ fn horizon(components: &[Component]) -> Horizon {
         let Some((_, q)) = c.ratio else {
             return Horizon::Unbounded;
         };
+        let q = u64::from(q.get());
         match (q_all / gcd(q_all, q)).checked_mul(q) {
             Some(l) => q_all = l,
             None => return Horizon::Unbounded,
@@ -1218,6 +1513,7 @@ fn horizon(components: &[Component]) -> Horizon {
         let Some((p, q)) = c.ratio else {
             return Horizon::Unbounded;
         };
+        let q = u64::from(q.get());
         let Some(m) = p.checked_mul(q_all / q) else {
             return Horizon::Unbounded;
         };

@@ -1,10 +1,12 @@
 //! Motor characteristics `M_d(ω)`: the parabola of seed 000 (eq. 3–4) and the Kloss curve
 //! (eq. 2) with a documented fit to a parabola.
 //!
-//! The steady-state prediction needs the parabola form `M_d = A·ω² + B` (it makes the equation
+//! The closed-form steady state needs the parabola form `M_d = A·ω² + B` (it makes the equation
 //! of motion linear in `u = ω²`). A real induction motor follows the Kloss curve; the simulator
-//! integrates the curve itself ([`Motor::torque`]) while the prediction uses its fitted
-//! parabola ([`Motor::model`]).
+//! integrates the curve itself ([`Motor::torque`]), and so does the prediction (by shooting
+//! over one period, the `shooting` module), starting from the fitted parabola
+//! ([`Motor::model`]); the parabola alone stands in only where the load's orders have no common
+//! period (no periodic solution exists: [`Horizon::Unbounded`](crate::drive::Horizon)).
 //!
 //! ## Which branch the parabola describes
 //! With `A < 0` the parabola falls monotonically for every `ω > 0` (`dM_d/dω = 2Aω < 0`), so
@@ -134,7 +136,8 @@ pub struct Kloss {
     breakdown_torque: f64,
 }
 
-/// How a Kloss curve is replaced by a parabola `A·ω² + B` for the steady-state prediction.
+/// How a Kloss curve is replaced by a parabola `A·ω² + B`: the start of the prediction's
+/// shooting, and the prediction itself only for load orders with no common period.
 ///
 /// No parabola of this family follows the Kloss curve over its whole working branch: the
 /// Kloss slope goes from `2·M_m/(σ_m·ω_s)` at synchronous speed to 0 at breakdown, while the
@@ -258,7 +261,8 @@ impl Motor {
         }
     }
 
-    /// A motor with a Kloss characteristic, predicted through the given parabola fit.
+    /// A motor with a Kloss characteristic; the prediction integrates the curve itself, the
+    /// parabola fit is its start (and the prediction where the load has no common period).
     pub fn kloss(k: Kloss, fit: KlossFit) -> Result<Self, ConfigError> {
         Ok(Self {
             kloss: Some(k),

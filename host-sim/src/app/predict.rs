@@ -76,6 +76,16 @@ fn not_covered(e: ConfigError) -> Option<String> {
              many of its cycles, that the periodic solution needs more than {} trapezoid nodes",
             drive_monitor::drive::MAX_NODES
         )),
+        ConfigError::OutOfRange("inertia") => Some(format!(
+            "shaft.inertia: the Kloss drive is so stiff against its inertia that one period \
+             needs more than {} Runge–Kutta steps",
+            drive_monitor::drive::MAX_STEPS
+        )),
+        ConfigError::OutOfRange("load.harmonics") => Some(
+            "load.harmonics: no attracting periodic steady state was found for the Kloss drive \
+             (its speed swings far past the breakdown point)"
+                .to_string(),
+        ),
         ConfigError::Capacity("inertia_harmonics") => Some(format!(
             "shaft.inertia_harmonics: more than {} harmonics",
             drive_monitor::drive::MAX_INERTIA_HARMONICS
@@ -85,7 +95,72 @@ fn not_covered(e: ConfigError) -> Option<String> {
 }
 
 /// The drive model with the constant part of the inertia only.
+/// `None` where the core does not predict the drive (a Kloss drive it refuses:
+/// [`irregularity_not_predicted`] says why).
 fn constant_inertia_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
+    match constant_inertia_build(scene, file)? {
+        None => Ok(None),
+        Some(Ok(m)) => Ok(Some(m)),
+        Some(Err(e)) if not_covered(e).is_some() => Ok(None),
+        Some(Err(e)) => Err(core_error(scene, file, "shaft", e)),
+    }
+}
+
+/// The drive model with the constant part of the inertia only, and the core's error when it
+/// refuses the drive as a whole.
+#[allow(clippy::type_complexity)]
+fn constant_inertia_build(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<Result<DriveModel, ConfigError>>, SceneError> {
+    Ok(drive_parts_of(scene, file)?
+        .map(|(motor, load, inertia, flywheel)| DriveModel::new(motor, load, inertia, flywheel)))
+}
+
+/// What a simulation of a scene's motor-driven shaft needs: the motor, the load and the square
+/// of a start speed (the predicted mean of ω²).
+#[derive(Debug, Clone)]
+pub struct DriveParts {
+    /// The motor.
+    pub motor: Motor,
+    /// The load torque.
+    pub load: Load,
+    /// ω² to start from, s⁻².
+    pub u_start: f64,
+}
+
+/// The motor and load of a scene for simulation: those of its drive model, or, for a Kloss
+/// drive whose steady state the core refuses to predict ([`irregularity_not_predicted`]),
+/// the scene's own, started at the tangent parabola's mean speed. `None` without a torque motor
+/// and a load.
+pub fn drive_parts(
+    scene: &Scene,
+    file: &Path,
+    model: Option<&DriveModel>,
+) -> Result<Option<DriveParts>, SceneError> {
+    if let Some(m) = model {
+        return Ok(Some(DriveParts {
+            motor: *m.motor(),
+            load: m.load().clone(),
+            u_start: m.u_mean(),
+        }));
+    }
+    Ok(drive_parts_of(scene, file)?.map(|(motor, load, ..)| {
+        let p = motor.model();
+        let u_start = (p.b() - load.mean()) / -p.a();
+        DriveParts {
+            motor,
+            load,
+            u_start,
+        }
+    }))
+}
+
+/// The scene's motor, load, inertia and flywheel as the core validates them.
+fn drive_parts_of(
+    scene: &Scene,
+    file: &Path,
+) -> Result<Option<(Motor, Load, f64, f64)>, SceneError> {
     let (Some(motor), Some(load)) = (&scene.motor, &scene.load) else {
         return Ok(None);
     };
@@ -127,9 +202,7 @@ fn constant_inertia_model(scene: &Scene, file: &Path) -> Result<Option<DriveMode
             "missing: a motor-driven scene needs [shaft] inertia",
         ));
     };
-    DriveModel::new(motor, load, shaft.inertia, shaft.flywheel)
-        .map(Some)
-        .map_err(|e| core_error(scene, file, "shaft", e))
+    Ok(Some((motor, load, shaft.inertia, shaft.flywheel)))
 }
 
 /// What the core's speed samples do to the predicted δ: each sample is the angle of
@@ -172,7 +245,9 @@ pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
                 .reduce(f64::min)?;
             std::f64::consts::TAU / order
         }
-        Horizon::Period { radians, .. } | Horizon::Varying { radians, .. } => radians,
+        Horizon::Period { radians, .. }
+        | Horizon::Varying { radians, .. }
+        | Horizon::Shooting { radians, .. } => radians,
         Horizon::Unbounded => return None,
     };
     if !(span > 0.0 && period > 0.0) {
@@ -521,6 +596,9 @@ pub struct IrregularityOut {
     /// predicted speeds ([`kloss_note`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motor_note: Option<String>,
+    /// The steady state integrates the Kloss curve itself ([`kloss_note`]; text only).
+    #[serde(skip)]
+    pub kloss_curve: bool,
     /// With `[shaft] inertia_harmonics`: how the J(φ) steady state was computed (absent for a
     /// constant inertia).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -529,8 +607,19 @@ pub struct IrregularityOut {
 
 /// How a J(φ) steady state was computed (`None` for a constant inertia).
 pub fn inertia_note(model: &DriveModel) -> Option<String> {
-    let drive_monitor::drive::Horizon::Varying { radians, nodes } = model.horizon() else {
-        return None;
+    use drive_monitor::drive::Horizon;
+    let (radians, nodes) = match model.horizon() {
+        Horizon::Varying { radians, nodes } => (radians, nodes),
+        Horizon::Shooting { radians, .. } if !model.inertia_harmonics().is_empty() => {
+            let n = model.inertia_harmonics().len();
+            return Some(format!(
+                "J(φ) from shaft.inertia_harmonics ({n} harmonic{}): eq. 1 in w = J·ω² with \
+                 the Kloss curve, integrated over its period of {radians:.4} rad (see the \
+                 motor line); ∂δ/∂J and ∂δ/∂M_m by central differences",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
+        _ => return None,
     };
     Some(format!(
         "J(φ) from shaft.inertia_harmonics ({} harmonic{}): eq. 1, linear in w = J·ω², solved \
@@ -546,22 +635,42 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
     ))
 }
 
-/// What a Kloss motor's prediction stands on: the closed form (seed 000 eq. 11–13) needs a
-/// parabola `A·ω² + B`, and the Kloss curve is replaced by its tangent parabola at synchronous
-/// speed (exact there, above the curve towards breakdown), while `run` integrates the curve
-/// itself. Says so, with the largest difference between the two over the predicted speeds
-/// `[omega_min, omega_max]` (65 points), in N·m and in % of the curve's torque there. `None`
-/// for a parabola motor.
-pub fn kloss_note(
-    motor: &drive_monitor::drive::Motor,
-    omega_min: f64,
-    omega_max: f64,
-) -> Option<String> {
+/// What a Kloss motor's prediction stands on. With a common period of the load (and
+/// inertia) orders the core integrates the Kloss curve itself over one period
+/// ([`drive_monitor::drive::Horizon::Shooting`]: eq. 1 in `w = J·ω²`, sixth-order Runge–Kutta,
+/// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
+/// step count. Without one (no periodic solution exists: `Horizon::Unbounded`) the Kloss curve
+/// is replaced by its tangent parabola at synchronous speed (exact there, above the curve
+/// towards breakdown) for the conservative bound, and the note says that, with the largest
+/// difference between the two over the predicted speeds `[omega_min, omega_max]` (65 points),
+/// in N·m and in % of the curve's torque there. `None` for a parabola motor.
+pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
+    use drive_monitor::drive::Horizon;
+    let motor = model.motor();
     let k = motor.kloss_curve()?;
+    match model.horizon() {
+        Horizon::Shooting { radians, steps } if steps > 0 => {
+            return Some(format!(
+                "the Kloss motor is predicted with its curve itself (eq. 1 in w = J·ω² \
+                 integrated over the period of {radians:.4} rad, sixth-order Runge–Kutta on \
+                 {steps} steps, Newton on the periodic start; `run` integrates the same \
+                 curve; ∂δ/∂J and ∂δ/∂M_m by central differences)"
+            ))
+        }
+        Horizon::Shooting { .. } | Horizon::Constant => {
+            return Some(
+                "the Kloss motor is predicted with its curve itself (`run` integrates the same \
+                 curve)"
+                    .to_string(),
+            )
+        }
+        _ => {}
+    }
     let p = motor.model();
     let head = format!(
-        "the Kloss motor is predicted through its tangent parabola at synchronous speed \
-         (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
+        "the load's orders have no common period, so no periodic steady state exists to \
+         integrate: the Kloss motor is predicted through its tangent parabola at synchronous \
+         speed (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
         p.a(),
         p.b()
     );
@@ -692,8 +801,19 @@ impl Prediction {
 /// period, a J(φ) so close to 0 that the solution needs more nodes than the core holds, more
 /// harmonics than it holds. A constant-inertia prediction would silently leave the variation
 /// out (its ½·ω²·dJ/dφ term alone makes ω swing), so none is given; `run` simulates the drive.
+/// A Kloss drive the core refuses is named here too: one so stiff against its inertia that a
+/// period needs more than [`drive_monitor::drive::MAX_STEPS`] steps, or one with no attracting
+/// periodic steady state found.
 pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
-    let base = constant_inertia_model(scene, Path::new("scene")).ok()??;
+    let base = match constant_inertia_build(scene, Path::new("scene")).ok()?? {
+        Ok(base) => base,
+        Err(e) => {
+            let why = not_covered(e)?;
+            return Some(format!(
+                "{why}; δ is not predicted for this drive (`drive-sim run` simulates it)"
+            ));
+        }
+    };
     let why = not_covered(with_inertia(scene, &base).err()?)?;
     Some(format!(
         "{why}; δ is not predicted for this J(φ) (`drive-sim run` simulates it)"
@@ -704,7 +824,7 @@ pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
 pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let mut p = Prediction::default();
     let model = drive_model(scene, file)?;
-    if model.is_some() {
+    if model.is_some() || scene.motor.is_some() {
         p.irregularity_not_predicted = irregularity_not_predicted(scene);
     }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
@@ -716,6 +836,14 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let sampled = sampled_delta(scene, file, &model)?;
         let prediction = model.predict();
         let stall = match prediction {
+            drive_monitor::drive::Prediction::Stalls(s)
+                if s.u_mean <= 0.0 && model.motor().kloss_curve().is_some() =>
+            {
+                Some(
+                    "the mean load is beyond the motor's breakdown torque M_m (or below −M_m): \
+                     no speed and no flywheel carry it",
+                )
+            }
             drive_monitor::drive::Prediction::Stalls(s) if s.u_mean <= 0.0 => Some(
                 "the mean load exceeds the motor's torque at standstill: no speed and no \
                  flywheel carry it",
@@ -726,14 +854,28 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             ),
             _ => None,
         };
+        let kloss_curve = model.motor().kloss_curve().is_some()
+            && matches!(
+                model.horizon(),
+                drive_monitor::drive::Horizon::Shooting { .. }
+                    | drive_monitor::drive::Horizon::Constant
+            );
         let working_branch_warning = prediction
             .steady()
             .filter(|s| !s.within_working_branch)
             .map(|s| {
+                let why = if kloss_curve {
+                    "for part of the period the drive runs past the Kloss curve's breakdown \
+                     point, where its torque falls with the speed (the prediction integrates the \
+                     curve and its periodic state attracts; a little more load or less inertia \
+                     can tip it into a stall)"
+                } else {
+                    "the characteristic stands for a real motor only above it (past its \
+                     breakdown point a real motor's torque falls, and it may stall)"
+                };
                 format!(
                     "WARNING: ω min {:.3} rad/s is below the motor's breakdown speed {:.3} rad/s: \
-                     the characteristic stands for a real motor only above it (past its \
-                     breakdown point a real motor's torque falls, and it may stall)",
+                     {why}",
                     s.omega_min,
                     model.motor().model().working_min_speed()
                 )
@@ -746,8 +888,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
+            kloss_curve,
             motor_note: kloss_note(
-                model.motor(),
+                &model,
                 irr.omega_min,
                 if irr.steady_state { irr.omega_max } else { 0.0 },
             ),

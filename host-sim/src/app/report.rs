@@ -456,7 +456,11 @@ pub fn prediction_text(p: &Prediction) -> String {
         let _ = writeln!(
             s,
             "Predicted running irregularity (steady state, {})",
-            if i.inertia_note.is_some() {
+            if i.kloss_curve && i.inertia_note.is_some() {
+                "seed 000 eq. 1 with the Kloss curve and J(φ)"
+            } else if i.kloss_curve {
+                "seed 000 eq. 1 with the Kloss curve"
+            } else if i.inertia_note.is_some() {
                 "seed 000 eq. 1 with J(φ)"
             } else {
                 "seed 000 eq. 11–13"

@@ -28,7 +28,6 @@ use drive_monitor::alarm::{AlarmConfig, AlarmEvent, Verdict};
 #[cfg(doc)]
 use drive_monitor::balancer::DEFAULT_MARGIN;
 use drive_monitor::balancer::{Classifier, Machine};
-use drive_monitor::drive::DriveModel;
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Tolerances, Wheel};
 use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
@@ -931,7 +930,7 @@ struct Assembly {
 fn shaft_model(
     scene: &Scene,
     file: &Path,
-    model: Option<&DriveModel>,
+    model: Option<&predict::DriveParts>,
     over: Overrides,
     effects: &mut Vec<Box<dyn Effect>>,
     names: &mut Vec<&'static str>,
@@ -968,12 +967,12 @@ fn shaft_model(
             let shaft = scene.shaft.as_ref().ok_or_else(|| {
                 SceneError::value(file, "shaft", "missing: a motor-driven scene needs [shaft]")
             })?;
-            effects.push(Box::new(*model.motor()));
+            effects.push(Box::new(model.motor));
             names.push("motor");
             // Start at the predicted mean speed (or the given one) to shorten the transient.
             let omega0 = shaft
                 .initial_speed
-                .unwrap_or_else(|| model.u_mean().max(0.0).sqrt());
+                .unwrap_or_else(|| model.u_start.max(0.0).sqrt());
             Ok(ShaftModel::Dynamic(DynamicShaft {
                 inertia: shaft.inertia,
                 flywheel: shaft.flywheel,
@@ -1030,14 +1029,14 @@ fn speed_profile(scene: &Scene, over: Overrides) -> Option<SpeedProfile> {
 fn assemble(
     scene: &Scene,
     file: &Path,
-    model: Option<&DriveModel>,
+    model: Option<&predict::DriveParts>,
     over: Overrides,
 ) -> Result<Assembly, SceneError> {
     let mut effects: Vec<Box<dyn Effect>> = Vec::new();
     let mut names = Vec::new();
     let shaft = shaft_model(scene, file, model, over, &mut effects, &mut names)?;
     if let (Some(model), true) = (model, matches!(shaft, ShaftModel::Dynamic(_))) {
-        effects.push(Box::new(model.load().clone()));
+        effects.push(Box::new(model.load.clone()));
         names.push("load");
     }
     let rotor_speed0 = match &shaft {
@@ -1167,13 +1166,14 @@ pub fn run_with(
 ) -> Result<RunReport, SceneError> {
     let started = Instant::now();
     let model = predict::drive_model(scene, file)?;
+    let parts = predict::drive_parts(scene, file, model.as_ref())?;
     let Assembly {
         system,
         names,
         vib_params,
         vib_machine,
         rotor,
-    } = assemble(scene, file, model.as_ref(), over)?;
+    } = assemble(scene, file, parts.as_ref(), over)?;
     let vib_range = names
         .iter()
         .position(|n| *n == "vibration")
@@ -1196,9 +1196,9 @@ pub fn run_with(
         .encoder
         .as_ref()
         .map_or(1, |e| u64::from(e.grid_lines()));
-    let expected_edges = model
+    let expected_edges = parts
         .as_ref()
-        .map_or(1e3, |m| m.u_mean().max(1.0).sqrt())
+        .map_or(1e3, |m| m.u_start.max(1.0).sqrt())
         .max(over.speed.unwrap_or(0.0))
         * duration
         / std::f64::consts::TAU
