@@ -35,7 +35,9 @@
 use super::load::{Harmonic, Load, MAX_HARMONICS};
 use super::motor::Motor;
 use super::shooting::{Characteristic, Failure, Shooter, Shot};
-use super::varying::{self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS};
+use super::varying::{
+    self, InertiaHarmonic, Solution, MAX_INERTIA_HARMONICS, MAX_NODES, SMALL_NODES,
+};
 use crate::error::{non_negative, positive, ConfigError};
 use core::cell::Cell;
 use core::f64::consts::PI;
@@ -664,11 +666,19 @@ impl DriveModel {
         let (radians, cycles) = common_period(orders).ok_or(bad_order)?;
         let start = varying::initial_nodes(cycles).ok_or(bad_order)?;
         let out_of_range = ConfigError::OutOfRange("inertia_harmonics");
-        let solution =
-            Solution::solve(self.varying_drive(radians), start, true).map_err(|_| out_of_range)?;
+        let drive = self.varying_drive(radians);
+        // The small solution first (4 KiB of stack); the large one only for a drive that needs
+        // more nodes.
+        let nodes = match resolved_nodes::<SMALL_NODES>(drive, start) {
+            Err(varying::Unresolved::Nodes) => {
+                resolved_nodes::<MAX_NODES>(drive, start.max(2 * SMALL_NODES))
+            }
+            r => r,
+        }
+        .map_err(|_| out_of_range)?;
         Ok(Horizon::Varying {
             radians,
-            nodes: solution.nodes() as u32,
+            nodes: nodes as u32,
         })
     }
 
@@ -683,9 +693,10 @@ impl DriveModel {
         }
     }
 
-    /// The J(φ) solution on the model's nodes (`None` on the constant-inertia path; the
-    /// constructor computed the same solution, so it does not fail here).
-    fn varying_solution(&self) -> Option<Solution<'_>> {
+    /// The J(φ) solution on the model's nodes, held in `N` (`None` on the constant-inertia
+    /// path, or when the nodes are more than `N`; the constructor computed the same solution,
+    /// so it does not fail otherwise).
+    fn varying_solution<const N: usize>(&self) -> Option<Solution<'_, N>> {
         match self.horizon {
             Horizon::Varying { radians, nodes } => {
                 Solution::solve(self.varying_drive(radians), nodes as usize, false).ok()
@@ -694,12 +705,17 @@ impl DriveModel {
         }
     }
 
+    /// Whether the J(φ) solution fits the small buffer.
+    fn small_solution(&self) -> bool {
+        matches!(self.horizon, Horizon::Varying { nodes, .. } if nodes as usize <= SMALL_NODES)
+    }
+
     /// The steady-state curve, for evaluating ω at many angles: on the J(φ) path it holds the
     /// solution's spectrum (about 64 KiB), each evaluation `O(nodes)`.
     pub fn steady_curve(&self) -> SteadyCurve<'_> {
         SteadyCurve {
             model: self,
-            solution: self.varying_solution(),
+            solution: self.varying_solution::<MAX_NODES>(),
             shooter: self.shooter(),
             from: Cell::new((0.0, f64::NAN)),
         }
@@ -764,10 +780,20 @@ impl DriveModel {
         }
     }
 
-    /// Out of line, so that the solution's 64 KiB of stack stay off the constant-inertia path.
-    #[inline(never)]
+    /// Out of line, so that the solution's stack stays off the constant-inertia path, and in
+    /// the small buffer when the nodes fit it.
     fn varying_omega_squared(&self, phi: f64) -> f64 {
-        self.steady_curve().omega_squared(phi)
+        if self.small_solution() {
+            self.varying_omega_squared_in::<SMALL_NODES>(phi)
+        } else {
+            self.varying_omega_squared_in::<MAX_NODES>(phi)
+        }
+    }
+
+    #[inline(never)]
+    fn varying_omega_squared_in<const N: usize>(&self, phi: f64) -> f64 {
+        self.varying_solution::<N>()
+            .map_or(f64::NAN, |s| s.omega_squared(phi))
     }
 
     /// Steady-state speed at shaft angle `phi`, rad/s, for plots and for comparison with a
@@ -814,11 +840,20 @@ impl DriveModel {
         }
     }
 
-    /// [`Self::state`] on the J(φ) path; out of line, so that the solution's 64 KiB of stack
-    /// stay off the constant-inertia path.
-    #[inline(never)]
+    /// [`Self::state`] on the J(φ) path: in the small buffer when the nodes fit it.
     fn varying_state(&self) -> (f64, Extremes) {
-        match self.varying_solution() {
+        if self.small_solution() {
+            self.varying_state_in::<SMALL_NODES>()
+        } else {
+            self.varying_state_in::<MAX_NODES>()
+        }
+    }
+
+    /// Out of line, one copy per buffer, so that the solution's stack (4 or 64 KiB) stays off
+    /// the constant-inertia path and the small buffer's callers.
+    #[inline(never)]
+    fn varying_state_in<const N: usize>(&self) -> (f64, Extremes) {
+        match self.varying_solution::<N>() {
             Some(mut sol) => {
                 let e = sol.extremes();
                 (
@@ -1299,10 +1334,21 @@ impl DriveModel {
     }
 }
 
+/// The nodes that resolve `drive`'s J(φ) solution from `start` on, within a buffer of `N`
+/// (out of line, one copy per buffer: only a drive that needs more than the small buffer
+/// takes the large one's stack).
+#[inline(never)]
+fn resolved_nodes<const N: usize>(
+    drive: varying::Drive<'_>,
+    start: usize,
+) -> Result<usize, varying::Unresolved> {
+    Solution::<N>::solve(drive, start, true).map(|s| s.nodes())
+}
+
 /// The steady state as a curve over φ ([`DriveModel::steady_curve`]).
 pub struct SteadyCurve<'a> {
     model: &'a DriveModel,
-    solution: Option<Solution<'a>>,
+    solution: Option<Solution<'a, MAX_NODES>>,
     shooter: Option<(Shooter<'a>, Shot)>,
     /// The last shooting point evaluated, `(φ within the period, y)`: evaluations at rising
     /// angles continue from it.

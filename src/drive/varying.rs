@@ -43,8 +43,10 @@
 //! One solution: five FFTs of `N` points (building the model solves once more for each node
 //! count it tries). One prediction: a solution, two more FFTs for the node scan, and up to 16
 //! golden-section refinements of an extremum, each 66 evaluations of the series (`O(N)` each).
-//! The solution keeps [`MAX_NODES`] complex values on the stack (64 KiB), in functions kept out
-//! of line so that the constant-inertia path does not carry that frame. It is design-time
+//! The solution keeps its spectrum on the stack: 256 complex values (4 KiB) when the drive is
+//! resolved on that many nodes (the usual case), [`MAX_NODES`] (64 KiB) only when it needs
+//! more, each size in functions of its own kept out of line, so that neither the
+//! constant-inertia path nor a small drive carries the large frame. It is design-time
 //! code; the monitor's per-edge paths never run it.
 
 use super::load::{Harmonic, MAX_ORDER};
@@ -55,6 +57,9 @@ use core::f64::consts::PI;
 pub const MAX_INERTIA_HARMONICS: usize = 8;
 /// Largest number of trapezoid nodes over one common period.
 pub const MAX_NODES: usize = 4096;
+/// Nodes a solution holds when that is enough (4 KiB of stack): the usual drive needs 64 to
+/// 256; only one that needs more takes the [`MAX_NODES`] solution's 64 KiB.
+pub(super) const SMALL_NODES: usize = 256;
 /// Fewest nodes over one common period.
 const MIN_NODES: usize = 64;
 /// Nodes per cycle of the fastest order, at least.
@@ -322,13 +327,13 @@ impl Candidates {
 }
 
 /// The periodic solution over one period, as the spectrum of `ṽ + i·P̃` on `N` nodes.
-pub(super) struct Solution<'a> {
+pub(super) struct Solution<'a, const N: usize> {
     drive: Drive<'a>,
     nodes: usize,
     /// `2π/T`.
     base: f64,
     /// Spectrum of `z = ṽ/v_scale + i·P̃` (normalised: `z(φ) = Σ Z_m·e^{i·m·base·φ}`).
-    z: [C; MAX_NODES],
+    z: [C; N],
     v_mean: f64,
     /// The scale ṽ is stored at: `Z` holds the spectrum of `ṽ/v_scale + i·P̃`.
     v_scale: f64,
@@ -382,19 +387,22 @@ pub(super) fn initial_nodes(fastest: u64) -> Option<usize> {
     (n <= MAX_NODES as u64).then_some(n as usize)
 }
 
-impl<'a> Solution<'a> {
+impl<'a, const N: usize> Solution<'a, N> {
     /// The solution on `nodes` nodes, or with `adapt` the first power of two from `nodes` on
-    /// that resolves both spectra.
+    /// that resolves both spectra; [`Unresolved::Nodes`] when that is more than `N`.
     pub(super) fn solve(
         drive: Drive<'a>,
         mut nodes: usize,
         adapt: bool,
     ) -> Result<Self, Unresolved> {
+        if nodes > N {
+            return Err(Unresolved::Nodes);
+        }
         let mut s = Solution {
             drive,
             nodes,
             base: 2.0 * PI / drive.period,
-            z: [C::ZERO; MAX_NODES],
+            z: [C::ZERO; N],
             v_mean: 0.0,
             v_scale: 1.0,
             mean_e: 0.0,
@@ -405,7 +413,7 @@ impl<'a> Solution<'a> {
             match s.fill() {
                 Ok(true) => return Ok(s),
                 Ok(false) if !adapt => return Ok(s),
-                Ok(false) if nodes < MAX_NODES => nodes *= 2,
+                Ok(false) if nodes < N => nodes *= 2,
                 Ok(false) => return Err(Unresolved::Nodes),
                 Err(e) => return Err(e),
             }
@@ -696,6 +704,16 @@ impl<'a> Solution<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The solution most drives use holds 256 nodes: about 4 KiB, not the 64 KiB of the
+    /// largest.
+    #[test]
+    fn the_small_solution_is_a_sixteenth_of_the_large() {
+        let small = core::mem::size_of::<Solution<'static, SMALL_NODES>>();
+        let large = core::mem::size_of::<Solution<'static, MAX_NODES>>();
+        assert!(small < 4096 + 256, "{small}");
+        assert!(large > 65536, "{large}");
+    }
 
     #[test]
     fn fft_matches_the_direct_sum() {
