@@ -1421,9 +1421,7 @@ mod tests {
         // in the middle of a revolution (no edge missing). Nothing is a fault, and every
         // revolution after sync is counted at its gap.
         let p = Pattern::missing_teeth(36, 2);
-        let mut c = EncoderConfig::pattern(p, 1e6);
-        c.estimator = Estimator::Edges(1);
-        c.min_speed = 1.0;
+        let c = one_edge_pattern(p, 1.0);
         let tooth_s = 5000.0 / 1e6;
         let w0 = TAU / 36.0 / tooth_s;
         let drop_at = TAU * 5.5;
@@ -1443,6 +1441,14 @@ mod tests {
         assert!(d.edges.revolutions >= 9, "{d:?}");
     }
 
+    /// A pattern wheel at a 1 MHz timer, one-edge samples, down to `min_speed` rad/s.
+    fn one_edge_pattern(p: Pattern, min_speed: f64) -> EncoderConfig {
+        let mut c = EncoderConfig::pattern(p, 1e6);
+        c.estimator = Estimator::Edges(1);
+        c.min_speed = min_speed;
+        c
+    }
+
     /// Cranking: ω = ω̄(1 + a·sin(2φ + phase)) (two compression strokes per turn).
     fn cranking(mean: f64, a: f64, phase: f64) -> impl Fn(f64) -> f64 {
         move |phi: f64| mean * (1.0 + a * (2.0 * phi + phase).sin())
@@ -1455,9 +1461,7 @@ mod tests {
         // not clearly long (2^0.75 = 1.68), and at 4 of 6 phases the wheel never synced.
         // Against their geometric mean (2.07) it is.
         let p = Pattern::missing_teeth(24, 1);
-        let mut c = EncoderConfig::pattern(p, 1e6);
-        c.estimator = Estimator::Edges(1);
-        c.min_speed = 5.0;
+        let c = one_edge_pattern(p, 5.0);
         for k in 0..12 {
             let phase = TAU * f64::from(k) / 12.0;
             let mut m = monitor(c, 1);
@@ -1488,9 +1492,7 @@ mod tests {
     #[test]
     fn cranking_ripple_on_an_8_1_wheel_syncs_without_faults() {
         let p = Pattern::missing_teeth(8, 1);
-        let mut c = EncoderConfig::pattern(p, 1e6);
-        c.estimator = Estimator::Edges(1);
-        c.min_speed = 5.0;
+        let c = one_edge_pattern(p, 5.0);
         for a in [0.2, 0.3, 0.4] {
             let mut m = monitor(c, 1);
             let evs = stream(
@@ -1538,9 +1540,7 @@ mod tests {
             ("12+1", Pattern::from_teeth(24, &half).unwrap()),
         ];
         for (name, p) in wheels {
-            let mut c = EncoderConfig::pattern(p, 1e6);
-            c.estimator = Estimator::Edges(1);
-            c.min_speed = 5.0;
+            let c = one_edge_pattern(p, 5.0);
             // The stroke phase against the wheel: where the speed peaks and dips.
             for phase in [0.0, 0.8, 1.6, 2.4] {
                 let crank = move |phi: f64| 25.0 * (1.0 + 0.4 * (2.0 * phi + phase).sin());

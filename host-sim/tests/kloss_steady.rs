@@ -4,14 +4,10 @@
 //! approach of `varying_inertia.rs`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod drive_common;
+
 use drive_monitor::drive::{
     DriveModel, Harmonic, Horizon, InertiaHarmonic, Kloss, KlossFit, Load, Motor,
-};
-use host_sim::engine::encoder::EncoderConfig;
-use host_sim::engine::ode::Integrator;
-use host_sim::engine::system::{
-    DynamicShaft, InertiaHarmonic as SimHarmonic, Observer, ShaftModel, Simulation, StepView,
-    System,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -74,64 +70,6 @@ fn random_drive(rng: &mut ChaCha8Rng, k: usize) -> (DriveModel, f64) {
     (model, rate)
 }
 
-/// Dense-output samples per step for the simulated extremes.
-const SAMPLES_PER_STEP: u32 = 64;
-
-/// After `from` seconds: the largest relative difference of the simulated ω from the
-/// predicted curve at 8 points of every step, and the simulated (φ, ω) at 64.
-struct Compare<'a> {
-    from: f64,
-    curve: &'a drive_monitor::drive::SteadyCurve<'a>,
-    worst: f64,
-    samples: Vec<(f64, f64)>,
-}
-
-impl Observer for Compare<'_> {
-    fn edge(&mut self, _e: &host_sim::engine::encoder::Edge) {}
-    fn step(&mut self, s: &StepView<'_>) {
-        if s.t0() < self.from {
-            return;
-        }
-        for i in 1..=SAMPLES_PER_STEP {
-            let t = s.t0() + (s.t1() - s.t0()) * f64::from(i) / f64::from(SAMPLES_PER_STEP);
-            let sh = s.shaft(t);
-            if i % 8 == 0 {
-                let want = self.curve.steady_omega(sh.phi).unwrap();
-                self.worst = self.worst.max((sh.omega / want - 1.0).abs());
-            }
-            self.samples.push((sh.phi, sh.omega));
-        }
-    }
-}
-
-/// The extreme of the parabola through three samples around the extreme sample.
-fn vertex(p: &[(f64, f64)], i: usize) -> f64 {
-    let ((x0, y0), (x1, y1), (x2, y2)) = (p[i - 1], p[i], p[i + 1]);
-    let d01 = (y1 - y0) / (x1 - x0);
-    let d12 = (y2 - y1) / (x2 - x1);
-    let c2 = (d12 - d01) / (x2 - x0);
-    let c1 = d01 - c2 * (x0 + x1);
-    if c2 == 0.0 {
-        return y1;
-    }
-    let xv = -c1 / (2.0 * c2);
-    y0 + d01 * (xv - x0) + c2 * (xv - x0) * (xv - x1)
-}
-
-/// ωmax and ωmin of the simulation: extreme samples refined by the parabola through their
-/// neighbours.
-fn simulated_extremes(samples: &[(f64, f64)]) -> (f64, f64) {
-    let interior = 1..samples.len() - 1;
-    let imax = interior
-        .clone()
-        .max_by(|&i, &j| samples[i].1.total_cmp(&samples[j].1))
-        .unwrap();
-    let imin = interior
-        .min_by(|&i, &j| samples[i].1.total_cmp(&samples[j].1))
-        .unwrap();
-    (vertex(samples, imax), vertex(samples, imin))
-}
-
 /// 24 random Kloss drives (seed 11; 8 of them with J(φ)), each integrated from its predicted
 /// mean speed until the transient has decayed below 1e-13 at the slowest damping rate over the
 /// predicted speeds, then over two common periods: the simulated ω follows the predicted curve
@@ -152,46 +90,9 @@ fn kloss_prediction_matches_the_simulation() {
         let settle_rad = 13.0 * std::f64::consts::LN_10 / rate;
         let settle = settle_rad / predicted.omega_min;
         let window = 2.0 * radians / predicted.omega_min;
-        let shaft = DynamicShaft {
-            inertia: model.inertia(),
-            flywheel: model.flywheel(),
-            harmonics: model
-                .inertia_harmonics()
-                .iter()
-                .map(|h| SimHarmonic {
-                    amplitude: h.amplitude(),
-                    order: h.order(),
-                    phase: h.phase(),
-                })
-                .collect(),
-            phi0: 0.0,
-            omega0: predicted.omega_rms,
-        };
-        let system = System::new(
-            ShaftModel::Dynamic(shaft),
-            vec![Box::new(*model.motor()), Box::new(model.load().clone())],
-        )
-        .unwrap();
-        let mut sim = Simulation::new(
-            system,
-            Integrator::Dop853 {
-                rtol: 1e-12,
-                atol: 1e-12,
-                max_step: None,
-            },
-            EncoderConfig::ideal(16, 1e6),
-        )
-        .unwrap();
-        let curve = model.steady_curve();
-        let mut cmp = Compare {
-            from: settle,
-            curve: &curve,
-            worst: 0.0,
-            samples: Vec::new(),
-        };
-        sim.run_observed(settle + window, &mut cmp).unwrap();
-        let (hi, lo) = simulated_extremes(&cmp.samples);
-        let delta = 2.0 * (hi - lo) / (hi + lo);
+        let sim = drive_common::simulate(&model, predicted.omega_rms, settle, window);
+        let (hi, lo) = (sim.omega_max, sim.omega_min);
+        let delta = sim.delta();
         let rel = (delta / predicted.delta - 1.0).abs();
         let ext = (hi / predicted.omega_max - 1.0)
             .abs()
@@ -200,14 +101,14 @@ fn kloss_prediction_matches_the_simulation() {
             "drive {k}: δ predicted {:.12} simulated {delta:.12} (rel {rel:.1e}), ω extremes \
              {ext:.1e}, ω worst {:.1e}, {} load harmonics, {} inertia harmonics, {steps} steps",
             predicted.delta,
-            cmp.worst,
+            sim.worst,
             model.load().harmonics().len(),
             model.inertia_harmonics().len(),
         );
-        worst_omega = worst_omega.max(cmp.worst);
+        worst_omega = worst_omega.max(sim.worst);
         worst_delta = worst_delta.max(rel);
         worst_ext = worst_ext.max(ext);
-        assert!(cmp.worst < 1e-10, "drive {k}: ω off by {:e}", cmp.worst);
+        assert!(sim.worst < 1e-10, "drive {k}: ω off by {:e}", sim.worst);
         assert!(ext < 1e-10, "drive {k}: extremes off by {ext:e}");
         // 1e-8 relative, plus what 1e-12 relative errors of the two simulated extremes make
         // of δ (4e-12): the simulation's own floor for the smallest swings.

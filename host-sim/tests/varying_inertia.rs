@@ -3,13 +3,9 @@
 //! the simulator (DOP853, rtol = atol = 1e-12) on random drives run to their steady state.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod drive_common;
+
 use drive_monitor::drive::{DriveModel, Harmonic, InertiaHarmonic, Load, Motor, Parabola};
-use host_sim::engine::encoder::EncoderConfig;
-use host_sim::engine::ode::Integrator;
-use host_sim::engine::system::{
-    DynamicShaft, InertiaHarmonic as SimHarmonic, Observer, ShaftModel, Simulation, StepView,
-    System,
-};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
@@ -49,64 +45,6 @@ fn random_drive(rng: &mut ChaCha8Rng) -> DriveModel {
         .unwrap()
 }
 
-/// Dense-output samples per step for the simulated extremes.
-const SAMPLES_PER_STEP: u32 = 64;
-
-/// After `from` seconds: the largest relative difference of the simulated ω from the
-/// predicted curve at 8 points of every step, and the simulated (φ, ω) at 64.
-struct Compare<'a> {
-    from: f64,
-    curve: &'a drive_monitor::drive::SteadyCurve<'a>,
-    worst: f64,
-    samples: Vec<(f64, f64)>,
-}
-
-impl Observer for Compare<'_> {
-    fn edge(&mut self, _e: &host_sim::engine::encoder::Edge) {}
-    fn step(&mut self, s: &StepView<'_>) {
-        if s.t0() < self.from {
-            return;
-        }
-        for i in 1..=SAMPLES_PER_STEP {
-            let t = s.t0() + (s.t1() - s.t0()) * f64::from(i) / f64::from(SAMPLES_PER_STEP);
-            let sh = s.shaft(t);
-            if i % 8 == 0 {
-                let want = self.curve.steady_omega(sh.phi).unwrap();
-                self.worst = self.worst.max((sh.omega / want - 1.0).abs());
-            }
-            self.samples.push((sh.phi, sh.omega));
-        }
-    }
-}
-
-/// The extreme of the parabola through three samples around the extreme sample.
-fn vertex(p: &[(f64, f64)], i: usize) -> f64 {
-    let ((x0, y0), (x1, y1), (x2, y2)) = (p[i - 1], p[i], p[i + 1]);
-    let d01 = (y1 - y0) / (x1 - x0);
-    let d12 = (y2 - y1) / (x2 - x1);
-    let c2 = (d12 - d01) / (x2 - x0);
-    let c1 = d01 - c2 * (x0 + x1);
-    if c2 == 0.0 {
-        return y1;
-    }
-    let xv = -c1 / (2.0 * c2);
-    y0 + d01 * (xv - x0) + c2 * (xv - x0) * (xv - x1)
-}
-
-/// δ of the simulation: extreme samples refined by the parabola through their neighbours.
-fn simulated_delta(samples: &[(f64, f64)]) -> f64 {
-    let interior = 1..samples.len() - 1;
-    let imax = interior
-        .clone()
-        .max_by(|&i, &j| samples[i].1.total_cmp(&samples[j].1))
-        .unwrap();
-    let imin = interior
-        .min_by(|&i, &j| samples[i].1.total_cmp(&samples[j].1))
-        .unwrap();
-    let (hi, lo) = (vertex(samples, imax), vertex(samples, imin));
-    2.0 * (hi - lo) / (hi + lo)
-}
-
 /// 24 random drives (seed 7), each integrated from ω = √ū until its transient has decayed
 /// below 1e-13 (`exp(p̄·φ)`, `|p̄| ≥ 2a/J0`), then over two common periods: the simulated ω
 /// follows the predicted curve within 1e-10 relative at every dense-output point, and δ agrees
@@ -127,57 +65,20 @@ fn predicted_delta_with_varying_inertia_matches_the_simulation() {
         let mean_speed = model.u_mean().sqrt();
         let settle = settle_rad / predicted.omega_min;
         let window = 2.0 * radians / predicted.omega_min;
-        let shaft = DynamicShaft {
-            inertia: model.inertia(),
-            flywheel: model.flywheel(),
-            harmonics: model
-                .inertia_harmonics()
-                .iter()
-                .map(|h| SimHarmonic {
-                    amplitude: h.amplitude(),
-                    order: h.order(),
-                    phase: h.phase(),
-                })
-                .collect(),
-            phi0: 0.0,
-            omega0: mean_speed,
-        };
-        let system = System::new(
-            ShaftModel::Dynamic(shaft),
-            vec![Box::new(*model.motor()), Box::new(model.load().clone())],
-        )
-        .unwrap();
-        let mut sim = Simulation::new(
-            system,
-            Integrator::Dop853 {
-                rtol: 1e-12,
-                atol: 1e-12,
-                max_step: None,
-            },
-            EncoderConfig::ideal(16, 1e6),
-        )
-        .unwrap();
-        let curve = model.steady_curve();
-        let mut cmp = Compare {
-            from: settle,
-            curve: &curve,
-            worst: 0.0,
-            samples: Vec::new(),
-        };
-        sim.run_observed(settle + window, &mut cmp).unwrap();
-        let delta = simulated_delta(&cmp.samples);
+        let sim = drive_common::simulate(&model, mean_speed, settle, window);
+        let delta = sim.delta();
         let rel = (delta / predicted.delta - 1.0).abs();
         eprintln!(
             "drive {k}: δ predicted {:.12} simulated {delta:.12} (rel {rel:.1e}), ω worst {:.1e}, \
              {} inertia harmonics, nodes {:?}",
             predicted.delta,
-            cmp.worst,
+            sim.worst,
             model.inertia_harmonics().len(),
             model.horizon()
         );
-        worst_omega = worst_omega.max(cmp.worst);
+        worst_omega = worst_omega.max(sim.worst);
         worst_delta = worst_delta.max(rel);
-        assert!(cmp.worst < 1e-10, "drive {k}: ω off by {:e}", cmp.worst);
+        assert!(sim.worst < 1e-10, "drive {k}: ω off by {:e}", sim.worst);
         assert!(
             rel < 1e-8,
             "drive {k}: δ {delta} against {}",

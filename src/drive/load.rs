@@ -8,6 +8,26 @@ pub const MAX_HARMONICS: usize = 8;
 /// Largest accepted harmonic order (cycles per shaft revolution).
 pub const MAX_ORDER: f64 = 1e6;
 
+/// The checks every harmonic term shares (load torque or inertia), its sign already checked:
+/// an order at most [`MAX_ORDER`], a finite amplitude, a finite phase within ±1e9 rad; errors
+/// name `keys` (order, amplitude, phase).
+pub(super) fn checked_term(
+    keys: [&'static str; 3],
+    order: f64,
+    amplitude: f64,
+    phase: f64,
+) -> Result<[f64; 3], ConfigError> {
+    if order > MAX_ORDER {
+        return Err(ConfigError::OutOfRange(keys[0]));
+    }
+    let amplitude = finite(keys[1], amplitude)?;
+    let phase = finite(keys[2], phase)?;
+    if libm::fabs(phase) > 1e9 {
+        return Err(ConfigError::OutOfRange(keys[2]));
+    }
+    Ok([order, amplitude, phase])
+}
+
 /// One harmonic `amplitude·sin(order·φ + phase)` of the load torque.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -22,14 +42,12 @@ impl Harmonic {
     /// a constant `amplitude·sin(phase)`), `amplitude` in N·m (any sign) and `phase` in rad.
     pub fn new(order: f64, amplitude: f64, phase: f64) -> Result<Self, ConfigError> {
         let order = non_negative("harmonic.order", order)?;
-        if order > MAX_ORDER {
-            return Err(ConfigError::OutOfRange("harmonic.order"));
-        }
-        let amplitude = finite("harmonic.amplitude", amplitude)?;
-        let phase = finite("harmonic.phase", phase)?;
-        if libm::fabs(phase) > 1e9 {
-            return Err(ConfigError::OutOfRange("harmonic.phase"));
-        }
+        let [order, amplitude, phase] = checked_term(
+            ["harmonic.order", "harmonic.amplitude", "harmonic.phase"],
+            order,
+            amplitude,
+            phase,
+        )?;
         Ok(Self {
             order,
             amplitude,

@@ -377,28 +377,17 @@ impl DriveModel {
     /// it against the closed form.
     #[cfg(test)]
     pub(super) fn on_varying_path(&self) -> Result<Self, ConfigError> {
-        let h = self.inertia_harmonics.clone();
-        Self::build(
-            self.motor,
-            self.load.clone(),
-            self.inertia,
-            self.flywheel,
-            &h,
-            Path::Varying,
-        )
+        self.rebuilt_on(self.motor, self.inertia, self.flywheel, Path::Varying)
     }
 
     /// The same drive by shooting with its parabola, for the tests that check the shooting
     /// against the closed form.
     #[cfg(test)]
     pub(super) fn on_shooting_path(&self) -> Result<Self, ConfigError> {
-        let h = self.inertia_harmonics.clone();
-        Self::build(
+        self.rebuilt_on(
             self.motor,
-            self.load.clone(),
             self.inertia,
             self.flywheel,
-            &h,
             Path::ShootingParabola,
         )
     }
@@ -409,8 +398,19 @@ impl DriveModel {
 
     /// Rebuilds with other motor and inertias, keeping the inertia harmonics and the path.
     fn rebuilt(&self, motor: Motor, inertia: f64, flywheel: f64) -> Result<Self, ConfigError> {
+        self.rebuilt_on(motor, inertia, flywheel, self.path())
+    }
+
+    /// The same drive's load and inertia harmonics with these parts, on `path`.
+    fn rebuilt_on(
+        &self,
+        motor: Motor,
+        inertia: f64,
+        flywheel: f64,
+        path: Path,
+    ) -> Result<Self, ConfigError> {
         let h = self.inertia_harmonics.clone();
-        Self::build(motor, self.load.clone(), inertia, flywheel, &h, self.path())
+        Self::build(motor, self.load.clone(), inertia, flywheel, &h, path)
     }
 
     fn build(

@@ -3,7 +3,7 @@
 //! flywheel sizing and sensitivities, and arbitrary inputs.
 
 use super::shooting::{Characteristic, Shooter, STEPS_PER_CYCLE};
-use super::tests::{next, random_varying};
+use super::tests::{finite_results, next, random_varying};
 use super::*;
 use crate::testutil::{h, steady};
 use core::f64::consts::PI;
@@ -306,26 +306,7 @@ proptest! {
         let Ok(harmonics) = harmonics else { return Ok(()); };
         let Ok(load) = Load::new(m1_frac * mm, &harmonics) else { return Ok(()); };
         let Ok(m) = DriveModel::new(motor, load, j, 0.0) else { return Ok(()); };
-        match m.predict() {
-            Prediction::Steady(s) => {
-                prop_assert!(s.omega_max.is_finite() && s.omega_min > 0.0);
-                prop_assert!(s.omega_min <= s.omega_max);
-                prop_assert!(s.delta.is_finite() && (0.0..2.0).contains(&s.delta));
-                if let Some(sens) = m.sensitivity() {
-                    prop_assert!(sens.d_delta_d_inertia.is_finite());
-                    prop_assert!(sens.d_delta_d_breakdown_torque.is_finite());
-                }
-            }
-            Prediction::Stalls(st) => prop_assert!(st.u_min <= 0.0 && !st.u_mean.is_nan()),
-        }
-        if let Ok(irr) = m.irregularity(Some(limit)) {
-            prop_assert!(irr.delta.is_finite() && irr.omega_max.is_finite());
-            if let Some(f) = irr.flywheel_for_limit {
-                prop_assert!(f.is_finite() && f >= 0.0);
-                let sized = m.with_flywheel(f).unwrap();
-                prop_assert!(sized.predict().steady().is_some_and(|s| s.delta <= limit));
-            }
-        }
+        finite_results(&m, limit)?;
         prop_assert!(!m.omega_squared(1.0).is_nan() || m.predict().steady().is_none());
     }
 }

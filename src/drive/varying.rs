@@ -49,8 +49,8 @@
 //! constant-inertia path nor a small drive carries the large frame. It is design-time
 //! code; the monitor's per-edge paths never run it.
 
-use super::load::{Harmonic, MAX_ORDER};
-use crate::error::{finite, positive, ConfigError};
+use super::load::{checked_term, Harmonic};
+use crate::error::{positive, ConfigError};
 use core::f64::consts::PI;
 
 /// Fixed capacity of inertia harmonics.
@@ -80,18 +80,20 @@ pub struct InertiaHarmonic {
 }
 
 impl InertiaHarmonic {
-    /// A harmonic of `order` cycles per revolution (positive, at most [`MAX_ORDER`]; may be
+    /// A harmonic of `order` cycles per revolution (positive, at most [`MAX_ORDER`](super::MAX_ORDER); may be
     /// fractional), `amplitude` in kg·m² (any sign) and `phase` in rad (|phase| ≤ 1e9).
     pub fn new(order: f64, amplitude: f64, phase: f64) -> Result<Self, ConfigError> {
         let order = positive("inertia_harmonic.order", order)?;
-        if order > MAX_ORDER {
-            return Err(ConfigError::OutOfRange("inertia_harmonic.order"));
-        }
-        let amplitude = finite("inertia_harmonic.amplitude", amplitude)?;
-        let phase = finite("inertia_harmonic.phase", phase)?;
-        if libm::fabs(phase) > 1e9 {
-            return Err(ConfigError::OutOfRange("inertia_harmonic.phase"));
-        }
+        let [order, amplitude, phase] = checked_term(
+            [
+                "inertia_harmonic.order",
+                "inertia_harmonic.amplitude",
+                "inertia_harmonic.phase",
+            ],
+            order,
+            amplitude,
+            phase,
+        )?;
         Ok(Self {
             order,
             amplitude,
