@@ -2165,6 +2165,8 @@ proptest! {
             }
             let st = t.update(&c, x);
             prop_assert_eq!(st.regime == Regime::Unknown, !x.is_finite());
+            // History only ever turns a bistable segment into balancing.
+            prop_assert!(!st.by_history || st.regime == Regime::Balancing);
         }
     }
 

@@ -377,11 +377,25 @@ fn criterion_writes_its_page_and_json() {
             .len()
             == checks.len()
     );
+    let mut arrived = 0;
     for p in m["points"].as_array().unwrap() {
         assert!(["balancing", "gathering", "bistable"].contains(&p["class"].as_str().unwrap()));
+        // Only bistable speeds are reached with the loads balanced; there the tracker says
+        // balancing from history.
+        if let Some(a) = p["arrived"].as_object() {
+            assert_eq!(p["class"], "bistable");
+            assert_eq!(a["class"], "balancing");
+            assert_eq!(a["by_history"], true);
+            assert!(a["from"].as_f64().unwrap() > 0.0);
+            arrived += 1;
+        }
     }
     let md = std::fs::read_to_string(dir.join("criterion.md")).unwrap();
     assert!(md.contains("criterion --machines 1 --seed 3 --out"), "{md}");
+    assert!(
+        md.contains(&format!("At {arrived} of the ")),
+        "{arrived} speeds reached balanced: {md}"
+    );
     for f in ["criterion-resonance.svg", "criterion-additional.svg"] {
         assert!(std::fs::read_to_string(dir.join(f))
             .unwrap()

@@ -510,8 +510,14 @@ pub struct RegimeEvent {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RegimeStatus {
     /// The held regime (`Balancing`, `Gathering`, `Bistable`; `Unknown` for a non-finite
-    /// speed or before the first valid one).
+    /// speed or before the first valid one). Where the table says `Bistable` but the loads
+    /// are known to balance (see [`RegimeStatus::by_history`]), `Balancing`.
     pub regime: Regime,
+    /// The regime comes from the loads' history, not from the speed alone: the table says
+    /// [`Regime::Bistable`] here, and the speed reached this segment from a `Balancing` one
+    /// through segments where the balancing position is stable, so the loads that balanced
+    /// there still balance ([`RegimeTracker`]).
+    pub by_history: bool,
     /// The speed is within the margin band of a characteristic speed.
     pub near_characteristic: bool,
     /// Set when the held regime changed on this update.
@@ -520,16 +526,37 @@ pub struct RegimeStatus {
 
 /// Hysteresis state: holds a segment until the speed is past its edges by the relative
 /// hysteresis, so a speed sitting on a boundary does not chatter.
+///
+/// It also remembers whether the loads balance where the table alone cannot say. In a
+/// `Bistable` segment the balancing position is stable and another state can persist too,
+/// so which one the loads are in depends on how the speed got there. One history decides it:
+/// loads that balanced in a `Balancing` segment stay at the balancing position while the
+/// speed moves through segments where that position stays stable (every class but
+/// `Gathering`), so there the tracker reports `Balancing` ([`RegimeStatus::by_history`]).
+/// This is the seed's advice read backwards: to make the loads gather again the speed must
+/// drop below the stable stretch ([`Advice::drop_below`]). Arriving from a `Gathering`
+/// segment (a run-up through a resonance) or starting inside the segment leaves it
+/// `Bistable`: a run-up captures the loads at most speeds of a capture band, but not at all
+/// (`docs/criterion.md`). The history holds for speed changes that are slow against the loads'
+/// relaxation: on 120 random machines, loads ramped into a bistable segment from a balancing
+/// one within the machine's base run time stayed balanced at 830 of 831 speeds; the other was a
+/// run-down from 571 to 68 rad/s, which left them captured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RegimeTracker {
     held: Option<u8>,
+    /// The loads balanced in a `Balancing` segment and every segment held since has kept the
+    /// balancing position stable.
+    balanced: bool,
 }
 
 impl RegimeTracker {
     /// A tracker holding nothing yet.
     pub const fn new() -> Self {
-        RegimeTracker { held: None }
+        RegimeTracker {
+            held: None,
+            balanced: false,
+        }
     }
 
     /// Feeds one speed in rad/s (sign ignored). A non-finite speed keeps the held segment
@@ -538,6 +565,7 @@ impl RegimeTracker {
         if !speed.is_finite() {
             return RegimeStatus {
                 regime: Regime::Unknown,
+                by_history: false,
                 near_characteristic: false,
                 event: None,
             };
@@ -557,13 +585,39 @@ impl RegimeTracker {
                 }
             }
         };
+        let was = before.map_or(Regime::Unknown, |h| self.resolved(c, h));
+        if before != Some(next) {
+            self.balanced = match c.segment_regime(next) {
+                Regime::Balancing => true,
+                // Still balanced only if every segment passed over kept the position stable
+                // (a jump across a `Gathering` segment loses the history).
+                Regime::Bistable(_) => {
+                    self.balanced
+                        && before.is_some_and(|h| (h.min(next)..=h.max(next)).all(|i| c.stable(i)))
+                }
+                _ => false,
+            };
+        }
         self.held = Some(next.min(MAX_SEGMENTS) as u8);
-        let from = before.map_or(Regime::Unknown, |h| c.segment_regime(h));
-        let to = c.segment_regime(next);
+        let to = self.resolved(c, next);
         RegimeStatus {
             regime: to,
+            by_history: to != c.segment_regime(next),
             near_characteristic: c.near(s),
-            event: (from != to).then_some(RegimeEvent { from, to, speed: s }),
+            event: (was != to).then_some(RegimeEvent {
+                from: was,
+                to,
+                speed: s,
+            }),
+        }
+    }
+
+    /// The regime of segment `i` with the loads' history: `Balancing` for a `Bistable`
+    /// segment the loads arrived at balanced.
+    fn resolved(&self, c: &Classifier, i: usize) -> Regime {
+        match c.segment_regime(i) {
+            Regime::Bistable(_) if self.balanced => Regime::Balancing,
+            r => r,
         }
     }
 }

@@ -1577,6 +1577,54 @@ const SEED_TABLE: RegimeTable<'static> = RegimeTable {
     ],
 };
 
+/// The tracker resolves a bistable segment by the loads' history: balanced loads that come down
+/// (or up) into it through stable segments stay balanced; loads arriving from a gathering
+/// segment, or a start inside it, leave it bistable.
+#[test]
+fn a_tracker_keeps_balanced_loads_balanced_through_a_bistable_segment() {
+    let c = Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap();
+    let capture = Regime::Bistable(BistableReason::Capture);
+    let mut t = RegimeTracker::new();
+    let st = t.update(&c, 2.5);
+    assert_eq!((st.regime, st.by_history), (Regime::Balancing, false));
+    // Down into the capture band: still balancing, from history, and no event.
+    let st = t.update(&c, 1.6);
+    assert_eq!(
+        (st.regime, st.by_history, st.event),
+        (Regime::Balancing, true, None)
+    );
+    assert_eq!(c.classify(1.6), capture);
+    // Below the stable stretch the loads gather; back up, the band is bistable again.
+    let st = t.update(&c, 1.2);
+    assert_eq!(
+        st.event.map(|e| (e.from, e.to)),
+        Some((Regime::Balancing, Regime::Gathering))
+    );
+    let st = t.update(&c, 1.6);
+    assert_eq!((st.regime, st.by_history), (capture, false));
+    assert_eq!(
+        st.event.map(|e| (e.from, e.to)),
+        Some((Regime::Gathering, capture))
+    );
+    // Up past the band and down again: balancing from history once more.
+    assert_eq!(
+        t.update(&c, 2.5).event.map(|e| e.to),
+        Some(Regime::Balancing)
+    );
+    let st = t.update(&c, 1.6);
+    assert_eq!((st.regime, st.by_history), (Regime::Balancing, true));
+    // A NaN keeps the history.
+    assert_eq!(t.update(&c, f32::NAN).regime, Regime::Unknown);
+    assert_eq!(t.update(&c, 1.6).regime, Regime::Balancing);
+    // A jump across the unstable band [1.0874, 1.4252) loses it.
+    let st = t.update(&c, 1.05);
+    assert_eq!((st.regime, st.by_history), (capture, false));
+    // A start inside a bistable segment knows no history.
+    let mut fresh = RegimeTracker::new();
+    let st = fresh.update(&c, 1.6);
+    assert_eq!((st.regime, st.by_history), (capture, false));
+}
+
 #[test]
 fn table_classifier_reads_the_table() {
     let c = Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap();

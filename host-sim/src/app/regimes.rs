@@ -33,8 +33,8 @@ use crate::app::scene::{Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions, StabilityMap};
 use crate::engine::vibration::VibrationMachine;
 use drive_monitor::balancer::{
-    BistableReason, Classifier, Machine, Regime, RegimeSegment, RegimeTable, ZoneKind,
-    DEFAULT_MARGIN, TABLE_MARGIN,
+    BistableReason, Classifier, Machine, Regime, RegimeSegment, RegimeStatus, RegimeTable,
+    RegimeTracker, ZoneKind, DEFAULT_MARGIN, TABLE_MARGIN,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -290,6 +290,56 @@ pub fn classifier(
     Ok((c, margin, false))
 }
 
+/// A speed inside the `Balancing` segment of `segs` nearest to `w` (in ratio) that is
+/// reachable from `w`'s segment through segments where the balancing position is stable:
+/// the geometric middle of a bounded segment, 1.1 times the start of the last (half the end
+/// of a first one). `None` when a `Gathering` segment lies between `w` and every one.
+pub fn balanced_start(segs: &[RegimeSegment], w: f64) -> Option<f64> {
+    let i = segs
+        .partition_point(|s| f64::from(s.from) <= w)
+        .checked_sub(1)?;
+    let inside = |k: usize| {
+        let from = f64::from(segs.get(k)?.from);
+        let to = segs.get(k + 1).map_or(f64::INFINITY, |s| f64::from(s.from));
+        Some(if !to.is_finite() {
+            1.1 * from
+        } else if from > 0.0 {
+            (from * to).sqrt()
+        } else {
+            0.5 * to
+        })
+    };
+    let balancing = |k: &usize| segs.get(*k).is_some_and(|s| s.regime == Regime::Balancing);
+    let stable = |k: &usize| segs.get(*k).is_some_and(|s| s.regime != Regime::Gathering);
+    let up = (i..segs.len())
+        .take_while(stable)
+        .find(balancing)
+        .and_then(inside);
+    let down = (0..=i)
+        .rev()
+        .take_while(stable)
+        .find(balancing)
+        .and_then(inside);
+    match (up, down) {
+        (Some(a), Some(b)) => Some(if (a / w).ln().abs() <= (w / b).ln().abs() {
+            a
+        } else {
+            b
+        }),
+        (a, b) => a.or(b),
+    }
+}
+
+/// The tracker's status after a linear ramp of the speed from `from` to `to` (400 steps).
+pub fn tracked(c: &Classifier, from: f64, to: f64) -> RegimeStatus {
+    let mut t = RegimeTracker::new();
+    let mut st = t.update(c, from as f32);
+    for k in 1..=400 {
+        st = t.update(c, (from + (to - from) * f64::from(k) / 400.0) as f32);
+    }
+    st
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
@@ -441,5 +491,37 @@ mod tests {
         let (c, margin, exact) = classifier(&small, &path, &m, Some(&d)).unwrap();
         assert!(!exact && margin == DEFAULT_MARGIN);
         assert_eq!(c.classify(110.0), Regime::Balancing);
+    }
+
+    fn seg(from: f32, regime: Regime) -> RegimeSegment {
+        RegimeSegment { from, regime }
+    }
+
+    #[test]
+    fn a_balanced_start_is_found_only_through_stable_segments() {
+        let cap = Regime::Bistable(BistableReason::Capture);
+        let segs = [
+            seg(0.0, Regime::Gathering),
+            seg(10.0, cap),
+            seg(20.0, Regime::Balancing),
+            seg(30.0, Regime::Gathering),
+            seg(40.0, cap),
+        ];
+        // Up into [20, 30): its geometric middle.
+        assert_eq!(balanced_start(&segs, 15.0), Some(600f64.sqrt()));
+        // Above the unstable band there is no balancing segment to come from.
+        assert_eq!(balanced_start(&segs, 45.0), None);
+        // From inside an unstable segment nothing is reachable.
+        assert_eq!(balanced_start(&segs, 5.0), None);
+        // Balancing on both sides: the nearer in ratio (11/6 against 6/2.5); a last segment
+        // is entered at 1.1 times its start, a first one at half its end (11/5.1 against
+        // 5.1/2.5).
+        let both = [
+            seg(0.0, Regime::Balancing),
+            seg(5.0, cap),
+            seg(10.0, Regime::Balancing),
+        ];
+        assert_eq!(balanced_start(&both, 6.0), Some(11.0));
+        assert_eq!(balanced_start(&both, 5.1), Some(2.5));
     }
 }

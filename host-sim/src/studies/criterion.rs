@@ -25,8 +25,13 @@
 //! show the second attractor exists, so the speed is bistable indeed; loads that balance show
 //! only that it is not reached from that start. Where it says bistable for capture, the loads
 //! are also run up ([`runup_outcome`]): together at rest with the rotor at the lowest grid
-//! speed, the rotor ramped to the speed over `T` (below) and held there for `T`; loads still
-//! gathered at the end were captured by the run-up and stay so at that speed. A run lasts at least the scene's
+//! speed, the rotor ramped to the speed over `T` (below) and held there for `T` (the hold
+//! doubled up to three times until the residual settles); loads still gathered at the end were
+//! captured by the run-up and stay so at that speed. Where it says `Bistable` and a `Balancing`
+//! segment of the table is reachable through segments where the balancing position stays
+//! stable, the loads are brought there balanced ([`Point::arrived`]): started near the
+//! balancing position inside that segment, the rotor ramped to the speed the same way, and the
+//! core's [`RegimeTracker`] fed the same ramp. A run lasts at least the scene's
 //! `T = clamp(30/r, 1000, 10000)` in the seed's time `τ = ω̃·t` (`r = min(ε·β, 1/β)`, the slower
 //! of the loads' own relaxation and the overdamped drift of the balancing position), and at
 //! least `10/|σ|` with `σ` the Floquet growth rate of the least stable perturbation at that
@@ -49,7 +54,7 @@
 //! The run's own tolerances (`rtol` 1e-8, `atol` 1e-10, DOPRI5) are those of the scene.
 
 use crate::app::predict;
-use crate::app::regimes::{self, Design};
+use crate::app::regimes::{self, balanced_start, tracked, Design};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{MotorSpec, Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions};
@@ -303,17 +308,33 @@ pub fn outcome(
 }
 
 /// A run-up to `speed`: the loads started together at rest with the rotor at `from`, the
-/// rotor ramped linearly to `speed` over `ramp` seconds and held there as long (the final
-/// quarter, where the residual is judged, lies inside the hold). Gathered at the end (residual
-/// at least 10 % throughout the final quarter): the loads a run-up captured stayed captured at
-/// `speed`; balanced: they were released on the way or during the hold. One run, no doubling
-/// (`settled` says whether either holds).
+/// rotor ramped linearly to `speed` over `ramp` seconds and held there ([`ramp_outcome`]).
+/// Gathered at the end (residual at least 10 % throughout the final quarter): the loads a
+/// run-up captured stayed captured at `speed`; balanced: they were released on the way or
+/// during the hold.
 pub fn runup_outcome(
     scene: &Scene,
     file: &Path,
     from: f64,
     speed: f64,
     ramp: f64,
+) -> Result<Outcome, SceneError> {
+    ramp_outcome(scene, file, from, speed, ramp, true)
+}
+
+/// The rotor ramped linearly from `from` to `speed` over `ramp` seconds and held there as
+/// long, the loads started together at rest (`together`) or near the balancing position;
+/// judged on the final quarter of the run (inside the hold): balanced when the residual stays
+/// at most 1 % there, gathered when it stays at least 10 % throughout. Otherwise the hold is
+/// doubled, up to three times, as [`outcome`] doubles its runs, and a run still undecided is
+/// judged as there (balancing below 3.16 %, unsettled).
+pub fn ramp_outcome(
+    scene: &Scene,
+    file: &Path,
+    from: f64,
+    speed: f64,
+    ramp: f64,
+    together: bool,
 ) -> Result<Outcome, SceneError> {
     let mut s = scene.clone();
     s.encoder = None;
@@ -322,18 +343,25 @@ pub fn runup_outcome(
         to: speed,
         duration: ramp,
     });
-    s.simulation.duration = 2.0 * ramp;
-    let d = regime_of(&s, file, None, true)?;
-    let balanced = d.residual_relative <= BALANCED;
-    let away = d.residual_min_relative >= AWAY;
-    Ok(Outcome::judged(
-        speed,
-        true,
-        balanced,
-        balanced || away,
-        &d,
-        &s,
-    ))
+    let mut k = 0;
+    loop {
+        s.simulation.duration = ramp * (1.0 + f64::from(1u32 << k));
+        let d = regime_of(&s, file, None, together)?;
+        let balanced = d.residual_relative <= BALANCED;
+        let away = d.residual_min_relative >= AWAY;
+        if balanced || away || k == DOUBLINGS {
+            let balancing = balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt());
+            return Ok(Outcome::judged(
+                speed,
+                together,
+                balancing,
+                balanced || away,
+                &d,
+                &s,
+            ));
+        }
+        k += 1;
+    }
 }
 
 /// Runs `s` (at a prescribed `speed`, or with its own motor) and returns its regime samples.
@@ -410,6 +438,27 @@ pub struct Point {
     /// ([`runup_outcome`]): only where the class is bistable for capture outside the default
     /// margin band. Whether loads a run-up captured stay captured here.
     pub runup: Option<Outcome>,
+    /// Where the class is bistable (outside the default margin band) and a `Balancing`
+    /// segment of the table is reachable through segments where the balancing position is
+    /// stable: the loads balanced there and the speed brought here ([`Arrival`]).
+    pub arrived: Option<Arrival>,
+}
+
+/// A bistable speed reached with the loads balanced: the rotor ramped from a speed inside the
+/// nearest `Balancing` segment reachable through stable segments (the geometric middle of a
+/// bounded one, 1.1 times the start of the last) to this speed over the machine's base run
+/// time and held, the loads started near the balancing position ([`ramp_outcome`]); the
+/// core's [`RegimeTracker`] fed the same ramp.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Arrival {
+    /// Where the ramp started, rad/s.
+    pub from: f64,
+    /// The tracker's regime at the end of the ramp (`"balancing"` from the loads' history).
+    pub class: &'static str,
+    /// The tracker reported it from history ([`drive_monitor::balancer::RegimeStatus::by_history`]).
+    pub by_history: bool,
+    /// What the loads did.
+    pub outcome: Outcome,
 }
 
 /// An exact boundary checked by simulation and by a tighter integration.
@@ -565,6 +614,9 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
     };
     let bad = |e| predict::value_error(&file, "monitor", e);
     let classifier = Classifier::from_table(&table, 0.0, 0.0).map_err(bad)?;
+    // The run-time tracker as firmware would build it: the default band, no hysteresis (the
+    // ramps it is fed are monotone).
+    let tracker = Classifier::from_table(&table, TABLE_MARGIN, 0.0).map_err(bad)?;
     let Some(vm) = regimes::vibration_machine(&scene, &file)? else {
         return Err(SceneError::value(&file, "autobalancer", "missing"));
     };
@@ -610,6 +662,19 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
         } else {
             None
         };
+        // Bistable: reached with the loads balanced, as the core's tracker is told.
+        let arrived = match balanced_start(&segments, w) {
+            Some(from) if matches!(class, Regime::Bistable(_)) && near > BAND => {
+                let st = tracked(&tracker, from, w);
+                Some(Arrival {
+                    from,
+                    class: st.regime.name(),
+                    by_history: st.by_history,
+                    outcome: ramp_outcome(&scene, &file, from, w, base, false)?,
+                })
+            }
+            _ => None,
+        };
         points.push(Point {
             speed: w,
             class: class.name(),
@@ -622,6 +687,7 @@ pub fn study_machine(sample: Sample) -> Result<MachineResult, SceneError> {
             simulated,
             together,
             runup,
+            arrived,
         });
     }
     let mut checks = Vec::new();
@@ -758,6 +824,12 @@ pub struct Tally {
     pub capture_runup: Together,
     /// Loads started together at rest at the speeds bistable for coexisting gathered loads.
     pub coexisting_together: Together,
+    /// Bistable speeds (either reason) the loads can reach balanced ([`Point::arrived`]).
+    pub reachable: usize,
+    /// Of those, where the core's tracker, fed the ramp, commits from the loads' history.
+    pub history_committed: usize,
+    /// Of those, where the loads brought there balanced stayed balanced (settled).
+    pub history_agreeing: usize,
 }
 
 impl Tally {
@@ -768,6 +840,18 @@ impl Tally {
     /// Agreeing fraction of the committed speeds.
     pub fn agreement(&self) -> f64 {
         self.agreeing as f64 / self.committed.max(1) as f64
+    }
+    /// Committed fraction of the speeds when the loads are known to have balanced: the
+    /// table's committed speeds and the bistable ones where the tracker commits from
+    /// history ([`Point::arrived`]).
+    pub fn history_commit_rate(&self) -> f64 {
+        (self.committed + self.history_committed) as f64 / self.speeds.max(1) as f64
+    }
+    /// Agreeing fraction of [`Tally::history_commit_rate`]'s committed speeds: the table's
+    /// agreeing ones and the bistable ones where the loads brought there balanced stayed so.
+    pub fn history_agreement(&self) -> f64 {
+        (self.agreeing + self.history_agreeing) as f64
+            / (self.committed + self.history_committed).max(1) as f64
     }
     /// What if: the committed fraction were every bistable speed where gathered loads were
     /// not seen to persist committed as balancing: for capture, where a run-up released them
@@ -827,6 +911,13 @@ pub fn tally_points<'a>(margin: f64, points: impl Iterator<Item = &'a Point>) ->
             _ => {
                 t.coexisting += 1;
                 t.coexisting_together.count(p.together);
+            }
+        }
+        if let Some(a) = p.arrived {
+            t.reachable += 1;
+            if a.by_history && a.class == "balancing" {
+                t.history_committed += 1;
+                t.history_agreeing += usize::from(a.outcome.settled && a.outcome.balancing);
             }
         }
     }
@@ -949,7 +1040,9 @@ pub fn headline(s: &Study) -> String {
     format!(
         "{} machines, {} speeds: with the ±{:.0} % margin the exact classifier commits at {} \
          ({}) and the simulation agrees at {} of them ({}); loads started together at rest \
-         balanced at {} of {} speeds committed to balancing; {} runs unsettled. Exact \
+         balanced at {} of {} speeds committed to balancing; {} runs unsettled. With the \
+         loads known to have balanced (the run-time tracker), it commits at {} ({}) and \
+         agrees at {} ({}). Exact \
          boundaries: {} of {} confirmed by simulation at ±{:.0} %, {} of {} unchanged by a 10⁴× \
          tighter integration.",
         s.machines.len(),
@@ -962,6 +1055,10 @@ pub fn headline(s: &Study) -> String {
         t.together_balancing,
         t.together,
         unsettled,
+        t.committed + t.history_committed,
+        pct(t.history_commit_rate()),
+        t.agreeing + t.history_agreeing,
+        pct(t.history_agreement()),
         sim_ok,
         checks.len(),
         100.0 * CHECK_OFFSET,
@@ -1250,6 +1347,7 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         pct(committed as f64 / main.speeds.max(1) as f64),
         pct(committed_agree as f64 / committed.max(1) as f64)
     );
+    history_section(&mut t, s);
     together_section(&mut t, s);
     // Exact boundaries checked.
     let checks = all_checks(s);
@@ -1533,6 +1631,89 @@ fn capture_points(s: &Study) -> impl Iterator<Item = &Point> {
 }
 
 /// The loads started together at rest at the bistable speeds: is the gathered state there?
+/// The bistable speeds reached with the loads balanced, and the run-time tracker there.
+fn history_section(t: &mut String, s: &Study) {
+    let main = tally(s, BAND);
+    let arrived: Vec<&Arrival> = s
+        .machines
+        .iter()
+        .flat_map(|m| &m.points)
+        .filter(|p| p.distance > BAND)
+        .filter_map(|p| p.arrived.as_ref())
+        .collect();
+    let committed = || arrived.iter().filter(|a| a.by_history);
+    let gathered = committed()
+        .filter(|a| a.outcome.settled && !a.outcome.balancing)
+        .count();
+    let unsettled = committed().filter(|a| !a.outcome.settled).count();
+    let declined = arrived.iter().filter(|a| !a.by_history).count();
+    let _ = write!(
+        t,
+        "\n### Bistable speeds reached with the loads balanced: the run-time tracker\n\n\
+         The table leaves a bistable speed to the machine's history, and the core's \
+         `RegimeTracker` knows one history that decides it: loads that balanced in a \
+         `Balancing` segment stay at the balancing position while the speed moves through \
+         segments where that position stays stable, so there it reports `Balancing` \
+         (`RegimeStatus::by_history`). At {} of the {} bistable speeds (outside the band) a \
+         `Balancing` segment is reachable that way; the rotor was ramped from inside it (the \
+         nearest such segment, its geometric middle, or 1.1 times the start of the last) to the \
+         speed over the machine's base run time and held as long (doubled until settled), the \
+         loads started near the balancing position, and the tracker was fed the same ramp. It committed to balancing \
+         at {}, and \
+         the loads **stayed balanced at {} of {}** ({}); {} gathered, {} unsettled.\n\n\
+         With that history the classifier commits at **{} of {} speeds ({})** and the \
+         simulation agrees at **{} of {} ({})**. Reached from rest instead (a run-up through \
+         the resonance) a capture band stays bistable: a run-up captures the loads at most of \
+         its speeds but not at all (below), and on lightly damped machines with wide bands \
+         captured and released speeds alternate along the band, so no rule of the speed \
+         history alone would commit there.\n\n",
+        arrived.len(),
+        main.capture + main.coexisting,
+        if declined == 0 {
+            "every one of them".to_string()
+        } else {
+            format!("{} of them (not at {declined})", main.history_committed)
+        },
+        main.history_agreeing,
+        main.history_committed,
+        pct(main.history_agreeing as f64 / main.history_committed.max(1) as f64),
+        gathered,
+        unsettled,
+        main.committed + main.history_committed,
+        main.speeds,
+        pct(main.history_commit_rate()),
+        main.agreeing + main.history_agreeing,
+        main.committed + main.history_committed,
+        pct(main.history_agreement()),
+    );
+    let misses: Vec<(usize, f64, &Arrival)> = s
+        .machines
+        .iter()
+        .flat_map(|m| m.points.iter().map(move |p| (m.sample.id, p)))
+        .filter(|(_, p)| p.distance > BAND)
+        .filter_map(|(id, p)| p.arrived.as_ref().map(|a| (id, p.speed, a)))
+        .filter(|(_, _, a)| a.by_history && !(a.outcome.settled && a.outcome.balancing))
+        .collect();
+    if !misses.is_empty() {
+        t.push_str(
+            "Where the loads brought there balanced did not stay so:\n\n\
+             | machine | speed, rad/s | ramped from, rad/s | residual max | slip 1 − Ω/ω | settled |\n\
+             |---:|---:|---:|---:|---:|---|\n",
+        );
+        for (id, w, a) in misses {
+            let _ = writeln!(
+                t,
+                "| {id} | {w:.2} | {:.2} | {:.3} | {:.1} % | {} |",
+                a.from,
+                a.outcome.residual_relative,
+                100.0 * a.outcome.slip,
+                if a.outcome.settled { "yes" } else { "no" }
+            );
+        }
+        t.push('\n');
+    }
+}
+
 fn together_section(t: &mut String, s: &Study) {
     let main = tally(s, BAND);
     let c = main.capture_together;
@@ -1567,8 +1748,9 @@ fn together_section(t: &mut String, s: &Study) {
     let _ = write!(
         t,
         "\n\nRun up instead (the loads together at rest with the rotor at the machine's lowest grid \
-         speed, ramped to the speed over the machine's base run time and held there as long, the \
-         residual judged over the final quarter): of the {} capture-bistable speeds the loads \
+         speed, ramped to the speed over the machine's base run time and held there as long, \
+         the hold doubled up to three times until the residual settles, judged over the final \
+         quarter): of the {} capture-bistable speeds the loads \
          **stayed captured at {}** (gathered at the end of the hold) and were **released at {}** \
          (balanced), {} unsettled.",
         u.started, u.gathered, u.balanced, u.unsettled
@@ -1615,8 +1797,8 @@ fn together_section(t: &mut String, s: &Study) {
         "\n\nWhat if every capture-bistable speed where a run-up released the loads were \
          committed as balancing (not the classifier's figure: its table says bistable there): \
          it would commit at {} of {} speeds (**{}**, against its {}). Committing the capture \
-         bands is what a higher commit rate would take, and the run-ups show loads captured \
-         there.\n",
+         bands from the speed alone is what a higher commit rate without the loads' history \
+         would take, and the run-ups show loads captured there.\n",
         main.committed + u.balanced + main.coexisting_together.balanced,
         main.speeds,
         pct(main.what_if_commit_rate()),
@@ -1801,6 +1983,7 @@ mod tests {
             simulated: o,
             together: None,
             runup: None,
+            arrived: None,
         }
     }
 
@@ -1822,6 +2005,43 @@ mod tests {
     fn run_up(mut p: Point, balancing: bool, settled: bool) -> Point {
         p.runup = together_run(&p, balancing, settled);
         p
+    }
+
+    #[test]
+    fn speeds_reached_balanced_are_tallied_with_the_tracker() {
+        let cap = Some("capture");
+        let arrive = |mut p: Point, by_history: bool, balancing: bool, settled: bool| {
+            p.arrived = Some(Arrival {
+                from: 80.0,
+                class: if by_history { "balancing" } else { "bistable" },
+                by_history,
+                outcome: Outcome {
+                    balancing,
+                    settled,
+                    ..p.simulated
+                },
+            });
+            p
+        };
+        let points = [
+            point("balancing", None, 0.5),
+            point("gathering", None, 0.5),
+            // Committed from history: stayed balanced, gathered, unsettled.
+            arrive(point("bistable", cap, 0.5), true, true, true),
+            arrive(point("bistable", cap, 0.5), true, false, true),
+            arrive(point("bistable", cap, 0.5), true, true, false),
+            // Reached, but the tracker did not commit; not reachable.
+            arrive(point("bistable", cap, 0.5), false, true, true),
+            point("bistable", cap, 0.5),
+        ];
+        let t = tally_points(BAND, points.iter());
+        assert_eq!((t.speeds, t.committed, t.agreeing), (7, 2, 2));
+        assert_eq!(
+            (t.reachable, t.history_committed, t.history_agreeing),
+            (4, 3, 1)
+        );
+        assert!((t.history_commit_rate() - 5.0 / 7.0).abs() < 1e-15);
+        assert!((t.history_agreement() - 3.0 / 5.0).abs() < 1e-15);
     }
 
     #[test]

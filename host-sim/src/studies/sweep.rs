@@ -5,9 +5,11 @@
 
 use crate::app::predict;
 use crate::app::progress::progress_bar;
+use crate::app::regimes::{balanced_start, tracked};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{Scene, SceneError};
-use drive_monitor::balancer::{RegimeSegment, DEFAULT_MARGIN};
+use crate::studies::criterion::ramp_outcome;
+use drive_monitor::balancer::{Regime, RegimeSegment, DEFAULT_MARGIN};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -30,6 +32,26 @@ pub struct SweepPoint {
     /// What the loads did, started near the balancing position with a small perturbation
     /// (or together at rest with `--together`): "balancing" | "saturated" | "gathering".
     pub regime_simulated: &'static str,
+    /// Final residual unbalance relative to the rotor's.
+    pub residual_relative: f64,
+    /// Where the class is bistable and the tracker commits from the loads' history once the
+    /// speed comes from a `Balancing` segment of the table through stable ones: that start
+    /// and what the loads did ([`Arrived`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub arrived: Option<Arrived>,
+}
+
+/// A bistable speed reached with the loads balanced: the rotor ramped from `from` (inside the
+/// nearest `Balancing` segment reachable through stable ones,
+/// [`crate::app::regimes::balanced_start`]) over the scene's duration and held, the loads
+/// started near the balancing position ([`crate::studies::criterion::ramp_outcome`]), where
+/// the core's `RegimeTracker`, fed the same ramp, says "balancing" from history.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Arrived {
+    /// Where the ramp started, rad/s.
+    pub from: f64,
+    /// What the loads did: "balancing", "gathering" or "unsettled".
+    pub simulated: &'static str,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
 }
@@ -68,6 +90,10 @@ pub struct Sweep {
     pub committed: usize,
     /// Of those, the points where the simulation agrees.
     pub committed_agreeing: usize,
+    /// Bistable points where the tracker commits from history ([`SweepPoint::arrived`]).
+    pub history_committed: usize,
+    /// Of those, where the loads brought there balanced stayed balanced.
+    pub history_agreeing: usize,
     /// The classifier is built from the exact table (else from the criterion's).
     pub exact: bool,
     /// The damped characteristic speeds (the criterion's zone boundaries), rad/s.
@@ -117,14 +143,14 @@ impl Sweep {
     pub fn markdown(&self) -> String {
         use std::fmt::Write;
         let mut s = String::from(
-            "| speed, rad/s | criterion | core class | simulated | residual / rotor unbalance |\n\
-             |---:|---|---|---|---:|\n",
+            "| speed, rad/s | criterion | core class | simulated | residual / rotor unbalance | reached balanced: from, rad/s → simulated |\n\
+             |---:|---|---|---|---:|---|\n",
         );
         for p in &self.points {
             let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
             let _ = writeln!(
                 s,
-                "| {:.2} | {} | {}{} | {}{} | {:.2e} |",
+                "| {:.2} | {} | {}{} | {}{} | {:.2e} | {} |",
                 p.speed,
                 p.regime_predicted,
                 p.regime_class,
@@ -135,20 +161,39 @@ impl Sweep {
                 } else {
                     ""
                 },
-                p.residual_relative
+                p.residual_relative,
+                p.arrived.map_or("—".to_string(), |a| format!(
+                    "{:.1} → {}{}",
+                    a.from,
+                    a.simulated,
+                    if a.simulated == "balancing" {
+                        ""
+                    } else {
+                        " ≠"
+                    }
+                ))
             );
         }
         let _ = writeln!(
             s,
             "\nThe core's classifier ({} table) commits at {} of {} speeds; the simulation \
              agrees at {} of them (≠ marks the others). The seed's criterion alone, away from \
-             its characteristic speeds (outside the margin band): {} of {} speeds agree.",
+             its characteristic speeds (outside the margin band): {} of {} speeds agree.\n\n\
+             Reached with the loads balanced (the last column: the rotor ramped from inside a \
+             `Balancing` segment of the table through segments where the balancing position \
+             stays stable, over the scene's duration, then held), the core's `RegimeTracker` \
+             also commits at {} bistable speeds, balancing from the loads' history, and the \
+             loads stayed balanced at {} of them: {} of {} speeds committed with that history.",
             if self.exact { "exact" } else { "criterion" },
             self.committed,
             self.points.len(),
             self.committed_agreeing,
             self.agreeing,
-            self.away_from_characteristic
+            self.away_from_characteristic,
+            self.history_committed,
+            self.history_agreeing,
+            self.committed + self.history_committed,
+            self.points.len()
         );
         s
     }
@@ -246,6 +291,7 @@ pub fn sweep(
     // The sweep judges the loads, not δ: no encoder, so no edges to generate.
     let mut quiet = scene.clone();
     quiet.encoder = None;
+    let segments: Vec<RegimeSegment> = classifier.segments().collect();
     let bar = progress_bar(steps, "speeds", progress);
     let points: Result<Vec<SweepPoint>, SceneError> = (0..steps)
         .into_par_iter()
@@ -259,8 +305,35 @@ pub fn sweep(
                     loads_together: together,
                 },
             )?;
-            bar.inc(1);
             let class = classifier.classify(speed as f32);
+            let arrived = match balanced_start(&segments, speed) {
+                Some(start) if matches!(class, Regime::Bistable(_)) => {
+                    let st = tracked(&classifier, start, speed);
+                    if st.by_history {
+                        let o = ramp_outcome(
+                            &quiet,
+                            file,
+                            start,
+                            speed,
+                            quiet.simulation.duration,
+                            false,
+                        )?;
+                        Some(Arrived {
+                            from: start,
+                            simulated: match (o.settled, o.balancing) {
+                                (false, _) => "unsettled",
+                                (true, true) => "balancing",
+                                (true, false) => "gathering",
+                            },
+                            residual_relative: o.residual_relative,
+                        })
+                    } else {
+                        None
+                    }
+                }
+                _ => None,
+            };
+            bar.inc(1);
             Ok(SweepPoint {
                 speed,
                 regime_predicted: machine.zone_kind_at(speed).name(),
@@ -268,6 +341,7 @@ pub fn sweep(
                 regime_reason: class.reason().map(|r| r.name()),
                 regime_simulated: r.regime_simulated.unwrap_or("unknown"),
                 residual_relative: r.residual_relative.unwrap_or(f64::NAN),
+                arrived,
             })
         })
         .collect();
@@ -283,7 +357,6 @@ pub fn sweep(
         .iter()
         .filter(|p| p.regime_class == "balancing" || p.regime_class == "gathering")
         .collect();
-    let segments: Vec<RegimeSegment> = classifier.segments().collect();
     let zones = segments
         .iter()
         .enumerate()
@@ -305,6 +378,11 @@ pub fn sweep(
         committed_agreeing: committed
             .iter()
             .filter(|p| agrees(p.regime_class, p.regime_simulated))
+            .count(),
+        history_committed: points.iter().filter(|p| p.arrived.is_some()).count(),
+        history_agreeing: points
+            .iter()
+            .filter(|p| p.arrived.is_some_and(|a| a.simulated == "balancing"))
             .count(),
         exact,
         boundaries,
