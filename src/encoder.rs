@@ -593,6 +593,16 @@ impl Encoder {
     pub const fn samples_span(&self) -> u16 {
         self.k
     }
+    /// The noise floor a δ window reports at a steady mean speed `omega` rad/s (sign
+    /// ignored): `2/(K·ticks per captured edge)` = `2·ω·E/(K·2π·timer_hz)` for `E` captured
+    /// edges a revolution, one tick of quantisation at each end of a `K`-edge sample
+    /// ([`crate::irregularity::Measurement::noise_floor`]), for judging beforehand whether a
+    /// configuration resolves a δ (the alarm judges a window only when its floor is at most
+    /// [`crate::alarm::AlarmConfig::floor_fraction`] of the limit).
+    pub fn noise_floor_at(&self, omega: f32) -> f32 {
+        2.0 * omega.abs() * f32::from(self.edges)
+            / (f32::from(self.k.max(1)) * core::f32::consts::TAU * self.timer_hz)
+    }
     /// Counter mask (2^bits − 1).
     pub const fn mask(&self) -> u32 {
         self.mask

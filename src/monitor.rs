@@ -842,6 +842,13 @@ mod tests {
                     (f64::from(r.delta) - 0.03).abs() <= f64::from(r.noise_floor) + 1e-5,
                     "{r:?}"
                 );
+                // The floor the encoder expects at the window's mean speed (one rounding
+                // apart: the window counts its edges and ticks).
+                let expected = m.encoder().noise_floor_at(r.omega_mean);
+                assert!(
+                    (r.noise_floor / expected - 1.0).abs() < 1e-5,
+                    "{r:?}, {expected}"
+                );
                 // Angle over time of ω̄(1 + ε sin): ω̄·√(1 − ε²).
                 let mean = 134.0 * (1.0 - 0.015f64.powi(2)).sqrt();
                 assert!((f64::from(r.omega_mean) / mean - 1.0).abs() < 2e-6, "{r:?}");
@@ -941,6 +948,12 @@ mod tests {
                 assert!(
                     (r.delta - 0.02).abs() < 2e-3,
                     "{positions}-{missing}: {r:?}"
+                );
+                // The floor counts the teeth present, not the grid positions.
+                let expected = m.encoder().noise_floor_at(r.omega_mean);
+                assert!(
+                    (r.noise_floor / expected - 1.0).abs() < 1e-5,
+                    "{positions}-{missing}: {r:?}, {expected}"
                 );
             }
             let d = m.diagnostics().edges;

@@ -728,23 +728,23 @@ pub struct SupportsOut {
     pub allocation: &'static str,
 }
 
-/// The warning when the δ alarm of `scene` could judge no window at the predicted speed: a
-/// window's noise floor is 2/(K·ticks per interval) (`irregularity`'s), that is
-/// 2·ω̄/(K·timer_hz·pitch) for `K = encoder.estimator_edges` edges of `pitch` rad each, and
-/// the core's alarm counts a window only when it is at most `floor_fraction` (0.2) of the
-/// limit.
+/// The warning when the δ alarm of `scene` could judge no window at the predicted speed: the
+/// noise floor a window reports there ([`drive_monitor::encoder::Encoder::noise_floor_at`],
+/// `2·ω̄/(K·timer_hz·pitch)` for `K = encoder.estimator_edges` edges of `pitch` rad each)
+/// above the fraction of the limit (0.2) the core's alarm judges a window under.
 fn alarm_floor_warning(
     scene: &Scene,
     file: &Path,
     limit: Option<f64>,
     prediction: &drive_monitor::drive::Prediction,
 ) -> Result<Option<String>, SceneError> {
-    let (Some(e), Some(limit), Some(steady)) = (&scene.encoder, limit, prediction.steady()) else {
+    let (Some(limit), Some(steady)) = (limit, prediction.steady()) else {
         return Ok(None);
     };
-    let wheel = crate::app::check::wheel(e, &scene.checker(file))?;
-    let pitch = std::f64::consts::TAU * f64::from(e.prescaler) / wheel.teeth.len().max(1) as f64;
-    let floor = 2.0 * steady.omega_rms / (f64::from(e.estimator_edges) * e.timer_hz * pitch);
+    let Some(encoder) = crate::app::run::core_encoder(scene, file)? else {
+        return Ok(None);
+    };
+    let floor = f64::from(encoder.noise_floor_at(steady.omega_rms as f32));
     let fraction = drive_monitor::alarm::AlarmConfig::new(limit as f32).floor_fraction;
     Ok((floor > f64::from(fraction) * limit).then(|| {
         format!(
