@@ -718,8 +718,23 @@ impl SpeedTracker {
         ticks: u32,
         uniform: bool,
     ) -> Option<Tooth> {
+        self.try_fast_as(enc, table, ticks, uniform, enc.ring_times())
+    }
+
+    /// [`SpeedTracker::try_fast`] with the ring's kind given (`times`: `enc.ring_times()`),
+    /// for a caller that has it at hand: where the caller's own tests have settled it, only
+    /// that kind's path is compiled in.
+    #[inline(always)]
+    pub(crate) fn try_fast_as<P: PitchTable>(
+        &mut self,
+        enc: &Encoder,
+        table: &P,
+        ticks: u32,
+        uniform: bool,
+        times: bool,
+    ) -> Option<Tooth> {
         // One branch on the ring's kind per edge, each kind's path without a select.
-        if enc.ring_times() {
+        if times {
             self.try_fast_in::<P, true>(enc, table, ticks, uniform)
         } else {
             self.try_fast_in::<P, false>(enc, table, ticks, uniform)
@@ -1282,7 +1297,8 @@ impl SpeedTracker {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
         let (mut frames, mut later) = (0u8, 0u8);
-        for (i, &(x, q)) in self.index.iter().take(usize::from(self.nidx)).enumerate() {
+        each_bit(self.waiting(), |i| {
+            let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
             let since = x.wrapping_sub(self.last) & m;
             // `i` < INDEXES ≤ 8: the bit is within the byte.
             let bit = 1u8.wrapping_shl(i as u32);
@@ -1291,7 +1307,7 @@ impl SpeedTracker {
             } else if since > 0 && since <= d {
                 frames |= bit;
             }
-        }
+        });
         (frames, later)
     }
 
@@ -1300,23 +1316,35 @@ impl SpeedTracker {
     /// counted as a missing frame.
     fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> bool {
         let (frames, later) = self.index_places(enc, t, seq);
-        let mut keep = 0usize;
-        for i in 0..usize::from(self.nidx) {
-            let bit = 1u8.wrapping_shl(i as u32);
-            if later & bit != 0 {
-                // A later edge's: kept, in order.
-                let slot = self.index.get(i).copied().unwrap_or((0, 0));
-                if let Some(to) = self.index.get_mut(keep) {
-                    *to = slot;
-                }
-                keep = keep.wrapping_add(1);
-            } else if frames & bit == 0 && self.sync == SyncState::Synced {
-                // An index that framed no edge: its edge was not seen.
-                self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
-            }
+        if self.sync == SyncState::Synced {
+            // An index that framed no edge and is no later edge's: its edge was not seen.
+            let lost = self.waiting() & !(frames | later);
+            self.counters.missing_frames =
+                self.counters.missing_frames.wrapping_add(lost.count_ones());
         }
-        self.nidx = keep as u8;
+        self.keep_indexes(later);
         frames != 0
+    }
+
+    /// Keeps the waiting index timestamps whose bit is set in `keep`, in order, and drops the
+    /// others. Careful path: out of line, one copy for its callers (code size).
+    #[inline(never)]
+    fn keep_indexes(&mut self, keep: u8) {
+        let mut n = 0usize;
+        each_bit(keep & self.waiting(), |i| {
+            let slot = self.index.get(i).copied().unwrap_or((0, 0));
+            if let Some(to) = self.index.get_mut(n) {
+                *to = slot;
+            }
+            n = n.wrapping_add(1);
+        });
+        self.nidx = n as u8;
+    }
+
+    /// The waiting index timestamps as bits (`nidx` ≤ INDEXES ≤ 8: within the byte).
+    #[inline(always)]
+    fn waiting(&self) -> u8 {
+        1u8.wrapping_shl(u32::from(self.nidx)).wrapping_sub(1)
     }
 
     /// An index waiting before a new time reference `t` (within a timeout of it) makes that
@@ -1326,24 +1354,19 @@ impl SpeedTracker {
             return;
         }
         let m = enc.mask();
-        let mut framed = false;
-        let mut keep = 0usize;
-        for i in 0..usize::from(self.nidx) {
+        let (mut framed, mut later) = (false, 0u8);
+        each_bit(self.waiting(), |i| {
             let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
             let before = t.wrapping_sub(x) & m;
-            let later = !reported_before(q, self.arrivals) || before == 0 || before > m / 2;
-            if later {
+            if !reported_before(q, self.arrivals) || before == 0 || before > m / 2 {
                 // Reported after this edge arrived, at its tick, or ahead of it: the next
-                // edge's.
-                if let Some(slot) = self.index.get_mut(keep) {
-                    *slot = (x, q);
-                }
-                keep = keep.wrapping_add(1);
+                // edge's (`i` < INDEXES ≤ 8: the bit is within the byte).
+                later |= 1u8.wrapping_shl(i as u32);
             } else if before <= enc.timeout_ticks() {
                 framed = true;
             }
-        }
-        self.nidx = keep as u8;
+        });
+        self.keep_indexes(later);
         if framed {
             self.sync = SyncState::Confirming;
             // The anchor with it: the careful path settled the count on entry (anchor = tooth),
@@ -1882,8 +1905,8 @@ impl SpeedTracker {
             head.get(i.wrapping_sub(1))
         };
         let sum = run.last.wrapping_sub(from.copied().unwrap_or(0));
-        // Leave what the fast path would have left, laid out from the ring's start: the last
-        // `m` times.
+        // Leave what the fast path would have left: the last `m` times laid out from the
+        // ring's start, ready for the next batch.
         let tail = i.checked_sub(m).and_then(|from| caps.get(from..i));
         if let Some(tail) = tail {
             // In copies of 16 times, each a few block moves inline (a longer one would call
@@ -1891,23 +1914,18 @@ impl SpeedTracker {
             let (lo, hi) = self.ring.split_at_mut(LAID_SHORT);
             lay(lo, tail.first_chunk());
             lay(hi, tail.get(LAID_SHORT..).and_then(<[u32]>::first_chunk));
+            self.pos = m as u32;
         } else {
-            // A short batch (`i` < `m` ≤ 32): the older times move down, the batch's follow.
-            let keep = m.saturating_sub(i);
-            for j in 0..keep {
-                let v = self.ring.get(j.wrapping_add(i)).copied().unwrap_or(0);
-                if let Some(d) = self.ring.get_mut(j) {
-                    *d = v;
-                }
-            }
-            // One masked slot at a time: a plain copy loop would become a call of `memcpy`.
+            // A short batch (`i` < `m`, rare): its times follow in the ring slot by slot, as
+            // the fast path writes them (the next batch lays the ring out again). One masked
+            // slot at a time: a plain copy loop would become a call of `memcpy`.
             for (j, &c) in caps.iter().take(i).enumerate() {
-                if let Some(d) = self.ring.get_mut(keep.wrapping_add(j) & (MAX_SPAN - 1)) {
+                if let Some(d) = self.ring.get_mut(m.wrapping_add(j) & (MAX_SPAN - 1)) {
                     *d = c;
                 }
             }
+            self.pos = m.wrapping_add(i) as u32;
         }
-        self.pos = m as u32;
         self.tooth = self.tooth.wrapping_add(i as u16);
         self.last = run.last;
         self.sum = sum;
@@ -2050,50 +2068,57 @@ impl Run {
     /// `K = head.len()` samples starting at `head`, the others `K` captures back in `caps`,
     /// and refreshes the band after capture `refresh − 1` and every [`BAND_REFRESH`] after it
     /// as the fast path does. Returns how many were taken. Out of line: the run's state stays
-    /// in registers through all its loops.
+    /// in registers through all its loops. One copy of the loop ([`Run::take`]) for both kinds
+    /// of sample start and every stretch between refreshes (code size: a few instructions
+    /// more per stretch than a copy for each).
     #[inline(never)]
     fn batch(&mut self, enc: &Encoder, caps: &[u32], head: &[u32], mut refresh: usize) -> usize {
         let (n, k) = (caps.len(), head.len());
         let mut i = 0usize;
-        if self.fresh || refresh == 1 {
-            // The first capture alone: the first sample of a window is both extremes (then
-            // `fastest ≤ slowest` holds), and a single capture before a refresh tooth (a batch
-            // that starts one tooth before it, as an aligned DMA half-buffer does) costs less
-            // as one step than as a run of its own.
-            let (Some(&c), Some(&s)) = (caps.first(), head.first()) else {
-                return 0;
-            };
-            if self.fresh {
-                if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
-                    return 0;
-                }
+        if self.fresh {
+            // The first sample is both extremes (then `fastest ≤ slowest` holds in the loops;
+            // it is taken again there, which changes nothing, and if the capture is not taken,
+            // the run's extremes are not used).
+            if let (Some(&c), Some(&s)) = (caps.first(), head.first()) {
                 let t = c.wrapping_sub(s);
                 let slowest = self.fastest.wrapping_add(self.range).max(t);
                 self.fastest = self.fastest.min(t);
                 self.range = slowest.wrapping_sub(self.fastest);
-                self.fresh = false;
-                self.last = c;
-            } else if !self.step(c, s) {
+            }
+            self.fresh = false;
+        }
+        if refresh == 1 {
+            // A single capture before a refresh tooth (a batch that starts one tooth before
+            // it, as an aligned DMA half-buffer does) costs less as one step than as a run of
+            // its own.
+            let (Some(&c), Some(&s)) = (caps.first(), head.first()) else {
+                return 0;
+            };
+            if !self.step(c, s) {
                 return 0;
             }
             i = 1;
         }
         loop {
             let end = n.min(refresh);
-            // Samples that start before the batch (at the ring's times), then the others (at
-            // the batch's own captures, K back).
-            let mid = end.min(k);
-            // (`i` counts captures taken, at most `n`: the sums below do not wrap; `i ≥ k` in
-            // the second run, since `mid < end` means `mid = k`.)
-            if i < mid {
-                i = i.wrapping_add(self.take(
-                    caps.get(i..mid).unwrap_or(&[]),
-                    head.get(i..).unwrap_or(&[]),
-                ));
-            }
-            if i >= mid && i < end {
+            // (`i` counts captures taken, at most `n`: the sums below do not wrap.)
+            while i < end {
+                // Samples that start before the batch (at the ring's times), then the others
+                // (at the batch's own captures, K back).
+                let start = if i < k {
+                    head.get(i..)
+                } else {
+                    caps.get(i.wrapping_sub(k)..)
+                };
                 let now = caps.get(i..end).unwrap_or(&[]);
-                i = i.wrapping_add(self.take(now, caps.get(i.wrapping_sub(k)..).unwrap_or(&[])));
+                let start = start.unwrap_or(&[]);
+                let want = now.len().min(start.len());
+                let took = self.take(now, start);
+                i = i.wrapping_add(took);
+                if took < want || want == 0 {
+                    // Stopped outside the band.
+                    return i;
+                }
             }
             if i != refresh {
                 return i;
@@ -2262,6 +2287,17 @@ pub(crate) fn each_pair<A, B>(mut a: &mut [A], mut b: &[B], mut f: impl FnMut(&m
     while let ([x, a_rest @ ..], [y, b_rest @ ..]) = (a, b) {
         f(x, y);
         (a, b) = (a_rest, b_rest);
+    }
+}
+
+/// Calls `f` with the number of every set bit of `bits`, lowest first. A loop of a count the
+/// compiler does not know, which it keeps one turn long: the loops over the few waiting index
+/// pulses (careful path) would otherwise be unrolled, at several times the code.
+#[inline(always)]
+fn each_bit(mut bits: u8, mut f: impl FnMut(usize)) {
+    while bits != 0 {
+        f(bits.trailing_zeros() as usize);
+        bits &= bits.wrapping_sub(1);
     }
 }
 
