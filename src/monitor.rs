@@ -537,65 +537,47 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         let uniform = self.encoder.is_uniform() && P::NOMINAL;
         let mut rest = captures;
         loop {
-            // Runs of ordinary teeth through the tracker's bulk path (no observer, a uniform
-            // disc at its nominal pitches, a 32-bit counter); otherwise each capture tries the
-            // fast path. (Read at every turn, not once: as a test the compiler could take out
-            // of the loop, it would make two copies of the loop and of the callback's calls.)
-            let times = self.encoder.ring_times();
-            let batch = !O::WATCHES_TEETH && uniform && times;
-            if batch {
+            if !O::WATCHES_TEETH && uniform {
                 // The ordinary teeth in one tight loop, as the fast path would take them (the
-                // usual case: the whole batch at the first turn). A run that stops short of
-                // its most stops at a capture the fast path would not take either.
-                let again;
-                (rest, again) = self.bulk(rest);
-                if again {
-                    continue;
-                }
+                // usual case: the whole batch at the first turn).
+                rest = self.bulk(rest);
             }
             let Some((&t, tail)) = rest.split_first() else {
                 break;
             };
             rest = tail;
-            if !batch {
-                if let Some(tooth) =
-                    self.tracker
-                        .try_fast_as(&self.encoder, &self.table, t, uniform, times)
-                {
-                    observer.tooth(&tooth);
-                    self.state.add(tooth.dt, tooth.sample, uniform);
-                    continue;
+            if let Some(tooth) = self
+                .tracker
+                .try_fast(&self.encoder, &self.table, t, uniform)
+            {
+                observer.tooth(&tooth);
+                self.state.add(tooth.dt, tooth.sample, uniform);
+            } else {
+                // The careful path as `on_edge` takes it (one copy of it for every caller's
+                // callback); a second window it ends is handed on at once, and the edge after
+                // it takes the careful path, as it would after `on_edge`.
+                if let Some(o) = self.slow_edge(t, Some(Direction::Forward), observer) {
+                    on_window(o);
                 }
-            }
-            // The careful path as `on_edge` takes it (one copy of it for every caller's
-            // callback); a second window it ends is handed on at once, and the edge after it
-            // takes the careful path, as it would after `on_edge`.
-            if let Some(o) = self.slow_edge(t, Some(Direction::Forward), observer) {
-                on_window(o);
-            }
-            if let Some(o) = self.spill.take() {
-                on_window(o);
+                if let Some(o) = self.spill.take() {
+                    on_window(o);
+                }
             }
         }
     }
 
     /// [`SpeedTracker::bulk`] on the leading captures of `captures` (a uniform disc at its
-    /// nominal pitches, no observer), folded into the window: the captures it left, and
-    /// whether it stopped only at the most a run may take (then the next capture may start
-    /// another run; otherwise the fast path would not take it).
+    /// nominal pitches, no observer), folded into the window; the captures it left.
     #[inline(always)]
-    fn bulk<'c>(&mut self, captures: &'c [u32]) -> (&'c [u32], bool) {
+    fn bulk<'c>(&mut self, captures: &'c [u32]) -> &'c [u32] {
         let mut extremes = self.state.uniform_extremes();
         let (taken, ticks) = self.tracker.bulk(&self.encoder, captures, &mut extremes);
         if taken == 0 {
-            return (captures, false);
+            return captures;
         }
         self.state
             .add_run(ticks, extremes, self.encoder.uniform_span());
-        (
-            captures.get(taken..).unwrap_or(&[]),
-            taken == self.encoder.bulk_max(),
-        )
+        captures.get(taken..).unwrap_or(&[])
     }
 
     /// At the end of a recording or a run, when no edge will follow: the window held for the
