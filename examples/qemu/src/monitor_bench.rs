@@ -10,7 +10,7 @@
 //!
 //! Lines printed (the names are a contract, `docs/accuracy.md` quotes them):
 //! `bench monitor::on_edge`, `bench monitor::on_edge+learner`, `bench monitor::on_captures/64`
-//! (instructions per edge), `bench monitor::window_finish` (per window),
+//! (instructions per edge, with two decimals), `bench monitor::window_finish` (per window),
 //! `memory: DeltaMonitor<1024>`, `memory: DeltaMonitor<1024>+learner` (bytes),
 //! `stack: construct` (bytes).
 
@@ -295,8 +295,11 @@ pub fn run() {
     // its own, so formatting stays out of the measured passes).
     feed(&mut monitor(16, 8), ticks, true);
     let empty = feed_empty(ticks);
-    let per_edge =
-        |total: u64, empty: u64| (total.saturating_sub(empty) + EDGES as u64 / 2) / EDGES as u64;
+    // In hundredths of an instruction, rounded, printed with two decimals (`20.49`): a goal
+    // such as "at most 20" shows in the line itself.
+    let per_edge = |total: u64, empty: u64| {
+        PerEdge((100 * total.saturating_sub(empty) + EDGES as u64 / 2) / EDGES as u64)
+    };
     let mut m = monitor(16, 8);
     let (total16, windows) = feed(&mut m, ticks, false);
     let d = m.diagnostics();
@@ -511,4 +514,15 @@ fn entry_points_agree(ticks: &Ticks, delta: f32) {
         last,
         delta
     );
+}
+
+/// Instructions per edge in hundredths, shown with two decimals in the bench lines' column
+/// (`   20.49`).
+#[derive(Clone, Copy)]
+struct PerEdge(u64);
+
+impl core::fmt::Display for PerEdge {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{:>4}.{:02}", self.0 / 100, self.0 % 100)
+    }
 }

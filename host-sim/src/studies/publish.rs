@@ -106,6 +106,18 @@ fn bench_line(line: &str) -> Option<(String, String)> {
     Some((name.trim().to_string(), n.to_string()))
 }
 
+/// The monitor's instructions per edge, edge by edge and in DMA batches of 64, from the bench
+/// lines (printed with two decimals, `44.33`; an integer reads too).
+fn per_edge_figures(benches: &[(String, String)]) -> Option<(f64, f64)> {
+    let find = |name: &str| {
+        benches
+            .iter()
+            .find(|(n, _)| n == name)
+            .and_then(|(_, v)| v.parse::<f64>().ok())
+    };
+    find("monitor::on_edge").zip(find("monitor::on_captures/64"))
+}
+
 /// Runs the firmware under QEMU and collects what it reports.
 fn target_benches() -> Result<TargetReport, String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -178,13 +190,7 @@ pub fn accuracy(out: &Path, target: bool) -> Result<Vec<PathBuf>, String> {
             memory,
             accuracy,
         } = target_benches()?;
-        let find = |name: &str| {
-            benches
-                .iter()
-                .find(|(n, _)| n == name)
-                .and_then(|(_, v)| v.parse::<f64>().ok())
-        };
-        per_edge = find("monitor::on_edge").zip(find("monitor::on_captures/64"));
+        per_edge = per_edge_figures(&benches);
         let md = &mut target_section;
         let _ = writeln!(
             md,
@@ -364,6 +370,26 @@ mod tests {
             bench_line("bench monitor::on_captures/64           24"),
             Some(("monitor::on_captures/64".into(), "24".into()))
         );
+        // The per-edge figures come with two decimals.
+        assert_eq!(
+            bench_line("bench monitor::on_captures/64        19.71"),
+            Some(("monitor::on_captures/64".into(), "19.71".into()))
+        );
         assert_eq!(bench_line("accuracy libm::sqrt 5e-8"), None);
+    }
+
+    #[test]
+    fn per_edge_figures_read_two_decimals() {
+        let benches: Vec<_> = [
+            "bench monitor::on_edge               44.33",
+            "bench monitor::on_edge+learner       54.85",
+            "bench monitor::on_captures/64        19.71",
+            "bench monitor::on_captures/1024      15.76",
+        ]
+        .into_iter()
+        .filter_map(bench_line)
+        .collect();
+        assert_eq!(per_edge_figures(&benches), Some((44.33, 19.71)));
+        assert_eq!(per_edge_figures(&benches[..2]), None);
     }
 }
