@@ -772,3 +772,38 @@ fn a_small_rotors_support_loads_keep_their_digits() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `run` classifies with the core's regime tracker fed every window's speed: ramped down into
+/// the one-mass machine's capture band (bistable on [72.3, 90.4) rad/s) from 120 rad/s with
+/// the loads near the balancing position, it says balancing from history (and the loads did
+/// balance); run up into it with the loads together at rest, the band stays bistable.
+#[test]
+fn run_reads_the_regime_from_the_speed_history() {
+    let dir = scratch("history");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/one-mass-runup.toml");
+    let text = std::fs::read_to_string(scene).unwrap();
+    let ramp = |from: &str, start: &str| {
+        text.replace("from = 0.0 ", &format!("from = {from} "))
+            .replace("to = 130.0 ", "to = 80.0 ")
+            .replace("duration = 130.0 ", "duration = 20.0 ")
+            .replace("duration = 160.0 ", "duration = 40.0 ")
+            .replace("start = \"together\"", start)
+    };
+    let down = ramp("120.0", "");
+    assert!(down.contains("from = 120.0 ") && down.contains("duration = 40.0 "));
+    let path = dir.join("rundown.toml");
+    std::fs::write(&path, down).unwrap();
+    let v = json(&["run", path.to_str().unwrap(), "--json"]);
+    assert_eq!(v["regime_class"], "balancing", "{v}");
+    assert_eq!(v["regime_by_history"], true);
+    assert_eq!(v["regime_simulated"], "balancing");
+    let (ok, out, err) = drive_sim(&["run", path.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("from the speed's history"), "{out}");
+    let path = dir.join("runup.toml");
+    std::fs::write(&path, ramp("40.0", "start = \"together\"")).unwrap();
+    let v = json(&["run", path.to_str().unwrap(), "--json"]);
+    assert_eq!(v["regime_class"], "bistable", "{v}");
+    assert!(v.get("regime_by_history").is_none());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

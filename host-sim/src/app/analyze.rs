@@ -711,9 +711,16 @@ pub fn analyze<R: BufRead>(
         let ticks = clock.ticks(end);
         clock.note(ticks, end);
         st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
-        // A window held for the edge after its frame, which the recording does not have.
-        let o = monitor.release_held();
-        st.after(&mut monitor, &clock, o, &mut report, on_decision);
+        // A window held for the edge after its frame, which the recording does not have, and
+        // a second window the last call ended (handed by the next call): until none is left.
+        loop {
+            let o = monitor.release_held();
+            let last = o.is_none();
+            st.after(&mut monitor, &clock, o, &mut report, on_decision);
+            if last {
+                break;
+            }
+        }
     }
     let d = monitor.diagnostics();
     let e = d.edges;

@@ -153,9 +153,14 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let (Some(p), Some(sim)) = (r.regime_predicted, r.regime_simulated) {
         let _ = writeln!(
             s,
-            "Regime at the measured speed: core class {}{}, criterion {p}, simulation {sim} (residual unbalance {} of the rotor's)",
+            "Regime at the measured speed: core class {}{}{}, criterion {p}, simulation {sim} (residual unbalance {} of the rotor's)",
             r.regime_class.unwrap_or("?"),
             r.regime_reason.map_or(String::new(), |x| format!(" ({x})")),
+            if r.regime_by_history {
+                " (from the speed's history: the table says bistable here, and the loads came balanced from a balancing speed)"
+            } else {
+                ""
+            },
             r.residual_relative
                 .map_or("–".to_string(), |x| format!("{x:.2e}"))
         );

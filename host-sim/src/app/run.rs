@@ -27,7 +27,7 @@ use crate::engine::vibration::{
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent, Verdict};
 #[cfg(doc)]
 use drive_monitor::balancer::DEFAULT_MARGIN;
-use drive_monitor::balancer::{Classifier, Machine};
+use drive_monitor::balancer::{Classifier, Machine, RegimeTracker};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Tolerances, Wheel};
 use drive_monitor::irregularity::{Measurement, WindowConfig, WindowLength, WindowReport};
 use drive_monitor::monitor::{fault_name, DeltaMonitor};
@@ -176,6 +176,12 @@ pub struct RunReport {
     /// Why bistable: "capture" | "coexisting".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_reason: Option<&'static str>,
+    /// `regime_class` comes from the speed's history, not the last speed alone: the table
+    /// says bistable there, and the measured speed came from a balancing segment through
+    /// segments where the balancing position stays stable, so the loads that balanced there
+    /// still do (`balancer::RegimeTracker`, fed every valid window's speed).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub regime_by_history: bool,
     /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
     /// for its rotor, settled on the least residual it can leave) | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -675,6 +681,8 @@ struct Collector<'a> {
     steps: u64,
     stop: Option<Stop>,
     last_window: Option<Measurement>,
+    /// Mean speed of every valid window, in order: the history the regime tracker is fed.
+    window_speeds: Vec<f32>,
     vibration: Option<(&'a VibrationMachine, std::ops::Range<usize>)>,
     samples: Samples,
     sample_every: f64,
@@ -779,6 +787,7 @@ impl Collector<'_> {
                 self.counted.push((r.delta, r.noise_floor));
             }
             self.last_window = Some(r);
+            self.window_speeds.push(r.omega_mean);
         }
         if self.keep_windows {
             self.windows.push(w);
@@ -1233,6 +1242,7 @@ pub fn run_with(
         steps: 0,
         stop: None,
         last_window: None,
+        window_speeds: Vec::new(),
         vibration: vib_machine.as_ref().zip(vib_range),
         samples: if together {
             Samples::All(Vec::new())
@@ -1327,12 +1337,20 @@ pub fn run_with(
         Samples::All(v) => v,
         Samples::Stream(s) => s.samples(),
     };
-    // The end of the run: a window held for the edge after its frame is released as it is.
-    if let Some(o) = col.monitor.as_mut().and_then(|m| m.release_held()) {
+    // The end of the run: a window held for the edge after its frame is released as it is,
+    // and a second window the last edge ended (handed by the next call).
+    while let Some(o) = col.monitor.as_mut().and_then(|m| m.release_held()) {
         col.outcome(stats.time, o);
     }
     measurement(&mut report, &mut col);
-    regime(scene, file, &mut report, vib_machine.as_ref(), &samples)?;
+    regime(
+        scene,
+        file,
+        &mut report,
+        vib_machine.as_ref(),
+        &samples,
+        &col.window_speeds,
+    )?;
     report.capture = capture_analysis(scene, file, vib_params.as_ref(), &samples)?;
     supports(scene, file, &mut report, col.reactions)?;
     report.alarms = col.alarms;
@@ -1530,10 +1548,23 @@ fn regime(
     report: &mut RunReport,
     vib_machine: Option<&VibrationMachine>,
     samples: &[RegimeSample],
+    speeds: &[f32],
 ) -> Result<(), SceneError> {
     if let (Some(machine), Some(w)) = (predict::machine(scene, file)?, report.speed_measured) {
         let (classifier, _) = regime_classifier(scene, file, &machine)?;
-        let class = classifier.classify(w as f32);
+        // The tracker fed every valid window's speed, as firmware would: outside the margin
+        // band its segment is the one `classify` gives at the last speed (the hysteresis is
+        // half the margin), and it knows whether the loads arrived balanced.
+        let mut tracker = RegimeTracker::new();
+        let mut status = None;
+        for &s in speeds {
+            status = Some(tracker.update(&classifier, s));
+        }
+        let class = match status {
+            Some(st) if !st.near_characteristic => st.regime,
+            _ => classifier.classify(w as f32),
+        };
+        report.regime_by_history = status.is_some_and(|st| st.by_history && class == st.regime);
         report.regime_class = Some(class.name());
         report.regime_reason = class.reason().map(|r| r.name());
         // The criterion's own zone at the measured speed (no margin, no capture check).
