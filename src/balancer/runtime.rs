@@ -19,7 +19,7 @@ pub enum Regime {
     /// exact table ([`Classifier::from_table`]) the balancing position is unstable here; in the
     /// criterion's ([`Classifier::new`]) the criterion says the loads gather.
     Gathering,
-    /// The balancing position is stable, but another state can persist too ([`BistableReason`]):
+    /// A balancing position is stable, but another state can persist too ([`BistableReason`]):
     /// which regime sets in depends on the machine's history.
     Bistable(BistableReason),
     /// Within the margin band about a boundary of the table, where the class is not to be
@@ -70,7 +70,8 @@ pub struct SpeedBand {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Advice {
-    /// When the balancing position is stable at this speed (`Balancing` or `Bistable`): to
+    /// When the balancing position is stable at this speed (`Balancing`, or `Bistable` for
+    /// capture or coexisting loads): to
     /// get the loads to gather again (re-enter the exciter mode), drop the speed below this,
     /// the start of the stable stretch shrunk by the margin, rad/s; the speed can be raised
     /// again once the loads are stuck. `None` when the loads already gather here, or the
@@ -447,9 +448,14 @@ impl Classifier {
         self.segment_regime(self.segment(s))
     }
 
-    /// The balancing position is stable in segment `i` (every regime but `Gathering`).
+    /// The balancing position the loads balance at elsewhere (the equally spaced one of three
+    /// or more) is stable in segment `i`: every regime but `Gathering` and
+    /// `Bistable(Family)`.
     fn stable(&self, i: usize) -> bool {
-        !matches!(self.seg_regime.get(i), Some(Regime::Gathering) | None)
+        !matches!(
+            self.seg_regime.get(i),
+            Some(Regime::Gathering | Regime::Bistable(BistableReason::Family)) | None
+        )
     }
 
     /// What to do at `speed` rad/s (see [`Advice`]). NaN and ±∞ give no advice.
@@ -478,14 +484,17 @@ impl Classifier {
             None
         };
         // The highest segment where the loads gather, starting at or below s.
-        let exciter_band = (0..=i).rev().find(|&g| !self.stable(g)).and_then(|g| {
-            let (from, to) = self.segment_range(g);
-            let band = SpeedBand {
-                from: from * (1.0 + self.margin),
-                to: to * (1.0 - self.margin),
-            };
-            (to.is_finite() && band.from < band.to).then_some(band)
-        });
+        let exciter_band = (0..=i)
+            .rev()
+            .find(|&g| self.seg_regime.get(g) == Some(&Regime::Gathering))
+            .and_then(|g| {
+                let (from, to) = self.segment_range(g);
+                let band = SpeedBand {
+                    from: from * (1.0 + self.margin),
+                    to: to * (1.0 - self.margin),
+                };
+                (to.is_finite() && band.from < band.to).then_some(band)
+            });
         Advice {
             drop_below,
             exciter_band,

@@ -49,14 +49,19 @@ pub enum BistableReason {
     /// The seed's criterion says the gathered loads hold together here (`Re H > 0`): loads
     /// that gathered can stay gathered, while loads near the balancing position stay balanced.
     Coexisting,
+    /// Three or more loads: the equally spaced fan of balancing positions is unstable here, but
+    /// another balancing position of their family is stable, so the loads can balance there or
+    /// gather, depending on where they start.
+    Family,
 }
 
 impl BistableReason {
-    /// Lower-case name as used in the host's JSON: `"capture"` or `"coexisting"`.
+    /// Lower-case name as used in the host's JSON: `"capture"`, `"coexisting"` or `"family"`.
     pub fn name(self) -> &'static str {
         match self {
             BistableReason::Capture => "capture",
             BistableReason::Coexisting => "coexisting",
+            BistableReason::Family => "family",
         }
     }
 }
@@ -161,6 +166,7 @@ pub(crate) const fn same_regime(a: Regime, b: Regime) -> bool {
             (x, y),
             (BistableReason::Capture, BistableReason::Capture)
                 | (BistableReason::Coexisting, BistableReason::Coexisting)
+                | (BistableReason::Family, BistableReason::Family)
         ),
         (Regime::Balancing, Regime::Balancing)
         | (Regime::Gathering, Regime::Gathering)

@@ -166,6 +166,9 @@ pub fn rust_table(
                     Regime::Bistable(BistableReason::Coexisting) => {
                         "Regime::Bistable(BistableReason::Coexisting)"
                     }
+                    Regime::Bistable(BistableReason::Family) => {
+                        "Regime::Bistable(BistableReason::Family)"
+                    }
                     // A validated table has neither.
                     Regime::NearCharacteristic | Regime::Unknown => "Regime::Unknown",
                 };

@@ -14,15 +14,19 @@
 //!
 //! The table ([`table`]) commits to `Gathering` where the balancing position is unstable (the
 //! loads cannot balance, whatever their history: for two loads the balancing position is
-//! unique; for more, see the limits below), to `Balancing` where it is stable and neither (2)
+//! unique; for more, see below), to `Balancing` where it is stable and neither (2)
 //! nor (3) holds, and says `Bistable(Capture)` where it is stable and (2) holds,
 //! `Bistable(Coexisting)` where it is stable and only (3) holds. Below the scanned range the
 //! class at its lowest speed is kept, above it the class at its highest (the scan reaches
 //! past every characteristic speed and capture window, and is extended until the balancing
 //! position is stable at its top).
 //!
-//! Limits: for `N ≥ 3` loads the balancing positions form a family and the analysis is of the
-//! equally spaced fan; a balancer too small for its rotor (`D > N·m·R`) has no balancing
+//! For `N ≥ 3` loads the balancing positions form a family. Stability is decided for the
+//! equally spaced fan (the simulator's start) and for [`FAMILY_MEMBERS`] other members
+//! ([`family_members`]); where the fan is unstable but a member is stable the loads can balance
+//! there or gather, and the table says `Bistable(Family)`, committing to `Gathering` only where
+//! every member analysed is unstable. Limits: members between those sampled are not analysed;
+//! a balancer too small for its rotor (`D > N·m·R`) has no balancing
 //! position, so it has no exact table ([`Design::exact`] is `None`) and the criterion's table
 //! is used, its `Balancing` meaning the loads sit at their limit opposite the unbalance
 //! ([`Design::residual_floor`]).
@@ -64,6 +68,12 @@ pub struct Exact {
     pub segments: Vec<(f64, Regime)>,
     /// The criterion's boundaries beside the exact ones.
     pub comparison: Vec<Comparison>,
+    /// Three or more loads: the members of their family of balancing positions analysed
+    /// beside the equally spaced fan ([`family_members`]); 0 for two loads.
+    pub family_members: usize,
+    /// Where each of those members is stable (Floquet, the fan's scan settings).
+    #[serde(skip)]
+    pub family: Vec<StabilityMap>,
 }
 
 /// A boundary of the seed criterion's zones and the exact boundary of the same kind nearest
@@ -93,6 +103,33 @@ pub fn vibration_machine(
     VibrationMachine::new(&p)
         .map(Some)
         .map_err(|e| value_error(file, "autobalancer", e))
+}
+
+/// The growth rate σ (1/s) of the least stable perturbation of the balancing position at
+/// `speed` rad/s (Floquet, at the tolerance of `exact`'s map): positive where it is unstable.
+/// A run shows its regime only after several `1/|σ|` (see [`settle_time`]).
+pub fn growth_rate(
+    scene: &Scene,
+    file: &Path,
+    exact: &Exact,
+    speed: f64,
+) -> Result<Option<f64>, SceneError> {
+    let Some(vm) = vibration_machine(scene, file)? else {
+        return Ok(None);
+    };
+    let Ok(f) = Floquet::new(&vm) else {
+        return Ok(None);
+    };
+    f.multipliers(speed, exact.map.options.rtol)
+        .map(|m| Some(m.growth_rate()))
+        .map_err(|e| SceneError::value(file, "autobalancer", e.to_string()))
+}
+
+/// How long a run at a speed with growth rate `sigma` (1/s) takes to show its regime:
+/// `10/|σ|`, ten e-foldings of the least stable perturbation (as the criterion study runs),
+/// seconds; infinite at `σ = 0`.
+pub fn settle_time(sigma: f64) -> f64 {
+    10.0 / sigma.abs()
 }
 
 /// The speeds scanned for `machine`: from a quarter of its lowest resonance to four times its
@@ -135,7 +172,7 @@ pub fn stability_map(
 
 /// The regime table from the exact stability map and the machine's criterion and capture
 /// windows (module docs), as `(from rad/s, regime)` ascending from 0, neighbours different.
-pub fn table(map: &StabilityMap, machine: &Machine) -> Vec<(f64, Regime)> {
+pub fn table(map: &StabilityMap, family: &[StabilityMap], machine: &Machine) -> Vec<(f64, Regime)> {
     let captured = |w: f64| {
         machine
             .capture_windows()
@@ -144,7 +181,12 @@ pub fn table(map: &StabilityMap, machine: &Machine) -> Vec<(f64, Regime)> {
     };
     let regime = |w: f64| {
         if !map.stable_at(w) {
-            Regime::Gathering
+            // Three or more loads can balance at another member of their family.
+            if family.iter().any(|f| f.stable_at(w)) {
+                Regime::Bistable(BistableReason::Family)
+            } else {
+                Regime::Gathering
+            }
         } else if captured(w) {
             Regime::Bistable(BistableReason::Capture)
         } else if machine.zone_kind_at(w) == ZoneKind::Gathering {
@@ -153,7 +195,12 @@ pub fn table(map: &StabilityMap, machine: &Machine) -> Vec<(f64, Regime)> {
             Regime::Balancing
         }
     };
-    let mut cuts: Vec<f64> = map.boundaries.iter().map(|b| b.speed).collect();
+    let mut cuts: Vec<f64> = map
+        .boundaries
+        .iter()
+        .chain(family.iter().flat_map(|f| &f.boundaries))
+        .map(|b| b.speed)
+        .collect();
     cuts.extend(machine.zones().iter().skip(1).map(|z| z.from));
     for c in machine.capture_windows() {
         cuts.push(c.from);
@@ -206,6 +253,49 @@ pub fn core_segments(
     Ok(out)
 }
 
+/// How many members of the family of balancing positions of three or more loads are analysed
+/// beside the equally spaced fan.
+pub const FAMILY_MEMBERS: usize = 8;
+
+/// Members of the family of balancing positions of `fan.len() ≥ 3` loads (angles relative to
+/// the shaft) other than the equally spaced fan `fan`: the first load turned by `k·2π/9`
+/// (`k` = 1 to [`FAMILY_MEMBERS`]), the loads after it up to the last two kept, the last two
+/// placed to close the balance again (two unit vectors summing to what is left: their mean
+/// direction ± `acos(|v|/2)`), where they can. None for two loads (their balancing position
+/// is unique up to the pair's exchange).
+///
+/// For three or more loads the balancing positions form a family, and the fan's stability
+/// does not decide the regime: where the fan is unstable another member may be stable and
+/// the loads balance there (a three-ball machine whose fan is unstable at 70 rad/s balances
+/// in simulation; `host-sim/tests/vibration.rs`).
+pub fn family_members(fan: &[f64]) -> Vec<Vec<f64>> {
+    let n = fan.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    let sum = |a: &[f64]| {
+        a.iter()
+            .fold((0.0, 0.0), |(x, y), t| (x + t.cos(), y + t.sin()))
+    };
+    let (cx, cy) = sum(fan);
+    (1..=FAMILY_MEMBERS)
+        .filter_map(|k| {
+            let mut a = fan.to_vec();
+            a[0] += k as f64 * std::f64::consts::TAU / (FAMILY_MEMBERS + 1) as f64;
+            let (kx, ky) = sum(&a[..n - 2]);
+            let (vx, vy) = (cx - kx, cy - ky);
+            let len = vx.hypot(vy);
+            (len <= 2.0 && len > 0.0).then(|| {
+                let mid = vy.atan2(vx);
+                let half = (0.5 * len).acos();
+                a[n - 2] = mid + half;
+                a[n - 1] = mid - half;
+                a
+            })
+        })
+        .collect()
+}
+
 /// Each criterion boundary with the nearest exact boundary of its kind.
 pub fn compare(map: &StabilityMap, machine: &Machine) -> Vec<Comparison> {
     machine
@@ -238,12 +328,22 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
     let exact = match Floquet::new(&vm) {
         Ok(f) => {
             let map = stability_map(&f, machine, file)?;
-            let segments = table(&map, machine);
+            let err = |e: crate::engine::vibration::floquet::StabilityError| {
+                SceneError::value(file, "autobalancer", e.to_string())
+            };
+            let family = family_members(f.angles())
+                .iter()
+                .map(|a| Floquet::with_angles(&vm, a).and_then(|m| m.map(&map.options)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(err)?;
+            let segments = table(&map, &family, machine);
             let comparison = compare(&map, machine);
             Some(Exact {
                 map,
                 segments,
                 comparison,
+                family_members: family.len(),
+                family,
             })
         }
         Err(_) => None,
@@ -384,7 +484,7 @@ mod tests {
         let until = m.capture_windows()[0].until; // 90.41
         let capture = Regime::Bistable(BistableReason::Capture);
         // Stable from 72, as the Floquet analysis finds for this machine.
-        let t = table(&map_with(false, &[72.0]), &m);
+        let t = table(&map_with(false, &[72.0]), &[], &m);
         assert_eq!(
             t,
             vec![
@@ -394,7 +494,7 @@ mod tests {
             ]
         );
         // Stable already below the criterion's boundary: coexisting with gathered loads there.
-        let t = table(&map_with(false, &[55.0]), &m);
+        let t = table(&map_with(false, &[55.0]), &[], &m);
         assert_eq!(
             t,
             vec![
@@ -405,7 +505,7 @@ mod tests {
             ]
         );
         // An unstable band inside the capture window and another above it.
-        let t = table(&map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]), &m);
+        let t = table(&map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]), &[], &m);
         assert_eq!(
             t,
             vec![
@@ -420,7 +520,7 @@ mod tests {
         );
         // Never stable: gathering everywhere.
         assert_eq!(
-            table(&map_with(false, &[]), &m),
+            table(&map_with(false, &[]), &[], &m),
             vec![(0.0, Regime::Gathering)]
         );
     }
@@ -523,5 +623,92 @@ mod tests {
         ];
         assert_eq!(balanced_start(&both, 6.0), Some(11.0));
         assert_eq!(balanced_start(&both, 5.1), Some(2.5));
+    }
+
+    /// Every family member balances the rotor exactly as the fan does, and differs from it.
+    #[test]
+    fn family_members_balance_the_rotor() {
+        for (n, d) in [(3usize, 0.3), (3, 1.2), (4, 0.5), (5, 2.0)] {
+            let fan = crate::engine::vibration::balancing_fan(n, 1.0, d, 0.4).unwrap();
+            let fan = &fan[..n];
+            let members = family_members(fan);
+            assert!(
+                members.len() >= FAMILY_MEMBERS / 2,
+                "{n} {d}: {}",
+                members.len()
+            );
+            let closure = |a: &[f64]| {
+                let (x, y) = a
+                    .iter()
+                    .fold((0.0, 0.0), |(x, y), t| (x + t.cos(), y + t.sin()));
+                (x + d * 0.4f64.cos(), y + d * 0.4f64.sin())
+            };
+            for m in &members {
+                let (x, y) = closure(m);
+                assert!(x.hypot(y) < 1e-12, "{n} {d}: {m:?} leaves ({x}, {y})");
+                assert!(m.iter().zip(fan).any(|(a, b)| (a - b).abs() > 1e-3));
+            }
+        }
+        assert!(family_members(&[0.0, 2.0]).is_empty());
+    }
+
+    /// Three balls whose equally spaced fan is unstable just below where it becomes stable
+    /// (69.0 to 73.1 rad/s) balance there in simulation at another member of their family:
+    /// the table says bistable (family), not gathering. Two balls on the same machine have no
+    /// family.
+    #[test]
+    fn three_loads_balance_where_their_fan_is_unstable() {
+        let text = "[[platform]]\nmass = 40.0\nstiffness = 2.0e5\ndamping = 4000.0\n\n\
+            [autobalancer]\nkind = \"ball\"\nplatform = 1\nloads = 3\nload_mass = 0.3\n\
+            radius = 0.08\nhousing_mass = 3.0\nviscosity = 5.0\nrotor_unbalance = 0.03\n\n\
+            [motor]\nmodel = \"speed\"\nspeed = 70.0\n\n[simulation]\nduration = 10.0\n";
+        let path = std::path::PathBuf::from("three-balls.toml");
+        let scene = Scene::parse(text, &path).unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let exact = d.exact.as_ref().unwrap();
+        // Six of the eight turns of the first ball leave a balance the last two can close.
+        assert_eq!(exact.family_members, 6);
+        assert!(!exact.map.stable_at(70.0));
+        let family = Regime::Bistable(BistableReason::Family);
+        let at = |w: f64| {
+            exact
+                .segments
+                .iter()
+                .rev()
+                .find(|(from, _)| *from <= w)
+                .map(|s| s.1)
+        };
+        assert_eq!(at(70.0), Some(family), "{:?}", exact.segments);
+        assert_eq!(at(60.0), Some(Regime::Gathering));
+        let sigma = growth_rate(&scene, &path, exact, 70.0).unwrap().unwrap();
+        assert!(sigma > 0.0);
+        let (r, _, settled) =
+            crate::studies::sweep::settled_run(&scene, &path, 70.0, false, Some(sigma)).unwrap();
+        assert!(settled);
+        assert_eq!(
+            r.regime_simulated,
+            Some("balancing"),
+            "{:?}",
+            r.regime_detail
+        );
+        // At 72 rad/s, in the same band, the loads started near the fan gather instead.
+        let sigma = growth_rate(&scene, &path, exact, 72.0).unwrap().unwrap();
+        let (r, _, settled) =
+            crate::studies::sweep::settled_run(&scene, &path, 72.0, false, Some(sigma)).unwrap();
+        assert!(settled);
+        assert_eq!(
+            r.regime_simulated,
+            Some("gathering"),
+            "{:?}",
+            r.regime_detail
+        );
+        // Two balls: no family, so the fan's instability is gathering.
+        let two = Scene::parse(&text.replace("loads = 3", "loads = 2"), &path).unwrap();
+        let m2 = predict::machine(&two, &path).unwrap().unwrap();
+        let d2 = design(&two, &path, &m2).unwrap().unwrap();
+        let e2 = d2.exact.as_ref().unwrap();
+        assert_eq!(e2.family_members, 0);
+        assert!(e2.segments.iter().all(|s| s.1 != family));
     }
 }

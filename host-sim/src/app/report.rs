@@ -164,6 +164,18 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             r.residual_relative
                 .map_or("–".to_string(), |x| format!("{x:.2e}"))
         );
+    } else if let Some(sim) = r.regime_simulated {
+        // No measured speed (no [encoder]): what the loads did, without the core's class.
+        let _ = writeln!(
+            s,
+            "Regime simulated: {sim} (residual unbalance {} of the rotor's; no [encoder], so no \
+             measured speed for the core to classify)",
+            r.residual_relative
+                .map_or("–".to_string(), |x| format!("{x:.2e}"))
+        );
+    }
+    if let Some(why) = &r.regime_unsettled {
+        let _ = writeln!(s, "The simulated regime is unsettled: {why}");
     }
     if let Some(c) = &r.capture {
         s.push_str(&crate::app::capture::summary(c));

@@ -21,8 +21,8 @@ use crate::engine::system::{
 };
 use crate::engine::vibration::{
     classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind, LoadPlacement,
-    PlatformParams, RegimeCriteria, RegimeReport, RegimeSample, VibrationMachine,
-    VibrationMachineParams,
+    PlatformParams, Regime as SimRegime, RegimeCriteria, RegimeReport, RegimeSample,
+    VibrationMachine, VibrationMachineParams,
 };
 use drive_monitor::alarm::{AlarmConfig, AlarmEvent, Verdict};
 #[cfg(doc)]
@@ -182,6 +182,9 @@ pub struct RunReport {
     /// still do (`balancer::RegimeTracker`, fed every valid window's speed).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub regime_by_history: bool,
+    /// Why `regime_simulated` is "unsettled": the run ended before the loads' regime showed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_unsettled: Option<String>,
     /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
     /// for its rotor, settled on the least residual it can leave) | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -1578,11 +1581,66 @@ fn regime(
         if let Some(r) = classify(samples, &criteria) {
             report.regime_simulated = Some(r.regime.as_str());
             report.residual_relative = Some(r.residual_relative);
+            // A verdict the run is too short for: the residual between the thresholds, or
+            // still under 1 % where the balancing position is unstable and the run is shorter
+            // than ten e-foldings of its growth (`drive-sim sweep` runs such speeds longer).
+            let sigma = if r.regime == SimRegime::Balancing {
+                balancing_growth_rate(vm, r.rotor_speed.abs())
+            } else {
+                None
+            };
+            let duration = scene.simulation.duration;
+            report.regime_unsettled = match r.regime {
+                SimRegime::Gathering if r.residual_min_relative < UNSETTLED_AWAY => Some(format!(
+                    "the residual unbalance was still between 1 % and {:.0} % of the rotor's \
+                     over the final quarter ({:.2e} to {:.2e}): the run ended before the loads \
+                     settled (lengthen simulation.duration)",
+                    100.0 * UNSETTLED_AWAY,
+                    r.residual_min_relative,
+                    r.residual_relative
+                )),
+                SimRegime::Balancing
+                    if sigma.is_some_and(|g| {
+                        g > 0.0 && duration < crate::app::regimes::settle_time(g)
+                    }) =>
+                {
+                    let g = sigma.unwrap_or(0.0);
+                    Some(format!(
+                        "the balancing position is unstable at {:.2} rad/s (growth rate {g:.3e} \
+                         1/s), and the {duration} s run is shorter than ten e-foldings of it \
+                         ({:.0} s): the residual may still grow (lengthen simulation.duration)",
+                        r.rotor_speed.abs(),
+                        crate::app::regimes::settle_time(g)
+                    ))
+                }
+                _ => None,
+            };
+            if report.regime_unsettled.is_some() {
+                report.regime_simulated = Some("unsettled");
+            }
             report.regime_detail = Some(r);
         }
     }
     Ok(())
 }
+
+/// The growth rate σ (1/s) of the least stable perturbation of two loads' balancing position
+/// at `speed` rad/s (Floquet, one monodromy at the stability map's tolerance). `None` for three
+/// or more loads, which can balance at another member of their family than the fan analysed,
+/// and where there is no balancing position.
+fn balancing_growth_rate(vm: &VibrationMachine, speed: f64) -> Option<f64> {
+    use crate::engine::vibration::floquet::{Floquet, ScanOptions};
+    if vm.loads() != 2 || speed.is_nan() || speed <= 0.0 {
+        return None;
+    }
+    let f = Floquet::new(vm).ok()?;
+    let rtol = ScanOptions::new(1.0, 2.0).rtol;
+    f.multipliers(speed, rtol).ok().map(|m| m.growth_rate())
+}
+
+/// Gathering needs the residual at least this (relative to the rotor's) throughout the final
+/// quarter of a run; between 1 % and this the run has not settled.
+const UNSETTLED_AWAY: f64 = 0.1;
 
 /// The warning for a shaft measured above the service speed: the permissible residual
 /// unbalance (ISO 21940-11, `U_per = 1000·G·m/ω`) was allotted for the service speed, and at a

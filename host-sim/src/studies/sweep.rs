@@ -5,7 +5,7 @@
 
 use crate::app::predict;
 use crate::app::progress::progress_bar;
-use crate::app::regimes::{balanced_start, tracked};
+use crate::app::regimes::{balanced_start, growth_rate, settle_time, tracked};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{Scene, SceneError};
 use crate::studies::criterion::ramp_outcome;
@@ -30,10 +30,17 @@ pub struct SweepPoint {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_reason: Option<&'static str>,
     /// What the loads did, started near the balancing position with a small perturbation
-    /// (or together at rest with `--together`): "balancing" | "saturated" | "gathering".
+    /// (or together at rest with `--together`): "balancing" | "saturated" | "gathering", or
+    /// "unsettled" when no run up to [`settled_run`]'s longest decided it.
     pub regime_simulated: &'static str,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
+    /// Length of the (last) run, s: see [`settled_run`].
+    pub duration: f64,
+    /// Floquet growth rate of the balancing position's least stable perturbation here, 1/s
+    /// (with an exact table).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub growth_rate: Option<f64>,
     /// Where the class is bistable and the tracker commits from the loads' history once the
     /// speed comes from a `Balancing` segment of the table through stable ones: that start
     /// and what the loads did ([`Arrived`]).
@@ -90,6 +97,8 @@ pub struct Sweep {
     pub committed: usize,
     /// Of those, the points where the simulation agrees.
     pub committed_agreeing: usize,
+    /// Points where no run settled ([`settled_run`]): neither agreeing nor disagreeing.
+    pub unsettled: usize,
     /// Bistable points where the tracker commits from history ([`SweepPoint::arrived`]).
     pub history_committed: usize,
     /// Of those, where the loads brought there balanced stayed balanced.
@@ -156,7 +165,10 @@ impl Sweep {
                 p.regime_class,
                 p.regime_reason.map_or(String::new(), |r| format!(" ({r})")),
                 p.regime_simulated,
-                if committed && !agrees(p.regime_class, p.regime_simulated) {
+                if committed
+                    && p.regime_simulated != "unsettled"
+                    && !agrees(p.regime_class, p.regime_simulated)
+                {
                     " ≠"
                 } else {
                     ""
@@ -176,7 +188,11 @@ impl Sweep {
         }
         let _ = writeln!(
             s,
-            "\nThe core's classifier ({} table) commits at {} of {} speeds; the simulation \
+            "\nEach speed runs until its regime shows: at least ten e-foldings of the balancing \
+             position's least stable perturbation (`10/|σ|` from the exact analysis, up to ten \
+             times the scene's duration), doubled up to three times while the residual is \
+             between 1 % and 10 % of the rotor's; {} speeds did not settle (\"unsettled\").\n\n\
+             The core's classifier ({} table) commits at {} of {} speeds; the simulation \
              agrees at {} of them (≠ marks the others). The seed's criterion alone, away from \
              its characteristic speeds (outside the margin band): {} of {} speeds agree.\n\n\
              Reached with the loads balanced (the last column: the rotor ramped from inside a \
@@ -184,6 +200,7 @@ impl Sweep {
              stays stable, over the scene's duration, then held), the core's `RegimeTracker` \
              also commits at {} bistable speeds, balancing from the loads' history, and the \
              loads stayed balanced at {} of them: {} of {} speeds committed with that history.",
+            self.unsettled,
             if self.exact { "exact" } else { "criterion" },
             self.committed,
             self.points.len(),
@@ -246,6 +263,51 @@ impl Sweep {
     }
 }
 
+/// Longest run relative to the scene's duration that a slow growth or decay (`10/|σ|`) may
+/// ask for before doubling.
+const SETTLE_CAP: f64 = 10.0;
+/// Times a run still between the thresholds is doubled.
+const DOUBLINGS: u32 = 3;
+/// Runs `scene` at `speed` until its regime shows: for at least the scene's duration and
+/// `10/|σ|` (ten e-foldings of the least stable perturbation, `sigma` from the exact
+/// analysis; at most [`SETTLE_CAP`] times the scene's duration), doubled up to
+/// [`DOUBLINGS`] times while `run` says the loads have not settled (the residual between 1 %
+/// and 10 % of the rotor's over the final quarter, or a balancing verdict from a run shorter
+/// than `10/σ` where the balancing position is unstable). Returns the last run, its duration and whether it
+/// settled. A fixed-length run judged a slowly growing residual still under 1 % as
+/// balancing, and a slowly decaying one as gathering.
+pub fn settled_run(
+    scene: &Scene,
+    file: &Path,
+    speed: f64,
+    together: bool,
+    sigma: Option<f64>,
+) -> Result<(crate::app::run::RunReport, f64, bool), SceneError> {
+    let base = scene.simulation.duration;
+    let mut s = scene.clone();
+    s.simulation.duration = sigma.map_or(base, |g| settle_time(g).min(SETTLE_CAP * base).max(base));
+    let mut k = 0;
+    loop {
+        let r = run(
+            &s,
+            file,
+            Overrides {
+                speed: Some(speed),
+                loads_together: together,
+            },
+        )?;
+        // `run` says "unsettled" when the residual lies between the thresholds, or when a
+        // balancing verdict comes from a run shorter than `10/σ` where the balancing position
+        // is unstable.
+        let decided = r.regime_simulated != Some("unsettled");
+        if decided || k == DOUBLINGS {
+            return Ok((r, s.simulation.duration, decided));
+        }
+        s.simulation.duration *= 2.0;
+        k += 1;
+    }
+}
+
 /// Runs `scene` at the speeds of `request`, in parallel.
 pub fn sweep(
     scene: &Scene,
@@ -291,20 +353,18 @@ pub fn sweep(
     // The sweep judges the loads, not δ: no encoder, so no edges to generate.
     let mut quiet = scene.clone();
     quiet.encoder = None;
+    let exact_design = design.as_ref().and_then(|d| d.exact.as_ref());
     let segments: Vec<RegimeSegment> = classifier.segments().collect();
     let bar = progress_bar(steps, "speeds", progress);
     let points: Result<Vec<SweepPoint>, SceneError> = (0..steps)
         .into_par_iter()
         .map(|i| {
             let speed = from + (to - from) * i as f64 / (steps - 1) as f64;
-            let r = run(
-                &quiet,
-                file,
-                Overrides {
-                    speed: Some(speed),
-                    loads_together: together,
-                },
-            )?;
+            let sigma = match exact_design {
+                Some(e) => growth_rate(&quiet, file, e, speed)?,
+                None => None,
+            };
+            let (r, duration, settled) = settled_run(&quiet, file, speed, together, sigma)?;
             let class = classifier.classify(speed as f32);
             let arrived = match balanced_start(&segments, speed) {
                 Some(start) if matches!(class, Regime::Bistable(_)) => {
@@ -339,8 +399,14 @@ pub fn sweep(
                 regime_predicted: machine.zone_kind_at(speed).name(),
                 regime_class: class.name(),
                 regime_reason: class.reason().map(|r| r.name()),
-                regime_simulated: r.regime_simulated.unwrap_or("unknown"),
+                regime_simulated: if settled {
+                    r.regime_simulated.unwrap_or("unknown")
+                } else {
+                    "unsettled"
+                },
                 residual_relative: r.residual_relative.unwrap_or(f64::NAN),
+                duration,
+                growth_rate: sigma,
                 arrived,
             })
         })
@@ -378,6 +444,10 @@ pub fn sweep(
         committed_agreeing: committed
             .iter()
             .filter(|p| agrees(p.regime_class, p.regime_simulated))
+            .count(),
+        unsettled: points
+            .iter()
+            .filter(|p| p.regime_simulated == "unsettled")
             .count(),
         history_committed: points.iter().filter(|p| p.arrived.is_some()).count(),
         history_agreeing: points
