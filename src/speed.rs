@@ -1928,8 +1928,10 @@ impl SpeedTracker {
     fn linearize(&mut self, m: usize) {
         let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
         if first.wrapping_add(m) <= MAX_SPAN {
-            // Not wrapped (the usual case: a few careful edges after a batch): moved down in
-            // place, each time read before anything overwrites it (`first + j ≥ j`).
+            // Not wrapped (the usual case, once a revolution: a few careful edges after a
+            // batch): moved down in place, each time read before anything overwrites it
+            // (`first + j ≥ j`). Apart from the turn below, which would do it too but moves
+            // all 32 slots one by one (0.3 instructions per edge more in batches).
             for j in 0..m {
                 let v = self.ring.get(first.wrapping_add(j)).copied().unwrap_or(0);
                 if let Some(d) = self.ring.get_mut(j) {
@@ -1940,26 +1942,25 @@ impl SpeedTracker {
             return;
         }
         // Wrapped: the whole ring turned left by `first` in place, slot `j` taking slot
-        // `j + first` (masked), one cycle of slots at a time (no copy of it, whose zeroing and
-        // copying would call `memset` and `memcpy`). `first` ≠ 0: `first + m` > 32.
-        let cycles = 1usize.wrapping_shl(first.trailing_zeros());
-        for c in 0..cycles {
-            let held = self.ring.get(c).copied().unwrap_or(0);
-            let mut j = c;
-            loop {
-                let next = j.wrapping_add(first) & (MAX_SPAN - 1);
-                if next == c {
-                    break;
-                }
-                let v = self.ring.get(next).copied().unwrap_or(0);
-                if let Some(d) = self.ring.get_mut(j) {
-                    *d = v;
-                }
-                j = next;
-            }
+        // `j + first` (masked), one slot a turn, 32 in all: along the cycle through `c`, and
+        // where it closes the held time put back and the next cycle started (`gcd(first,
+        // 32)` cycles). No copy of the ring, whose zeroing and copying would call `memset`
+        // and `memcpy`; one flat loop, not a loop per cycle (code size).
+        let (mut c, mut j) = (0usize, 0usize);
+        let mut held = self.ring.first().copied().unwrap_or(0);
+        for _ in 0..MAX_SPAN {
+            let next = j.wrapping_add(first) & (MAX_SPAN - 1);
+            let (v, to) = if next == c {
+                c = c.wrapping_add(1);
+                let v = core::mem::replace(&mut held, self.ring.get(c).copied().unwrap_or(0));
+                (v, c)
+            } else {
+                (self.ring.get(next).copied().unwrap_or(0), next)
+            };
             if let Some(d) = self.ring.get_mut(j) {
-                *d = held;
+                *d = v;
             }
+            j = to;
         }
         self.pos = m as u32;
     }
