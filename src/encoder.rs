@@ -611,6 +611,16 @@ impl Encoder {
     pub const fn timeout_ticks(&self) -> u32 {
         self.timeout
     }
+    /// The longest time between two [`crate::monitor::DeltaMonitor::poll`]s, in ticks, that is
+    /// sure to see a standstill: the time since the last edge is read modulo the counter, so
+    /// a poll must come after the timeout and before the counter has wrapped past the last
+    /// edge, a window of `2^bits − timeout` ticks. Firmware polls at least this often (with a
+    /// 16-bit counter and a minimum speed near its limit the window can be a small part of
+    /// the counter's period).
+    pub const fn poll_interval_ticks(&self) -> u32 {
+        // `new` keeps the timeout below the mask.
+        self.mask.saturating_sub(self.timeout)
+    }
     /// Timer clock, Hz.
     pub const fn timer_hz(&self) -> f32 {
         self.timer_hz

@@ -1347,3 +1347,31 @@ fn a_delta_within_its_noise_floor_is_not_reported_as_resolved() {
         "{said}"
     );
 }
+
+/// A 16-bit counter at 1 MHz with the minimum speed near its limit (5.4 rad/s on a 36-1
+/// wheel: a timeout of 64.6 ms against a 65.5 ms counter period) leaves 0.9 ms after the
+/// timeout in which a poll sees the standstill before the counter wraps past the last edge.
+/// Polled every 1 ms, a stop was missed at some phases (no timeout, "synced at the end");
+/// the polls now come at least twice in that window, so every stop is seen.
+#[test]
+fn a_stop_is_seen_when_the_counter_barely_covers_the_timeout() {
+    let cfg = configure(&AnalyzeOptions {
+        counter_bits: Some(16),
+        min_speed: Some(5.4),
+        ..wheel("36-1")
+    })
+    .unwrap();
+    let enc = drive_monitor::encoder::Encoder::new(cfg.encoder).unwrap();
+    let window = f64::from(enc.poll_interval_ticks()) / cfg.encoder.timer_hz;
+    assert!(window < 1e-3, "{window}");
+    assert!(host_sim::app::analyze::poll_interval(&enc) <= 0.5 * window);
+    for k in 0..12 {
+        let stop = 2.5 + f64::from(k) * 0.83e-3;
+        let rising = wheel_teeth(36, 1, 20.0, stop);
+        let mut reader =
+            text_reader(saleae_of_rising(&rising, 1e6, 4.0), "stop16.csv", None).unwrap();
+        let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.timeouts, 1, "stop at {stop} s");
+        assert_eq!(report.sync_state, "searching", "stop at {stop} s");
+    }
+}

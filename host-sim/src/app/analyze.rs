@@ -383,12 +383,24 @@ impl EdgeSink for Seen {
     }
 }
 
-/// The poll interval for a counter of `bits` at `timer_hz`: [`POLL_INTERVAL`], or a quarter of
-/// the counter's period when that is shorter (elapsed time is measured modulo the counter).
-pub fn poll_interval(timer_hz: f64, bits: u8) -> f64 {
-    let period = 2f64.powi(i32::from(bits)) / timer_hz;
-    POLL_INTERVAL.min(period / 4.0)
+/// The poll interval for `enc`: [`POLL_INTERVAL`], a quarter of the counter's period, or half
+/// of [`Encoder::poll_interval_ticks`] (the window after the timeout in which a poll sees a
+/// standstill before the counter wraps past the last edge), whichever is shortest (elapsed
+/// time is measured modulo the counter).
+pub fn poll_interval(enc: &Encoder) -> f64 {
+    let hz = f64::from(enc.timer_hz());
+    let period = (f64::from(enc.mask()) + 1.0) / hz;
+    let window = f64::from(enc.poll_interval_ticks()) / hz;
+    POLL_INTERVAL
+        .min(period / 4.0)
+        .min(window / 2.0)
+        .max(MIN_POLL_INTERVAL)
 }
+
+/// The shortest poll interval: a configuration whose standstill window
+/// ([`Encoder::poll_interval_ticks`]) is shorter than twice this can have a stop missed
+/// between two polls.
+pub const MIN_POLL_INTERVAL: f64 = 1e-5;
 
 /// Converts capture times to ticks and back.
 struct Clock {
@@ -587,7 +599,7 @@ pub fn analyze<R: BufRead>(
         latest: (0, 0.0),
     };
     let mut polls = Polls {
-        every: poll_interval(cfg.encoder.timer_hz, cfg.encoder.counter_bits),
+        every: poll_interval(&enc),
         timeout: f64::from(enc.timeout_ticks()) / cfg.encoder.timer_hz,
         last: f64::NEG_INFINITY,
     };
