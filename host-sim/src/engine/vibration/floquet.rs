@@ -44,7 +44,8 @@
 //! `[cos α; sin α]` in the angles), `Φ(T)·V = V` makes `[V W]ᵀ·Φ(T)·[V W]` block upper
 //! triangular with the identity on `V`, so the remaining multipliers are exactly the
 //! eigenvalues of `Wᵀ·Φ(T)·W`. The balancing position is **stable** when all of them lie
-//! strictly inside the unit circle, **unstable** when one lies outside. [`Multipliers`] reports
+//! strictly inside the unit circle, **unstable** when one lies outside (a slow drift's
+//! multiplier within the integration's resolution of 1 set aside first: next section). [`Multipliers`] reports
 //! how far `Φ(T)·V` is from `V` (integration error) as a check.
 //!
 //! # The slow drift: a multiplier within the integration's resolution of 1
@@ -186,7 +187,8 @@ impl ScanOptions {
     /// to a relative bracket of 1e-7 (so each is placed to better than 1e-6), monodromy to
     /// 1e-10 (the spectral radius to about 1e-10: its sign against 1 is decided far inside
     /// the bracket), extrema of `ln(radius)` within 0.2 of zero searched (so a band of
-    /// instability narrower than the grid is not stepped over).
+    /// instability narrower than the grid is not stepped over). A slow drift's multiplier within
+    /// `rtol` of 1 is therefore not told from 1 ([`resolution`], module docs).
     pub fn new(from: f64, to: f64) -> Self {
         ScanOptions {
             from,
