@@ -505,6 +505,11 @@ pub struct StabilityOut {
     pub criterion: Vec<crate::app::regimes::Comparison>,
     /// Monodromy matrices integrated.
     pub evaluations: usize,
+    /// Where the multiplier of the loads' slow drift along the balancing positions (neutral at
+    /// D = 0) lay within the integration's resolution of 1 and was treated as neutral, as at
+    /// D = 0 (absent: nowhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drift_treated_as_neutral: Option<crate::engine::vibration::floquet::Unresolved>,
 }
 
 /// One segment of the regime table.
@@ -954,6 +959,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 .collect(),
             criterion: e.comparison.clone(),
             evaluations: e.map.evaluations,
+            drift_treated_as_neutral: e.map.unresolved,
         });
         let segment = |from: f64, r: drive_monitor::balancer::Regime| SegmentOut {
             from,

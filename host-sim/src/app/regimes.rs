@@ -21,6 +21,11 @@
 //! past every characteristic speed and capture window, and is extended until the balancing
 //! position is stable at its top).
 //!
+//! Where the multiplier of the loads' slow drift along what is a family of balancing
+//! positions at `D = 0` cannot be told from 1 (a tiny `D`: it is `1 − O(D²)`), it is treated as
+//! neutral, as at `D = 0`, and the map says where ([`StabilityMap::unresolved`], shown by
+//! `predict`; see [`crate::engine::vibration::floquet`]).
+//!
 //! For `N ≥ 3` loads the balancing positions form a family. Stability is decided for the
 //! equally spaced fan (the simulator's start) and for [`FAMILY_MEMBERS`] other members
 //! ([`family_members`]); where the fan is unstable but a member is stable the loads can balance
@@ -474,6 +479,7 @@ mod tests {
             evaluations: 0,
             steps: 0,
             neutral_drift: 0.0,
+            unresolved: None,
         }
     }
 
@@ -591,6 +597,52 @@ mod tests {
         let (c, margin, exact) = classifier(&small, &path, &m, Some(&d)).unwrap();
         assert!(!exact && margin == DEFAULT_MARGIN);
         assert_eq!(c.classify(110.0), Regime::Balancing);
+    }
+
+    #[test]
+    fn an_unbalance_too_small_to_resolve_gives_the_table_of_d_0() {
+        // The one-mass machine with D = 1e-9 kg·m (1e-8 of its capacity): the loads' drift
+        // along what is a family of balancing positions at D = 0 has the multiplier
+        // 1 − 3e-17, and its sign against 1 was noise (109 boundaries from 61 to 491 rad/s).
+        // D = 1e-9, 1e-8 and 1e-7 must give the table of D = 0 (3 boundaries: 61.4423, 61.6829,
+        // 72.9103 rad/s; balancing from 90.406), and say that the drift was set aside.
+        let (scene, path, m) = one_mass();
+        let at = |d: f64| {
+            let mut s = scene.clone();
+            s.autobalancer.as_mut().unwrap().rotor_unbalance = Some(d);
+            design(&s, &path, &m).unwrap().unwrap().exact.unwrap()
+        };
+        let zero = at(0.0);
+        assert!(zero.map.unresolved.is_none());
+        let speeds: Vec<f64> = zero.map.boundaries.iter().map(|b| b.speed).collect();
+        assert_eq!(speeds.len(), 3, "{speeds:?}");
+        for (w, want) in speeds.iter().zip([61.4423, 61.6829, 72.9103]) {
+            assert!((w - want).abs() < 1e-4, "{speeds:?}");
+        }
+        let until = m.capture_windows()[0].until;
+        assert_eq!(zero.segments.last(), Some(&(until, Regime::Balancing)));
+        for d in [1e-9, 1e-8, 1e-7] {
+            let e = at(d);
+            let got: Vec<f64> = e.map.boundaries.iter().map(|b| b.speed).collect();
+            assert_eq!(got.len(), 3, "D = {d}: {got:?}");
+            for (a, b) in got.iter().zip(&speeds) {
+                assert!(
+                    (a / b - 1.0).abs() < 1e-6,
+                    "D = {d}: {got:?} against {speeds:?}"
+                );
+            }
+            assert_eq!(e.map.stable_at_from, zero.map.stable_at_from);
+            let regimes = |x: &Exact| x.segments.iter().map(|s| s.1).collect::<Vec<_>>();
+            assert_eq!(regimes(&e), regimes(&zero), "D = {d}");
+            assert_eq!(e.segments.last(), Some(&(until, Regime::Balancing)));
+            // Said, not silent: where the drift was set aside and to what resolution.
+            let u = e.map.unresolved.unwrap();
+            assert!(u.evaluations > e.map.evaluations / 2, "D = {d}: {u:?}");
+            assert!(u.resolution == 1e-10 && u.largest <= u.resolution, "{u:?}");
+        }
+        // The bundled scene's ordinary unbalance: nothing set aside.
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        assert!(d.exact.unwrap().map.unresolved.is_none());
     }
 
     fn seg(from: f32, regime: Regime) -> RegimeSegment {

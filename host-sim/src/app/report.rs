@@ -658,6 +658,20 @@ pub fn prediction_text(p: &Prediction) -> String {
                 st.scanned[1],
                 if st.stable_at_start { "stable" } else { "unstable" }
             );
+            if let Some(u) = &st.drift_treated_as_neutral {
+                let _ = writeln!(
+                    s,
+                    "  the loads' slow drift along the balancing positions (neutral at D = 0) has a \
+                     multiplier within {:.0e} of 1, the integration's resolution, at {} of those \
+                     speeds ({:.2}–{:.2} rad/s; |ρ − 1| at most {:.1e}): treated there as \
+                     neutral, as at D = 0",
+                    u.resolution,
+                    u.evaluations,
+                    u.speeds[0],
+                    u.speeds[1],
+                    u.largest
+                );
+            }
             for b in &st.boundaries {
                 let _ = writeln!(
                     s,

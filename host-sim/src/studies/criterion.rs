@@ -1127,7 +1127,10 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
          angles, platforms at rest: an exact periodic solution at a prescribed rotor speed), \
          whose monodromy matrix over one revolution is integrated (DOP853, rtol {:e}) and whose \
          Floquet multipliers decide stability, the neutral directions (moves along the family \
-         of balancing positions, multiplier exactly 1) removed exactly \
+         of balancing positions, multiplier exactly 1) removed exactly, and the multiplier of \
+         the loads' slow drift along what is such a direction at D = 0 set aside as neutral \
+         where it lies within the integration's resolution of 1 (a rotor unbalance tiny against \
+         the capacity) \
          (`host-sim/src/engine/vibration/floquet.rs`). The speeds where stability changes are \
          found on a grid of {} speeds per octave, with every near-critical extremum of the \
          spectral radius searched, and bisected to {:e} relative. The exact regime table \
@@ -1382,6 +1385,20 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         .map(|e| e.map.steps)
         .max()
         .unwrap_or(0);
+    let unresolved = s
+        .machines
+        .iter()
+        .filter_map(|m| m.design.exact.as_ref())
+        .filter(|e| e.map.unresolved.is_some())
+        .count();
+    let unresolved_text = if unresolved == 0 {
+        " No machine's slow drift came within the integration's resolution of 1.".to_string()
+    } else {
+        format!(
+            " At {unresolved} machines the slow drift's multiplier came within the integration's \
+             resolution of 1 at some speeds and was set aside as neutral there."
+        )
+    };
     let neutral_text = if neutral == 0 {
         "Every machine has a rotor unbalance (D > 0), so none has a neutral direction to remove."
             .to_string()
@@ -1390,7 +1407,7 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
             "The neutral directions of the {neutral} machines without rotor unbalance stay \
              neutral to {drift:.1e} over a revolution (the largest drift met)."
         )
-    };
+    } + &unresolved_text;
     let _ = writeln!(
         t,
         "## The exact boundaries checked\n\n\

@@ -44,8 +44,38 @@
 //! `[cos α; sin α]` in the angles), `Φ(T)·V = V` makes `[V W]ᵀ·Φ(T)·[V W]` block upper
 //! triangular with the identity on `V`, so the remaining multipliers are exactly the
 //! eigenvalues of `Wᵀ·Φ(T)·W`. The balancing position is **stable** when all of them lie
-//! strictly inside the unit circle, **unstable** when one lies outside. [`Multipliers`] reports
+//! strictly inside the unit circle, **unstable** when one lies outside (a slow drift's
+//! multiplier within the integration's resolution of 1 set aside first: next section). [`Multipliers`] reports
 //! how far `Φ(T)·V` is from `V` (integration error) as a check.
+//!
+//! # The slow drift: a multiplier within the integration's resolution of 1
+//!
+//! When the loads are nearly collinear (two loads and a rotor unbalance `D` small against
+//! the capacity `N·m·R`; any number of loads with `D` near the capacity), `[cos α; sin α]`
+//! has a small singular value `σ` (for two loads `σ = √2·D/(N·m·R)`). Its right singular
+//! vector `s` — turning the pair together, for two loads — is a neutral direction of the
+//! collinear limit: the residual unbalance it leaves, and with it the drift of the loads along
+//! `s`, is `O(σ)`, and its multiplier is `1 + c(ω)·σ²`. On the bundled one-mass machine
+//! `c·σ²` is `−2.9e-5·(D/1e-3 kg·m)²` at 80 rad/s and changes sign near the resonance. With
+//! `D = 1e-9 kg·m` (1e-8 of the capacity) that is `3e-17`, below the rounding of `Φ(T)`
+//! (measured about `5e-15` there), and the sign of `ρ − 1` on that direction is noise: a scan
+//! that decides stability from it finds a hundred spurious boundaries.
+//!
+//! The scan does not decide from what it cannot resolve. The multiplier whose eigenvector lies
+//! along `s` (alignment at least [`SLOW_ALIGNMENT`], found by inverse iteration on `Wᵀ·Φ(T)·W`)
+//! and that lies within the resolution [`resolution`] of 1 is set aside as neutral, as it is
+//! exactly when `D = 0`, and reported ([`Multipliers::unresolved`],
+//! [`StabilityMap::unresolved`]); the balancing position is then stable when every other
+//! multiplier lies inside the unit circle. The resolution is the integration tolerance (the
+//! accuracy the scan claims for the spectral radius, [`ScanOptions::new`]), at least
+//! [`ROUNDING_FLOOR`]. Setting aside a multiplier within `rtol` of 1 loses nothing physical:
+//! it grows or decays by less than `rtol` per revolution, 1e10 revolutions per e-fold at
+//! `rtol = 1e-10`. This is done per speed rather than by analysing small `D` as `D = 0`
+//! because `c(ω)` depends on the machine and on the speed (it crosses zero), so no one
+//! threshold on `D` separates resolved from unresolved; away from such speeds, and for
+//! ordinary unbalances, the drift multiplier is far outside the resolution and nothing is set
+//! aside. Any other multiplier comes within the resolution of 1 only at a boundary, where
+//! the sign is immaterial to the bracket; it is never set aside.
 //!
 //! For `N ≥ 3` the balancing positions form a family and the analysis is of one member: the
 //! equally spaced fan the simulator starts near ([`super::balancing_fan`]), or the angles given
@@ -62,7 +92,7 @@
 
 use super::{balancing_fan, VibrationMachine, MAX_LOADS, MAX_PLATFORMS};
 use crate::engine::ode::{Integrator, OdeSystem, Solver};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -115,6 +145,10 @@ pub struct Multipliers {
     /// `max |Φ(T)·v − v|` over an orthonormal basis `v` of the neutral directions: zero in exact
     /// arithmetic, the integration error otherwise.
     pub neutral_drift: f64,
+    /// `ρ − 1` of the slow drift's multiplier when it lay within the resolution of 1 and was
+    /// set aside as neutral (see the module docs); not among `values` then. `None`: nothing set
+    /// aside.
+    pub unresolved: Option<f64>,
 }
 
 impl Multipliers {
@@ -153,7 +187,8 @@ impl ScanOptions {
     /// to a relative bracket of 1e-7 (so each is placed to better than 1e-6), monodromy to
     /// 1e-10 (the spectral radius to about 1e-10: its sign against 1 is decided far inside
     /// the bracket), extrema of `ln(radius)` within 0.2 of zero searched (so a band of
-    /// instability narrower than the grid is not stepped over).
+    /// instability narrower than the grid is not stepped over). A slow drift's multiplier within
+    /// `rtol` of 1 is therefore not told from 1 ([`resolution`], module docs).
     pub fn new(from: f64, to: f64) -> Self {
         ScanOptions {
             from,
@@ -194,6 +229,23 @@ pub struct StabilityMap {
     pub steps: u64,
     /// Largest neutral drift met (see [`Multipliers::neutral_drift`]).
     pub neutral_drift: f64,
+    /// Where the slow drift's multiplier could not be told from 1 and was set aside as neutral
+    /// (module docs); `None` if it never was.
+    pub unresolved: Option<Unresolved>,
+}
+
+/// The speeds of a scan at which the slow drift's multiplier lay within the integration's
+/// resolution of 1 and was treated as neutral (as at `D = 0`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Unresolved {
+    /// Monodromy matrices at which it was set aside (of [`StabilityMap::evaluations`]).
+    pub evaluations: usize,
+    /// Lowest and highest speed at which it was, rad/s.
+    pub speeds: [f64; 2],
+    /// The resolution: `|ρ − 1|` up to which it is set aside ([`resolution`]).
+    pub resolution: f64,
+    /// The largest `|ρ − 1|` set aside.
+    pub largest: f64,
 }
 
 impl StabilityMap {
@@ -232,7 +284,28 @@ pub struct Floquet {
     rows: Vec<Vec<f64>>,
     /// Orthonormal basis of the neutral directions (the null space of `[cos α; sin α]`).
     neutral: Vec<Vec<f64>>,
+    /// The slow drift direction (module docs): the right singular vector of `[cos α; sin α]`
+    /// for its smaller singular value, when it has two non-zero ones.
+    slow: Option<Vec<f64>>,
 }
+
+/// `|ρ − 1|` below which the slow drift's multiplier is not told from 1 (module docs): the
+/// integration tolerance, at least [`ROUNDING_FLOOR`].
+pub fn resolution(rtol: f64) -> f64 {
+    rtol.max(ROUNDING_FLOOR)
+}
+
+/// The rounding floor of a multiplier near 1: `Φ(T)` has entries of order 1 and is the
+/// product of some tens of steps, so its eigenvalues carry a rounding error of some tens of
+/// `f64::EPSILON`. Measured on the one-mass machine with `D = 1e-9 kg·m` (drift multiplier
+/// `1 − 3e-17` in exact arithmetic): `|ρ − 1|` up to `5e-15` at rtol 1e-10 and 1e-12. 1e-13
+/// leaves a factor 20.
+pub const ROUNDING_FLOOR: f64 = 1e-13;
+
+/// Least `|x·s|` (eigenvector `x` and slow direction `s`, both unit, in the reduced
+/// coordinates) for a multiplier to count as the slow drift's: the eigenvector at least half
+/// along the drift. At `D = 1e-9 kg·m` on the one-mass machine it is 1 to rounding.
+pub const SLOW_ALIGNMENT: f64 = 0.5;
 
 /// Largest component below which a Gram–Schmidt remainder counts as zero (the loads'
 /// directions are unit vectors, so this is an absolute tolerance on angles' cosines).
@@ -250,6 +323,35 @@ fn orthonormal_remainder(basis: &[Vec<f64>], v: &[f64]) -> Option<Vec<f64>> {
     }
     let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
     (norm > RANK_TOL).then(|| r.iter().map(|x| x / norm).collect())
+}
+
+/// The right singular vector of the `2 × N` matrix `[cos; sin]` for its smaller singular
+/// value (unit length; `None` if that value is zero).
+fn slow_direction(cos: &[f64], sin: &[f64]) -> Option<Vec<f64>> {
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let (cc, cs, ss) = (dot(cos, cos), dot(cos, sin), dot(sin, sin));
+    // The Gram matrix [[cc, cs], [cs, ss]]: its major axis at angle θ, the minor one at θ + π/2.
+    let theta = 0.5 * (2.0 * cs).atan2(cc - ss);
+    let (u0, u1) = (-theta.sin(), theta.cos());
+    let v: Vec<f64> = cos.iter().zip(sin).map(|(c, s)| u0 * c + u1 * s).collect();
+    let norm = dot(&v, &v).sqrt();
+    (norm > 0.0).then(|| v.iter().map(|x| x / norm).collect())
+}
+
+/// `|x·target|` for the unit eigenvector `x` of `m` for its eigenvalue `lambda` (real), by
+/// three steps of inverse iteration shifted 1e-8 off it; 0 if the shifted matrix is singular.
+fn eigenvector_alignment(m: &DMatrix<f64>, lambda: f64, target: &DVector<f64>) -> f64 {
+    let n = m.nrows();
+    let shift = lambda + 1e-8 * (1.0 + lambda.abs());
+    let lu = (m - DMatrix::identity(n, n) * shift).lu();
+    let mut x = DVector::from_element(n, 1.0 / (n as f64).sqrt());
+    for _ in 0..3 {
+        match lu.solve(&x) {
+            Some(y) if y.norm().is_finite() && y.norm() > 0.0 => x = &y / y.norm(),
+            _ => return 0.0,
+        }
+    }
+    x.dot(target).abs()
 }
 
 /// Most integration steps one stability scan may take: far more than any of the criterion
@@ -322,11 +424,15 @@ impl Floquet {
                 neutral.push(r);
             }
         }
+        let slow = (rows.len() == 2)
+            .then(|| slow_direction(&cos, &sin))
+            .flatten();
         Ok(Floquet {
             machine: machine.clone(),
             alpha: angles.to_vec(),
             rows,
             neutral,
+            slow,
         })
     }
 
@@ -480,14 +586,19 @@ impl Floquet {
     ) -> Result<(Multipliers, u64), StabilityError> {
         let (phi, steps) = self.monodromy_counted(omega, rtol)?;
         let (reduced, neutral_drift) = self.reduce(&phi);
-        let schur = nalgebra::Schur::try_new(reduced, f64::EPSILON, 100_000).ok_or_else(|| {
-            StabilityError::Numerical {
-                speed: omega,
-                message: "the Schur iteration did not converge".into(),
-            }
-        })?;
+        let schur =
+            nalgebra::Schur::try_new(reduced.clone(), f64::EPSILON, 100_000).ok_or_else(|| {
+                StabilityError::Numerical {
+                    speed: omega,
+                    message: "the Schur iteration did not converge".into(),
+                }
+            })?;
         let mut values: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
         values.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+        let unresolved = self.slow_within_resolution(&reduced, &values, resolution(rtol));
+        if let Some((k, _)) = unresolved {
+            values.remove(k);
+        }
         let radius = values.first().map_or(0.0, |z| z.norm());
         let m = Multipliers {
             speed: omega,
@@ -495,8 +606,39 @@ impl Floquet {
             radius,
             neutral: self.neutral.len(),
             neutral_drift,
+            unresolved: unresolved.map(|(_, d)| d),
         };
         Ok((m, steps))
+    }
+
+    /// The slow drift's multiplier among `values` (the eigenvalues of `reduced`), if it lies
+    /// within `res` of 1: its index and `ρ − 1` (module docs). Of the multipliers within `res`
+    /// of 1 (one, or two at a boundary where another crosses 1), the one whose eigenvector lies
+    /// most along the slow direction, if at least [`SLOW_ALIGNMENT`].
+    fn slow_within_resolution(
+        &self,
+        reduced: &DMatrix<f64>,
+        values: &[Complex<f64>],
+        res: f64,
+    ) -> Option<(usize, f64)> {
+        let slow = self.slow.as_ref()?;
+        let one = Complex::new(1.0, 0.0);
+        // The slow direction in the reduced coordinates: every non-angle coordinate first
+        // (zero), then its components on the row-space basis (see `reduce`).
+        let nl = self.machine.loads;
+        let mut target = vec![0.0; self.dim() - nl];
+        for r in &self.rows {
+            target.push(r.iter().zip(slow).map(|(a, b)| a * b).sum());
+        }
+        let target = DVector::from_vec(target);
+        values
+            .iter()
+            .enumerate()
+            .filter(|(_, z)| (*z - one).norm() <= res)
+            .map(|(k, z)| (k, z, eigenvector_alignment(reduced, z.re, &target)))
+            .filter(|(_, _, a)| *a >= SLOW_ALIGNMENT)
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .map(|(k, z, _)| (k, z.norm() - 1.0))
     }
 
     /// Scans `[opts.from, opts.to]` for changes of stability and bisects each.
@@ -523,6 +665,7 @@ impl Floquet {
         let mut evaluations = 0usize;
         let mut drift = 0.0f64;
         let mut steps = 0u64;
+        let mut unresolved: Option<Unresolved> = None;
         let mut eval = |w: f64| -> Result<f64, StabilityError> {
             let (m, n) = self.multipliers_counted(w, rtol)?;
             steps += n;
@@ -540,6 +683,17 @@ impl Floquet {
             }
             evaluations += 1;
             drift = drift.max(m.neutral_drift);
+            if let Some(d) = m.unresolved {
+                let u = unresolved.get_or_insert(Unresolved {
+                    evaluations: 0,
+                    speeds: [w, w],
+                    resolution: resolution(rtol),
+                    largest: 0.0,
+                });
+                u.evaluations += 1;
+                u.speeds = [u.speeds[0].min(w), u.speeds[1].max(w)];
+                u.largest = u.largest.max(d.abs());
+            }
             Ok(m.radius.ln())
         };
         let count = ((to / from).log2() * per_octave as f64).ceil().max(2.0) as usize;
@@ -598,6 +752,7 @@ impl Floquet {
             evaluations,
             steps,
             neutral_drift: drift,
+            unresolved,
         })
     }
 }
@@ -952,6 +1107,39 @@ mod tests {
                 "{tight:?} {m:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_slow_drift_within_the_resolution_is_set_aside_as_neutral() {
+        // Two loads, capacity 0.1 kg·m. D = 1e-9: the pair's common rotation has the
+        // multiplier 1 − O(1e-16), unresolvable; it is set aside, and the remaining
+        // multipliers are those of D = 0 (where the rotation is removed exactly) to O(D).
+        // D = 1e-3 and 0.03: the drift's multiplier is resolved (1e-6 and more from 1) and
+        // kept.
+        for omega in [40.0, 80.0] {
+            let zero = Floquet::new(&seed(2, 0.0))
+                .unwrap()
+                .multipliers(omega, 1e-10)
+                .unwrap();
+            let f = Floquet::new(&seed(2, 1e-9)).unwrap();
+            assert_eq!(f.neutral_count(), 0);
+            let tiny = f.multipliers(omega, 1e-10).unwrap();
+            let d = tiny.unresolved.unwrap();
+            assert!(d.abs() <= resolution(1e-10), "{tiny:?}");
+            assert_eq!(tiny.values.len(), f.dim() - 1);
+            assert!(
+                (tiny.radius - zero.radius).abs() < 1e-6,
+                "{tiny:?} {zero:?}"
+            );
+            for d in [1e-3, 0.03] {
+                let f = Floquet::new(&seed(2, d)).unwrap();
+                let m = f.multipliers(omega, 1e-10).unwrap();
+                assert!(m.unresolved.is_none(), "D = {d}: {m:?}");
+                assert_eq!(m.values.len(), f.dim());
+            }
+        }
+        assert_eq!(resolution(1e-10), 1e-10);
+        assert_eq!(resolution(1e-14), ROUNDING_FLOOR);
     }
 
     #[test]
