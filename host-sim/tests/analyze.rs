@@ -1375,3 +1375,35 @@ fn a_stop_is_seen_when_the_counter_barely_covers_the_timeout() {
         assert_eq!(report.sync_state, "searching", "stop at {stop} s");
     }
 }
+
+/// Options outside a fixed range are refused with the range, in the options' own terms (not
+/// the core's parameter names).
+#[test]
+fn options_out_of_range_name_their_range() {
+    let err = |o: AnalyzeOptions| configure(&o).err().unwrap();
+    let e = err(AnalyzeOptions {
+        lines: Some(0),
+        framing: Some(host_sim::app::analyze::FramingArg::Index),
+        ..AnalyzeOptions::default()
+    });
+    assert!(
+        e.contains("--lines is out of range: a disc has 2 to 8192 lines"),
+        "{e}"
+    );
+    let e = err(AnalyzeOptions {
+        estimator_edges: Some(40),
+        ..wheel("36-1")
+    });
+    assert!(
+        e.contains("--estimator-edges is out of range: a speed sample spans 1 to 32"),
+        "{e}"
+    );
+    for w in ["36-36", "36-34", "100-2"] {
+        let e = err(wheel(w));
+        assert!(
+            e.starts_with("--wheel is out of range: a wheel N-M has 3 to 128 positions"),
+            "{w}: {e}"
+        );
+        assert!(!e.contains("pattern."), "{w}: {e}");
+    }
+}

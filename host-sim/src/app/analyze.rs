@@ -1401,6 +1401,28 @@ fn option_of(parameter: &str) -> &'static str {
     }
 }
 
+/// The allowed values of an encoder parameter with a fixed range, as the options give them.
+fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
+    use drive_monitor::encoder::{MAX_PATTERN_POSITIONS, MAX_PATTERN_TEETH, MAX_SPAN};
+    use drive_monitor::ConfigError::{Capacity, OutOfRange};
+    match e {
+        OutOfRange("lines") => Some(format!(
+            "a disc has 2 to {} lines",
+            MAX_LINES.min(usize::from(drive_monitor::encoder::MAX_LINES))
+        )),
+        OutOfRange("estimator.edges") => Some(format!(
+            "a speed sample spans 1 to {MAX_SPAN} edges, and no more than the edges captured in \
+             a revolution"
+        )),
+        OutOfRange("pattern.positions" | "pattern.teeth" | "pattern.gaps")
+        | Capacity("pattern.teeth") => Some(format!(
+            "a wheel N-M has 3 to {MAX_PATTERN_POSITIONS} positions, of which M are missing and \
+             at least 3 (at most {MAX_PATTERN_TEETH}) are teeth"
+        )),
+        _ => None,
+    }
+}
+
 /// Checks the options and builds the analysis they describe.
 pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     use drive_monitor::encoder::{Estimator, Pattern};
@@ -1469,6 +1491,10 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         steady_tolerance: 0.02,
     });
     Encoder::new(enc).map_err(|e| {
+        // A value outside a fixed range: say the range in the option's own terms.
+        if let Some(range) = allowed(e) {
+            return format!("{} is out of range: {range}", option_of(e.parameter()));
+        }
         let mut m = format!(
             "{} does not fit: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",
             option_of(e.parameter()),
