@@ -733,28 +733,16 @@ mod tests {
         };
         assert_eq!(at(70.0), Some(family), "{:?}", exact.segments);
         assert_eq!(at(60.0), Some(Regime::Gathering));
-        let sigma = growth_rate(&scene, &path, exact, 70.0).unwrap().unwrap();
-        assert!(sigma > 0.0);
-        let (r, _, settled) =
-            crate::studies::sweep::settled_run(&scene, &path, 70.0, false, Some(sigma)).unwrap();
-        assert!(settled);
-        assert_eq!(
-            r.regime_simulated,
-            Some("balancing"),
-            "{:?}",
-            r.regime_detail
-        );
-        // At 72 rad/s, in the same band, the loads started near the fan gather instead.
-        let sigma = growth_rate(&scene, &path, exact, 72.0).unwrap().unwrap();
-        let (r, _, settled) =
-            crate::studies::sweep::settled_run(&scene, &path, 72.0, false, Some(sigma)).unwrap();
-        assert!(settled);
-        assert_eq!(
-            r.regime_simulated,
-            Some("gathering"),
-            "{:?}",
-            r.regime_detail
-        );
+        // The fan is unstable at both speeds; from near it the loads find a stable member at
+        // 70 rad/s and gather at 72.
+        for (w, want) in [(70.0, "balancing"), (72.0, "gathering")] {
+            let sigma = growth_rate(&scene, &path, exact, w).unwrap().unwrap();
+            assert!(sigma > 0.0, "{w}");
+            let (r, _, settled) =
+                crate::studies::sweep::settled_run(&scene, &path, w, false, Some(sigma)).unwrap();
+            assert!(settled, "{w}");
+            assert_eq!(r.regime_simulated, Some(want), "{w}: {:?}", r.regime_detail);
+        }
         // Two balls: no family, so the fan's instability is gathering.
         let two = Scene::parse(&text.replace("loads = 3", "loads = 2"), &path).unwrap();
         let m2 = predict::machine(&two, &path).unwrap().unwrap();

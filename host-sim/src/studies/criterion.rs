@@ -292,19 +292,29 @@ pub fn outcome(
         } else {
             d.residual_relative >= AWAY
         };
-        if balanced || away || k == DOUBLINGS {
-            let balancing = balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt());
-            return Ok(Outcome::judged(
-                speed,
-                together,
-                balancing,
-                balanced || away,
-                &d,
-                &s,
-            ));
+        if let Some(o) = judged_run(speed, together, &d, &s, (balanced, away), k == DOUBLINGS) {
+            return Ok(o);
         }
         k += 1;
     }
+}
+
+/// The outcome of run `s` at `speed` from its regime samples `d`, judged `(balanced, away)`
+/// (module docs), or `None` when neither holds and the run is to be doubled; after the
+/// `last` doubling an undecided run is judged balancing below 3.16 % (the geometric middle
+/// of the two thresholds) and counted as unsettled.
+fn judged_run(
+    speed: f64,
+    together: bool,
+    d: &RegimeReport,
+    s: &Scene,
+    (balanced, away): (bool, bool),
+    last: bool,
+) -> Option<Outcome> {
+    (balanced || away || last).then(|| {
+        let balancing = balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt());
+        Outcome::judged(speed, together, balancing, balanced || away, d, s)
+    })
 }
 
 /// A run-up to `speed`: the loads started together at rest with the rotor at `from`, the
@@ -349,16 +359,8 @@ pub fn ramp_outcome(
         let d = regime_of(&s, file, None, together)?;
         let balanced = d.residual_relative <= BALANCED;
         let away = d.residual_min_relative >= AWAY;
-        if balanced || away || k == DOUBLINGS {
-            let balancing = balanced || (!away && d.residual_relative < (BALANCED * AWAY).sqrt());
-            return Ok(Outcome::judged(
-                speed,
-                together,
-                balancing,
-                balanced || away,
-                &d,
-                &s,
-            ));
+        if let Some(o) = judged_run(speed, together, &d, &s, (balanced, away), k == DOUBLINGS) {
+            return Ok(o);
         }
         k += 1;
     }
