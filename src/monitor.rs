@@ -1686,6 +1686,42 @@ mod tests {
         assert_eq!(m.diagnostics().edges.reversals, 1);
     }
 
+    /// Index pulses while the shaft runs backwards mark no forward frame: five revolutions in
+    /// reverse (each with its index pulse) leave no missing frame, and once forward again the
+    /// monitor syncs and measures.
+    #[test]
+    fn index_pulses_in_reverse_are_no_missing_frames() {
+        let evs = stream(&uniform(256), Some(0.0), 24, 84e6, u32::MAX, &kneader(0.01));
+        let mut m = monitor(indexed(256, 4, 32, 84e6), 1);
+        let edge_at = |rev: usize| {
+            evs.iter()
+                .enumerate()
+                .filter(|(_, e)| matches!(e, Ev::Edge(_)))
+                .nth(rev * 256 + 100)
+                .map(|(i, _)| i)
+                .unwrap()
+        };
+        let (back, forward) = (edge_at(6), edge_at(11));
+        let mut out = run(&mut m, &evs[..back]);
+        for e in &evs[back..forward] {
+            match *e {
+                Ev::Index(t) => m.on_index(t),
+                Ev::Edge(t) => out.extend(m.on_edge(t, Some(Direction::Reverse))),
+            }
+        }
+        assert_eq!(m.shaft_state(), ShaftState::Reversed);
+        let before = out.len();
+        out.extend(run(&mut m, &evs[forward..]));
+        let d = m.diagnostics().edges;
+        assert_eq!((d.missing_frames, d.reversals), (0, 1), "{d:?}");
+        assert_eq!(m.sync_state(), SyncState::Synced);
+        let valid = out[before..].iter().filter(|o| o.report.valid()).count();
+        assert!(
+            valid >= 8,
+            "{valid} valid windows after running forward again"
+        );
+    }
+
     #[test]
     fn a_shaft_creeping_below_min_speed_does_not_flip_state() {
         // Edges every 1.5 timeouts, polled in between, with the direction flickering: no

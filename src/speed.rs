@@ -639,7 +639,10 @@ impl SpeedTracker {
     /// An index pulse captured at `ticks` (raw counter value). Report it before the captures
     /// that follow it; up to four may wait for their edge.
     pub fn on_index(&mut self, enc: &Encoder, ticks: u32) {
-        if enc.framing() != Framing::Index {
+        // While the shaft runs backwards an index pulse marks no forward frame (no forward
+        // edge will take it): it is not queued, so a reverse run is no string of missing
+        // frames. The frame is found again from the first index once the shaft runs forward.
+        if enc.framing() != Framing::Index || self.state == ShaftState::Reversed {
             return;
         }
         let t = ticks & enc.mask();
