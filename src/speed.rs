@@ -1293,7 +1293,12 @@ impl SpeedTracker {
             let bit = 1u8.wrapping_shl(i as u32);
             if !reported_before(q, seq) || (since > d && since < m / 2) {
                 later |= bit;
-            } else if since > 0 && since <= d {
+            } else if since <= d {
+                // At the last accepted edge's own tick (`since` = 0) a timestamp still waiting
+                // was reported after that edge arrived (before it, it would have framed that
+                // edge): it frames this interval. An index a fraction of a tick after its edge
+                // shares the edge's tick about as often as not; counted lost, it made most
+                // revolutions a missing frame.
                 frames |= bit;
             }
         }
