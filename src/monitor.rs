@@ -1064,6 +1064,32 @@ mod tests {
         evs
     }
 
+    /// One random run of the fault tests on a toothed wheel: a wheel of `wheels`, a random
+    /// ripple, 30 revolutions with the faults `inject` adds, 2-edge samples; every valid window
+    /// is checked against the ripple's δ (2a less what samples of two pitches average away).
+    /// Returns how many windows were valid.
+    fn random_wheel_case<N: FnMut(u64) -> u64>(
+        wheels: &[(u8, u8)],
+        next: &mut N,
+        label: &str,
+        inject: impl FnOnce(&[Ev], &mut N) -> Vec<Ev>,
+    ) -> usize {
+        let (positions, missing) = wheels[next(wheels.len() as u64) as usize];
+        let p = Pattern::missing_teeth(positions, missing);
+        let (a, z, w) = random_ripple(next);
+        let clean = stream(&pattern_angles(p), None, 30, 84e6, u32::MAX, &w);
+        let evs = inject(&clean, next);
+        let mut c = EncoderConfig::pattern(p, 84e6);
+        c.estimator = Estimator::Edges(2);
+        c.min_speed = 20.0;
+        let mut m = monitor(c, 1);
+        let out = run(&mut m, &evs);
+        let x = z * TAU / f64::from(positions);
+        let expect = 2.0 * a * x.sin() / x;
+        let what = format!("{label}: {positions}-{missing}, a {a:.4}, z {z}");
+        check_valid(&out, expect, &what)
+    }
+
     #[test]
     fn sparse_faults_on_a_toothed_wheel_leave_no_wrong_valid_window() {
         // Random missing-tooth wheels and speed ripples over 30 revolutions, with faults
@@ -1083,22 +1109,12 @@ mod tests {
         for rate in [0.005, 0.01] {
             let (mut valid, mut runs) = (0usize, 0usize);
             for case in 0..600 {
-                let (positions, missing) = wheels[next(wheels.len() as u64) as usize];
-                let p = Pattern::missing_teeth(positions, missing);
-                let (a, z, w) = random_ripple(&mut next);
-                let clean = stream(&pattern_angles(p), None, 30, 84e6, u32::MAX, &w);
-                let evs = sparse_faults(&clean, rate, &mut next);
-                let mut c = EncoderConfig::pattern(p, 84e6);
-                c.estimator = Estimator::Edges(2);
-                c.min_speed = 20.0;
-                let mut m = monitor(c, 1);
-                let out = run(&mut m, &evs);
-                // δ = 2a less what samples of two pitches average away (as above).
-                let x = z * TAU / f64::from(positions);
-                let expect = 2.0 * a * x.sin() / x;
-                let what =
-                    format!("rate {rate}, case {case}: {positions}-{missing}, a {a:.4}, z {z}");
-                valid += check_valid(&out, expect, &what);
+                valid += random_wheel_case(
+                    &wheels,
+                    &mut next,
+                    &format!("rate {rate}, case {case}"),
+                    |clean, next| sparse_faults(clean, rate, next),
+                );
                 runs += 1;
             }
             // A clean run gives 26 valid windows (30 revolutions, the first ones framing):
@@ -1111,20 +1127,12 @@ mod tests {
         let mut next = lcg(0xc105);
         let valid: usize = (0..300)
             .map(|case| {
-                let (positions, missing) = wheels[next(wheels.len() as u64) as usize];
-                let p = Pattern::missing_teeth(positions, missing);
-                let (a, z, w) = random_ripple(&mut next);
-                let clean = stream(&pattern_angles(p), None, 30, 84e6, u32::MAX, &w);
-                let evs = clustered_faults(&clean, &mut next);
-                let mut c = EncoderConfig::pattern(p, 84e6);
-                c.estimator = Estimator::Edges(2);
-                c.min_speed = 20.0;
-                let mut m = monitor(c, 1);
-                let out = run(&mut m, &evs);
-                let x = z * TAU / f64::from(positions);
-                let expect = 2.0 * a * x.sin() / x;
-                let what = format!("clusters, case {case}: {positions}-{missing}, a {a:.4}, z {z}");
-                check_valid(&out, expect, &what)
+                random_wheel_case(
+                    &wheels,
+                    &mut next,
+                    &format!("clusters, case {case}"),
+                    clustered_faults,
+                )
             })
             .sum();
         // A cluster every 80 edges on average, most revolutions have one: a fifth of the clean

@@ -817,6 +817,13 @@ fn run_reads_the_regime_from_the_speed_history() {
 #[test]
 fn a_run_too_short_for_its_regime_says_unsettled() {
     let dir = scratch("unsettled");
+    // A sweep of two speeds, as JSON.
+    let sweep2 = |path: &std::path::Path, from: &str, to: &str| {
+        let p = path.to_str().unwrap();
+        json(&[
+            "sweep", p, "--from", from, "--to", to, "--steps", "2", "--json",
+        ])
+    };
     let light = "[[platform]]\nmass = 20.0\nstiffness = 1.0e5\ndamping = 2.0\n\n\
         [[platform]]\nmass = 300.0\nstiffness = 2.0e6\ndamping = 10.0\n\n\
         [[coupling]]\nbetween = [2, 1]\nstiffness = 5.0e4\ndamping = 1.0\n\n\
@@ -833,17 +840,7 @@ fn a_run_too_short_for_its_regime_says_unsettled() {
     let (ok, out, err) = drive_sim(&["run", path.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.contains("The simulated regime is unsettled"), "{out}");
-    let v = json(&[
-        "sweep",
-        path.to_str().unwrap(),
-        "--from",
-        "120",
-        "--to",
-        "125",
-        "--steps",
-        "2",
-        "--json",
-    ]);
+    let v = sweep2(&path, "120", "125");
     for p in v["points"].as_array().unwrap() {
         assert_eq!(p["regime_class"], "gathering", "{p}");
         assert_eq!(p["regime_simulated"], "gathering", "{p}");
@@ -857,17 +854,7 @@ fn a_run_too_short_for_its_regime_says_unsettled() {
         [simulation]\nduration = 10.0\n";
     let path = dir.join("pendulum.toml");
     std::fs::write(&path, pendulum).unwrap();
-    let v = json(&[
-        "sweep",
-        path.to_str().unwrap(),
-        "--from",
-        "79",
-        "--to",
-        "80",
-        "--steps",
-        "2",
-        "--json",
-    ]);
+    let v = sweep2(&path, "79", "80");
     for p in v["points"].as_array().unwrap() {
         assert_eq!(p["regime_class"], "balancing", "{p}");
         assert_eq!(p["regime_simulated"], "balancing", "{p}");

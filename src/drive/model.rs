@@ -506,13 +506,7 @@ impl DriveModel {
     #[inline(never)]
     fn shoot(&mut self, curve: Characteristic) -> Result<bool, ConfigError> {
         let parabola = matches!(curve, Characteristic::Parabola(_));
-        let orders = self
-            .load
-            .harmonics()
-            .iter()
-            .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
-            .map(Harmonic::order)
-            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order));
+        let orders = self.periodic_orders();
         let any = orders.clone().next().is_some();
         let Some((radians, cycles)) = common_period(orders).filter(|_| any) else {
             if !self.inertia_harmonics.is_empty() {
@@ -651,17 +645,22 @@ impl DriveModel {
         Some((shooter, shot))
     }
 
-    /// The common period of the load and inertia orders and the trapezoid nodes that resolve
-    /// the periodic solution over it (out of line: see [`Self::varying_state`]).
-    #[inline(never)]
-    fn varying_horizon(&self) -> Result<Horizon, ConfigError> {
-        let orders = self
-            .load
+    /// The orders the periodic solution has to repeat over: every load harmonic that is
+    /// there (order and amplitude non-zero) and every inertia harmonic.
+    fn periodic_orders(&self) -> impl Iterator<Item = f64> + Clone + '_ {
+        self.load
             .harmonics()
             .iter()
             .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
             .map(Harmonic::order)
-            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order));
+            .chain(self.inertia_harmonics.iter().map(InertiaHarmonic::order))
+    }
+
+    /// The common period of the load and inertia orders and the trapezoid nodes that resolve
+    /// the periodic solution over it (out of line: see [`Self::varying_state`]).
+    #[inline(never)]
+    fn varying_horizon(&self) -> Result<Horizon, ConfigError> {
+        let orders = self.periodic_orders();
         let bad_order = ConfigError::Inconsistent("inertia_harmonic.order");
         let (radians, cycles) = common_period(orders).ok_or(bad_order)?;
         let start = varying::initial_nodes(cycles).ok_or(bad_order)?;

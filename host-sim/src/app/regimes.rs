@@ -732,6 +732,11 @@ mod tests {
                 .map(|s| s.1)
         };
         assert_eq!(at(70.0), Some(family), "{:?}", exact.segments);
+        // The band README quotes: from 69.0 to 73.1 rad/s.
+        let from = exact.segments.iter().find(|s| s.1 == family).unwrap().0;
+        assert!((from - 69.0).abs() < 0.05, "{from}");
+        assert_eq!(exact.map.boundaries.len(), 1);
+        assert!((exact.map.boundaries[0].speed - 73.1).abs() < 0.05);
         assert_eq!(at(60.0), Some(Regime::Gathering));
         // The fan is unstable at both speeds; from near it the loads find a stable member at
         // 70 rad/s and gather at 72.

@@ -917,7 +917,8 @@ pub fn tally_points<'a>(margin: f64, points: impl Iterator<Item = &'a Point>) ->
         }
         if let Some(a) = p.arrived {
             t.reachable += 1;
-            if a.by_history && a.class == "balancing" {
+            // The tracker commits from history only to balancing.
+            if a.by_history {
                 t.history_committed += 1;
                 t.history_agreeing += usize::from(a.outcome.settled && a.outcome.balancing);
             }
