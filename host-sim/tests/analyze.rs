@@ -9,10 +9,15 @@ use host_sim::app::scene::Scene;
 use host_sim::engine::encoder::Edge;
 use std::path::{Path, PathBuf};
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("analyze-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// A file `name` in a scratch directory of its own, removed with the returned guard (when the
+/// test ends, a failing one's too).
+fn tmp(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::Builder::new()
+        .prefix("analyze-test-")
+        .tempdir()
+        .unwrap();
+    let file = dir.path().join(name);
+    (dir, file)
 }
 
 /// Simulates `text` writing a capture in `format` to `file`; the report keeps every edge.
@@ -236,7 +241,7 @@ fn check_clean(run: &RunReport, report: &AnalyzeReport, seen: &[Seen], lines: u3
 
 #[test]
 fn clean_cranking_of_a_36_2_wheel_from_a_saleae_capture() {
-    let file = tmp("crank-36-2.csv");
+    let (_scratch, file) = tmp("crank-36-2.csv");
     let run = simulate(
         &cranking("36-2", "sample_rate = 50e6", 2.0, ""),
         CaptureFormat::Saleae,
@@ -250,7 +255,7 @@ fn clean_cranking_of_a_36_2_wheel_from_a_saleae_capture() {
 
 #[test]
 fn clean_cranking_of_an_8_1_wheel_from_a_sigrok_capture() {
-    let file = tmp("crank-8-1.csv");
+    let (_scratch, file) = tmp("crank-8-1.csv");
     let run = simulate(
         &cranking("8-1", "sample_rate = 50e6\ndedup = true", 3.0, ""),
         CaptureFormat::Sigrok,
@@ -264,7 +269,7 @@ fn clean_cranking_of_an_8_1_wheel_from_a_sigrok_capture() {
 
 #[test]
 fn clean_cranking_from_a_plain_capture_of_a_60_2_wheel() {
-    let file = tmp("crank-60-2.csv");
+    let (_scratch, file) = tmp("crank-60-2.csv");
     let run = simulate(
         &cranking("60-2", "sample_rate = 50e6", 1.5, ""),
         CaptureFormat::Plain,
@@ -279,7 +284,7 @@ fn clean_cranking_from_a_plain_capture_of_a_60_2_wheel() {
 /// (the capture goes on for a second after it).
 #[test]
 fn a_stall_after_cranking_is_one_timeout_and_nothing_else() {
-    let file = tmp("stall.csv");
+    let (_scratch, file) = tmp("stall.csv");
     let text = cranking("36-2", "sample_rate = 50e6", 3.5, "").replace(
         "points = [[0.0, 0.0], [0.5, 25.0]]",
         "points = [[0.0, 0.0], [0.5, 25.0], [1.8, 25.0], [2.4, 0.0]]",
@@ -303,7 +308,7 @@ fn a_stall_after_cranking_is_one_timeout_and_nothing_else() {
 /// spans one; the real teeth behind them keep their numbers.
 #[test]
 fn noise_pulses_are_counted_as_glitches() {
-    let file = tmp("noise.csv");
+    let (_scratch, file) = tmp("noise.csv");
     let text = cranking(
         "36-2",
         "sample_rate = 50e6\nnoise_width = 2e-6",
@@ -359,7 +364,7 @@ fn noise_pulses_are_counted_as_glitches() {
 /// Dropped teeth are missing edges, each one.
 #[test]
 fn dropped_teeth_are_counted_as_missing() {
-    let file = tmp("dropped.csv");
+    let (_scratch, file) = tmp("dropped.csv");
     let text = cranking("36-2", "sample_rate = 50e6", 3.0, "drop_probability = 0.02");
     let run = simulate(&text, CaptureFormat::Saleae, &file);
     let (report, seen) = run_analyze(&file, wheel("36-2"));
@@ -407,7 +412,7 @@ fn index_lines(lines: u16) -> AnalyzeOptions {
 /// every revolution counted, no fault.
 #[test]
 fn an_index_disc_from_two_channels() {
-    let file = tmp("index.csv");
+    let (_scratch, file) = tmp("index.csv");
     let run = simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
     let (report, seen) = run_analyze(&file, index_lines(24));
     assert_eq!(report.index_channel.as_deref(), Some("Channel 1"));
@@ -429,7 +434,7 @@ fn an_index_disc_from_two_channels() {
 /// (Read as plain f64, every interval was off by up to 240 ticks of the 1 GHz timer.)
 #[test]
 fn unix_times_read_as_exactly_as_times_from_zero() {
-    let file = tmp("index-from-zero.csv");
+    let (_scratch, file) = tmp("index-from-zero.csv");
     simulate(&index_disc(1.0), CaptureFormat::Plain, &file);
     let text = std::fs::read_to_string(&file).unwrap();
     let mut shifted = String::new();
@@ -445,7 +450,7 @@ fn unix_times_read_as_exactly_as_times_from_zero() {
         }
         shifted.push('\n');
     }
-    let epoch = tmp("index-unix-times.csv");
+    let (_scratch, epoch) = tmp("index-unix-times.csv");
     std::fs::write(&epoch, shifted).unwrap();
     let options = AnalyzeOptions {
         timer_hz: Some(1e9),
@@ -467,7 +472,7 @@ fn unix_times_read_as_exactly_as_times_from_zero() {
 /// is an error naming the row, not a floor widened by the wrong factor.
 #[test]
 fn a_sample_rate_too_slow_for_the_rows_is_refused() {
-    let file = tmp("index-rate.csv");
+    let (_scratch, file) = tmp("index-rate.csv");
     simulate(&index_disc(0.2), CaptureFormat::Saleae, &file);
     let cfg = configure(&index_lines(24)).unwrap();
     for (rate, ok) in [(1e3, false), (10e6, true)] {
@@ -491,7 +496,7 @@ fn a_sample_rate_too_slow_for_the_rows_is_refused() {
 /// invalid" alone.
 #[test]
 fn a_capture_shorter_than_a_window_says_so() {
-    let file = tmp("index-short.csv");
+    let (_scratch, file) = tmp("index-short.csv");
     simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
     let options = AnalyzeOptions {
         window_revolutions: Some(100),
@@ -514,7 +519,7 @@ fn a_capture_shorter_than_a_window_says_so() {
 fn an_index_disc_configured_with_the_wrong_lines_says_so() {
     // A 24-line disc analyzed as 20 or 25 lines never syncs; the report counts the missing
     // frames and says how many captures come between index pulses.
-    let file = tmp("index-wrong-lines.csv");
+    let (_scratch, file) = tmp("index-wrong-lines.csv");
     simulate(&index_disc(3.0), CaptureFormat::Saleae, &file);
     for lines in [20u16, 24, 25] {
         let (report, _) = run_analyze(&file, index_lines(lines));
@@ -564,7 +569,7 @@ fn captures_round_trip_in_every_format() {
         CaptureFormat::Sigrok,
         CaptureFormat::Plain,
     ] {
-        let file = tmp(&format!("round-{}.csv", format.name()));
+        let (_scratch, file) = tmp(&format!("round-{}.csv", format.name()));
         let run = simulate(&text, format, &file);
         // The level the writer was given, sample by sample: the tooth signal (set by each
         // pulse edge) exclusive-or the noise pulses; a transition where it changes.
@@ -951,7 +956,7 @@ fn a_channel_without_edges_is_named_with_the_channels_that_change() {
 /// steady, and the report says so: its δ includes the change of speed, not the ripple alone.
 #[test]
 fn windows_of_a_run_down_are_reported_not_steady() {
-    let file = tmp("rundown.csv");
+    let (_scratch, file) = tmp("rundown.csv");
     let text = cranking("36-2", "sample_rate = 50e6", 4.0, "").replace(
         "points = [[0.0, 0.0], [0.5, 25.0]]",
         "points = [[0.0, 0.0], [0.5, 25.0], [2.5, 25.0], [3.3, 2.0]]",
@@ -1155,7 +1160,7 @@ fn a_file_cut_off_in_the_middle_of_a_row_says_so() {
 /// it; the timer's floor alone is exceeded many times over.
 #[test]
 fn a_coarsely_sampled_capture_widens_the_noise_floor() {
-    let file = tmp("coarse.csv");
+    let (_scratch, file) = tmp("coarse.csv");
     let run = simulate(
         &cranking("36-2", "sample_rate = 3e5\ndedup = true", 3.0, ""),
         CaptureFormat::Sigrok,

@@ -120,9 +120,12 @@ fn sweep_json_keeps_its_contract() {
 }
 
 /// A bundled scene with some text replaced, written to a file of its own.
-fn variant(scene: &str, name: &str, edits: &[(&str, &str)]) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("drive-sim-variant-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+fn variant(
+    dir: &std::path::Path,
+    scene: &str,
+    name: &str,
+    edits: &[(&str, &str)],
+) -> std::path::PathBuf {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/").to_string() + scene + ".toml";
     let mut text = std::fs::read_to_string(path).unwrap();
     for (from, to) in edits {
@@ -141,7 +144,14 @@ fn variant(scene: &str, name: &str, edits: &[(&str, &str)]) -> std::path::PathBu
 /// is flagged (only `run` did), and the allocation rule is named.
 #[test]
 fn predict_says_what_its_numbers_are() {
-    let stall = variant("kneader", "stall.toml", &[("mean = 24.0", "mean = 170.0")]);
+    let scratch_dir = scratch("variant");
+    let dir = scratch_dir.path();
+    let stall = variant(
+        dir,
+        "kneader",
+        "stall.toml",
+        &[("mean = 24.0", "mean = 170.0")],
+    );
     let v = json(&["predict", stall.to_str().unwrap(), "--json"]);
     let i = &v["irregularity"];
     assert_eq!(i["steady_state"], false);
@@ -151,6 +161,7 @@ fn predict_says_what_its_numbers_are() {
     assert!(i["stall"].as_str().unwrap().contains("mean load"), "{i}");
 
     let tiny = variant(
+        dir,
         "kneader",
         "tiny.toml",
         &[("delta_limit = 0.06", "delta_limit = 1e-12")],
@@ -166,6 +177,7 @@ fn predict_says_what_its_numbers_are() {
     );
 
     let low = variant(
+        dir,
         "kneader",
         "low.toml",
         &[
@@ -180,6 +192,7 @@ fn predict_says_what_its_numbers_are() {
     assert!(w.contains("below the motor's breakdown speed"), "{w}");
 
     let heavy = variant(
+        dir,
         "auger",
         "heavy.toml",
         &[("amount = 2.0e-3", "amount = 0.2")],
@@ -208,7 +221,8 @@ fn a_sweep_beyond_the_speed_range_names_to() {
 
 #[test]
 fn plots_are_written() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-plots-{}", std::process::id()));
+    let scratch_dir = scratch("plots");
+    let dir = scratch_dir.path();
     let (ok, _, err) = drive_sim(&["run", "kneader", "--plot", dir.to_str().unwrap()]);
     assert!(ok, "{err}");
     for f in ["kneader-speed.svg", "kneader-delta.svg"] {
@@ -218,15 +232,14 @@ fn plots_are_written() {
     let (ok, _, err) = drive_sim(&["run", "auger", "--plot", dir.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(dir.join("auger-supports.svg").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn predict_rejects_a_delta_limit_below_f64_resolution() {
     // The kneader with a δ limit far below what f64 resolves (2.2e-16): an error naming the
     // file and the key, not a flywheel of 1e19 kg·m².
-    let dir = std::env::temp_dir().join(format!("drive-sim-limit-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = scratch("limit");
+    let dir = scratch_dir.path();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kneader.toml");
     let text = std::fs::read_to_string(scene).unwrap();
     assert!(text.contains("delta_limit = 0.06"));
@@ -244,7 +257,6 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
             "{cmd}: {err}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// An alarm that cannot judge a window for its noise floor says so: the kneader (δ 0.033)
@@ -252,8 +264,8 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
 /// so the core's alarm counts no window; "no alarm" alone would read as a drive within it.
 #[test]
 fn an_alarm_that_judged_no_window_says_why() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-blind-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = scratch("blind");
+    let dir = scratch_dir.path();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kneader.toml");
     let text = std::fs::read_to_string(scene).unwrap();
     let text = text
@@ -285,12 +297,12 @@ fn an_alarm_that_judged_no_window_says_why() {
         out.contains("no alarm — the alarm judged none of the") && out.contains("timer_hz"),
         "{out}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn runup_reports_the_capture_and_out_needs_loads_together() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-capture-{}", std::process::id()));
+    let scratch_dir = scratch("capture");
+    let dir = scratch_dir.path();
     let (ok, out, err) = drive_sim(&["run", "one-mass-runup", "--plot", dir.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(
@@ -306,13 +318,12 @@ fn runup_reports_the_capture_and_out_needs_loads_together() {
     }
     let (ok, _, err) = drive_sim(&["run", "one-mass", "--out", dir.to_str().unwrap()]);
     assert!(!ok && err.contains("start = \"together\""), "{err}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bad_scenes_name_the_file_and_key_and_fail() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = scratch("bad");
+    let dir = scratch_dir.path();
     let cases = [
         ("unknown.toml", "[shaft]\ninertia = 0.3\nflywhel = 1.0\n", "flywhel"),
         ("missing.toml", "[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_torque = 158.0\n", "breakdown_speed"),
@@ -342,7 +353,6 @@ fn bad_scenes_name_the_file_and_key_and_fail() {
     }
     let (ok, _, err) = drive_sim(&["run", "no-such-scene.toml"]);
     assert!(!ok && err.contains("no-such-scene.toml"), "{err}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -350,7 +360,8 @@ fn criterion_writes_its_page_and_json() {
     // One machine (a single platform, so one criterion boundary): the page names the command
     // that regenerates it, and the JSON carries the machine, its grid, its exact boundaries
     // with their checks and the criterion's boundary beside them.
-    let dir = std::env::temp_dir().join(format!("drive-sim-criterion-{}", std::process::id()));
+    let scratch_dir = scratch("criterion");
+    let dir = scratch_dir.path();
     let (ok, out, err) = drive_sim(&[
         "criterion",
         "--machines",
@@ -401,14 +412,14 @@ fn criterion_writes_its_page_and_json() {
             .unwrap()
             .starts_with("<svg"));
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A scratch directory for one test, removed by the test.
-fn scratch(tag: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("drive-sim-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch directory for one test, removed when it is dropped (a failing test's too).
+fn scratch(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("drive-sim-{tag}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
@@ -424,7 +435,8 @@ fn bundled_scenes_only_by_name_and_a_missing_path_is_an_error() {
     let (ok, _, err) = drive_sim(&["predict", "kneader.toml"]);
     assert!(!ok && err.contains("kneader.toml: cannot read"), "{err}");
     // A scene file at a path runs from that path.
-    let dir = scratch("by-path");
+    let scratch_dir = scratch("by-path");
+    let dir = scratch_dir.path();
     let path = dir.join("kneader.toml");
     std::fs::write(
         &path,
@@ -436,7 +448,6 @@ fn bundled_scenes_only_by_name_and_a_missing_path_is_an_error() {
     let v = json(&["run", path.to_str().unwrap(), "--json"]);
     assert_eq!(v["simulated_seconds"], 3.0);
     assert_eq!(v["scene"], path.to_str().unwrap());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -449,7 +460,8 @@ fn scene_files_are_bounded_and_an_empty_scene_is_an_error() {
             "{err}"
         );
     }
-    let dir = scratch("empty");
+    let scratch_dir = scratch("empty");
+    let dir = scratch_dir.path();
     let empty = dir.join("empty.toml");
     std::fs::write(&empty, "# nothing here\n\n").unwrap();
     let only = dir.join("only-description.toml");
@@ -462,7 +474,6 @@ fn scene_files_are_bounded_and_an_empty_scene_is_an_error() {
             "{err}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -504,7 +515,8 @@ fn a_closed_pipe_or_a_full_disk_ends_quietly_with_a_failure() {
 #[test]
 fn output_directories_are_checked_before_simulating() {
     // Finding 9: a bad --plot/--out failed after the whole run, without the path.
-    let dir = scratch("outdirs");
+    let scratch_dir = scratch("outdirs");
+    let dir = scratch_dir.path();
     let file = dir.join("a-file");
     std::fs::write(&file, "").unwrap();
     let below = file.join("plots");
@@ -527,7 +539,6 @@ fn output_directories_are_checked_before_simulating() {
             assert!(!err.contains("motor"), "{err}");
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -597,8 +608,8 @@ fn undersized_balancer_is_a_design_result() {
 
 #[test]
 fn run_writes_a_capture_that_analyze_reads() {
-    let dir = std::env::temp_dir().join(format!("cli-capture-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = scratch("capture-readback");
+    let dir = scratch_dir.path();
     let scene = dir.join("crank.toml");
     std::fs::write(
         &scene,
@@ -671,14 +682,14 @@ fn run_writes_a_capture_that_analyze_reads() {
         !ok && err.contains("bad.csv:3:") && err.contains("not a logic level"),
         "{err}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn predict_says_a_prescribed_speed_gives_no_delta() {
     // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]
     // with [load] and [shaft], which it has.
-    let dir = scratch("prescribed");
+    let scratch_dir = scratch("prescribed");
+    let dir = scratch_dir.path();
     let path = dir.join("prescribed.toml");
     std::fs::write(
         &path,
@@ -693,14 +704,14 @@ fn predict_says_a_prescribed_speed_gives_no_delta() {
             && err.contains("model = \"speed\" prescribes the speed"),
         "{err}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn run_says_which_tables_a_prescribed_speed_leaves_out() {
     // A prescribed speed with [load] and [shaft]: neither moves the shaft, and the run said
     // nothing of them (the load's ripple simply did not show).
-    let dir = scratch("prescribed-run");
+    let scratch_dir = scratch("prescribed-run");
+    let dir = scratch_dir.path();
     let path = dir.join("prescribed.toml");
     std::fs::write(
         &path,
@@ -722,7 +733,6 @@ fn run_says_which_tables_a_prescribed_speed_leaves_out() {
     assert_eq!(notes.len(), 2, "{v}");
     assert!(notes[0].as_str().unwrap().starts_with("[load]"), "{v}");
     assert!(notes[1].as_str().unwrap().starts_with("[shaft]"), "{v}");
-    std::fs::remove_dir_all(&dir).unwrap();
     // A motor-driven scene leaves nothing out, and its δ limit is in the JSON as in the text.
     let v = json(&["run", "kneader", "--json"]);
     assert!(v.get("not_simulated").is_none(), "{v}");
@@ -736,8 +746,8 @@ fn run_says_which_tables_a_prescribed_speed_leaves_out() {
 /// 22 % off, and A's rotating part (0.067 N) vanished. Small loads keep four digits now.
 #[test]
 fn a_small_rotors_support_loads_keep_their_digits() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-small-rotor-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = scratch("small-rotor");
+    let dir = scratch_dir.path();
     let scene = dir.join("small.toml");
     std::fs::write(
         &scene,
@@ -770,7 +780,6 @@ fn a_small_rotors_support_loads_keep_their_digits() {
         ok && out.contains("static loads A 2402.0 N, B 2230.4 N"),
         "{out}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `run` classifies with the core's regime tracker fed every window's speed: ramped down into
@@ -779,7 +788,8 @@ fn a_small_rotors_support_loads_keep_their_digits() {
 /// balance); run up into it with the loads together at rest, the band stays bistable.
 #[test]
 fn run_reads_the_regime_from_the_speed_history() {
-    let dir = scratch("history");
+    let scratch_dir = scratch("history");
+    let dir = scratch_dir.path();
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/one-mass-runup.toml");
     let text = std::fs::read_to_string(scene).unwrap();
     let ramp = |from: &str, start: &str| {
@@ -805,7 +815,6 @@ fn run_reads_the_regime_from_the_speed_history() {
     let v = json(&["run", path.to_str().unwrap(), "--json"]);
     assert_eq!(v["regime_class"], "bistable", "{v}");
     assert!(v.get("regime_by_history").is_none());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A lightly damped two-mass machine whose balancing position is unstable at 120 rad/s, so
@@ -816,7 +825,8 @@ fn run_reads_the_regime_from_the_speed_history() {
 /// sweep now runs it until it balances.
 #[test]
 fn a_run_too_short_for_its_regime_says_unsettled() {
-    let dir = scratch("unsettled");
+    let scratch_dir = scratch("unsettled");
+    let dir = scratch_dir.path();
     // A sweep of two speeds, as JSON.
     let sweep2 = |path: &std::path::Path, from: &str, to: &str| {
         let p = path.to_str().unwrap();
@@ -859,5 +869,4 @@ fn a_run_too_short_for_its_regime_says_unsettled() {
         assert_eq!(p["regime_class"], "balancing", "{p}");
         assert_eq!(p["regime_simulated"], "balancing", "{p}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

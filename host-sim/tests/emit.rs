@@ -30,8 +30,11 @@ fn the_firmware_table_is_what_predict_emits_now() {
 
 #[test]
 fn out_writes_the_same_and_errors_name_the_cause() {
-    let dir = std::env::temp_dir().join(format!("drive-sim-emit-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let scratch_dir = tempfile::Builder::new()
+        .prefix("drive-sim-emit-")
+        .tempdir()
+        .unwrap();
+    let dir = scratch_dir.path();
     let file = dir.join("table.rs");
     let path = file.to_str().unwrap();
     let (ok, out, err) = drive_sim(&["predict", "two-mass", "--emit", "rust", "--out", path]);
@@ -40,7 +43,6 @@ fn out_writes_the_same_and_errors_name_the_cause() {
     assert!(ok, "{err}");
     assert_eq!(std::fs::read_to_string(&file).unwrap(), printed);
     assert!(printed.contains("pub const MACHINE: MachineTable<'static>"));
-    std::fs::remove_dir_all(&dir).unwrap();
     // No machine in the scene; an unwritable output; --out without --emit.
     let (ok, _, err) = drive_sim(&["predict", "kneader", "--emit", "rust"]);
     assert!(

@@ -200,8 +200,11 @@ mod tests {
 
     #[test]
     fn writes_an_svg_with_its_labels() {
-        let dir = std::env::temp_dir().join(format!("plot-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch_dir = tempfile::Builder::new()
+            .prefix("plot-test-")
+            .tempdir()
+            .unwrap();
+        let dir = scratch_dir.path();
         let path = dir.join("t.svg");
         write_svg(
             &path,
@@ -225,6 +228,5 @@ mod tests {
         .unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("<svg") && svg.contains("limit") && svg.contains("gathering"));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
