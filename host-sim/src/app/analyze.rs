@@ -680,15 +680,11 @@ pub fn analyze<R: BufRead>(
         }
         // The periodic task between the last event and this one.
         if let Some(t0) = last_event {
-            polls.between(
-                t0,
-                t,
-                &mut clock,
-                &mut st,
-                &mut monitor,
-                &mut report,
-                on_decision,
-            );
+            for p in polls.between(t0, t) {
+                let ticks = clock.ticks(p);
+                clock.note(ticks, p);
+                st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+            }
         }
         let ticks = clock.ticks(t);
         clock.note(ticks, t);
@@ -711,18 +707,11 @@ pub fn analyze<R: BufRead>(
     // recording did times out where a firmware's poll would see it, not at the end of the
     // file), and a last poll there.
     if let Some(t0) = last_event {
-        polls.between(
-            t0,
-            end,
-            &mut clock,
-            &mut st,
-            &mut monitor,
-            &mut report,
-            on_decision,
-        );
-        let ticks = clock.ticks(end);
-        clock.note(ticks, end);
-        st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+        for p in polls.between(t0, end).into_iter().chain([end]) {
+            let ticks = clock.ticks(p);
+            clock.note(ticks, p);
+            st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
+        }
         // A window held for the edge after its frame, which the recording does not have, and
         // a second window the last call ended (handed by the next call): until none is left.
         loop {
@@ -842,27 +831,18 @@ struct Polls {
 }
 
 impl Polls {
-    /// Polls after the event at `t0` and before `t`, every [`Polls::every`]. A poll finds
-    /// nothing until the timeout has passed: only the ones around it are made.
-    #[allow(clippy::too_many_arguments)]
-    fn between(
-        &mut self,
-        t0: f64,
-        t: f64,
-        clock: &mut Clock,
-        st: &mut State,
-        monitor: &mut DeltaMonitor<MAX_LINES>,
-        report: &mut AnalyzeReport,
-        on_decision: &mut dyn FnMut(&Decision),
-    ) {
+    /// The times of the polls after the event at `t0` and before `t`, every [`Polls::every`],
+    /// taken as made. A poll finds nothing until the timeout has passed: only the ones around
+    /// it are made.
+    fn between(&mut self, t0: f64, t: f64) -> Vec<f64> {
+        let mut times = Vec::new();
         let mut p = self.last.max(t0 + self.timeout - 2.0 * self.every).max(t0) + self.every;
         while p < t && p <= t0 + self.timeout + 2.0 * self.every {
-            let ticks = clock.ticks(p);
-            clock.note(ticks, p);
-            st.poll(monitor, clock, ticks, report, on_decision);
+            times.push(p);
             self.last = p;
             p += self.every;
         }
+        times
     }
 }
 
