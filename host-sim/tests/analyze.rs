@@ -428,6 +428,42 @@ fn an_index_disc_from_two_channels() {
     assert!(frames >= 4);
 }
 
+/// A capture taken through the timer's input prescaler (one capture in 4 line edges): the
+/// simulation and the analysis of its recording (which holds every line edge) capture one edge
+/// in four, so the speed is the shaft's and every revolution is framed by its index. (Every
+/// line edge was fed: the speed read 4 times the shaft's, and every window of an index disc
+/// was invalid, a missing frame.)
+#[test]
+fn a_prescaled_capture_takes_one_edge_in_four() {
+    let (_scratch, file) = tmp("index-prescaled.csv");
+    let text = index_disc(2.0).replace("lines = 24", "lines = 24\nprescaler = 4");
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let speed = run.speed_measured.unwrap();
+    assert!((speed - 40.0).abs() < 1e-3, "{speed}");
+    assert!(run.windows >= 10 && run.invalid_windows == 0, "{run:?}");
+    let options = AnalyzeOptions {
+        prescaler: Some(4),
+        ..index_lines(24)
+    };
+    let (report, seen) = run_analyze(&file, options);
+    let line_edges = teeth(&run.edge_list).len() as u64;
+    assert_eq!(report.edges, line_edges);
+    assert_eq!(report.captured, line_edges / 4);
+    assert!(seen.iter().all(|s| matches!(s, Seen::Tooth { .. })));
+    assert_eq!(report.missing_frames, 0);
+    let synced = report.sync_acquired.unwrap();
+    let frames = teeth(&run.edge_list)
+        .iter()
+        .filter(|e| e.tooth == 0 && e.true_time > synced + 1e-9)
+        .count();
+    assert_eq!(report.revolutions as usize, frames);
+    for w in report.windows.iter().filter(|w| w.valid) {
+        let mean = w.omega_mean.unwrap();
+        assert!((mean - 40.0).abs() < 1e-3, "{mean}");
+    }
+    assert!(report.valid_windows >= 10 && report.invalid_windows == 0);
+}
+
 /// A capture whose times are Unix times (1.76e9 s: an f64 resolves only 0.24 µs there) reads
 /// as exactly as the same capture from 0: the same decisions at the same times (counted from
 /// the first time's whole seconds, which the report names) and the same δ in every window.

@@ -302,8 +302,12 @@ pub struct AnalyzeReport {
     /// when it is 10 000 s or more, such as a Unix time; else 0): every time reported is
     /// counted from it.
     pub time_origin: i64,
-    /// Edges of the chosen polarity on the encoder channel (fed to the core).
+    /// Edges of the chosen polarity on the encoder channel.
     pub edges: u64,
+    /// Of them, those captured and fed to the core: one in `prescaler` (all without one).
+    pub captured: u64,
+    /// The emulated capture's input prescaler: one capture every this many edges.
+    pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
     pub index_pulses: u64,
     /// Edges the core accepted as teeth.
@@ -588,6 +592,7 @@ pub fn analyze<R: BufRead>(
         wheel: wheel_text(&enc),
         timer_hz: cfg.encoder.timer_hz,
         counter_bits: cfg.encoder.counter_bits,
+        prescaler: cfg.encoder.prescaler,
         sample_rate: reader.sample_rate(),
         sync_state: "searching",
         ..Default::default()
@@ -622,6 +627,8 @@ pub fn analyze<R: BufRead>(
     // less than a sample period apart: the rate or the file is wrong.
     let period = reader.sample_rate().map(|r| 1.0 / r);
     let mut previous_time: Option<f64> = None;
+    let prescaler = u32::from(cfg.encoder.prescaler.max(1));
+    let mut prescaled = 0u32;
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
@@ -643,7 +650,19 @@ pub fn analyze<R: BufRead>(
             }
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
-        let encoder_edge = edge(ch) == Some(cfg.edge);
+        let channel_edge = edge(ch) == Some(cfg.edge);
+        if channel_edge {
+            report.edges += 1;
+        }
+        // The timer's input prescaler: one capture in `prescaler` edges of the channel, the
+        // first at the prescaler-th (a noise pulse's edge counts like any other).
+        let encoder_edge = channel_edge && {
+            prescaled += 1;
+            prescaled == prescaler
+        };
+        if encoder_edge {
+            prescaled = 0;
+        }
         // B's level as A changes; unknown when B changed in the same sample.
         let direction = match dch {
             Some((d, lead)) if encoder_edge && prev[d] == levels[d] => match levels[d] {
@@ -695,7 +714,7 @@ pub fn analyze<R: BufRead>(
             monitor.on_index(ticks);
         }
         if encoder_edge {
-            report.edges += 1;
+            report.captured += 1;
             periods.capture();
             let o = monitor.on_edge_observed(ticks, direction, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
@@ -744,7 +763,7 @@ pub fn analyze<R: BufRead>(
     // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
     // or time references after a standstill or a reversal.
     report.unjudged_at_end = report
-        .edges
+        .captured
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
     if report.sample_rate.is_none() {
         report.time_grid = grid.step();
@@ -1094,7 +1113,14 @@ pub fn text(r: &AnalyzeReport) -> String {
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
-        r.edges,
+        if r.prescaler > 1 {
+            format!(
+                "{} on the channel, {} captured (one in {}, the input prescaler) and",
+                r.edges, r.captured, r.prescaler
+            )
+        } else {
+            r.captured.to_string()
+        },
         r.accepted,
         if r.index_pulses > 0 {
             format!(", {} index pulses", r.index_pulses)
@@ -1346,6 +1372,8 @@ pub struct AnalyzeOptions {
     pub timer_hz: Option<f64>,
     /// `--counter-bits`.
     pub counter_bits: Option<u8>,
+    /// `--prescaler`.
+    pub prescaler: Option<u8>,
     /// `--min-speed`.
     pub min_speed: Option<f64>,
     /// `--estimator-edges`.
@@ -1373,6 +1401,7 @@ fn option_of(parameter: &str) -> &'static str {
         "timer_hz" => "--timer-hz",
         "min_speed" => "--min-speed",
         "counter_bits" => "--counter-bits",
+        "prescaler" => "--prescaler",
         "estimator.edges" => "--estimator-edges",
         "lines" => "--lines",
         "window.revolutions" => "--window-revolutions",
@@ -1394,6 +1423,7 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
             "a speed sample spans 1 to {MAX_SPAN} edges, and no more than the edges captured in \
              a revolution"
         )),
+        OutOfRange("prescaler") => Some("the input prescaler is 1, 2, 4 or 8".into()),
         OutOfRange("pattern.positions" | "pattern.teeth" | "pattern.gaps")
         | Capacity("pattern.teeth") => Some(format!(
             "a wheel N-M has 3 to {MAX_PATTERN_POSITIONS} positions, of which M are missing and \
@@ -1453,6 +1483,9 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     }
     if let Some(b) = o.counter_bits {
         enc.counter_bits = b;
+    }
+    if let Some(p) = o.prescaler {
+        enc.prescaler = p;
     }
     if let Some(w) = o.min_speed {
         enc.min_speed = w;

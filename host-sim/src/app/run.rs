@@ -678,6 +678,11 @@ struct Collector<'a> {
     judged: AlarmJudged,
     trace: Vec<(f64, f64)>,
     trace_every: u64,
+    /// The capture's input prescaler (one capture in this many line edges) and the edges it
+    /// has counted since its last capture.
+    prescaler: u32,
+    prescaled: u32,
+    /// Edges captured and fed to the core.
     edges: u64,
     all_edges: u64,
     reverse_edges: u64,
@@ -824,6 +829,13 @@ impl Observer for Collector<'_> {
             m.on_index(edge.ticks);
             return;
         }
+        // The timer's input prescaler: one capture in `prescaler` line edges, the first at the
+        // prescaler-th (a noise pulse's edge counts like any other).
+        self.prescaled += 1;
+        if self.prescaled < self.prescaler {
+            return;
+        }
+        self.prescaled = 0;
         self.edges += 1;
         if edge.direction == crate::engine::encoder::Direction::Reverse {
             self.reverse_edges += 1;
@@ -1208,13 +1220,18 @@ pub fn run_with(
         .encoder
         .as_ref()
         .map_or(1, |e| u64::from(e.grid_lines()));
+    let prescaler = scene
+        .encoder
+        .as_ref()
+        .map_or(1, |e| u32::from(e.prescaler.max(1)));
     let expected_edges = parts
         .as_ref()
         .map_or(1e3, |m| m.u_start.max(1.0).sqrt())
         .max(over.speed.unwrap_or(0.0))
         * duration
         / std::f64::consts::TAU
-        * lines as f64;
+        * lines as f64
+        / f64::from(prescaler);
     // 4000 samples a run, and at least 100 a second (a capture's slip beats need them).
     let sample_every = (duration / 4000.0).min(0.01);
     let together = vib_params
@@ -1239,6 +1256,8 @@ pub fn run_with(
         judged: AlarmJudged::default(),
         trace: Vec::new(),
         trace_every: ((expected_edges / 4000.0) as u64).max(1),
+        prescaler,
+        prescaled: 0,
         edges: 0,
         all_edges: 0,
         reverse_edges: 0,

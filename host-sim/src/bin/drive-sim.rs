@@ -177,6 +177,11 @@ struct AnalyzeArgs {
     /// The emulated counter width, bits (16 to 32; default 32, or the scene's).
     #[arg(long)]
     counter_bits: Option<u8>,
+    /// The emulated capture's input prescaler: one capture every 1, 2, 4 or 8 edges of the
+    /// channel, as a timer's input prescaler takes them (default 1, or the scene's; a uniform
+    /// disc only, whose lines it divides).
+    #[arg(long)]
+    prescaler: Option<u8>,
     /// Slowest speed still running, rad/s (default 1, or the scene's).
     #[arg(long)]
     min_speed: Option<f64>,
@@ -202,6 +207,7 @@ impl AnalyzeArgs {
             scene,
             timer_hz: self.timer_hz,
             counter_bits: self.counter_bits,
+            prescaler: self.prescaler,
             min_speed: self.min_speed,
             estimator_edges: self.estimator_edges,
             window_revolutions: self.window_revolutions,
