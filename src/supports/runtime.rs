@@ -113,7 +113,9 @@ impl SupportMonitor {
         })
     }
 
-    /// Loads and flags at speed `omega` rad/s. Total: any f32 gives a defined status.
+    /// Loads and flags at speed `omega` rad/s. Total: any f32 gives a defined status. For a
+    /// δ window, pass its fastest speed ([`crate::irregularity::Measurement::omega_max`]): the
+    /// unbalance load |D|·ω² peaks there, about (1 + δ/2)² times its value at the mean speed.
     pub fn update(&self, omega: f32) -> SupportStatus {
         let w2 = omega * omega;
         let valid = !w2.is_nan();

@@ -206,30 +206,36 @@ pub fn fmt_force(f: f64) -> String {
 /// the simulated reactions against the load limits.
 fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
     let load = |v: Option<f64>| v.map_or("–".to_string(), fmt_force);
-    let mut text = match (u.speed, u.simulated_reaction_level) {
-        (Some(speed), _) => format!(
-            "Supports at {speed:.2} rad/s: peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {} N, B {} N; unbalance A {}, B {}\n",
+    // The simulated reactions, each with its level against the load limit when there is one.
+    let reactions = |k: usize| match u.simulated_reaction_level {
+        Some(levels) => format!(
+            "{} N ({} against the load limit)",
+            fmt_force(u.simulated_peak_reaction[k]),
+            levels[k]
+        ),
+        None => format!("{} N", fmt_force(u.simulated_peak_reaction[k])),
+    };
+    let mut text = match u.speed {
+        Some(speed) => format!(
+            "Supports at {speed:.2} rad/s (the fastest speed of the last window{}): peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {}, B {}; unbalance A {}, B {}\n",
+            u.speed_mean
+                .map_or(String::new(), |m| format!(", mean {m:.2}")),
             load(u.peak_load[0]),
             u.load_level[0],
             load(u.peak_load[1]),
             u.load_level[1],
-            fmt_force(u.simulated_peak_reaction[0]),
-            fmt_force(u.simulated_peak_reaction[1]),
+            reactions(0),
+            reactions(1),
             u.unbalance_level[0],
             u.unbalance_level[1]
         ),
-        (None, levels) => {
-            let levels = levels.unwrap_or(["unknown"; 2]);
-            format!(
-                "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {} N ({} against the load limit), B {} N ({}); unbalance A {}, B {}\n",
-                fmt_force(u.simulated_peak_reaction[0]),
-                levels[0],
-                fmt_force(u.simulated_peak_reaction[1]),
-                levels[1],
-                u.unbalance_level[0],
-                u.unbalance_level[1]
-            )
-        }
+        None => format!(
+            "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {}, B {}; unbalance A {}, B {}\n",
+            reactions(0),
+            reactions(1),
+            u.unbalance_level[0],
+            u.unbalance_level[1]
+        ),
     };
     if let Some(w) = &u.above_service_speed {
         text.push_str("  ");
