@@ -338,6 +338,25 @@ fn bad_scenes_name_the_file_and_key_and_fail() {
             "[shaft]\ninertia = 0.3\n[motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 150.0\nbreakdown_torque = 158.0\n[load]\nmean = 24.0\n",
             "motor.",
         ),
+        // Arrays longer than their key takes: refused as shorter ones are (the extra values
+        // were dropped unsaid: three `[t, ω, x]` points ran as `[t, ω]`).
+        (
+            "triples.toml",
+            "[motor]\nmodel = \"profile\"\npoints = [[0.0, 0.0, 9.0], [1.0, 100.0, 9.0]]\n",
+            "points = [[0.0, 0.0, 9.0]",
+        ),
+        (
+            "window.toml",
+            "[motor]\nmodel = \"speed\"\nspeed = 50.0\n[encoder]\nlines = 60\ntimer_hz = 1e6\nglitch_window = [0.3, 0.7, 0.9]\n",
+            "glitch_window = [0.3, 0.7, 0.9]",
+        ),
+        // A nested array quoted as written (it was called "`encoder.gaps = [...]` (the
+        // default)").
+        (
+            "gaps.toml",
+            "[motor]\nmodel = \"speed\"\nspeed = 50.0\n[encoder]\nlines = 36\ntimer_hz = 1e6\nframing = \"none\"\ngaps = [[0, 2]]\n",
+            "`encoder.gaps = [[0, 2]]`: only for a pattern wheel",
+        ),
     ];
     for (file, text, key) in cases {
         let path = dir.join(file);

@@ -159,20 +159,24 @@ impl<'a> Checker<'a> {
         Checker { file, written }
     }
 
-    /// `key`'s value as written (an array of numbers from its elements, which [`Written`]
-    /// keeps one by one), or `x` marked as the default.
+    /// `key`'s value as written (an array, of arrays too, from its elements, which
+    /// [`Written`] keeps one by one), or `x` marked as the default.
     pub fn shown(&self, key: &str, x: impl std::fmt::Display) -> String {
+        self.as_written(key, 2)
+            .unwrap_or_else(|| format!("{x} (the default)"))
+    }
+
+    /// `key`'s value as written, if the file gives it: a value, or an array of them, nested
+    /// up to `depth` deep (`gaps = [[0, 2]]` is two deep), element by element.
+    fn as_written(&self, key: &str, depth: u32) -> Option<String> {
         if let Some(v) = self.written.get(key) {
-            return v.to_string();
+            return Some(v.to_string());
         }
-        let elements: Vec<&str> = (1..)
-            .map_while(|i| self.written.get(&format!("{key}[{i}]")))
+        let inner = depth.checked_sub(1)?;
+        let elements: Vec<String> = (1..)
+            .map_while(|i| self.as_written(&format!("{key}[{i}]"), inner))
             .collect();
-        if elements.is_empty() {
-            format!("{x} (the default)")
-        } else {
-            format!("[{}]", elements.join(", "))
-        }
+        (!elements.is_empty()).then(|| format!("[{}]", elements.join(", ")))
     }
 
     /// The error for `key` (value `x`): `rule` says what is allowed.

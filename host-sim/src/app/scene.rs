@@ -260,6 +260,44 @@ pub enum MotorSpec {
     },
 }
 
+/// An array of exactly `N` values: more are refused as fewer are (serde's arrays read the first
+/// `N` of a TOML array and drop the rest unsaid: `support_load_limit = [8000, 1, 2]` ran with
+/// B's limit 1 N).
+fn exact<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let values = Vec::<T>::deserialize(d)?;
+    let n = values.len();
+    values.try_into().map_err(|_| {
+        serde::de::Error::invalid_length(n, &format!("an array of length {N}").as_str())
+    })
+}
+
+/// [`exact`] for a key that may be left out (with `#[serde(default)]`).
+fn exact_some<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    exact(d).map(Some)
+}
+
+/// A list of arrays of exactly `N` values each (see [`exact`]), for a key that may be left
+/// out (with `#[serde(default)]`).
+fn exact_each<'de, D, T, const N: usize>(d: D) -> Result<Option<Vec<[T; N]>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    #[derive(Deserialize)]
+    #[serde(bound = "T: Deserialize<'de>")]
+    struct Exact<T, const N: usize>(#[serde(deserialize_with = "exact")] [T; N]);
+    let list = Vec::<Exact<T, N>>::deserialize(d)?;
+    Ok(Some(list.into_iter().map(|Exact(a)| a).collect()))
+}
+
 /// `[motor] model`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -301,6 +339,7 @@ pub struct MotorTable {
     /// Ramp: ramp time.
     pub duration: Option<f64>,
     /// Profile: `[t, ω]` points.
+    #[serde(default, deserialize_with = "exact_each")]
     pub points: Option<Vec<[f64; 2]>>,
 }
 
@@ -445,7 +484,7 @@ pub struct EncoderSpec {
     #[serde(default)]
     pub wheel: Option<String>,
     /// Gaps of a pattern wheel on the grid of `lines`: `[first missing position, count]` each.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact_each")]
     pub gaps: Option<Vec<[u16; 2]>>,
     /// Teeth of a pattern wheel: the grid positions (0 … lines−1) that carry a tooth.
     #[serde(default)]
@@ -491,7 +530,7 @@ pub struct EncoderSpec {
     pub glitch_probability: f64,
     /// Where a noise pulse falls between two teeth, as fractions of the tooth interval
     /// `[from, to]` (default `[0, 1]`, anywhere).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact_some")]
     pub glitch_window: Option<[f64; 2]>,
 }
 
@@ -655,6 +694,7 @@ pub struct PlatformSpec {
 #[serde(deny_unknown_fields)]
 pub struct CouplingSpec {
     /// The two platforms (1-based).
+    #[serde(deserialize_with = "exact")]
     pub between: [u8; 2],
     /// Stiffness, N/m.
     pub stiffness: f64,
@@ -736,7 +776,7 @@ pub struct RotorSpec {
     /// Service speed, rad/s.
     pub service_speed: f64,
     /// Allowed dynamic load at A and B, N.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact_some")]
     pub support_load_limit: Option<[f64; 2]>,
 }
 
