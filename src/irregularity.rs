@@ -233,8 +233,8 @@ impl WindowState {
 
     /// Back to [`WindowState::new`] in place without a call of `memset` (its 40 bytes are
     /// zeros: see [`crate::speed::EdgeCounters::clear`]).
-    pub(crate) fn clear(&mut self) {
-        let z = core::hint::black_box(0u32);
+    /// `z` is an opaque zero (see [`crate::speed::EdgeCounters::clear`]).
+    pub(crate) fn clear(&mut self, z: u32) {
         let none = Sample { span: z, ticks: z };
         *self = WindowState {
             started: false,

@@ -65,8 +65,8 @@ impl Diagnostics {
 
     /// Back to [`Diagnostics::ZERO`] in place without a call of `memset` (see
     /// [`EdgeCounters::clear`]).
-    fn clear(&mut self) {
-        self.edges.clear();
+    fn clear(&mut self, z: u32) {
+        self.edges.clear(z);
         (self.valid_windows, self.invalid_windows, self.alarms_raised) = (0, 0, 0);
     }
 }
@@ -371,9 +371,11 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         self.window = window;
         self.alarm = alarm;
         self.table.store(&[]);
-        self.tracker.reset();
-        self.state.clear();
-        self.diag.clear();
+        // One opaque zero for all of it (see `EdgeCounters::clear`).
+        let z = core::hint::black_box(0u32);
+        self.tracker.reset(z);
+        self.state.clear(z);
+        self.diag.clear(z);
         self.spill = None;
         self.held = None;
     }

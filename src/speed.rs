@@ -223,8 +223,9 @@ impl EdgeCounters {
     /// Back to [`EdgeCounters::ZERO`] in place, one store a counter. The zero is opaque to
     /// the optimizer: ten stores of a constant zero would become a call of `memset` (a run of
     /// more than 32 zero bytes is one on a Cortex-M), which configuration would then link.
-    pub(crate) fn clear(&mut self) {
-        let z = core::hint::black_box(0);
+    /// `z` is that opaque zero (one for all the monitor's state: each `black_box` is a store
+    /// and a load of its own).
+    pub(crate) fn clear(&mut self, z: u32) {
         *self = EdgeCounters {
             accepted: z,
             glitches: z,
@@ -479,9 +480,9 @@ impl SpeedTracker {
     /// zero). Assigning `new()` would zero some 550 bytes with a call of `memset`, which
     /// configuration would then link; the numbers take an opaque zero for the same reason
     /// (see [`EdgeCounters::clear`]). The list names every field, so a new one is not missed.
-    pub(crate) fn reset(&mut self) {
+    /// `z` is an opaque zero (see [`EdgeCounters::clear`]).
+    pub(crate) fn reset(&mut self, z: u32) {
         const NEW: SpeedTracker = SpeedTracker::new();
-        let z = core::hint::black_box(0u32);
         let SpeedTracker {
             state,
             sync,
@@ -527,7 +528,7 @@ impl SpeedTracker {
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
         (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
-        counters.clear();
+        counters.clear(z);
     }
 
     /// The shaft state.
