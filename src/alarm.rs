@@ -151,17 +151,18 @@ impl DeltaAlarm {
         let below = r.delta < self.config.limit * (1.0 - self.config.hysteresis);
         self.over = ((self.over << 1) | (v == Verdict::Over) as u32) & mask;
         self.under = ((self.under << 1) | below as u32) & mask;
-        let n = self.config.raise_after as u32;
-        let event = if !self.active && self.over.count_ones() >= n {
-            self.active = true;
-            Some(AlarmEvent::Raised)
-        } else if self.active && self.under.count_ones() >= n {
-            self.active = false;
-            Some(AlarmEvent::Cleared)
+        // Off, the windows over the limit raise it; on, those below the hysteresis clear it
+        // (one count of the history that matters: less code in the window's path).
+        let (history, event) = if self.active {
+            (self.under, AlarmEvent::Cleared)
         } else {
-            None
+            (self.over, AlarmEvent::Raised)
         };
-        (v, event)
+        if history.count_ones() < u32::from(self.config.raise_after) {
+            return (v, None);
+        }
+        self.active = !self.active;
+        (v, Some(event))
     }
 }
 

@@ -393,7 +393,10 @@ impl Encoder {
         (*unit_rad, *base, *long, *short) = (other.unit_rad, other.base, other.long, other.short);
         (*uniform_span, *pattern_swing, *uniform) =
             (other.uniform_span, other.pattern_swing, other.uniform);
-        *pattern = other.pattern;
+        // Without pattern wheels every encoder's pattern is all zeros: nothing to copy.
+        if PATTERNS {
+            *pattern = other.pattern;
+        }
     }
 
     /// The encoder of an unconfigured monitor: no edges, so the monitor ignores everything

@@ -233,8 +233,8 @@ impl WindowState {
 
     /// Back to [`WindowState::new`] in place without a call of `memset` (its 40 bytes are
     /// zeros: see [`crate::speed::EdgeCounters::clear`]).
-    pub(crate) fn clear(&mut self) {
-        let z = core::hint::black_box(0u32);
+    /// `z` is an opaque zero (see [`crate::speed::EdgeCounters::clear`]).
+    pub(crate) fn clear(&mut self, z: u32) {
         let none = Sample { span: z, ticks: z };
         *self = WindowState {
             started: false,
@@ -416,6 +416,40 @@ impl WindowState {
         k: u16,
         uniform: bool,
     ) -> Option<WindowReport> {
+        self.on_tooth_of(window, tooth, unit_rad, timer_hz, k, uniform)
+    }
+
+    /// [`WindowState::on_tooth`], one copy for each kind of sample: a caller that knows the
+    /// kind at compile time (the monitor) links only its own (a DMA-fed firmware's window
+    /// code was 772 bytes with both kinds in one copy, 704 with its own; the window's
+    /// measurement is then out of line).
+    #[inline(always)]
+    pub(crate) fn on_tooth_of(
+        &mut self,
+        window: &Window,
+        tooth: &Tooth,
+        unit_rad: f32,
+        timer_hz: f32,
+        k: u16,
+        uniform: bool,
+    ) -> Option<WindowReport> {
+        if uniform {
+            self.on_tooth_in::<true>(window, tooth, unit_rad, timer_hz, k)
+        } else {
+            self.on_tooth_in::<false>(window, tooth, unit_rad, timer_hz, k)
+        }
+    }
+
+    #[inline(never)]
+    fn on_tooth_in<const UNIFORM: bool>(
+        &mut self,
+        window: &Window,
+        tooth: &Tooth,
+        unit_rad: f32,
+        timer_hz: f32,
+        k: u16,
+    ) -> Option<WindowReport> {
+        let uniform = UNIFORM;
         if !tooth.synced {
             return None;
         }

@@ -223,8 +223,9 @@ impl EdgeCounters {
     /// Back to [`EdgeCounters::ZERO`] in place, one store a counter. The zero is opaque to
     /// the optimizer: ten stores of a constant zero would become a call of `memset` (a run of
     /// more than 32 zero bytes is one on a Cortex-M), which configuration would then link.
-    pub(crate) fn clear(&mut self) {
-        let z = core::hint::black_box(0);
+    /// `z` is that opaque zero (one for all the monitor's state: each `black_box` is a store
+    /// and a load of its own).
+    pub(crate) fn clear(&mut self, z: u32) {
         *self = EdgeCounters {
             accepted: z,
             glitches: z,
@@ -382,8 +383,13 @@ fn log_sq(a: f32, b: f32) -> f32 {
     l * l
 }
 
-/// The grid pitch of `tooth` in base pitches.
+/// The grid pitch of `tooth` (one of the wheel's) in base pitches: 1 but on a pattern wheel
+/// (exactly what the quotient gives, so that without pattern wheels the compiler folds every
+/// product and quotient with it away).
 fn pitch_ratio(enc: &Encoder, tooth: u16) -> f32 {
+    if enc.framing() != Framing::Pattern {
+        return 1.0;
+    }
     enc.grid_pitch(tooth) as f32 / enc.base_pitch() as f32
 }
 
@@ -474,9 +480,9 @@ impl SpeedTracker {
     /// zero). Assigning `new()` would zero some 550 bytes with a call of `memset`, which
     /// configuration would then link; the numbers take an opaque zero for the same reason
     /// (see [`EdgeCounters::clear`]). The list names every field, so a new one is not missed.
-    pub(crate) fn reset(&mut self) {
+    /// `z` is an opaque zero (see [`EdgeCounters::clear`]).
+    pub(crate) fn reset(&mut self, z: u32) {
         const NEW: SpeedTracker = SpeedTracker::new();
-        let z = core::hint::black_box(0u32);
         let SpeedTracker {
             state,
             sync,
@@ -522,7 +528,7 @@ impl SpeedTracker {
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
         (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
-        counters.clear();
+        counters.clear(z);
     }
 
     /// The shaft state.
@@ -1066,12 +1072,18 @@ impl SpeedTracker {
         // Unsynced on a pattern wheel, the previous interval may have been the longest pitch
         // and this one the shortest: only what is short even against that is a glitch.
         let expected = if synced || enc.framing() != Framing::Pattern {
-            r as f32 * enc.grid_pitch(if synced { next } else { 0 }) as f32 / base as f32
-                * if synced {
-                    self.recorded_swing(enc, self.tooth, next)
-                } else {
-                    1.0
-                }
+            // Every pitch the base but on a pattern wheel (a power of two: the product and
+            // the quotient were exact, and are left out).
+            let per = if enc.framing() == Framing::Pattern {
+                r as f32 * enc.grid_pitch(if synced { next } else { 0 }) as f32 / base as f32
+            } else {
+                r as f32
+            };
+            per * if synced {
+                self.recorded_swing(enc, self.tooth, next)
+            } else {
+                1.0
+            }
         } else {
             let (lo, hi) = (0..edges).fold((u32::MAX, 0), |(lo, hi), k| {
                 let p = enc.grid_pitch(k);
@@ -1280,11 +1292,13 @@ impl SpeedTracker {
     /// arrived, timed after the last accepted edge and not after it), and those that are a
     /// later edge's (reported after it arrived, or timed after it). The others lost their
     /// edge. One scan, out of line, for the judgement and the acceptance alike.
+    /// Also how many of them lost their edge (counted here: a count of the bits left would be
+    /// a sequence of some 30 bytes in the acceptance).
     #[inline(never)]
-    fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8) {
+    fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8, u8) {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
-        let (mut frames, mut later) = (0u8, 0u8);
+        let (mut frames, mut later, mut lost) = (0u8, 0u8, 0u8);
         // A plain loop, not `each_bit`: it runs at every index pulse, where the set-bit loop
         // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less.
         for (i, &(x, q)) in self.index.iter().take(usize::from(self.nidx)).enumerate() {
@@ -1300,21 +1314,21 @@ impl SpeedTracker {
                 // shares the edge's tick about as often as not; counted lost, it made most
                 // revolutions a missing frame.
                 frames |= bit;
+            } else {
+                lost = lost.wrapping_add(1);
             }
         }
-        (frames, later)
+        (frames, later, lost)
     }
 
     /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
     /// ending at `t`. Timestamps older than the last accepted edge lost their edge: each is
     /// counted as a missing frame.
     fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> bool {
-        let (frames, later) = self.index_places(enc, t, seq);
+        let (frames, later, lost) = self.index_places(enc, t, seq);
         if self.sync == SyncState::Synced {
             // An index that framed no edge and is no later edge's: its edge was not seen.
-            let lost = self.waiting() & !(frames | later);
-            self.counters.missing_frames =
-                self.counters.missing_frames.wrapping_add(lost.count_ones());
+            self.counters.missing_frames = self.counters.missing_frames.wrapping_add(lost.into());
         }
         self.keep_indexes(later);
         frames != 0
@@ -1937,14 +1951,20 @@ impl SpeedTracker {
         let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
         if first.wrapping_add(m) <= MAX_SPAN {
             // Not wrapped (the usual case, once a revolution: a few careful edges after a
-            // batch): moved down in place, each time read before anything overwrites it
-            // (`first + j ≥ j`). Apart from the turn below, which would do it too but moves
-            // all 32 slots one by one (0.3 instructions per edge more in batches).
-            for j in 0..m {
-                let v = self.ring.get(first.wrapping_add(j)).copied().unwrap_or(0);
-                if let Some(d) = self.ring.get_mut(j) {
-                    *d = v;
-                }
+            // batch): moved down, a copy of fixed size through a temporary (a few block
+            // moves inline). With `m` = 32 that is `first` = 0, laid out already. Apart from
+            // the turn below, which would do it too but moves all 32 slots one by one (0.3
+            // instructions per edge more in batches); a loop slot by slot was 60 bytes more.
+            if m == LAID_SHORT {
+                let times = self
+                    .ring
+                    .get(first..)
+                    .and_then(<[u32]>::first_chunk::<LAID_SHORT>)
+                    .copied();
+                // Opaque, so that the two copies are not merged into one overlapping move (a
+                // call of `memmove`).
+                let times = core::hint::black_box(times);
+                lay(&mut self.ring, times.as_ref());
             }
             self.pos = m as u32;
             return;
