@@ -280,6 +280,22 @@ fn clean_cranking_from_a_plain_capture_of_a_60_2_wheel() {
     check_clean(&run, &report, &seen, 60, 50e6);
 }
 
+#[test]
+fn clean_cranking_of_a_36_1_wheel_from_a_value_change_dump() {
+    let (_scratch, file) = tmp("crank-36-1.vcd");
+    let run = simulate(
+        &cranking("36-1", "sample_rate = 24e6", 2.0, ""),
+        CaptureFormat::Vcd,
+        &file,
+    );
+    let (report, seen) = run_analyze(&file, wheel("36-1"));
+    assert_eq!(report.format, "vcd");
+    // The rate from the dump's comment (24 MHz: a period of 41.67 ns, times in fs).
+    assert_eq!(report.sample_rate, Some(24e6));
+    assert!(report.revolutions >= 4, "{}", report.revolutions);
+    check_clean(&run, &report, &seen, 36, 24e6);
+}
+
 /// Start from rest, crank, stall: the only fault is the timeout once the shaft has stopped
 /// (the capture goes on for a second after it).
 #[test]
@@ -595,7 +611,7 @@ fn an_index_disc_configured_with_the_wrong_lines_says_so() {
 }
 
 /// Every format writes and reads back the same transitions, to its time resolution: the
-/// sample grid (sigrok, plain exactly; Saleae's nine decimals to half a nanosecond).
+/// sample grid (sigrok, plain and VCD exactly; Saleae's nine decimals to half a nanosecond).
 #[test]
 fn captures_round_trip_in_every_format() {
     let text = cranking("8-1", "sample_rate = 1e6", 0.7, "glitch_probability = 0.05")
@@ -604,6 +620,7 @@ fn captures_round_trip_in_every_format() {
         CaptureFormat::Saleae,
         CaptureFormat::Sigrok,
         CaptureFormat::Plain,
+        CaptureFormat::Vcd,
     ] {
         let (_scratch, file) = tmp(&format!("round-{}.csv", format.name()));
         let run = simulate(&text, format, &file);

@@ -1,7 +1,8 @@
 //! Logic-analyzer capture files: what `drive-sim run --capture` writes and `drive-sim analyze`
 //! reads.
 //!
-//! Three CSV formats, each a level-over-time record of one or more digital channels:
+//! Three CSV formats and value change dumps ([`vcd`]), each a level-over-time record of one or
+//! more digital channels:
 //!
 //! - **Saleae Logic 2** digital export: a header `Time [s],Channel 0,Channel 1,...`, then one
 //!   row per instant at which at least one channel changes, the time in seconds (Logic 2 writes
@@ -42,6 +43,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::encoder::Edge;
 
+mod vcd;
+
 /// Longest line read, bytes (a row of [`MAX_CHANNELS`] channels is about 550 bytes).
 pub const MAX_LINE_BYTES: usize = 4096;
 /// Most channels a capture file may have.
@@ -57,6 +60,9 @@ pub enum CaptureFormat {
     Sigrok,
     /// Plain `time_s,level` CSV.
     Plain,
+    /// Value change dump (IEEE 1364 VCD: sigrok/PulseView, Saleae Logic 2, HDL simulators);
+    /// its one-bit variables are the channels.
+    Vcd,
 }
 
 impl CaptureFormat {
@@ -66,6 +72,7 @@ impl CaptureFormat {
             CaptureFormat::Saleae => "saleae",
             CaptureFormat::Sigrok => "sigrok",
             CaptureFormat::Plain => "plain",
+            CaptureFormat::Vcd => "vcd",
         }
     }
 
@@ -75,6 +82,10 @@ impl CaptureFormat {
         match self {
             CaptureFormat::Saleae => (0..n).map(|i| format!("Channel {i}")).collect(),
             CaptureFormat::Sigrok => (0..n).map(|i| format!("D{i}")).collect(),
+            CaptureFormat::Vcd => ["encoder", "index"][..n]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
             CaptureFormat::Plain => ["level", "index"][..n]
                 .iter()
                 .map(|s| s.to_string())
@@ -206,6 +217,8 @@ pub struct CaptureReader<R> {
     origin: Option<i64>,
     /// The line last read had no line end (the end of the file).
     unterminated: bool,
+    /// A value change dump's identifiers, time unit and pending tokens.
+    vcd: vcd::Vcd,
 }
 
 /// A first time of this magnitude or more (s) is read relative to its whole seconds: an f64
@@ -310,6 +323,7 @@ impl<R: BufRead> CaptureReader<R> {
             last_time: f64::NEG_INFINITY,
             origin: None,
             unterminated: false,
+            vcd: vcd::Vcd::default(),
         };
         let first = loop {
             match r.read_line()? {
@@ -318,7 +332,9 @@ impl<R: BufRead> CaptureReader<R> {
                 Some(l) => break l,
             }
         };
-        let detected = if first.starts_with(';') {
+        let detected = if first.trim_start().starts_with('$') {
+            Some(CaptureFormat::Vcd)
+        } else if first.starts_with(';') {
             Some(CaptureFormat::Sigrok)
         } else if first.starts_with("Time [s]") {
             Some(CaptureFormat::Saleae)
@@ -336,7 +352,8 @@ impl<R: BufRead> CaptureReader<R> {
                 (None, None) => return Err(r.err_here(
                     "cannot tell the capture format: expected a Saleae Logic 2 export (a header \
                      `Time [s],Channel 0,...`), a sigrok/PulseView export (`;` comment lines, then \
-                     a header row) or a plain `time_s,level` file; name it with --format",
+                     a header row), a value change dump (`$` sections) or a plain `time_s,level` \
+                     file; name it with --format",
                 )),
             };
         match r.format {
@@ -351,6 +368,7 @@ impl<R: BufRead> CaptureReader<R> {
                 "the header `time_s,level` (or `time_s,level,index`)",
             )?,
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
+            CaptureFormat::Vcd => r.header_vcd(first)?,
         }
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
@@ -570,6 +588,9 @@ impl<R: BufRead> CaptureReader<R> {
 
     /// The next row: its time, s, and the level of every channel; `None` at the end.
     pub fn next_row(&mut self) -> Result<Option<(f64, &[Level])>, CaptureError> {
+        if self.format == CaptureFormat::Vcd {
+            return self.next_vcd_row();
+        }
         let line = match self.held.take() {
             Some(l) => l,
             None => loop {
@@ -673,19 +694,25 @@ impl<R: BufRead> CaptureReader<R> {
                         Err(_) => bad("a time in seconds"),
                     });
                 };
-                let origin = *self.origin.get_or_insert_with(|| {
-                    let whole = atto / ATTO;
-                    if whole.abs() >= ORIGIN_FROM {
-                        i64::try_from(whole).unwrap_or(0)
-                    } else {
-                        0
-                    }
-                });
-                // The difference taken exactly, then rounded once: a time far from 0 keeps its
-                // resolution.
-                Ok(atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64)
+                Ok(self.seconds_from_atto(atto))
             }
         }
+    }
+
+    /// A time given exactly in attoseconds, s: counted from the first time's whole seconds
+    /// when that is large (see [`ORIGIN_FROM`]).
+    fn seconds_from_atto(&mut self, atto: i128) -> f64 {
+        let origin = *self.origin.get_or_insert_with(|| {
+            let whole = atto / ATTO;
+            if whole.abs() >= ORIGIN_FROM {
+                i64::try_from(whole).unwrap_or(0)
+            } else {
+                0
+            }
+        });
+        // The difference taken exactly, then rounded once: a time far from 0 keeps its
+        // resolution.
+        atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64
     }
 }
 
@@ -705,6 +732,28 @@ enum Rows {
     Changes,
     /// A row per sample (sigrok's default).
     Every,
+}
+
+/// The VCD time unit of a capture at `rate` samples per second: the largest of s, ms, us,
+/// ns, ps in which the sample period is a whole number of units, else fs (times rounded to
+/// the nearest); with its units per second.
+fn vcd_unit(rate: u64) -> (&'static str, u64) {
+    let rate = rate.max(1);
+    [
+        ("s", 1),
+        ("ms", 1_000),
+        ("us", 1_000_000),
+        ("ns", 1_000_000_000),
+        ("ps", 1_000_000_000_000),
+    ]
+    .into_iter()
+    .find(|&(_, per_s)| per_s % rate == 0)
+    .unwrap_or(("fs", 1_000_000_000_000_000))
+}
+
+/// The VCD identifier code of channel `k` (`!`, `"`, `#`, ...).
+fn vcd_id(k: usize) -> char {
+    char::from(b'!' + k as u8)
 }
 
 /// A pending level change of one channel.
@@ -815,6 +864,28 @@ impl<W: Write> CaptureWriter<W> {
                     head.push_str(",logic");
                 }
             }
+            CaptureFormat::Vcd => {
+                let (unit, _) = vcd_unit(rate);
+                let _ = writeln!(
+                    head,
+                    "$version drive-sim {} (simulated capture) $end",
+                    env!("CARGO_PKG_VERSION")
+                );
+                // sigrok's own words for the rate, which the reader takes from them.
+                let _ = writeln!(
+                    head,
+                    "$comment Acquisition with {n}/{n} channels at {} $end",
+                    sigrok_rate_string(rate)
+                );
+                let _ = writeln!(
+                    head,
+                    "$timescale 1 {unit} $end\n$scope module drive-sim $end"
+                );
+                for (k, c) in names.iter().enumerate() {
+                    let _ = writeln!(head, "$var wire 1 {} {c} $end", vcd_id(k));
+                }
+                head.push_str("$upscope $end\n$enddefinitions $end");
+            }
         }
         head.push('\n');
         w.out.write_all(head.as_bytes())?;
@@ -918,6 +989,27 @@ impl<W: Write> CaptureWriter<W> {
             }
             CaptureFormat::Sigrok => {
                 let _ = write!(self.line, "{}", (n as u64 + 1) * self.period);
+            }
+            CaptureFormat::Vcd => {
+                // The sample's time in whole units, rounded where the period is not one.
+                let (_, per_s) = vcd_unit(rate as u64);
+                let units =
+                    (i128::from(n) * i128::from(per_s) * 2 + rate as i128) / (2 * rate as i128);
+                let _ = writeln!(self.line, "#{units}");
+                let first = self.written_sample < 0;
+                if first {
+                    self.line.push_str("$dumpvars\n");
+                }
+                for (k, &l) in levels.iter().enumerate() {
+                    if first || self.written.get(k) != Some(&l) {
+                        let _ = writeln!(self.line, "{}{}", u8::from(l), vcd_id(k));
+                    }
+                }
+                if first {
+                    self.line.push_str("$end\n");
+                }
+                self.rows_written += 1;
+                return self.out.write_all(self.line.as_bytes());
             }
         }
         for &l in levels {

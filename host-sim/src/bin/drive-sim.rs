@@ -44,7 +44,8 @@ enum Command {
         #[arg(long, value_enum, default_value = "saleae", requires = "capture")]
         capture_format: CaptureFormat,
     },
-    /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV):
+    /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV, or a
+    /// value change dump):
     /// windows, faults, sync, edges and revolutions counted.
     Analyze {
         /// The capture file.
@@ -54,9 +55,10 @@ enum Command {
         format: Option<CaptureFormat>,
         #[command(flatten)]
         options: AnalyzeArgs,
-        /// The logic analyzer's samples per second, Hz. A sigrok file states it (needed when it
-        /// does not: its time column alone is not exact; it must agree with the comment when
-        /// there is one); for any format it widens the windows' noise floor by the sampling's
+        /// The logic analyzer's samples per second, Hz. A sigrok file states it, and so does a
+        /// value change dump from sigrok (needed for a sigrok CSV that does not: its time
+        /// column alone is not exact; it must agree with the file when it states one); for any
+        /// format it widens the windows' noise floor by the sampling's
         /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long)]
         sample_rate: Option<f64>,
