@@ -615,14 +615,22 @@ impl Encoder {
         self.timeout
     }
     /// The longest time between two [`crate::monitor::DeltaMonitor::poll`]s, in ticks, that is
-    /// sure to see a standstill: the time since the last edge is read modulo the counter, so
-    /// a poll must come after the timeout and before the counter has wrapped past the last
-    /// edge, a window of `2^bits − timeout` ticks. Firmware polls at least this often (with a
-    /// 16-bit counter and a minimum speed near its limit the window can be a small part of
+    /// sure to see a standstill. The time since the last edge is read modulo the counter, and
+    /// of the `2^bits − timeout` ticks after the timeout before the counter wraps past the last
+    /// edge, the first half is where a poll sees the stop; the second half is where a `now`
+    /// read a little before the last edge fed lands (the capture interrupt fed an edge between
+    /// the periodic task's reading of the timer and its poll), which is no stop. Firmware polls
+    /// at least this often and reads `now` at most this long before the last capture it fed
+    /// (with a 16-bit counter and a minimum speed near its limit this can be a small part of
     /// the counter's period).
     pub const fn poll_interval_ticks(&self) -> u32 {
         // `new` keeps the timeout below the mask.
-        self.mask.saturating_sub(self.timeout)
+        let half = self.mask.saturating_sub(self.timeout) / 2;
+        if half == 0 {
+            1
+        } else {
+            half
+        }
     }
     /// Timer clock, Hz.
     pub const fn timer_hz(&self) -> f32 {

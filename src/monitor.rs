@@ -1705,6 +1705,49 @@ mod tests {
         assert_eq!(m.diagnostics().edges.reversals, 1);
     }
 
+    /// A periodic poll racing the capture interrupt: `now` read from the timer, then an edge
+    /// fed, then `poll(now)`, `now` one tick before that edge. It is no stop: every window
+    /// stays valid (read modulo the counter the elapsed time was 2^32 − 1 ticks, a timeout:
+    /// windows were cut, the sync lost, and a drive over its δ limit raised no alarm). A stop
+    /// is still seen within the poll interval after the timeout, on a 16-bit counter too.
+    #[test]
+    fn a_poll_that_read_now_before_the_last_edge_is_no_stop() {
+        for bits in [32u8, 16] {
+            let mut cfg = indexed(256, 4, bits, 1e6);
+            cfg.min_speed = 10.0;
+            let mut m = monitor(cfg, 1);
+            let mask = m.encoder().mask();
+            let evs = stream(&uniform(256), Some(0.0), 30, 1e6, mask, &kneader(0.04));
+            let mut out = Vec::new();
+            let mut last = 0;
+            for (i, e) in evs.iter().enumerate() {
+                match *e {
+                    Ev::Index(t) => m.on_index(t),
+                    Ev::Edge(t) => {
+                        out.extend(m.on_edge(t, Some(Direction::Forward)));
+                        last = t;
+                        if i % 97 == 0 {
+                            out.extend(m.poll(t.wrapping_sub(1) & mask));
+                        }
+                    }
+                }
+            }
+            let d = m.diagnostics();
+            assert_eq!(d.edges.timeouts, 0, "{bits} bits: {d:?}");
+            assert!(out.iter().all(|o| o.report.valid()), "{bits} bits");
+            assert!(d.valid_windows >= 25, "{bits} bits: {d:?}");
+            // The stop: seen by a poll at the end of the interval after the timeout.
+            let (timeout, interval) = (
+                m.encoder().timeout_ticks(),
+                m.encoder().poll_interval_ticks(),
+            );
+            assert!(m.poll(last.wrapping_add(timeout) & mask).is_none());
+            let at = last.wrapping_add(timeout).wrapping_add(interval) & mask;
+            let o = m.poll(at).unwrap();
+            assert_eq!(o.report.fault(), Some(Fault::Timeout), "{bits} bits");
+        }
+    }
+
     /// An index pulse a fraction of a tick after its edge (0.6 µs at 1 MHz, at 800 rad/s on
     /// 256 lines) shares the edge's tick about as often as not, and is reported after it: it
     /// frames the next interval either way. Counted lost when it shared the tick, it made

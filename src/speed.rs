@@ -666,9 +666,10 @@ impl SpeedTracker {
         self.block_fast();
     }
 
-    /// Checks for a timeout at time `now` (ticks). Call it at least once per counter period:
-    /// elapsed time is measured modulo the counter. Reports [`Fault::Timeout`] when a running
-    /// shaft stops (once per stop).
+    /// Checks for a timeout at time `now` (ticks). Call it at least once every
+    /// [`Encoder::poll_interval_ticks`]: elapsed time is measured modulo the counter. Reports
+    /// [`Fault::Timeout`] when a running shaft stops (once per stop). A `now` read before the
+    /// last edge fed (a capture interrupt between reading the timer and this call) is no stop.
     pub fn poll<P: PitchTable, S: EdgeSink>(
         &mut self,
         enc: &Encoder,
@@ -685,7 +686,11 @@ impl SpeedTracker {
             self.last
         };
         let elapsed = (now & enc.mask()).wrapping_sub(latest) & enc.mask();
-        if elapsed > enc.timeout_ticks() {
+        // A stop is seen within the poll interval after the timeout. Beyond it the elapsed
+        // time is that of a `now` read before the last edge (it wraps to just under the
+        // counter's period: read as a stop, a poll racing a capture interrupt cut the window
+        // and lost the sync, and a drive over its δ limit never raised the alarm).
+        if elapsed.wrapping_sub(enc.timeout_ticks()).wrapping_sub(1) < enc.poll_interval_ticks() {
             self.settle(enc);
             self.flush(enc, table, sink);
             self.stop_running(now & enc.mask(), sink);
