@@ -689,9 +689,17 @@ pub fn prediction_text(p: &Prediction) -> String {
             for c in &st.criterion {
                 let _ = writeln!(
                     s,
-                    "  criterion boundary {:.3} rad/s ({}): nearest exact {}",
+                    "  criterion boundary {:.3} rad/s ({}): nearest exact boundary where the \
+                     balancing position becomes {} {}",
                     c.criterion,
                     c.kind,
+                    // A resonance is where the criterion's balancing begins, an additional
+                    // speed where it ends: each is set beside the exact boundary of its kind.
+                    if c.kind == "resonance" {
+                        "stable"
+                    } else {
+                        "unstable"
+                    },
                     match (c.exact, c.difference) {
                         (Some(e), Some(d)) => format!("{e:.3} rad/s ({:+.2} %)", 100.0 * d),
                         _ => "none".to_string(),

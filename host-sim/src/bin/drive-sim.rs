@@ -90,10 +90,10 @@ enum Command {
         /// The name of a bundled scene (`drive-sim scenes`), or a scene file's path.
         scene: String,
         /// Lowest speed, rad/s.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         from: f64,
         /// Highest speed, rad/s.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         to: f64,
         /// Number of speeds (2 to 1000).
         #[arg(long, default_value_t = 20, value_parser = sweep_steps)]
