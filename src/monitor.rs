@@ -232,7 +232,14 @@ impl<O: EdgeSink, P: PitchTable> EdgeSink for Feed<'_, O, P> {
     #[inline(never)]
     fn fault(&mut self, fault: Fault, time: u32) {
         self.observer.fault(fault, time);
+        // A missing frame found at the edge after a frame the count took lies against the
+        // window that ended there; the one that began there goes on (its end frame, with its
+        // index, vouches for the count).
+        let begun = fault == Fault::MissingFrame && self.held.is_some();
         self.release(Some(fault));
+        if begun {
+            return;
+        }
         if let Some(r) = self.state.abort(fault, time, self.last_edge) {
             finish(self.alarm, self.diag, &r, self.first, self.spill);
         }
@@ -241,13 +248,18 @@ impl<O: EdgeSink, P: PitchTable> EdgeSink for Feed<'_, O, P> {
 
 impl<O: EdgeSink, P: PitchTable> Feed<'_, O, P> {
     /// The edge after the frame is judged: the held window stands, unless `fault` is an edge
-    /// fault, which lies against the frame (a timeout, a reversal or a missing frame does
-    /// not). Careful path: out of line, one copy for its callers (code size).
+    /// fault, which lies against the frame, or a missing frame, which the tracker finds there
+    /// when the frame edge was taken by the count and its index did not come (a timeout or a
+    /// reversal does not). Careful path: out of line, one copy for its callers (code size).
     #[inline(never)]
     fn release(&mut self, fault: Option<Fault>) {
         if let Some(r) = self.held.as_mut() {
             if let Some(
-                f @ (Fault::Glitch | Fault::MissingEdge | Fault::ExtraEdge | Fault::Unexplained),
+                f @ (Fault::Glitch
+                | Fault::MissingEdge
+                | Fault::ExtraEdge
+                | Fault::Unexplained
+                | Fault::MissingFrame),
             ) = fault
             {
                 r.result = Err(f);
@@ -1777,6 +1789,74 @@ mod tests {
         assert_eq!(m.sync_state(), SyncState::Synced);
         let valid = out.iter().filter(|o| o.report.valid()).count();
         assert!(valid >= 36, "{valid} of {}", out.len());
+    }
+
+    /// An index within a tick of its edge, reported before or after it as it comes (a Z gated
+    /// with A, captured on the same edge; the capture interrupts' order is arbitrary), and
+    /// jittering a tick either side: synced, the count decides which edge it frames. It
+    /// framed one edge or the next as the order flipped, each flip a missing or extra edge on
+    /// a clean disc (5 missing and 4 extra edges, 4 missing frames in 26 revolutions of a
+    /// capture); now none, every window valid. An index that does not come is still a
+    /// missing frame, found at the edge after its frame, and that window is invalid.
+    #[test]
+    fn an_index_a_tick_from_its_edge_either_side_frames_the_same_edge() {
+        for mode in 0..3u32 {
+            let mut m = monitor(indexed(256, 4, 32, 1e6), 1);
+            let per_edge = 1e6 * core::f64::consts::TAU / 256.0 / 300.0;
+            let mut out = Vec::new();
+            let mut seed = 12345u32;
+            let mut next = || {
+                seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+                seed >> 16
+            };
+            for k in 0..256 * 40u32 {
+                let t = (f64::from(k) * per_edge) as u32;
+                let frame = k % 256 == 0;
+                // Mode 2: the index of revolution 20 never comes.
+                let index = frame && !(mode == 2 && k / 256 == 20);
+                let r = next();
+                // Mode 0: the index at the edge's tick; 1 and 2: a tick either side too.
+                let ti = match (mode, r % 3) {
+                    (0, _) | (_, 0) => t,
+                    (_, 1) => t.wrapping_sub(1),
+                    _ => t.wrapping_add(1),
+                };
+                let first = r & 8 == 0 && ti <= t;
+                if index && first {
+                    m.on_index(ti);
+                }
+                out.extend(m.on_edge(t, Some(Direction::Forward)));
+                if index && !first {
+                    m.on_index(ti);
+                }
+            }
+            let d = m.diagnostics().edges;
+            assert_eq!(
+                (d.missing, d.extra, d.glitches),
+                (0, 0, 0),
+                "mode {mode}: {d:?}"
+            );
+            assert_eq!(m.sync_state(), SyncState::Synced);
+            let invalid: Vec<_> = out.iter().filter(|o| !o.report.valid()).collect();
+            if mode < 2 {
+                assert_eq!(d.missing_frames, 0, "mode {mode}: {d:?}");
+                assert!(invalid.is_empty(), "mode {mode}: {invalid:?}");
+            } else {
+                assert_eq!(d.missing_frames, 1, "{d:?}");
+                assert!(
+                    !invalid.is_empty()
+                        && invalid
+                            .iter()
+                            .all(|o| o.report.fault() == Some(Fault::MissingFrame)),
+                    "{invalid:?}"
+                );
+            }
+            assert!(
+                out.len() - invalid.len() >= 36,
+                "mode {mode}: {}",
+                out.len()
+            );
+        }
     }
 
     /// Index pulses while the shaft runs backwards mark no forward frame: five revolutions in

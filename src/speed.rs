@@ -317,6 +317,11 @@ pub struct SpeedTracker {
     /// An edge was rejected as a glitch since the last accepted one: the next accepted edge's
     /// interval spans it, and forms no sample.
     across: bool,
+    /// The last accepted edge is the frame by the count (synced on an index disc), and its
+    /// index had not been reported when it was accepted: reported after it at its own tick
+    /// (a Z gated with A, captured on the same edge), it is that frame's, and the next edge
+    /// settles it; else that revolution's frame is missing.
+    owed: bool,
     /// Waiting index timestamps, each with the number of edges that had arrived when it was
     /// reported: an index belongs to an edge that arrived after it. (Modulo the counter a
     /// timestamp alone cannot say which edge it falls before once intervals approach the
@@ -462,6 +467,7 @@ impl SpeedTracker {
             npend: 0,
             out_of_band: false,
             across: false,
+            owed: false,
             index: [(0, 0); INDEXES],
             arrivals: 0,
             nidx: 0,
@@ -511,6 +517,7 @@ impl SpeedTracker {
             npend,
             out_of_band,
             across,
+            owed,
             index: _,
             arrivals,
             nidx,
@@ -523,7 +530,7 @@ impl SpeedTracker {
         } = self;
         (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
         (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
-        *across = false;
+        (*across, *owed) = (false, false);
         (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
@@ -889,6 +896,7 @@ impl SpeedTracker {
     ) {
         if direction == Some(Direction::Reverse) {
             self.flush(enc, table, sink);
+            self.settle_owed(t, sink);
             if self.state == ShaftState::Running {
                 self.counters.reversals = self.counters.reversals.wrapping_add(1);
                 sink.fault(Fault::Reversal, t);
@@ -1299,18 +1307,44 @@ impl SpeedTracker {
     /// edge. One scan, out of line, for the judgement and the acceptance alike.
     /// Also how many of them lost their edge (counted here: a count of the bits left would be
     /// a sequence of some 30 bytes in the acceptance).
+    ///
+    /// A timestamp within a tick of an edge's may lie a hair before or after that edge (a Z
+    /// gated with A, captured on the same edge, or a little jitter): which edge it frames then
+    /// depends on the order the two were reported in, or on the jitter, and flipped from
+    /// revolution to revolution, each flip a missing or extra edge on a clean disc. Synced,
+    /// the count decides (where an interval is more than two ticks): within a tick of this
+    /// edge where the count puts the frame at the next edge, it is the next edge's; within a
+    /// tick after the last edge where that edge is a frame whose index was owed
+    /// ([`SpeedTracker::owed`]), it is that frame's (the fourth result).
     #[inline(never)]
-    fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8, u8) {
+    fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8, u8, bool) {
         let m = enc.mask();
         let d = t.wrapping_sub(self.last) & m;
-        let (mut frames, mut later, mut lost) = (0u8, 0u8, 0u8);
+        let (mut frames, mut later, mut lost, mut owed) = (0u8, 0u8, 0u8, false);
+        let synced = self.sync == SyncState::Synced;
+        // Where the count puts this edge: the tooth before the frame?
+        let before_frame = synced && d > 2 && tooth_after(self.tooth, 2, enc.edges()) == 0;
+        // Within a tick of the last edge, where that edge was the count's frame (its index
+        // owed) or this one is.
+        let near_last_frame =
+            synced && d > 2 && (self.owed || tooth_after(self.tooth, 1, enc.edges()) == 0);
         // A plain loop, not `each_bit`: it runs at every index pulse, where the set-bit loop
         // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less.
         for (i, &(x, q)) in self.index.iter().take(usize::from(self.nidx)).enumerate() {
             let since = x.wrapping_sub(self.last) & m;
             // `i` < INDEXES ≤ 8: the bit is within the byte.
             let bit = 1u8.wrapping_shl(i as u32);
-            if !reported_before(q, seq) || (since > d && since < m / 2) {
+            if !reported_before(q, seq) {
+                later |= bit;
+            } else if near_last_frame && (since <= 1 || since == m) {
+                if self.owed {
+                    owed = true;
+                } else {
+                    frames |= bit;
+                }
+            } else if (since > d && since < m / 2)
+                || (before_frame && since.wrapping_add(1) >= d && since <= d)
+            {
                 later |= bit;
             } else if since <= d {
                 // At the last accepted edge's own tick (`since` = 0) a timestamp still waiting
@@ -1323,20 +1357,21 @@ impl SpeedTracker {
                 lost = lost.wrapping_add(1);
             }
         }
-        (frames, later, lost)
+        (frames, later, lost, owed)
     }
 
     /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
     /// ending at `t`. Timestamps older than the last accepted edge lost their edge: each is
     /// counted as a missing frame.
-    fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> bool {
-        let (frames, later, lost) = self.index_places(enc, t, seq);
+    /// Also whether the owed frame's index came.
+    fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> (bool, bool) {
+        let (frames, later, lost, owed) = self.index_places(enc, t, seq);
         if self.sync == SyncState::Synced {
             // An index that framed no edge and is no later edge's: its edge was not seen.
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(lost.into());
         }
         self.keep_indexes(later);
-        frames != 0
+        (frames != 0, owed)
     }
 
     /// Keeps the waiting index timestamps whose bit is set in `keep`, in order, and drops the
@@ -1452,9 +1487,19 @@ impl SpeedTracker {
         let old_tooth = self.tooth;
         match enc.framing() {
             Framing::Index => {
-                let indexed = self.take_index(enc, t, seq);
+                let (indexed, late) = self.take_index(enc, t, seq);
                 match self.sync {
                     SyncState::Synced => {
+                        // The last edge's frame, taken by the count: its index came late, at
+                        // that edge's tick (the revolution it ended is counted now), or not.
+                        if core::mem::replace(&mut self.owed, false) {
+                            if late {
+                                self.counters.revolutions =
+                                    self.counters.revolutions.wrapping_add(1);
+                            } else {
+                                self.missing_frame(t, sink);
+                            }
+                        }
                         if indexed {
                             if tooth != 0 {
                                 // The index is authoritative: count the discrepancy, realign.
@@ -1472,11 +1517,14 @@ impl SpeedTracker {
                             }
                             frame = true;
                         } else if tooth == 0 {
-                            // The revolution's index did not come: keep counting, but this
-                            // revolution cannot be vouched for.
-                            self.counters.missing_frames =
-                                self.counters.missing_frames.wrapping_add(1);
-                            sink.fault(Fault::MissingFrame, t);
+                            // The frame by the count, its index not reported yet: it may still
+                            // come at this edge's own tick, reported after it. The frame is
+                            // taken (its window held by the monitor until the next edge) and
+                            // the next edge settles it: the index came, or the frame was
+                            // missing and the window is invalid (a missing frame found at the
+                            // edge after the frame lies against it).
+                            frame = true;
+                            self.owed = true;
                         }
                     }
                     SyncState::Confirming => {
@@ -1533,7 +1581,7 @@ impl SpeedTracker {
                 }
             }
         }
-        if frame && !realigned && was_synced {
+        if frame && !realigned && was_synced && !self.owed {
             self.counters.revolutions = self.counters.revolutions.wrapping_add(1);
         }
         if frame {
@@ -1742,6 +1790,7 @@ impl SpeedTracker {
             && self.prev != 0
             && self.npend == 0
             && self.nidx == 0
+            && !self.owed
             && !self.history
             && u16::from(self.fill) >= enc.samples_span();
         self.stop = if fast {
@@ -1761,6 +1810,7 @@ impl SpeedTracker {
     /// The running shaft stopped (a timeout): count it once, lose sync.
     #[inline(never)] // careful path: one copy for its callers (code size)
     fn stop_running<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
+        self.settle_owed(t, sink);
         if self.state == ShaftState::Running {
             self.counters.timeouts = self.counters.timeouts.wrapping_add(1);
             sink.fault(Fault::Timeout, t);
@@ -1768,6 +1818,21 @@ impl SpeedTracker {
         }
         self.state = ShaftState::Standstill;
         self.block_fast();
+    }
+
+    /// No edge follows an owed frame's (a stop, a reversal): its index never came.
+    fn settle_owed<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
+        if core::mem::replace(&mut self.owed, false) {
+            self.missing_frame(t, sink);
+        }
+    }
+
+    /// A revolution's index did not come: the count goes on, but that revolution cannot be
+    /// vouched for. Rare: one copy, out of line.
+    #[inline(never)]
+    fn missing_frame<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
+        self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
+        sink.fault(Fault::MissingFrame, t);
     }
 
     /// `t` is a new time reference: no interval, nothing pending. Rare (a start, a timeout, a
@@ -2020,6 +2085,7 @@ impl SpeedTracker {
             self.counters.sync_losses = self.counters.sync_losses.wrapping_add(1);
         }
         self.sync = SyncState::Searching;
+        self.owed = false;
         self.viable = 0;
         self.confirm = 0;
         self.seen_special = false;

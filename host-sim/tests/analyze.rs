@@ -544,6 +544,34 @@ fn a_sample_rate_too_slow_for_the_rows_is_refused() {
     }
 }
 
+/// Rows one sample period apart late in a capture (a one-sample noise pulse at 2.718 s, 50 MHz)
+/// are one period apart, whatever the rounding of their times: they were refused as closer.
+#[test]
+fn rows_one_sample_apart_late_in_a_capture_are_not_refused() {
+    let text = "Time [s],Channel 0\n0.000000000,0\n2.718281820,1\n2.718281840,0\n\
+                3.000000000,1\n3.000000020,0\n"
+        .to_string();
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(12),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(text.clone(), "late.csv", Some(50e6)).unwrap();
+    assert!(analyze(&mut reader, &cfg, &mut |_| {}).is_ok());
+    // At twice the rate they are two periods apart; half a period apart is still refused.
+    let mut reader = text_reader(text, "late.csv", Some(100e6)).unwrap();
+    assert!(analyze(&mut reader, &cfg, &mut |_| {}).is_ok());
+    let closer = "Time [s],Channel 0\n0.000000000,0\n2.718281820,1\n2.718281830,0\n";
+    let mut reader = text_reader(closer.to_string(), "late.csv", Some(50e6)).unwrap();
+    let e = analyze(&mut reader, &cfg, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("late.csv:4") && e.contains("less than one period"),
+        "{e}"
+    );
+}
+
 /// A capture shorter than one window says so, with both lengths, rather than "0 valid, 0
 /// invalid" alone.
 #[test]

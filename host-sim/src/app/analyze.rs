@@ -680,9 +680,13 @@ pub fn analyze<R: BufRead>(
         }
         prev.copy_from_slice(levels);
         if let (Some(p), Some(t0)) = (period, previous_time) {
-            // (Rows at one time are allowed: a level shown twice. 1e-9 of slack for the
-            // decimal times' rounding.)
-            if t > t0 && t - t0 < p * (1.0 - 1e-9) {
+            // (Rows at one time are allowed: a level shown twice. Slack for the rounding of
+            // the times: 1e-9 of the period, and a few units in the last place of the times
+            // themselves, whose difference loses that much; with the first alone, rows one
+            // sample apart read as closer from 0.25 s on at 24 MHz, and every sigrok export of
+            // a sample a row longer than that was refused.)
+            let slack = 1e-9 * p + 4.0 * f64::EPSILON * t.abs().max(t0.abs());
+            if t > t0 && t - t0 < p - slack {
                 return Err(AnalyzeError::Capture(reader.err_here(&format!(
                     "this row is {:.3e} s after the previous one, less than one period \
                      ({:.3e} s) of the sample rate {} Hz: the rate is wrong, or the file was \
