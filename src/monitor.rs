@@ -1859,6 +1859,28 @@ mod tests {
         }
     }
 
+    /// Discs of 255 and 257 lines configured as 256, run up from rest with some ripple: the
+    /// index comes a tooth early or late every revolution, so the frame is never confirmed,
+    /// missing frames are counted and no window is valid. (Once synced, as a capture with its
+    /// index on a line's edge was, the second revolution in a row whose index comes a tooth
+    /// late gives the count up; it stayed synced, realigning with an extra edge every
+    /// revolution, as if the encoder gained a pulse each turn.)
+    #[test]
+    fn one_line_more_than_configured_does_not_stay_synced() {
+        for lines in [255u32, 257] {
+            // A run-up from rest, as the capture that showed it: 2 rad/s to 134 over 4 turns.
+            let runup = |phi: f64| (2.0 + 5.3 * phi).min(100.0) * (1.0 + 0.05 * phi.sin());
+            let evs = stream(&uniform(lines), Some(0.0), 30, 1e6, u32::MAX, &runup);
+            let mut m = monitor(indexed(256, 4, 32, 1e6), 1);
+            let out = run(&mut m, &evs);
+            let d = m.diagnostics().edges;
+            assert_ne!(m.sync_state(), SyncState::Synced, "{lines}: {d:?}");
+            assert!(d.missing_frames >= 5, "{lines}: {d:?}");
+            assert!(d.extra + d.missing <= 1, "{lines}: {d:?}");
+            assert!(out.iter().all(|o| !o.report.valid()), "{lines}");
+        }
+    }
+
     /// Index pulses while the shaft runs backwards mark no forward frame: five revolutions in
     /// reverse (each with its index pulse) leave no missing frame, and once forward again the
     /// monitor syncs and measures.

@@ -322,6 +322,9 @@ pub struct SpeedTracker {
     /// (a Z gated with A, captured on the same edge), it is that frame's, and the next edge
     /// settles it; else that revolution's frame is missing.
     owed: bool,
+    /// The last frame of an index disc was realigned by its index (the count was a tooth
+    /// off): a second in a row says the disc has another number of lines than configured.
+    realigned: bool,
     /// Waiting index timestamps, each with the number of edges that had arrived when it was
     /// reported: an index belongs to an edge that arrived after it. (Modulo the counter a
     /// timestamp alone cannot say which edge it falls before once intervals approach the
@@ -468,6 +471,7 @@ impl SpeedTracker {
             out_of_band: false,
             across: false,
             owed: false,
+            realigned: false,
             index: [(0, 0); INDEXES],
             arrivals: 0,
             nidx: 0,
@@ -518,6 +522,7 @@ impl SpeedTracker {
             out_of_band,
             across,
             owed,
+            realigned,
             index: _,
             arrivals,
             nidx,
@@ -530,7 +535,7 @@ impl SpeedTracker {
         } = self;
         (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
         (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
-        (*across, *owed) = (false, false);
+        (*across, *owed, *realigned) = (false, false, false);
         (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
@@ -1500,7 +1505,17 @@ impl SpeedTracker {
                                 self.missing_frame(t, sink);
                             }
                         }
-                        if indexed {
+                        if indexed && tooth != 0 && self.realigned {
+                            // Realigned at the frame before too: not a stray or lost edge but
+                            // another number of lines than configured (one more: the index a
+                            // tooth late every revolution). The count is given up, and from this
+                            // index it is confirmed again, which such a disc never is (missing
+                            // frames are counted, as for one line fewer).
+                            self.lose_sync(true);
+                            self.sync = SyncState::Confirming;
+                            tooth = 0;
+                        } else if indexed {
+                            self.realigned = tooth != 0;
                             if tooth != 0 {
                                 // The index is authoritative: count the discrepancy, realign.
                                 let ahead = tooth <= edges / 2;
@@ -2086,6 +2101,7 @@ impl SpeedTracker {
         }
         self.sync = SyncState::Searching;
         self.owed = false;
+        self.realigned = false;
         self.viable = 0;
         self.confirm = 0;
         self.seen_special = false;

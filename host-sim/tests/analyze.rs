@@ -1310,6 +1310,29 @@ fn saleae_of_rising(rising: &[f64], rate: f64, end: f64) -> String {
     s
 }
 
+/// Lines faster than the timer ticks (an edge every 0.77 ticks of a 1 MHz timer: 8192 lines at
+/// 1000 rad/s) come two to a tick, which the core cannot tell apart (glitches and missing
+/// edges on a clean disc): the report says so and how to fix it, and says nothing at 2 MHz
+/// (1.5 ticks an edge).
+#[test]
+fn edges_faster_than_the_timer_are_warned_of() {
+    let rising: Vec<f64> = (0..5000).map(|i| f64::from(i) * 0.77e-6).collect();
+    for (hz, warned) in [(1e6, true), (2e6, false)] {
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(512),
+            timer_hz: Some(hz),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let text = saleae_of_rising(&rising, 100e6, 0.01);
+        let mut reader = text_reader(text, "fast.csv", None).unwrap();
+        let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.captures_at_one_tick > 1000, warned, "{hz}");
+        let said = host_sim::app::analyze::text(&report);
+        assert_eq!(said.contains("raise --timer-hz"), warned, "{said}");
+    }
+}
+
 /// A shaft that stops before the recording does: the timeout is where the firmware's poll
 /// would see it (the core's timeout after the last tooth), not at the end of the file, and so
 /// is the end of the window it makes invalid.

@@ -306,6 +306,9 @@ pub struct AnalyzeReport {
     pub edges: u64,
     /// Of them, those captured and fed to the core: one in `prescaler` (all without one).
     pub captured: u64,
+    /// Captures at the same timer tick as the one before: the timer is too slow to resolve
+    /// the edges (the report warns).
+    pub captures_at_one_tick: u64,
     /// The emulated capture's input prescaler: one capture every this many edges.
     pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
@@ -628,6 +631,7 @@ pub fn analyze<R: BufRead>(
     let period = reader.sample_rate().map(|r| 1.0 / r);
     let mut previous_time: Option<f64> = None;
     let prescaler = u32::from(cfg.encoder.prescaler.max(1));
+    let mut last_capture: Option<u32> = None;
     let mut prescaled = 0u32;
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
@@ -719,6 +723,13 @@ pub fn analyze<R: BufRead>(
         }
         if encoder_edge {
             report.captured += 1;
+            if let Some(p) = last_capture.replace(ticks) {
+                // Two captures at one tick: the timer cannot resolve the edges.
+                if ticks.wrapping_sub(p) & enc.mask() == 0 && direction != Some(Direction::Reverse)
+                {
+                    report.captures_at_one_tick += 1;
+                }
+            }
             periods.capture();
             let o = monitor.on_edge_observed(ticks, direction, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
@@ -1069,6 +1080,22 @@ pub fn text(r: &AnalyzeReport) -> String {
             _ => String::new(),
         }
     );
+    if r.captures_at_one_tick > 0 {
+        let _ = writeln!(
+            s,
+            "WARNING: {} of {} captures came at the same timer tick as the one before: the {} Hz \
+             timer cannot resolve the edges, and what it merges shows as glitches and missing \
+             edges; raise --timer-hz{}",
+            r.captures_at_one_tick,
+            r.captured,
+            r.timer_hz,
+            if r.prescaler < 8 {
+                " or capture through --prescaler"
+            } else {
+                ""
+            }
+        );
+    }
     if r.direction_unknown > 0 {
         let _ = writeln!(
             s,

@@ -32,7 +32,7 @@ pub(super) struct Vcd {
     /// The tokens of the current line not read yet.
     tokens: VecDeque<String>,
     /// The time, in units, whose changes are being gathered (none before the first `#T`).
-    time: Option<u64>,
+    time: Option<u128>,
     /// Whether a change or a `#T` has been read since the last row was given.
     pending: bool,
 }
@@ -224,7 +224,8 @@ impl<R: BufRead> CaptureReader<R> {
                 };
             };
             if let Some(digits) = token.strip_prefix('#') {
-                let t: u64 = digits.parse().map_err(|_| {
+                // (Past 2^64 units: 5 hours in fs, 213 days in ps.)
+                let t: u128 = digits.parse().map_err(|_| {
                     self.err_here(&format!("`{}` is not a time `#UNITS`", clip(&token)))
                 })?;
                 match self.vcd.time {
@@ -335,8 +336,15 @@ impl<R: BufRead> CaptureReader<R> {
     }
 
     /// The row at time `t` (units), s.
-    fn vcd_row(&mut self, t: u64) -> Result<Option<(f64, &[Level])>, CaptureError> {
-        let atto = i128::from(t).saturating_mul(self.vcd.unit_atto);
+    fn vcd_row(&mut self, t: u128) -> Result<Option<(f64, &[Level])>, CaptureError> {
+        let atto = i128::try_from(t)
+            .ok()
+            .and_then(|t| t.checked_mul(self.vcd.unit_atto))
+            .ok_or_else(|| {
+                self.err_here(&format!(
+                    "time #{t} is beyond 1.7e20 s: not a recording's time"
+                ))
+            })?;
         let time = self.seconds_from_atto(atto);
         self.last_time = time;
         self.rows += 1;
@@ -435,7 +443,8 @@ mod tests {
     }
 
     /// Times read exactly: a large time in picoseconds (20 000 s into a recording) keeps its
-    /// resolution, counted from its whole seconds.
+    /// resolution, counted from its whole seconds; so does one past 2^64 units (a Unix time in
+    /// femtoseconds).
     #[test]
     fn large_times_keep_their_resolution() {
         let text = "$timescale 1 ps $end\n$var wire 1 ! a $end\n$enddefinitions $end\n\
@@ -450,6 +459,10 @@ mod tests {
         assert_eq!(r.next_row().unwrap().unwrap().0, 1e-12);
         assert_eq!(r.next_row().unwrap().unwrap().0, 2e-12);
         assert_eq!(r.time_origin(), 20_000);
+        let text = "$timescale 1 fs $end\n$var wire 1 ! a $end\n$enddefinitions $end\n\
+            #1764130000000000000000001 1!\n";
+        let rows = reader(text, None).unwrap();
+        assert_eq!(rows[0].0, 1e-15);
     }
 
     #[test]
