@@ -419,6 +419,15 @@ fn ln(x: f32) -> f32 {
     exp as f32 * core::f32::consts::LN_2 + 2.0 * atanh
 }
 
+/// Where a waiting index timestamp falls against the edge judged: it frames the interval
+/// ending at that edge, is a later edge's, lost its edge, or is the owed frame's.
+const PLACE_FRAMES: u8 = 0;
+const PLACE_LATER: u8 = 1;
+const PLACE_LOST: u8 = 2;
+const PLACE_OWED: u8 = 3;
+/// What [`SpeedTracker::index_place`] needs of the edge judged.
+type PlaceAt = (u32, u32, u32, (bool, bool));
+
 /// What the judged edge is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Verdict {
@@ -1327,42 +1336,62 @@ impl SpeedTracker {
         let d = t.wrapping_sub(self.last) & m;
         let (mut frames, mut later, mut lost, mut owed) = (0u8, 0u8, 0u8, false);
         let synced = self.sync == SyncState::Synced;
-        // Where the count puts this edge: the tooth before the frame?
-        let before_frame = synced && d > 2 && tooth_after(self.tooth, 2, enc.edges()) == 0;
-        // Within a tick of the last edge, where that edge was the count's frame (its index
-        // owed) or this one is.
-        let near_last_frame =
-            synced && d > 2 && (self.owed || tooth_after(self.tooth, 1, enc.edges()) == 0);
+        // Where the count puts this edge (the tooth after `self.tooth`, numbered below
+        // `edges`): the tooth before the frame? The frame, or the edge after an owed frame?
+        let last = enc.edges().wrapping_sub(1);
+        let before_frame = synced && d > 2 && self.tooth.wrapping_add(1) == last;
+        let near_last_frame = synced && d > 2 && (self.owed || self.tooth == last);
         // A plain loop, not `each_bit`: it runs at every index pulse, where the set-bit loop
-        // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less.
-        for (i, &(x, q)) in self.index.iter().take(usize::from(self.nidx)).enumerate() {
-            let since = x.wrapping_sub(self.last) & m;
-            // `i` < INDEXES ≤ 8: the bit is within the byte.
+        // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less. Its
+        // classification out of line, the rest in one word: unrolled over the four slots with
+        // the classification inline it was 1.7 KB.
+        let at = (m, d, seq, (before_frame, near_last_frame));
+        let mut bits = 0u32;
+        for i in 0..usize::from(self.nidx).min(INDEXES) {
+            // Two bits a slot, `i` < INDEXES ≤ 8: within the word.
+            bits |= u32::from(self.index_place(i, &at)).wrapping_shl((i as u32).wrapping_mul(2));
+        }
+        for i in 0..usize::from(self.nidx).min(INDEXES) {
             let bit = 1u8.wrapping_shl(i as u32);
-            if !reported_before(q, seq) {
-                later |= bit;
-            } else if near_last_frame && (since <= 1 || since == m) {
-                if self.owed {
-                    owed = true;
-                } else {
-                    frames |= bit;
-                }
-            } else if (since > d && since < m / 2)
-                || (before_frame && since.wrapping_add(1) >= d && since <= d)
-            {
-                later |= bit;
-            } else if since <= d {
-                // At the last accepted edge's own tick (`since` = 0) a timestamp still waiting
-                // was reported after that edge arrived (before it, it would have framed that
-                // edge): it frames this interval. An index a fraction of a tick after its edge
-                // shares the edge's tick about as often as not; counted lost, it made most
-                // revolutions a missing frame.
-                frames |= bit;
-            } else {
-                lost = lost.wrapping_add(1);
+            match (bits.wrapping_shr((i as u32).wrapping_mul(2)) & 3) as u8 {
+                PLACE_FRAMES => frames |= bit,
+                PLACE_LATER => later |= bit,
+                PLACE_OWED => owed = true,
+                _ => lost = lost.wrapping_add(1),
             }
         }
         (frames, later, lost, owed)
+    }
+
+    /// Where waiting index timestamp `i` falls (see [`SpeedTracker::index_places`]), given
+    /// the counter mask, the interval of the edge judged, its arrival and where the count
+    /// puts it (the tooth before the frame; the frame or the edge after an owed frame).
+    #[inline(never)]
+    fn index_place(&self, i: usize, &(m, d, seq, (before_frame, near_last_frame)): &PlaceAt) -> u8 {
+        let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
+        let since = x.wrapping_sub(self.last) & m;
+        if !reported_before(q, seq) {
+            PLACE_LATER
+        } else if near_last_frame && (since <= 1 || since == m) {
+            if self.owed {
+                PLACE_OWED
+            } else {
+                PLACE_FRAMES
+            }
+        } else if (since > d && since < m / 2)
+            || (before_frame && since.wrapping_add(1) >= d && since <= d)
+        {
+            PLACE_LATER
+        } else if since <= d {
+            // At the last accepted edge's own tick (`since` = 0) a timestamp still waiting
+            // was reported after that edge arrived (before it, it would have framed that
+            // edge): it frames this interval. An index a fraction of a tick after its edge
+            // shares the edge's tick about as often as not; counted lost, it made most
+            // revolutions a missing frame.
+            PLACE_FRAMES
+        } else {
+            PLACE_LOST
+        }
     }
 
     /// Drops waiting index timestamps up to `t`; returns whether one framed the interval
