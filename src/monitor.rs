@@ -540,25 +540,34 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             on_window(o);
         }
         let uniform = self.encoder.is_uniform() && P::NOMINAL;
+        // The ordinary teeth go in tight loops (`bulk`) where they can: a uniform disc at its
+        // nominal pitches with a 32-bit counter, no observer.
+        let bulk = !O::WATCHES_TEETH && uniform;
         let mut rest = captures;
         loop {
-            if !O::WATCHES_TEETH && uniform {
-                // The ordinary teeth in one tight loop, as the fast path would take them (the
-                // usual case: the whole batch at the first turn).
-                rest = self.bulk(rest);
+            if bulk {
+                // The usual case: the whole batch at the first turn. Again after a run cut at
+                // `bulk_max`, so that the capture a run stopped at is one the fast path declines.
+                while let Some(r) = self.bulk(rest) {
+                    rest = r;
+                    if rest.is_empty() {
+                        break;
+                    }
+                }
             }
             let Some((&t, tail)) = rest.split_first() else {
                 break;
             };
             rest = tail;
-            // (Where a run stopped, the fast path fails but where the run was cut at
-            // `bulk_max`. Going to the careful path there, the run's cut tested instead, was
-            // 50 bytes smaller but cost 0.15 to 0.2 instructions per edge in batches of 64:
-            // the bench's loop around the call kept fewer values in registers.)
-            if let Some(tooth) = self
-                .tracker
-                .try_fast(&self.encoder, &self.table, t, uniform)
-            {
+            // With a 32-bit counter the fast path declines where a run stopped: no copy of it
+            // here (80 bytes; with a narrower counter it takes the captures one by one).
+            let fast = if bulk && self.encoder.ring_times() {
+                None
+            } else {
+                self.tracker
+                    .try_fast(&self.encoder, &self.table, t, uniform)
+            };
+            if let Some(tooth) = fast {
                 observer.tooth(&tooth);
                 self.state.add(tooth.dt, tooth.sample, uniform);
             } else {
@@ -576,17 +585,18 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     }
 
     /// [`SpeedTracker::bulk`] on the leading captures of `captures` (a uniform disc at its
-    /// nominal pitches, no observer), folded into the window; the captures it left.
+    /// nominal pitches, no observer), folded into the window; the captures it left, if it
+    /// took any.
     #[inline(always)]
-    fn bulk<'c>(&mut self, captures: &'c [u32]) -> &'c [u32] {
+    fn bulk<'c>(&mut self, captures: &'c [u32]) -> Option<&'c [u32]> {
         let mut extremes = self.state.uniform_extremes();
         let (taken, ticks) = self.tracker.bulk(&self.encoder, captures, &mut extremes);
         if taken == 0 {
-            return captures;
+            return None;
         }
         self.state
             .add_run(ticks, extremes, self.encoder.uniform_span());
-        captures.get(taken..).unwrap_or(&[])
+        captures.get(taken..)
     }
 
     /// At the end of a recording or a run, when no edge will follow: the window held for the
