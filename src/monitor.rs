@@ -536,15 +536,19 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         observer: &mut O,
         mut on_window: F,
     ) {
-        if let Some(o) = self.spill.take() {
-            on_window(o);
-        }
         let uniform = self.encoder.is_uniform() && P::NOMINAL;
         // The ordinary teeth go in tight loops (`bulk`) where they can: a uniform disc at its
         // nominal pitches with a 32-bit counter, no observer.
         let bulk = !O::WATCHES_TEETH && uniform;
         let mut rest = captures;
         loop {
+            // A window spilled by the last call, or by the careful path's last edge (a second
+            // window it ended): handed on first. One place for it, so one copy of the caller's
+            // callback less (72 bytes in the example firmware's entry point; 0.06
+            // instructions per edge in batches of 64).
+            if let Some(o) = self.spill.take() {
+                on_window(o);
+            }
             if bulk {
                 // The usual case: the whole batch at the first turn. Again after a run cut at
                 // `bulk_max`, so that the capture a run stopped at is one the fast path declines.
@@ -572,12 +576,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                 self.state.add(tooth.dt, tooth.sample, uniform);
             } else {
                 // The careful path as `on_edge` takes it (one copy of it for every caller's
-                // callback); a second window it ends is handed on at once, and the edge after
-                // it takes the careful path, as it would after `on_edge`.
+                // callback); a second window it ends is handed on at the loop's top, before
+                // the next capture, which takes the careful path, as it would after `on_edge`.
                 if let Some(o) = self.slow_edge(t, Some(Direction::Forward), observer) {
-                    on_window(o);
-                }
-                if let Some(o) = self.spill.take() {
                     on_window(o);
                 }
             }
