@@ -1937,14 +1937,19 @@ impl SpeedTracker {
         } else {
             // A short batch (`i` < `m`, rare): its times follow in the ring slot by slot, as
             // the fast path writes them. One masked slot at a time: a plain copy loop would
-            // become a call of `memcpy`.
-            let pos = self.pos as usize;
-            for (j, &c) in caps.iter().take(i).enumerate() {
-                if let Some(d) = self.ring.get_mut(pos.wrapping_add(j) & (MAX_SPAN - 1)) {
+            // become a call of `memcpy`. Not unrolled: 80 bytes less, for 10 instructions a
+            // time instead of about 5.
+            let mut pos = self.pos as usize;
+            let mut taken = caps.get(..i).unwrap_or(&[]);
+            while let Some((&c, rest)) = taken.split_first() {
+                if let Some(d) = self.ring.get_mut(pos & (MAX_SPAN - 1)) {
                     *d = c;
                 }
+                pos = pos.wrapping_add(1);
+                // Opaque, so that the loop is not unrolled (code size).
+                taken = core::hint::black_box(rest);
             }
-            self.pos = pos.wrapping_add(i) as u32;
+            self.pos = pos as u32;
         }
         self.tooth = self.tooth.wrapping_add(i as u16);
         self.last = run.last;
