@@ -187,7 +187,10 @@ pub struct DeltaMonitor<const N: usize, P: PitchTable = Nominal> {
 /// Where the tracker's findings go during one call: the window, the alarm, the observer, and
 /// the call's finished windows (the first one, and a second spilled to the next call). One
 /// type per observer, whatever the caller's window callback: the careful path is compiled
-/// once for every entry point.
+/// once for every entry point. A reference for each part, not one to a struct of the
+/// monitor holding them (with the window's state in it or apart): that was 84 or 76 bytes
+/// more code (the acceptance, where a tooth feeds the window, grew by 106 or 90; making a
+/// feed in `slow_edge` and `poll` took 50 or 44 less).
 struct Feed<'a, O: EdgeSink, P: PitchTable> {
     encoder: &'a Encoder,
     /// The monitor's pitch storage: whether its samples all span the same angle is then

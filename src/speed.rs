@@ -2088,8 +2088,9 @@ impl Run {
     /// per kind was 1 194. Measured against this form (QEMU, instructions per edge in batches
     /// of 64): the new extreme as a branch (the slowest or the fastest), as the two copies
     /// had it, made the compiler move registers on every capture, +1.3; the loop out of line,
-    /// called per stretch, +1.2; the first step refreshing the band through the loop's own
-    /// refresh, +2.1; no first step (a stretch of its own), +0.9.
+    /// called per stretch, +1.2, or once between refreshes with the switch inside it, +0.28
+    /// and 88 bytes more; the first step refreshing the band through the loop's own refresh,
+    /// +2.1; no first step (a stretch of its own), +0.9.
     #[inline(never)]
     fn batch(&mut self, enc: &Encoder, caps: &[u32], head: &[u32], mut refresh: usize) -> usize {
         let (n, k) = (caps.len(), head.len());
