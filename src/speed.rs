@@ -1978,15 +1978,16 @@ impl SpeedTracker {
     /// loops, and returns how many, with the ticks they span; the extremes of their `K`-edge
     /// samples are folded into `extremes` (slowest and fastest, as tick counts of samples of
     /// equal span). The first capture it stops at (outside the band, or a special tooth next)
-    /// is left for [`SpeedTracker::on_edge`]. Identical results: the band test and its refresh
-    /// points are the fast path's, and the state it leaves is the one the fast path would.
+    /// is left for the careful path (the fast path declines it), but where the run was cut at
+    /// `bulk_max` (call it again). Identical results: the band test and its refresh points
+    /// are the fast path's, and the state it leaves is the one the fast path would.
     ///
     /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
     /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), one range
-    /// test for the extremes. The capture times before the batch come from the ring, laid out
-    /// from its start (so the first `K` samples start at consecutive slots), and the ring is
-    /// written once, at the end, by a copy of fixed size. The loops themselves are
-    /// [`Run::batch`], out of line so that they keep their state in registers.
+    /// test for the extremes. The capture times before the batch are the ring's last `K`,
+    /// read where they lie (laid out from the ring's start first if they wrap round its end),
+    /// and the ring is written once, at the end, by a copy of fixed size. The loop itself is
+    /// [`Run::batch`], out of line so that it keeps its state in registers.
     #[inline(never)]
     pub(crate) fn bulk(
         &mut self,
@@ -2001,18 +2002,23 @@ impl SpeedTracker {
         let n = caps.len().min(room).min(enc.bulk_max());
         let caps = caps.get(..n).unwrap_or(&[]);
         let k = usize::from(enc.samples_span());
-        // The ring's last `m` times (at least the last K, and two for the newest interval),
-        // laid out from its start: a batch reads the K before it in one piece. `m` is 16 or
-        // 32, so that writing them back is a copy of fixed size (a few block moves).
+        // The batch writes the ring back as its last `m` times laid out from its start: `m`
+        // is 16 or 32 (at least K), so that is a copy of fixed size (a few block moves).
         let m = if k <= LAID_SHORT {
             LAID_SHORT
         } else {
             MAX_SPAN
         };
-        if self.pos != m as u32 {
+        // The ring's last K times, read in one piece where they lie unless they wrap round
+        // its end (then laid out from its start first). Laying them out whenever they were
+        // not at the start (once a revolution: the frame takes the careful path) moved 16
+        // times as one block there, 48 bytes more code.
+        let mut first = self.pos.wrapping_sub(k as u32) as usize & (MAX_SPAN - 1);
+        if first.wrapping_add(k) > MAX_SPAN {
             self.linearize(m);
+            first = m.wrapping_sub(k);
         }
-        let head = self.ring.get(m.wrapping_sub(k)..m).unwrap_or(&[]);
+        let head = self.ring.get(first..first.wrapping_add(k)).unwrap_or(&[]);
         let last0 = self.last;
         let mut run = Run::new(last0, self.lo, self.width, *extremes);
         // Captures up to and including the next one on a refresh tooth.
@@ -2039,14 +2045,20 @@ impl SpeedTracker {
             self.pos = m as u32;
         } else {
             // A short batch (`i` < `m`, rare): its times follow in the ring slot by slot, as
-            // the fast path writes them (the next batch lays the ring out again). One masked
-            // slot at a time: a plain copy loop would become a call of `memcpy`.
-            for (j, &c) in caps.iter().take(i).enumerate() {
-                if let Some(d) = self.ring.get_mut(m.wrapping_add(j) & (MAX_SPAN - 1)) {
+            // the fast path writes them. One masked slot at a time: a plain copy loop would
+            // become a call of `memcpy`. Not unrolled: 80 bytes less, for 10 instructions a
+            // time instead of about 5.
+            let mut pos = self.pos as usize;
+            let mut taken = caps.get(..i).unwrap_or(&[]);
+            while let Some((&c, rest)) = taken.split_first() {
+                if let Some(d) = self.ring.get_mut(pos & (MAX_SPAN - 1)) {
                     *d = c;
                 }
+                pos = pos.wrapping_add(1);
+                // Opaque, so that the loop is not unrolled (code size).
+                taken = core::hint::black_box(rest);
             }
-            self.pos = m.wrapping_add(i) as u32;
+            self.pos = pos as u32;
         }
         self.tooth = self.tooth.wrapping_add(i as u16);
         self.last = run.last;
@@ -2058,31 +2070,12 @@ impl SpeedTracker {
         (i, u64::from(run.last.wrapping_sub(last0)))
     }
 
-    /// Lays the ring's last `m` times out from its start (newest at `m − 1`), `pos` at `m`.
+    /// Lays the ring's last `m` times out from its start (newest at `m − 1`), `pos` at `m`,
+    /// when its last K wrap round its end (a batch reads them where they lie otherwise).
     #[cold]
     #[inline(never)]
     fn linearize(&mut self, m: usize) {
         let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
-        if first.wrapping_add(m) <= MAX_SPAN {
-            // Not wrapped (the usual case, once a revolution: a few careful edges after a
-            // batch): moved down, a copy of fixed size through a temporary (a few block
-            // moves inline). With `m` = 32 that is `first` = 0, laid out already. Apart from
-            // the turn below, which would do it too but moves all 32 slots one by one (0.3
-            // instructions per edge more in batches); a loop slot by slot was 60 bytes more.
-            if m == LAID_SHORT {
-                let times = self
-                    .ring
-                    .get(first..)
-                    .and_then(<[u32]>::first_chunk::<LAID_SHORT>)
-                    .copied();
-                // Opaque, so that the two copies are not merged into one overlapping move (a
-                // call of `memmove`).
-                let times = core::hint::black_box(times);
-                lay(&mut self.ring, times.as_ref());
-            }
-            self.pos = m as u32;
-            return;
-        }
         // Wrapped: the whole ring turned left by `first` in place, slot `j` taking slot
         // `j + first` (masked), one slot a turn, 32 in all: along the cycle through `c`, and
         // where it closes the held time put back and the next cycle started (`gcd(first,
@@ -2199,155 +2192,129 @@ impl Run {
     /// `K = head.len()` samples starting at `head`, the others `K` captures back in `caps`,
     /// and refreshes the band after capture `refresh − 1` and every [`BAND_REFRESH`] after it
     /// as the fast path does. Returns how many were taken. Out of line: the run's state stays
-    /// in registers through all its loops. A copy of the loop ([`Run::take`]) for each kind of
-    /// sample start: one copy serving both, its start picked per stretch, was 420 bytes
-    /// smaller but cost 0.4 instructions per edge in batches of 64.
+    /// in registers through its loop.
+    ///
+    /// One copy of the loop (four captures a turn) for both kinds of sample start, switching
+    /// from the ring's times to the batch's own when they run out: 818 bytes, where a copy
+    /// per kind was 1 194. Measured against this form (QEMU, instructions per edge in batches
+    /// of 64): the new extreme as a branch (the slowest or the fastest), as the two copies
+    /// had it, made the compiler move registers on every capture, +1.3; the loop out of line,
+    /// called per stretch, +1.2, or once between refreshes with the switch inside it, +0.28
+    /// and 88 bytes more; the first step refreshing the band through the loop's own refresh,
+    /// +2.1; no first step (a stretch of its own), +0.9.
     #[inline(never)]
     fn batch(&mut self, enc: &Encoder, caps: &[u32], head: &[u32], mut refresh: usize) -> usize {
         let (n, k) = (caps.len(), head.len());
+        let mut start = head;
+        // Captures taken (at most `n`: the sums below do not wrap).
         let mut i = 0usize;
         if self.fresh || refresh == 1 {
-            // The first capture alone: the first sample of a window is both extremes (then
-            // `fastest ≤ slowest` holds), and a single capture before a refresh tooth (a batch
-            // that starts one tooth before it, as an aligned DMA half-buffer does) costs less
-            // as one step than as a run of its own.
+            // The first sample folded in first: of a window that has just started, it is both
+            // extremes (then `fastest ≤ slowest` holds); if the first capture is not taken,
+            // nothing of the run is kept.
             let (Some(&c), Some(&s)) = (caps.first(), head.first()) else {
                 return 0;
             };
-            if self.fresh {
+            let t = c.wrapping_sub(s);
+            let slowest = self.fastest.wrapping_add(self.range).max(t);
+            self.fastest = self.fastest.min(t);
+            self.range = slowest.wrapping_sub(self.fastest);
+            if refresh == 1 {
+                // A batch that starts on a refresh tooth (an aligned DMA half-buffer): its
+                // first capture alone, with its own refresh (80 bytes).
                 if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
                     return 0;
                 }
-                let t = c.wrapping_sub(s);
-                let slowest = self.fastest.wrapping_add(self.range).max(t);
-                self.fastest = self.fastest.min(t);
-                self.range = slowest.wrapping_sub(self.fastest);
-                self.fresh = false;
                 self.last = c;
-            } else if !self.step(c, s) {
-                return 0;
-            }
-            i = 1;
-        }
-        loop {
-            let end = n.min(refresh);
-            // Samples that start before the batch (at the ring's times), then the others (at
-            // the batch's own captures, K back).
-            let mid = end.min(k);
-            // (`i` counts captures taken, at most `n`: the sums below do not wrap; `i ≥ k` in
-            // the second run, since `mid < end` means `mid = k`.)
-            if i < mid {
-                i = i.wrapping_add(self.take(
-                    caps.get(i..mid).unwrap_or(&[]),
-                    head.get(i..).unwrap_or(&[]),
-                ));
-            }
-            if i >= mid && i < end {
-                let now = caps.get(i..end).unwrap_or(&[]);
-                i = i.wrapping_add(self.take(now, caps.get(i.wrapping_sub(k)..).unwrap_or(&[])));
-            }
-            if i != refresh {
-                return i;
-            }
-            // The fast path's refresh after this tooth: around the mean of the last K (`i` =
-            // `refresh` ≥ 1).
-            let from = if i > k {
-                caps.get(i.wrapping_sub(1).wrapping_sub(k))
-            } else {
-                head.get(i.wrapping_sub(1))
-            };
-            (self.lo, self.width) = enc
-                .band(self.last.wrapping_sub(from.copied().unwrap_or(0)))
-                .unwrap_or((u32::MAX, 0));
-            refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
-            if i >= n {
-                return i;
+                (self.lo, self.width) = enc.band(t).unwrap_or((u32::MAX, 0));
+                refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
+                i = 1;
+                start = head.get(1..).unwrap_or(&[]);
             }
         }
-    }
-
-    /// Takes capture `c` if its interval is in the band, the sample ending at it starting at
-    /// `s`; whether it did.
-    #[inline(always)]
-    fn step(&mut self, c: u32, s: u32) -> bool {
-        if c.wrapping_sub(self.last).wrapping_sub(self.lo) > self.width {
-            return false;
-        }
-        let t = c.wrapping_sub(s);
-        let above = t.wrapping_sub(self.fastest);
-        if above > self.range {
-            if t < self.fastest {
-                self.range = self.range.wrapping_add(self.fastest.wrapping_sub(t));
-                self.fastest = t;
-            } else {
-                self.range = above;
-            }
-        }
-        self.last = c;
-        true
-    }
-
-    /// Takes captures `now` while their intervals are in the band; `start[j]` is when the
-    /// `K`-edge sample ending at `now[j]` starts. Returns how many were taken. Four captures a
-    /// turn; per capture a load, the band test, the sample and the range test of the extremes
-    /// (a branch taken only by a new extreme).
-    #[inline(always)]
-    fn take(&mut self, now: &[u32], start: &[u32]) -> usize {
-        let n = now.len().min(start.len());
-        let (mut now, mut start) = (now.get(..n).unwrap_or(&[]), start.get(..n).unwrap_or(&[]));
-        let (lo, width) = (self.lo, self.width);
+        let (mut lo, mut width) = (self.lo, self.width);
         let (mut last, mut fastest, mut range) = (self.last, self.fastest, self.range);
-        let mut step = |c: u32, s: u32| {
-            if c.wrapping_sub(last).wrapping_sub(lo) > width {
-                return false;
-            }
-            let t = c.wrapping_sub(s);
-            let above = t.wrapping_sub(fastest);
-            if above > range {
-                // A new extreme: the slowest (`t` above the range) or the fastest.
-                if t < fastest {
-                    range = range.wrapping_add(fastest.wrapping_sub(t));
-                    fastest = t;
+        // Per capture: the band test, the sample and the range test of the extremes; a new
+        // extreme (a fifth of the samples of the bench's stream) without a branch, both
+        // extremes recomputed.
+        macro_rules! step {
+            ($c:expr, $s:expr) => {{
+                let c: u32 = $c;
+                if c.wrapping_sub(last).wrapping_sub(lo) > width {
+                    false
                 } else {
-                    range = above;
+                    let t = c.wrapping_sub($s);
+                    if t.wrapping_sub(fastest) > range {
+                        // A new extreme: the slowest or the fastest.
+                        let slowest = fastest.wrapping_add(range).max(t);
+                        fastest = fastest.min(t);
+                        range = slowest.wrapping_sub(fastest);
+                    }
+                    last = c;
+                    true
+                }
+            }};
+        }
+        // The samples start at the ring's times, then (once they are used up) at the batch's
+        // own captures, K back: one copy of the loop for both.
+        let taken = 'run: loop {
+            let end = n.min(refresh);
+            let mut now = caps.get(i..end).unwrap_or(&[]);
+            while !now.is_empty() {
+                if start.is_empty() {
+                    start = caps;
+                }
+                let m = now.len().min(start.len());
+                let (mut a, mut b) = (now.get(..m).unwrap_or(&[]), start.get(..m).unwrap_or(&[]));
+                (now, start) = (now.get(m..).unwrap_or(&[]), start.get(m..).unwrap_or(&[]));
+                // Four captures a turn. Slice patterns, not `chunks_exact` or `zip`: no
+                // library precondition to check, in a debug build either.
+                while let ([c0, c1, c2, c3, a_rest @ ..], [s0, s1, s2, s3, b_rest @ ..]) = (a, b) {
+                    let here = end.wrapping_sub(now.len()).wrapping_sub(a.len());
+                    if !step!(*c0, *s0) {
+                        break 'run here;
+                    }
+                    if !step!(*c1, *s1) {
+                        break 'run here.wrapping_add(1);
+                    }
+                    if !step!(*c2, *s2) {
+                        break 'run here.wrapping_add(2);
+                    }
+                    if !step!(*c3, *s3) {
+                        break 'run here.wrapping_add(3);
+                    }
+                    (a, b) = (a_rest, b_rest);
+                }
+                while let ([c, a_rest @ ..], [s, b_rest @ ..]) = (a, b) {
+                    if !step!(*c, *s) {
+                        break 'run end.wrapping_sub(now.len()).wrapping_sub(a.len());
+                    }
+                    (a, b) = (a_rest, b_rest);
                 }
             }
-            last = c;
-            true
-        };
-        // How many were taken, from where the run stopped: `n` less the captures left (no
-        // counter in the loop). Slice patterns, not `chunks_exact` or `zip`: no library
-        // precondition to check, in a debug build either.
-        let taken = 'run: {
-            while let ([c0, c1, c2, c3, now_rest @ ..], [s0, s1, s2, s3, start_rest @ ..]) =
-                (now, start)
-            {
-                let here = n.wrapping_sub(now.len());
-                if !step(*c0, *s0) {
-                    break 'run here;
-                }
-                if !step(*c1, *s1) {
-                    break 'run here.wrapping_add(1);
-                }
-                if !step(*c2, *s2) {
-                    break 'run here.wrapping_add(2);
-                }
-                if !step(*c3, *s3) {
-                    break 'run here.wrapping_add(3);
-                }
-                (now, start) = (now_rest, start_rest);
+            i = end;
+            if i == refresh {
+                // The fast path's refresh after this tooth: around the mean of the last K (`i`
+                // = `refresh` ≥ 1).
+                let from = if i > k {
+                    caps.get(i.wrapping_sub(1).wrapping_sub(k))
+                } else {
+                    head.get(i.wrapping_sub(1))
+                };
+                (lo, width) = enc
+                    .band(last.wrapping_sub(from.copied().unwrap_or(0)))
+                    .unwrap_or((u32::MAX, 0));
+                refresh = refresh.wrapping_add(usize::from(BAND_REFRESH));
             }
-            while let ([c, now_rest @ ..], [s, start_rest @ ..]) = (now, start) {
-                if !step(*c, *s) {
-                    break 'run n.wrapping_sub(now.len());
-                }
-                (now, start) = (now_rest, start_rest);
+            if i >= n {
+                break i;
             }
-            n
         };
         self.last = last;
         self.fastest = fastest;
         self.range = range;
+        self.lo = lo;
+        self.width = width;
         taken
     }
 }
