@@ -407,24 +407,13 @@ impl WindowState {
     /// Feeds one accepted edge; returns a report when a window ends. `uniform`: every sample
     /// spans the same angle (a uniform disc at its nominal pitches). `unit_rad`, `timer_hz` and `k` are the encoder's (see
     /// [`crate::encoder::Encoder`]).
-    pub fn on_tooth(
-        &mut self,
-        window: &Window,
-        tooth: &Tooth,
-        unit_rad: f32,
-        timer_hz: f32,
-        k: u16,
-        uniform: bool,
-    ) -> Option<WindowReport> {
-        self.on_tooth_of(window, tooth, unit_rad, timer_hz, k, uniform)
-    }
-
-    /// [`WindowState::on_tooth`], one copy for each kind of sample: a caller that knows the
-    /// kind at compile time (the monitor) links only its own (a DMA-fed firmware's window
-    /// code was 772 bytes with both kinds in one copy, 704 with its own; the window's
-    /// measurement is then out of line).
+    ///
+    /// One copy for each kind of sample, picked inline: a caller that knows the kind at
+    /// compile time (the monitor) links only its own (a DMA-fed firmware's window code was
+    /// 772 bytes with both kinds in one copy, 704 with its own; the window's measurement is
+    /// then out of line).
     #[inline(always)]
-    pub(crate) fn on_tooth_of(
+    pub fn on_tooth(
         &mut self,
         window: &Window,
         tooth: &Tooth,

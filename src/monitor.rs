@@ -218,7 +218,7 @@ impl<O: EdgeSink, P: PitchTable> EdgeSink for Feed<'_, O, P> {
         self.release(None);
         let e = self.encoder;
         let uniform = e.is_uniform() && P::NOMINAL;
-        if let Some(r) = self.state.on_tooth_of(
+        if let Some(r) = self.state.on_tooth(
             self.window,
             tooth,
             e.unit_rad(),

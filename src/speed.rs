@@ -1525,15 +1525,13 @@ impl SpeedTracker {
                 match self.sync {
                     SyncState::Synced => {
                         // The last edge's frame, taken by the count: its index came late, at
-                        // that edge's tick (the revolution it ended is counted now), or not.
-                        if core::mem::replace(&mut self.owed, false) {
-                            if late {
-                                self.counters.revolutions =
-                                    self.counters.revolutions.wrapping_add(1);
-                            } else {
-                                self.missing_frame(t, sink);
-                            }
+                        // that edge's tick (the revolution it ended is counted now), or not
+                        // (`late` only where one was owed).
+                        if late {
+                            self.owed = false;
+                            self.counters.revolutions = self.counters.revolutions.wrapping_add(1);
                         }
+                        self.settle_owed(t, sink);
                         if indexed && tooth != 0 && self.realigned {
                             // Realigned at the frame before too: not a stray or lost edge but
                             // another number of lines than configured (one more: the index a
@@ -1864,7 +1862,8 @@ impl SpeedTracker {
         self.block_fast();
     }
 
-    /// No edge follows an owed frame's (a stop, a reversal): its index never came.
+    /// An owed frame's index did not come by the edge after it, or no edge follows it (a stop,
+    /// a reversal).
     fn settle_owed<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
         if core::mem::replace(&mut self.owed, false) {
             self.missing_frame(t, sink);

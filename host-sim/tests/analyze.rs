@@ -239,61 +239,71 @@ fn check_clean(run: &RunReport, report: &AnalyzeReport, seen: &[Seen], lines: u3
     }
 }
 
+/// A clean crank of `wheel` (`positions` of it) simulated for `duration` s, captured in `format`
+/// (`capture`: the scene's [capture] table, sampling at `rate`) and analysed: the format read
+/// is the one written, and every decision is right (`check_clean`).
+fn clean_crank(
+    wheel_name: &str,
+    positions: u32,
+    (capture, rate): (&str, f64),
+    duration: f64,
+    format: CaptureFormat,
+) -> AnalyzeReport {
+    let (_scratch, file) = tmp(&format!("crank-{wheel_name}.{}", format.name()));
+    let run = simulate(&cranking(wheel_name, capture, duration, ""), format, &file);
+    let (report, seen) = run_analyze(&file, wheel(wheel_name));
+    assert_eq!(report.format, format.name());
+    check_clean(&run, &report, &seen, positions, rate);
+    report
+}
+
 #[test]
 fn clean_cranking_of_a_36_2_wheel_from_a_saleae_capture() {
-    let (_scratch, file) = tmp("crank-36-2.csv");
-    let run = simulate(
-        &cranking("36-2", "sample_rate = 50e6", 2.0, ""),
+    let report = clean_crank(
+        "36-2",
+        36,
+        ("sample_rate = 50e6", 50e6),
+        2.0,
         CaptureFormat::Saleae,
-        &file,
     );
-    let (report, seen) = run_analyze(&file, wheel("36-2"));
-    assert_eq!(report.format, "saleae");
     assert!(report.revolutions >= 4, "{}", report.revolutions);
-    check_clean(&run, &report, &seen, 36, 50e6);
 }
 
 #[test]
 fn clean_cranking_of_an_8_1_wheel_from_a_sigrok_capture() {
-    let (_scratch, file) = tmp("crank-8-1.csv");
-    let run = simulate(
-        &cranking("8-1", "sample_rate = 50e6\ndedup = true", 3.0, ""),
+    let report = clean_crank(
+        "8-1",
+        8,
+        ("sample_rate = 50e6\ndedup = true", 50e6),
+        3.0,
         CaptureFormat::Sigrok,
-        &file,
     );
-    let (report, seen) = run_analyze(&file, wheel("8-1"));
-    assert_eq!(report.format, "sigrok");
     assert!(report.revolutions >= 6, "{}", report.revolutions);
-    check_clean(&run, &report, &seen, 8, 50e6);
 }
 
 #[test]
 fn clean_cranking_from_a_plain_capture_of_a_60_2_wheel() {
-    let (_scratch, file) = tmp("crank-60-2.csv");
-    let run = simulate(
-        &cranking("60-2", "sample_rate = 50e6", 1.5, ""),
+    clean_crank(
+        "60-2",
+        60,
+        ("sample_rate = 50e6", 50e6),
+        1.5,
         CaptureFormat::Plain,
-        &file,
     );
-    let (report, seen) = run_analyze(&file, wheel("60-2"));
-    assert_eq!(report.format, "plain");
-    check_clean(&run, &report, &seen, 60, 50e6);
 }
 
 #[test]
 fn clean_cranking_of_a_36_1_wheel_from_a_value_change_dump() {
-    let (_scratch, file) = tmp("crank-36-1.vcd");
-    let run = simulate(
-        &cranking("36-1", "sample_rate = 24e6", 2.0, ""),
+    let report = clean_crank(
+        "36-1",
+        36,
+        ("sample_rate = 24e6", 24e6),
+        2.0,
         CaptureFormat::Vcd,
-        &file,
     );
-    let (report, seen) = run_analyze(&file, wheel("36-1"));
-    assert_eq!(report.format, "vcd");
     // The rate from the dump's comment (24 MHz: a period of 41.67 ns, times in fs).
     assert_eq!(report.sample_rate, Some(24e6));
     assert!(report.revolutions >= 4, "{}", report.revolutions);
-    check_clean(&run, &report, &seen, 36, 24e6);
 }
 
 /// Start from rest, crank, stall: the only fault is the timeout once the shaft has stopped

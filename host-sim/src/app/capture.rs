@@ -463,6 +463,14 @@ mod tests {
         }
     }
 
+    /// The bundled one-mass machine.
+    fn one_mass() -> Machine {
+        let (scene, path) = crate::app::scene::resolve("one-mass").unwrap();
+        crate::app::predict::machine(&scene, &path)
+            .unwrap()
+            .unwrap()
+    }
+
     /// Samples of a made-up run-up at 1 rad/s² (ω = t): the loads turn with the rotor up to
     /// 60 rad/s, stay at 60 rad/s until the rotor reaches 91 rad/s, except for 0.3 s at
     /// ω = 75 where they speed up to within 1 % of the rotor, then turn with it again.
@@ -498,10 +506,7 @@ mod tests {
 
     #[test]
     fn finds_the_capture_and_its_release() {
-        let (scene, path) = crate::app::scene::resolve("one-mass").unwrap();
-        let machine = crate::app::predict::machine(&scene, &path)
-            .unwrap()
-            .unwrap();
+        let machine = one_mass();
         let w = machine.capture_windows()[0];
         let c = analyse(&made_up_runup(), &machine).unwrap();
         assert!(c.captured && c.released);
@@ -540,10 +545,7 @@ mod tests {
     /// the hold included, it read 0.35 rad/s²).
     #[test]
     fn a_hold_after_the_ramp_does_not_dilute_its_rate() {
-        let (scene, path) = crate::app::scene::resolve("one-mass").unwrap();
-        let machine = crate::app::predict::machine(&scene, &path)
-            .unwrap()
-            .unwrap();
+        let machine = one_mass();
         let rotor_angle = |t: f64| {
             if t < 80.0 {
                 0.5 * t * t

@@ -499,17 +499,7 @@ impl<R: BufRead> CaptureReader<R> {
                         clip(rest.trim())
                     ))
                 })?;
-                if let Some(given) = self.sample_rate {
-                    if (given - rate).abs() > 1e-9 * rate {
-                        return Err(self.err_here(&format!(
-                            "the file states `Samplerate: {}` ({rate} Hz) but --sample-rate is \
-                             {given} Hz: leave --sample-rate out (the file's rate is used) or \
-                             correct it",
-                            rest.trim()
-                        )));
-                    }
-                }
-                self.sample_rate = Some(rate);
+                self.stated_rate(rate, &format!("Samplerate: {}", rest.trim()))?;
             }
             line = loop {
                 match self.read_line()? {
@@ -697,6 +687,22 @@ impl<R: BufRead> CaptureReader<R> {
                 Ok(self.seconds_from_atto(atto))
             }
         }
+    }
+
+    /// A sample rate the file states (`text`, as it states it): kept, unless `--sample-rate`
+    /// says otherwise. For every format that states one (sigrok's CSV comment, its VCD's).
+    fn stated_rate(&mut self, rate: f64, text: &str) -> Result<(), CaptureError> {
+        if let Some(given) = self.sample_rate {
+            if (given - rate).abs() > 1e-9 * rate {
+                return Err(self.err_here(&format!(
+                    "the file states `{}` ({rate} Hz) but --sample-rate is {given} Hz: leave \
+                     --sample-rate out (the file's rate is used) or correct it",
+                    clip(text)
+                )));
+            }
+        }
+        self.sample_rate = Some(rate);
+        Ok(())
     }
 
     /// A time given exactly in attoseconds, s: counted from the first time's whole seconds

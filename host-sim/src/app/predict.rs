@@ -762,7 +762,7 @@ fn alarm_floor_warning(
 
 /// "normal" up to `fraction·limit`, "warning" up to `limit`, "over" above (in f64, as the
 /// design computes them).
-fn level_of(value: f64, fraction: f64, limit: f64) -> &'static str {
+pub(crate) fn level_of(value: f64, fraction: f64, limit: f64) -> &'static str {
     if value > limit {
         "over"
     } else if value > fraction * limit {

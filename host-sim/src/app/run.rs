@@ -1699,19 +1699,9 @@ fn supports(
         .map_err(|e| core_error(scene, file, "rotor", e))?;
     let finite = |v: f32| Some(f64::from(v)).filter(|v| v.is_finite());
     // The simulated reactions against the load limits, whatever the core measured.
-    let reaction_level = limits.support_load_limit().map(|l| {
-        let w = limits.warning_fraction();
-        [0, 1].map(|k| {
-            let (f, limit) = (reactions[k], l[k]);
-            if f > limit {
-                "over"
-            } else if f > w * limit {
-                "warning"
-            } else {
-                "normal"
-            }
-        })
-    });
+    let reaction_level = limits
+        .support_load_limit()
+        .map(|l| [0, 1].map(|k| predict::level_of(reactions[k], limits.warning_fraction(), l[k])));
     let out = match report.speed_peak_measured {
         // The unbalance load |D|·ω² peaks at the window's fastest speed: judged there (at the
         // mean, a drive with δ = 0.34 had its peak loads read 10 % low, "normal" for a bearing

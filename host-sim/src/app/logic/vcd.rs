@@ -170,7 +170,7 @@ impl<R: BufRead> CaptureReader<R> {
                     // sigrok: `Acquisition with 2/8 channels at 1 MHz`.
                     if let Some((_, rate)) = text.split_once(" channels at ") {
                         if let Some(rate) = parse_rate(rate) {
-                            self.vcd_rate(rate, &text)?;
+                            self.stated_rate(rate, &text)?;
                         }
                     }
                 }
@@ -191,21 +191,6 @@ impl<R: BufRead> CaptureReader<R> {
                  is never guessed)",
             )
         })?;
-        Ok(())
-    }
-
-    /// A sample rate the file states: kept, unless `--sample-rate` says otherwise.
-    fn vcd_rate(&mut self, rate: f64, text: &str) -> Result<(), CaptureError> {
-        if let Some(given) = self.sample_rate {
-            if (given - rate).abs() > 1e-9 * rate {
-                return Err(self.err_here(&format!(
-                    "the file states `{}` ({rate} Hz) but --sample-rate is {given} Hz: leave \
-                     --sample-rate out (the file's rate is used) or correct it",
-                    clip(text)
-                )));
-            }
-        }
-        self.sample_rate = Some(rate);
         Ok(())
     }
 
@@ -358,14 +343,21 @@ mod tests {
     use super::super::{CaptureFormat, CaptureReader, Level};
     use std::path::Path;
 
-    fn reader(text: &str, rate: Option<f64>) -> Result<Vec<(f64, Vec<Level>)>, String> {
-        let mut r = CaptureReader::new(
+    fn open(
+        text: &str,
+        rate: Option<f64>,
+    ) -> Result<CaptureReader<std::io::Cursor<String>>, String> {
+        CaptureReader::new(
             std::io::Cursor::new(text.to_string()),
             Path::new("cap.vcd"),
             None,
             rate,
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| e.to_string())
+    }
+
+    fn reader(text: &str, rate: Option<f64>) -> Result<Vec<(f64, Vec<Level>)>, String> {
+        let mut r = open(text, rate)?;
         assert_eq!(r.format(), CaptureFormat::Vcd);
         let mut rows = Vec::new();
         while let Some((t, l)) = r.next_row().map_err(|e| e.to_string())? {
@@ -396,13 +388,7 @@ mod tests {
             assert!((t - wt).abs() < 1e-18, "{t} against {wt}");
             assert_eq!(l, wl);
         }
-        let r = CaptureReader::new(
-            std::io::Cursor::new(SIGROK.to_string()),
-            Path::new("cap.vcd"),
-            None,
-            None,
-        )
-        .unwrap();
+        let r = open(SIGROK, None).unwrap();
         assert_eq!(r.channels(), ["D0", "D1"]);
         assert_eq!(r.sample_rate(), Some(1e6));
         // A --sample-rate that disagrees with the comment is an error.
@@ -432,13 +418,7 @@ mod tests {
             assert!((t - wt).abs() < 1e-20, "{t} against {wt}");
             assert_eq!(l, wl);
         }
-        let r = CaptureReader::new(
-            std::io::Cursor::new(text.to_string()),
-            Path::new("cap.vcd"),
-            None,
-            None,
-        )
-        .unwrap();
+        let r = open(text, None).unwrap();
         assert_eq!(r.channels(), ["a", "top.sub.a", "z [0]"]);
     }
 
@@ -449,13 +429,7 @@ mod tests {
     fn large_times_keep_their_resolution() {
         let text = "$timescale 1 ps $end\n$var wire 1 ! a $end\n$enddefinitions $end\n\
             #20000000000000001 1!\n#20000000000000002 0!\n";
-        let mut r = CaptureReader::new(
-            std::io::Cursor::new(text.to_string()),
-            Path::new("cap.vcd"),
-            None,
-            None,
-        )
-        .unwrap();
+        let mut r = open(text, None).unwrap();
         assert_eq!(r.next_row().unwrap().unwrap().0, 1e-12);
         assert_eq!(r.next_row().unwrap().unwrap().0, 2e-12);
         assert_eq!(r.time_origin(), 20_000);
