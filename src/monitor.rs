@@ -1995,6 +1995,57 @@ mod tests {
         assert_eq!(d.extra + d.missing, 1, "{d:?}");
     }
 
+    #[test]
+    fn a_stray_index_pulse_does_not_reframe_the_count() {
+        // A stray pulse on the index line 2.4 pitches after the real one (a bounce, a spike),
+        // at revolution 6 of a clean 100-line disc; then the next real index present, or lost
+        // under the stray pulse (an index held high until after it). It was taken as the
+        // frame three teeth off, counted as an extra line edge, and where the next index was
+        // lost the count was given up a revolution later without a fault: the window that
+        // ended at the next frame was valid with one revolution counted over 197 edges (ω
+        // mean half the truth). Now: a missing frame, the count kept, no line fault, and every
+        // valid window exactly one revolution of edges.
+        let evs = stream(&uniform(100), Some(0.0), 14, 1e6, u32::MAX, &kneader(0.01));
+        let indexes: Vec<usize> = evs
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| matches!(e, Ev::Index(_)))
+            .map(|(i, _)| i)
+            .collect();
+        for lose_next in [false, true] {
+            let at = indexes[6];
+            let (t0, t1) = (time_of(evs[at + 3]), time_of(evs[at + 4]));
+            let mut noisy = evs.clone();
+            if lose_next {
+                noisy.remove(indexes[7]);
+            }
+            noisy.insert(at + 4, Ev::Index(t0 + (t1 - t0) * 2 / 5));
+            let mut m = monitor(indexed(100, 4, 32, 1e6), 1);
+            let out = run(&mut m, &noisy);
+            let d = m.diagnostics().edges;
+            assert_eq!(
+                (d.extra, d.missing, d.glitches),
+                (0, 0, 0),
+                "{lose_next}: {d:?}"
+            );
+            assert_eq!(
+                d.missing_frames,
+                1 + u32::from(lose_next),
+                "{lose_next}: {d:?}"
+            );
+            assert_eq!(m.sync_state(), SyncState::Synced, "{lose_next}: {d:?}");
+            let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
+            assert!(valid.len() >= 10, "{lose_next}: {out:?}");
+            for o in valid {
+                assert_eq!(
+                    o.report.end_edge - o.report.start_edge,
+                    100,
+                    "{lose_next}: {o:?}"
+                );
+            }
+        }
+    }
+
     /// Index pulses while the shaft runs backwards mark no forward frame: five revolutions in
     /// reverse (each with its index pulse) leave no missing frame, and once forward again the
     /// monitor syncs and measures.

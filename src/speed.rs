@@ -1576,18 +1576,34 @@ impl SpeedTracker {
                         }
                         self.settle_owed(t, sink);
                         if indexed && tooth != 0 && self.realigned {
-                            // Realigned at the frame before too: not a stray or lost edge but
+                            // Disagreed at the frame before too: not a stray or lost edge but
                             // another number of lines than configured (one more: the index a
-                            // tooth late every revolution). The count is given up, and from this
-                            // index it is confirmed again, which such a disc never is (missing
-                            // frames are counted, as for one line fewer).
+                            // tooth late every revolution), or a count off that the index
+                            // disagrees with again. The count is given up, a missing frame (the
+                            // window that ends here is not vouched for), and from this index it
+                            // is confirmed again, which such a disc never is (missing frames are
+                            // counted, as for one line fewer).
                             self.lose_sync(true);
+                            self.missing_frame(t, sink);
                             self.sync = SyncState::Confirming;
                             tooth = 0;
+                        } else if indexed && tooth != 1 && tooth != edges.wrapping_sub(1) {
+                            // Two teeth or more from where the count puts the frame: a stray
+                            // pulse on the index line is likelier than as many line edges
+                            // lost or gained unseen (realigned, one stray pulse framed the
+                            // count three teeth off, blamed on the line as an extra edge). A
+                            // missing frame; the count is kept, and given up if the next index
+                            // disagrees too.
+                            self.realigned = tooth != 0;
+                            frame = tooth == 0;
+                            if tooth != 0 {
+                                self.missing_frame(t, sink);
+                            }
                         } else if indexed {
                             self.realigned = tooth != 0;
                             if tooth != 0 {
-                                // The index is authoritative: count the discrepancy, realign.
+                                // One tooth off: a line edge lost or gained unseen. The index
+                                // is authoritative: count the discrepancy, realign.
                                 let ahead = tooth <= edges / 2;
                                 if ahead {
                                     self.counters.extra = self.counters.extra.wrapping_add(1);

@@ -1139,6 +1139,56 @@ fn quadrature(lines: u32, omega: f64, stops: &[f64]) -> (String, Vec<f64>, usize
     (text, turns, backwards_rising)
 }
 
+/// A shaft at rest rocking by a fraction of a pitch across A's line edge (B never changes),
+/// or across A's and B's (each changes twice a cycle): every rising edge of A comes with B
+/// saying forward (the backward crossings are edges not captured), and it read as running at
+/// a steady speed, synced, with valid windows. The quadrature count says no pitch: the
+/// captures are fed as reverse, one reversal is counted where the shaft stops running, and no
+/// valid window reaches into the rocking.
+#[test]
+fn a_shaft_rocking_across_a_line_edge_is_not_running() {
+    use host_sim::app::analyze::{Channel, Lead};
+    let rev = std::f64::consts::TAU;
+    let p = rev / 50.0;
+    for centre in [0.0, p / 8.0] {
+        // Forward to 6 revolutions (an A rising edge), then 200 swings of ±0.2 pitch about it
+        // (or about the middle between it and B's rising edge).
+        let mut stops = vec![6.0 * rev + centre + 0.2 * p];
+        for _ in 0..100 {
+            stops.extend([6.0 * rev + centre - 0.2 * p, 6.0 * rev + centre + 0.2 * p]);
+        }
+        let (text, turns, _) = quadrature(50, 40.0, &stops);
+        // Unframed (the index pulse, rocked across too at the edge of revolution 6, is left
+        // out: without the fix its missing frames would hide what is checked here).
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            direction_channel: Some(Channel::Name("B".into())),
+            forward: Some(Lead::ALeads),
+            lines: Some(50),
+            framing: Some(host_sim::app::analyze::FramingArg::None),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut reader = text_reader(text, "q.csv", None).unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        assert!(
+            r.windows.iter().any(|w| w.valid),
+            "centre {centre}: {:?}",
+            r.windows
+        );
+        for w in r.windows.iter().filter(|w| w.valid) {
+            assert!(w.end <= turns[0] + 1e-3, "centre {centre}: {w:?}");
+        }
+        assert!(r.no_pitch >= 90, "centre {centre}: {r:?}");
+        assert!(r.reversals <= 1, "centre {centre}: {:?}", r.faults);
+        let said = host_sim::app::analyze::text(&r);
+        assert!(
+            said.contains("no step forward of the quadrature count"),
+            "{said}"
+        );
+    }
+}
+
 /// A reversal on a quadrature capture: with the B channel named, the core sees the direction
 /// of every edge, counts the reversal, takes no backwards edge as a tooth and no revolution
 /// run backwards; without it every edge counts as forward.

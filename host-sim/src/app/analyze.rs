@@ -108,6 +108,48 @@ impl Lead {
     }
 }
 
+/// A ×4 quadrature count of A (the encoder channel) and B (the direction channel).
+#[derive(Debug, Default)]
+struct Quadrature {
+    count: i64,
+    at_capture: i64,
+}
+
+impl Quadrature {
+    /// Counts the step from levels `from` to `to` of A and B: one forward or backward,
+    /// none where both changed within a sample or a level is unknown.
+    fn step(&mut self, lead: Lead, from: [Level; 2], to: [Level; 2]) {
+        // The place of a pair of levels along a forward cycle.
+        let place = |[a, b]: [Level; 2]| -> Option<i64> {
+            let (a, b) = match (a, b) {
+                (Level::Unknown, _) | (_, Level::Unknown) => return None,
+                (a, b) => (a == Level::High, b == Level::High),
+            };
+            let (a, b) = if lead == Lead::ALeads { (a, b) } else { (b, a) };
+            Some(match (a, b) {
+                (false, false) => 0,
+                (true, false) => 1,
+                (true, true) => 2,
+                (false, true) => 3,
+            })
+        };
+        if let (Some(x), Some(y)) = (place(from), place(to)) {
+            match (y - x).rem_euclid(4) {
+                1 => self.count += 1,
+                3 => self.count -= 1,
+                _ => {}
+            }
+        }
+    }
+
+    /// Whether the count moved forward since the last capture (this one now the last).
+    fn moved(&mut self) -> bool {
+        let moved = self.count > self.at_capture;
+        self.at_capture = self.count;
+        moved
+    }
+}
+
 /// A decision of the core on one edge, with its capture time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Decision {
@@ -358,6 +400,10 @@ pub struct AnalyzeReport {
     pub faults: Vec<FaultOut>,
     /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
     pub reverse_edges: u64,
+    /// Of them, captures with no step forward of the quadrature count (the encoder and
+    /// direction channels) since the capture before, itself so (no pitch: a shaft rocking
+    /// across a line edge), fed as reverse.
+    pub no_pitch: u64,
     /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
     /// the last edges of the capture, waiting for the two that would confirm them, and the
     /// first edge after a standstill or a reversal (a time reference only).
@@ -633,6 +679,9 @@ pub fn analyze<R: BufRead>(
     let prescaler = u32::from(cfg.encoder.prescaler.max(1));
     let mut last_capture: Option<u32> = None;
     let mut prescaled = 0u32;
+    // The quadrature count of the encoder and direction channels, and whether the capture
+    // before the last moved it forward (the first counts as moved).
+    let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
@@ -668,7 +717,7 @@ pub fn analyze<R: BufRead>(
             prescaled = 0;
         }
         // B's level as A changes; unknown when B changed in the same sample.
-        let direction = match dch {
+        let mut direction = match dch {
             Some((d, lead)) if encoder_edge && prev[d] == levels[d] => match levels[d] {
                 Level::Low => Some(lead.direction(levels[ch] == Level::High, false)),
                 Level::High => Some(lead.direction(levels[ch] == Level::High, true)),
@@ -676,6 +725,23 @@ pub fn analyze<R: BufRead>(
             },
             _ => None,
         };
+        if let Some((d, lead)) = dch {
+            quadrature.step(lead, [prev[ch], prev[d]], [levels[ch], levels[d]]);
+            if encoder_edge {
+                // A forward pitch moves the quadrature count on by four between captures of
+                // A. A capture that is no step forward since the one before, itself so, is no
+                // pitch: the shaft rocks across a line edge (each backward crossing is an edge
+                // not captured), which read as a steady forward pulse train. Fed as reverse:
+                // no tooth, and no running until the shaft moves on. (One such capture alone
+                // is left to the core: a noise pulse just before a real edge.)
+                let moved = quadrature.moved();
+                if !moved && !moved_before {
+                    direction = Some(Direction::Reverse);
+                    report.no_pitch += 1;
+                }
+                moved_before = moved;
+            }
+        }
         if encoder_edge && dch.is_some() && direction.is_none() {
             report.direction_unknown += 1;
         }
@@ -1223,6 +1289,15 @@ pub fn text(r: &AnalyzeReport) -> String {
             s,
             "{} edge(s) running in reverse (not taken as teeth)",
             r.reverse_edges
+        );
+    }
+    if r.no_pitch > 0 {
+        let _ = writeln!(
+            s,
+            "{} of them came with no step forward of the quadrature count since the capture \
+             before, itself so: no pitch (a shaft at rest rocking across a line edge), fed as \
+             reverse",
+            r.no_pitch
         );
     }
     if r.unjudged_at_end > 0 {
