@@ -177,6 +177,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let Some(why) = &r.regime_unsettled {
         let _ = writeln!(s, "The simulated regime is unsettled: {why}");
     }
+    if let Some(swing) = &r.regime_swing {
+        let _ = writeln!(s, "The simulated regime is gathering: {swing}");
+    }
     if let Some(c) = &r.capture {
         s.push_str(&crate::app::capture::summary(c));
     }

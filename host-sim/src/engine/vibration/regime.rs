@@ -142,6 +142,37 @@ pub struct RegimeReport {
     pub rotor_speed: f64,
     /// The loads turned measurably slower than the rotor (Sommerfeld capture when gathered).
     pub lagging: bool,
+    /// The residual's range was the same in each quarter of the final window (its least and
+    /// largest values each within [`STEADY_SWING`] of its largest, every quarter sampled):
+    /// a steady motion, not one still on its way. With the residual neither balanced nor
+    /// gathered, a self-oscillation about the balancing position where that is unstable.
+    pub steady: bool,
+}
+
+/// How closely the residual's least and largest values must repeat, quarter by quarter of
+/// the final window, for its motion to be steady: this fraction of its largest value.
+pub const STEADY_SWING: f64 = 0.03;
+
+/// Whether `win`'s residual has the same least and largest values (within
+/// [`STEADY_SWING`] of the largest) in each quarter of its time span, each quarter holding
+/// samples.
+fn steady(win: &[RegimeSample], min: f64, max: f64) -> bool {
+    let (Some(a), Some(b)) = (win.first(), win.last()) else {
+        return false;
+    };
+    let span = b.t - a.t;
+    let tol = STEADY_SWING * max;
+    (0..4).all(|q| {
+        let (lo, hi) = (
+            a.t + span * q as f64 / 4.0,
+            a.t + span * (q + 1) as f64 / 4.0,
+        );
+        let part = win.iter().filter(|s| s.t >= lo && s.t <= hi);
+        let (n, pmin, pmax) = part.fold((0usize, f64::INFINITY, 0.0f64), |(n, lo, hi), s| {
+            (n + 1, lo.min(s.residual), hi.max(s.residual))
+        });
+        n >= 2 && (pmax - max).abs() <= tol && (pmin - min).abs() <= tol
+    })
 }
 
 /// Classifies a run from its samples (in time order). `None` when fewer than two samples fall
@@ -179,6 +210,7 @@ pub fn classify(samples: &[RegimeSample], c: &RegimeCriteria) -> Option<RegimeRe
         load_speed,
         rotor_speed,
         lagging: load_speed.abs() < (1.0 - c.lag_fraction) * rotor_speed.abs(),
+        steady: steady(win, residual_min, residual_max),
     })
 }
 
@@ -258,6 +290,31 @@ mod tests {
             u[1] += mr * x.sin();
         }
         u[0].hypot(u[1])
+    }
+
+    #[test]
+    fn a_swing_is_steady_only_where_it_repeats_in_every_quarter() {
+        // 100 s sampled at 100 Hz, judged over the last 25 s: a residual swinging with a
+        // period of 3.7 s between 0.05 and 0.45, then the same growing by half over the run (an eighth over the window judged).
+        let run = |growth: f64| -> Vec<RegimeSample> {
+            (0..10_000)
+                .map(|i| {
+                    let t = f64::from(i) * 0.01;
+                    let swing = 0.25 + 0.2 * (core::f64::consts::TAU * t / 3.7).sin();
+                    RegimeSample {
+                        t,
+                        residual: swing * (1.0 + growth * t / 100.0),
+                        coherence: 0.3,
+                        mean_load_angle: 80.0 * t,
+                        rotor_angle: 80.0 * t,
+                    }
+                })
+                .collect()
+        };
+        let c = RegimeCriteria::new(1.0);
+        let r = classify(&run(0.0), &c).unwrap();
+        assert!(r.steady && r.regime == Regime::Gathering && !r.gathered && !r.lagging);
+        assert!(!classify(&run(0.5), &c).unwrap().steady);
     }
 
     #[test]
