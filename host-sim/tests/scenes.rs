@@ -822,3 +822,87 @@ fn a_refused_kloss_drive_is_not_predicted_with_the_reason() {
         "{w}"
     );
 }
+
+/// A load of orders 1/3 and 1/2 repeats every 6 revolutions. The default δ window was one
+/// cycle of the lowest order (3 revolutions), which holds half of the load's cycle: `run` read
+/// δ 16 % low and raised no alarm although `predict` put δ over the limit. The window is now
+/// the load's period, and the run measures the predicted δ and raises the alarm.
+#[test]
+fn the_default_window_holds_the_whole_load_period() {
+    let scene = "[simulation]\nduration = 30\nintegrator = \"dop853\"\nrtol = 1e-10\natol = 1e-10\n\
+                 settle = 10\n[shaft]\ninertia = 0.1\n[motor]\nmodel = \"parabola\"\n\
+                 no_load_speed = 145.0\nbreakdown_speed = 36.0\nbreakdown_torque = 158.0\n\
+                 [load]\nmean = 24.0\nharmonics = [{ order = 0.3333333333333333, amplitude = 12.0 }, \
+                 { order = 0.5, amplitude = 12.0, phase = 1.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n[monitor]\ndelta_limit = 0.055\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(6)
+    );
+    assert_eq!(host_sim::app::run::window_warning(&s), None);
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.window_warning, None);
+    let predicted = p.irregularity.unwrap().delta.unwrap();
+    assert!(predicted > 0.055, "{predicted}");
+    let r = run_trial(scene);
+    let (measured, floor) = (r.delta_measured.unwrap(), r.noise_floor.unwrap());
+    assert!(
+        (measured - predicted).abs() < floor,
+        "measured {measured}, predicted {predicted}, floor {floor}"
+    );
+    assert_eq!(r.alarms.first().map(|a| a.event), Some("raised"));
+    assert_eq!(r.window_warning, None);
+    // A window the scene sets is kept.
+    let three = format!("{scene}window_revolutions = 3\n");
+    let s3 = host_sim::app::scene::Scene::parse(&three, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s3).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(3)
+    );
+}
+
+/// Load orders with no common period (1 and √2): no window holds the load's cycle. The default
+/// window is one cycle of the lowest order, and `predict` and `run` say so, naming the orders
+/// and the window; a window the scene sets is not warned about.
+#[test]
+fn a_load_without_a_common_period_warns_of_its_window() {
+    let scene = "[simulation]\nduration = 2\n[shaft]\ninertia = 0.2\n[motor]\nmodel = \"kloss\"\n\
+                 synchronous_speed = 157.08\nbreakdown_slip = 0.2\nbreakdown_torque = 100.0\n\
+                 [load]\nmean = 90.0\nharmonics = [{ order = 1.0, amplitude = 5.0 }, \
+                 { order = 1.4142135623730951, amplitude = 5.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n[monitor]\ndelta_limit = 0.003\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::LoadOrder(1.0)
+    );
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let w = p.window_warning.clone().unwrap();
+    assert!(
+        w.starts_with("WARNING: the load's orders 1, 1.414214 have no common period")
+            && w.contains("lowest order 1 (1 revolution)")
+            && w.contains("δ may be read low"),
+        "{w}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(text.contains(&w), "{text}");
+    let r = run_trial(scene);
+    assert_eq!(r.window_warning.as_deref(), Some(w.as_str()));
+    assert!(host_sim::app::report::run_text(&s, &r).contains(&w));
+    let set = format!("{scene}window_revolutions = 70\n");
+    let s70 = host_sim::app::scene::Scene::parse(&set, path).unwrap();
+    assert_eq!(host_sim::app::run::window_warning(&s70), None);
+    // Orders whose common period is longer than the longest window: said as well.
+    let long = scene
+        .replace("order = 1.0,", "order = 0.0009775171065493646,")
+        .replace("1.4142135623730951", "0.0009794319294809011");
+    let sl = host_sim::app::scene::Scene::parse(&long, path).unwrap();
+    let wl = host_sim::app::run::window_warning(&sl).unwrap_or_default();
+    assert!(
+        wl.contains("repeat only every 1044483 revolutions") && wl.contains("(1023 revolutions)"),
+        "{wl}"
+    );
+}

@@ -782,6 +782,10 @@ pub struct Prediction {
     /// ([`irregularity_not_predicted`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub irregularity_not_predicted: Option<String>,
+    /// The δ monitor's default window cannot hold the load's whole period
+    /// ([`crate::app::run::window_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub window_warning: Option<String>,
     /// Support unbalances and limits (scenes with a rotor).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsOut>,
@@ -795,6 +799,7 @@ impl Prediction {
     pub fn is_empty(&self) -> bool {
         self.irregularity.is_none()
             && self.irregularity_not_predicted.is_none()
+            && self.window_warning.is_none()
             && self.supports.is_none()
             && self.autobalancer.is_none()
     }
@@ -831,6 +836,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let model = drive_model(scene, file)?;
     if model.is_some() || scene.motor.is_some() {
         p.irregularity_not_predicted = irregularity_not_predicted(scene);
+        p.window_warning = crate::app::run::window_warning(scene);
     }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);

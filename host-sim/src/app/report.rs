@@ -90,6 +90,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         if let Some(w) = r.speed_measured {
             let _ = writeln!(s, "  mean speed {w:.3} rad/s");
         }
+        if let Some(w) = &r.window_warning {
+            let _ = writeln!(s, "  {w}");
+        }
         match (r.delta_measured, r.delta_predicted) {
             (Some(m), Some(p)) => {
                 // The speed samples average away more than 1 % of the predicted δ: say what
@@ -548,6 +551,9 @@ pub fn prediction_text(p: &Prediction) -> String {
     }
     if let Some(why) = &p.irregularity_not_predicted {
         let _ = writeln!(s, "Running irregularity NOT PREDICTED: {why}");
+    }
+    if let Some(w) = &p.window_warning {
+        let _ = writeln!(s, "  {w}");
     }
     if let Some(u) = &p.supports {
         let _ = writeln!(s, "Support unbalance (seed 002) and limits (ISO 21940-11)");
