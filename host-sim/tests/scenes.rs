@@ -699,7 +699,7 @@ fn a_kloss_prediction_says_it_uses_the_kloss_curve() {
         text.contains("seed 000 eq. 1 with the Kloss curve)"),
         "{text}"
     );
-    // Orders 1 and √2: no common period, the tangent parabola's bound.
+    // Orders 1 and √2: no common period, the tangent parabola's prediction.
     let scene = scene.replace(
         "harmonics = [{ order = 0.125, amplitude = 12.0, phase = 0.0 }]",
         "harmonics = [{ order = 1.0, amplitude = 6.0, phase = 0.0 }, \
@@ -905,4 +905,52 @@ fn a_load_without_a_common_period_warns_of_its_window() {
         wl.contains("repeat only every 1044483 revolutions") && wl.contains("(1023 revolutions)"),
         "{wl}"
     );
+}
+
+/// A heavily loaded Kloss drive (ω_s 157.08 rad/s, σ_m 0.2, M_m 100 N·m, mean load 90 N·m)
+/// with load orders 1 and √2, which have no common period: the prediction goes through the
+/// tangent parabola at synchronous speed, and that is no bound for the Kloss drive. `run`
+/// integrates the curve itself; with 70-revolution windows (√2·70 is within 1e-4 of a whole
+/// number of cycles) it measures δ 8.7 % over the prediction at a mean speed below the
+/// predicted ω min, and with the flywheel the prediction sizes for δ 0.003 it measures δ over
+/// 0.003. The note says the prediction is no bound.
+#[test]
+fn the_tangent_parabola_is_no_bound_for_a_kloss_drive() {
+    let scene = |flywheel: f64| {
+        format!(
+            "[simulation]\nduration = 30\nintegrator = \"dop853\"\nrtol = 1e-11\natol = 1e-12\n\
+             settle = 15\n[shaft]\ninertia = 0.2\nflywheel = {flywheel}\n[motor]\n\
+             model = \"kloss\"\nsynchronous_speed = 157.08\nbreakdown_slip = 0.2\n\
+             breakdown_torque = 100.0\n[load]\nmean = 90.0\n\
+             harmonics = [{{ order = 1.0, amplitude = 5.0 }}, \
+             {{ order = 1.4142135623730951, amplitude = 5.0 }}]\n\
+             [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n\
+             [monitor]\ndelta_limit = 0.003\nwindow_revolutions = 70\n"
+        )
+    };
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(&scene(0.0), path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let i = p.irregularity.unwrap();
+    let (predicted, omega_min) = (i.delta.unwrap(), i.omega_min.unwrap());
+    assert!((predicted - 0.004152).abs() < 5e-7, "{predicted}");
+    assert!((omega_min - 141.946).abs() < 1e-3, "{omega_min}");
+    let note = i.motor_note.unwrap();
+    assert!(
+        note.contains("no bound for the Kloss drive") && note.contains("its δ can be larger"),
+        "{note}"
+    );
+    let flywheel = i.flywheel_for_limit.unwrap().unwrap();
+    assert!((flywheel - 0.0789).abs() < 1e-4, "{flywheel}");
+    let r = run_trial(&scene(0.0));
+    let (measured, mean) = (r.delta_measured.unwrap(), r.speed_measured.unwrap());
+    assert!(
+        (measured / predicted - 1.087).abs() < 0.005,
+        "measured {measured}, predicted {predicted}"
+    );
+    assert!((mean - 137.39).abs() < 0.01, "{mean}");
+    // With the flywheel the prediction sizes for the limit: δ still over it.
+    let r = run_trial(&scene(flywheel));
+    let measured = r.delta_measured.unwrap();
+    assert!((measured - 0.003249).abs() < 1e-5, "{measured}");
 }

@@ -84,9 +84,14 @@ pub enum Horizon {
         samples: u32,
     },
     /// Orders with no common period (not rationals with denominators ≤ [`MAX_DENOMINATOR`]) or
-    /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k`. That is the exact
-    /// supremum over an unbounded horizon for rationally independent orders (Kronecker), and a
-    /// conservative bound (δ too large, flywheel too big) for commensurate ones.
+    /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k` of the parabola
+    /// motor. For that motor it is the exact supremum over an unbounded horizon for rationally
+    /// independent orders (Kronecker), and a conservative bound (δ too large, flywheel too big)
+    /// for commensurate ones. A Kloss motor has no periodic solution to shoot for here and is
+    /// predicted through its tangent parabola at synchronous speed, which is no bound for it:
+    /// at a loaded drive's slip the curve lies below the parabola and is flatter in `w = J·ω²`,
+    /// so the drive runs slower than predicted and its δ can be larger (the flywheel sized from
+    /// it too small).
     Unbounded,
     /// The inertia depends on φ ([`DriveModel::with_inertia_harmonics`]): the periodic
     /// solution of eq. 1 in `w = J·ω²` over one common period of the load and inertia orders,

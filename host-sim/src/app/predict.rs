@@ -646,9 +646,11 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
 /// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
 /// step count. Without one (no periodic solution exists: `Horizon::Unbounded`) the Kloss curve
 /// is replaced by its tangent parabola at synchronous speed (exact there, above the curve
-/// towards breakdown) for the conservative bound, and the note says that, with the largest
-/// difference between the two over the predicted speeds `[omega_min, omega_max]` (65 points),
-/// in N·m and in % of the curve's torque there. `None` for a parabola motor.
+/// towards breakdown), and the note says that, with the largest difference between the two
+/// over the predicted speeds `[omega_min, omega_max]` (65 points), in N·m and in % of the
+/// curve's torque there, and that this is no bound for the Kloss drive: the curve is softer
+/// at a loaded drive's slip, so the drive runs slower and its δ can be larger than predicted.
+/// `None` for a parabola motor.
 pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
     use drive_monitor::drive::Horizon;
     let motor = model.motor();
@@ -679,8 +681,12 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
         p.a(),
         p.b()
     );
+    let caveat = "; this is no bound for the Kloss drive: at a loaded drive's slip the curve \
+                  lies below the parabola and is softer, so the drive runs slower than \
+                  predicted and its δ can be larger (the flywheel too small); `run` with a \
+                  `[monitor] window_revolutions` of many load cycles measures it";
     if !(omega_min > 0.0 && omega_max >= omega_min) {
-        return Some(head);
+        return Some(format!("{head}{caveat}"));
     }
     let (mut worst, mut at) = (0.0f64, omega_min);
     for i in 0..=64 {
@@ -701,7 +707,7 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
     };
     Some(format!(
         "{head}: over the predicted speeds the parabola differs from the curve by at most \
-         {worst:+.4} N·m at {at:.3} rad/s{share}"
+         {worst:+.4} N·m at {at:.3} rad/s{share}{caveat}"
     ))
 }
 
