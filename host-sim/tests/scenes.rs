@@ -954,3 +954,66 @@ fn the_tangent_parabola_is_no_bound_for_a_kloss_drive() {
     let measured = r.delta_measured.unwrap();
     assert!((measured - 0.003249).abs() < 1e-5, "{measured}");
 }
+
+/// The auger's rotor (service speed 60 rad/s, load limits 2420 / 8000 N here) driven by a Kloss
+/// motor whose predicted steady state reaches ω max 150.874 rad/s. `predict` judged the
+/// supports at the service speed only ("warning, normal") with nothing said of its own drive
+/// running 2.5× faster; `run` judged them at its window's ω max: support A over its limit.
+/// `predict` now judges them at the predicted ω max too (2402.0 + 1.4e-3·150.874² = 2433.9 N
+/// at A: over) and gives the same WARNING as `run` about the service speed.
+#[test]
+fn predict_judges_the_supports_at_its_own_drive_speed() {
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    let prescribed = "model = \"speed\"\nspeed = 60.0              # rad/s, prescribed\n";
+    assert!(auger.contains(prescribed));
+    let scene = auger.replace(
+        prescribed,
+        "model = \"kloss\"\nsynchronous_speed = 157.08\nbreakdown_slip = 0.2\n\
+         breakdown_torque = 100.0\n[shaft]\ninertia = 0.05\n[load]\nmean = 60.0\n\
+         harmonics = [{ order = 1.0, amplitude = 40.0 }]\n",
+    );
+    let scene = scene.replacen(
+        "support_load_limit = [8000.0, 8000.0]",
+        "support_load_limit = [2420.0, 8000.0]",
+        1,
+    );
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(&scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let omega_max = p.irregularity.as_ref().unwrap().omega_max.unwrap();
+    assert!((omega_max - 150.874).abs() < 1e-3, "{omega_max}");
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!(u.load_level, Some(["warning", "normal"]));
+    assert_eq!(u.predicted_speed, Some(omega_max));
+    let peak = u.peak_load_at_predicted_speed.unwrap();
+    let by_hand = 2402.0 + 1.4e-3 * omega_max * omega_max;
+    assert!(
+        (peak[0] - by_hand).abs() < 0.1,
+        "{} against {by_hand}",
+        peak[0]
+    );
+    assert_eq!(u.load_level_at_predicted_speed, Some(["over", "normal"]));
+    let w = u.above_service_speed.as_deref().unwrap();
+    assert!(
+        w.contains("runs at 150.87 rad/s, above the service speed 60 rad/s"),
+        "{w}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(
+            "at the predicted ω max 150.87 rad/s: peak A 2433.8 N, B 2244.0 N (over, normal)"
+        ) && text.contains(w),
+        "{text}"
+    );
+    // `run` judges the same way at its window's ω max.
+    let r = run_trial(&scene);
+    assert_eq!(r.supports.unwrap().load_level, ["over", "normal"]);
+    // Without a drive there is no predicted speed: the service speed alone, as before.
+    let s = host_sim::app::scene::Scene::parse(auger, path).unwrap();
+    let u = host_sim::app::predict::predict(&s, path)
+        .unwrap()
+        .supports
+        .unwrap();
+    assert_eq!(u.predicted_speed, None);
+    assert_eq!(u.above_service_speed, None);
+}

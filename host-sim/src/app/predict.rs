@@ -733,6 +733,20 @@ pub struct SupportsOut {
     pub unbalance_level: [&'static str; 2],
     /// Each peak load at the service speed against `support_load_limit` (null without).
     pub load_level: Option<[&'static str; 2]>,
+    /// The predicted drive's ω max, rad/s, where the supports are judged as `run` judges them
+    /// at its window's ω max (absent without a predicted steady state of the drive).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_speed: Option<f64>,
+    /// Peak support loads over one turn at `predicted_speed`, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_load_at_predicted_speed: Option<[f64; 2]>,
+    /// Each peak load at `predicted_speed` against `support_load_limit`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load_level_at_predicted_speed: Option<[&'static str; 2]>,
+    /// The WARNING when `predicted_speed` is above the service speed
+    /// ([`crate::app::run::above_service_speed`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub above_service_speed: Option<String>,
     /// How the permissible unbalance was allotted to the planes: "inboard" (ISO 21940-11's
     /// lever rule, shares held within 30–70 %) or "overhung" (this product's rule:
     /// `supports::Allocation::Overhung`).
@@ -932,6 +946,15 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let a = analysis(scene, &rotor, &limits, file)?;
         let r = a.report();
         let loads = rotor.loads(limits.service_speed());
+        // The drive's own prediction puts the shaft at up to ω max: judged there too, as `run`
+        // judges at its window's ω max.
+        let predicted_speed = p.irregularity.as_ref().and_then(|i| i.omega_max);
+        let at_predicted = predicted_speed.map(|w| rotor.loads(w));
+        let load_level_at = |loads: [drive_monitor::supports::LoadRange; 2]| {
+            limits
+                .support_load_limit()
+                .map(|l| [0, 1].map(|i| level_of(loads[i].peak, limits.warning_fraction(), l[i])))
+        };
         p.supports = Some(SupportsOut {
             unbalance_a: r.unbalance_a,
             unbalance_b: r.unbalance_b,
@@ -944,9 +967,12 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 level_of(r.unbalance_a, limits.warning_fraction(), r.permissible_a),
                 level_of(r.unbalance_b, limits.warning_fraction(), r.permissible_b),
             ],
-            load_level: limits
-                .support_load_limit()
-                .map(|l| [0, 1].map(|i| level_of(loads[i].peak, limits.warning_fraction(), l[i]))),
+            load_level: load_level_at(loads),
+            predicted_speed,
+            peak_load_at_predicted_speed: at_predicted.map(|l| [l[0].peak, l[1].peak]),
+            load_level_at_predicted_speed: at_predicted.and_then(load_level_at),
+            above_service_speed: predicted_speed
+                .and_then(|w| crate::app::run::above_service_speed(w, limits.service_speed())),
             allocation: match a.permissible.allocation {
                 drive_monitor::supports::Allocation::Inboard => "inboard",
                 drive_monitor::supports::Allocation::Overhung => "overhung",

@@ -595,6 +595,19 @@ pub fn prediction_text(p: &Prediction) -> String {
                 let _ = writeln!(s, "  maximum safe speed: not limited by the support loads");
             }
         }
+        if let (Some(w), Some(peak)) = (u.predicted_speed, u.peak_load_at_predicted_speed) {
+            let _ = writeln!(
+                s,
+                "  at the predicted ω max {w:.2} rad/s: peak A {} N, B {} N{}",
+                fmt_force(peak[0]),
+                fmt_force(peak[1]),
+                u.load_level_at_predicted_speed
+                    .map_or(String::new(), |l| format!(" ({}, {})", l[0], l[1]))
+            );
+        }
+        if let Some(w) = &u.above_service_speed {
+            let _ = writeln!(s, "  {w}");
+        }
     }
     if let Some(a) = &p.autobalancer {
         let _ = writeln!(s, "Auto-balancer regimes (seed 001)");
