@@ -35,11 +35,17 @@ pub const MAX_WINDOW_REVS: u16 = 1024;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum WindowLength {
-    /// A fixed number of revolutions.
+    /// A fixed number of revolutions. For a load of several orders, their common period:
+    /// [`crate::drive::period_revolutions`] (or [`crate::drive::DriveModel::period_revolutions`]).
     Revolutions(u16),
-    /// The load's lowest order (cycles per revolution, e.g. 0.125 for one load cycle per 8
+    /// One load order (cycles per revolution, e.g. 0.125 for one load cycle per 8
     /// revolutions). The window is the smallest whole number of revolutions holding a whole
-    /// number of load cycles (order within 1e-4 relative of a fraction with denominator ≤ 1024).
+    /// number of its cycles (order within 1e-4 relative of a fraction with denominator ≤ 1024).
+    /// That is the load's period when the load has this one order, or when every other order
+    /// is a whole multiple of it: for other loads give their fundamental order (1/6 for orders
+    /// 1/3 and 1/2, which repeat every 6 revolutions), or their period as
+    /// [`Revolutions`](Self::Revolutions). A window of the lowest order alone is shorter than
+    /// such a load's period and reads δ low.
     LoadOrder(f64),
 }
 

@@ -699,7 +699,7 @@ fn a_kloss_prediction_says_it_uses_the_kloss_curve() {
         text.contains("seed 000 eq. 1 with the Kloss curve)"),
         "{text}"
     );
-    // Orders 1 and √2: no common period, the tangent parabola's bound.
+    // Orders 1 and √2: no common period, the tangent parabola's prediction.
     let scene = scene.replace(
         "harmonics = [{ order = 0.125, amplitude = 12.0, phase = 0.0 }]",
         "harmonics = [{ order = 1.0, amplitude = 6.0, phase = 0.0 }, \
@@ -821,4 +821,199 @@ fn a_refused_kloss_drive_is_not_predicted_with_the_reason() {
         w.contains("runs past the Kloss curve's breakdown point"),
         "{w}"
     );
+}
+
+/// A load of orders 1/3 and 1/2 repeats every 6 revolutions. The default δ window was one
+/// cycle of the lowest order (3 revolutions), which holds half of the load's cycle: `run` read
+/// δ 16 % low and raised no alarm although `predict` put δ over the limit. The window is now
+/// the load's period, and the run measures the predicted δ and raises the alarm.
+#[test]
+fn the_default_window_holds_the_whole_load_period() {
+    let scene = "[simulation]\nduration = 30\nintegrator = \"dop853\"\nrtol = 1e-10\natol = 1e-10\n\
+                 settle = 10\n[shaft]\ninertia = 0.1\n[motor]\nmodel = \"parabola\"\n\
+                 no_load_speed = 145.0\nbreakdown_speed = 36.0\nbreakdown_torque = 158.0\n\
+                 [load]\nmean = 24.0\nharmonics = [{ order = 0.3333333333333333, amplitude = 12.0 }, \
+                 { order = 0.5, amplitude = 12.0, phase = 1.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n[monitor]\ndelta_limit = 0.055\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(6)
+    );
+    assert_eq!(host_sim::app::run::window_warning(&s), None);
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.window_warning, None);
+    let predicted = p.irregularity.unwrap().delta.unwrap();
+    assert!(predicted > 0.055, "{predicted}");
+    let r = run_trial(scene);
+    let (measured, floor) = (r.delta_measured.unwrap(), r.noise_floor.unwrap());
+    assert!(
+        (measured - predicted).abs() < floor,
+        "measured {measured}, predicted {predicted}, floor {floor}"
+    );
+    assert_eq!(r.alarms.first().map(|a| a.event), Some("raised"));
+    assert_eq!(r.window_warning, None);
+    // A window the scene sets is kept.
+    let three = format!("{scene}window_revolutions = 3\n");
+    let s3 = host_sim::app::scene::Scene::parse(&three, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s3).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(3)
+    );
+}
+
+/// Load orders with no common period (1 and √2): no window holds the load's cycle. The default
+/// window is one cycle of the lowest order, and `predict` and `run` say so, naming the orders
+/// and the window; a window the scene sets is not warned about.
+#[test]
+fn a_load_without_a_common_period_warns_of_its_window() {
+    let scene = "[simulation]\nduration = 2\n[shaft]\ninertia = 0.2\n[motor]\nmodel = \"kloss\"\n\
+                 synchronous_speed = 157.08\nbreakdown_slip = 0.2\nbreakdown_torque = 100.0\n\
+                 [load]\nmean = 90.0\nharmonics = [{ order = 1.0, amplitude = 5.0 }, \
+                 { order = 1.4142135623730951, amplitude = 5.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n[monitor]\ndelta_limit = 0.003\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::LoadOrder(1.0)
+    );
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let w = p.window_warning.clone().unwrap();
+    assert!(
+        w.starts_with("WARNING: the load's orders 1, 1.414214 have no common period")
+            && w.contains("lowest order 1 (1 revolution)")
+            && w.contains("δ may be read low"),
+        "{w}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(text.contains(&w), "{text}");
+    let r = run_trial(scene);
+    assert_eq!(r.window_warning.as_deref(), Some(w.as_str()));
+    assert!(host_sim::app::report::run_text(&s, &r).contains(&w));
+    let set = format!("{scene}window_revolutions = 70\n");
+    let s70 = host_sim::app::scene::Scene::parse(&set, path).unwrap();
+    assert_eq!(host_sim::app::run::window_warning(&s70), None);
+    // Orders whose common period is longer than the longest window: said as well.
+    let long = scene
+        .replace("order = 1.0,", "order = 0.0009775171065493646,")
+        .replace("1.4142135623730951", "0.0009794319294809011");
+    let sl = host_sim::app::scene::Scene::parse(&long, path).unwrap();
+    let wl = host_sim::app::run::window_warning(&sl).unwrap_or_default();
+    assert!(
+        wl.contains("repeat only every 1044483 revolutions") && wl.contains("(1023 revolutions)"),
+        "{wl}"
+    );
+}
+
+/// A heavily loaded Kloss drive (ω_s 157.08 rad/s, σ_m 0.2, M_m 100 N·m, mean load 90 N·m)
+/// with load orders 1 and √2, which have no common period: the prediction goes through the
+/// tangent parabola at synchronous speed, and that is no bound for the Kloss drive. `run`
+/// integrates the curve itself; with 70-revolution windows (√2·70 is within 1e-4 of a whole
+/// number of cycles) it measures δ 8.7 % over the prediction at a mean speed below the
+/// predicted ω min, and with the flywheel the prediction sizes for δ 0.003 it measures δ over
+/// 0.003. The note says the prediction is no bound.
+#[test]
+fn the_tangent_parabola_is_no_bound_for_a_kloss_drive() {
+    let scene = |flywheel: f64| {
+        format!(
+            "[simulation]\nduration = 30\nintegrator = \"dop853\"\nrtol = 1e-11\natol = 1e-12\n\
+             settle = 15\n[shaft]\ninertia = 0.2\nflywheel = {flywheel}\n[motor]\n\
+             model = \"kloss\"\nsynchronous_speed = 157.08\nbreakdown_slip = 0.2\n\
+             breakdown_torque = 100.0\n[load]\nmean = 90.0\n\
+             harmonics = [{{ order = 1.0, amplitude = 5.0 }}, \
+             {{ order = 1.4142135623730951, amplitude = 5.0 }}]\n\
+             [encoder]\nlines = 1024\ntimer_hz = 84000000.0\n\
+             [monitor]\ndelta_limit = 0.003\nwindow_revolutions = 70\n"
+        )
+    };
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(&scene(0.0), path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let i = p.irregularity.unwrap();
+    let (predicted, omega_min) = (i.delta.unwrap(), i.omega_min.unwrap());
+    assert!((predicted - 0.004152).abs() < 5e-7, "{predicted}");
+    assert!((omega_min - 141.946).abs() < 1e-3, "{omega_min}");
+    let note = i.motor_note.unwrap();
+    assert!(
+        note.contains("no bound for the Kloss drive") && note.contains("its δ can be larger"),
+        "{note}"
+    );
+    let flywheel = i.flywheel_for_limit.unwrap().unwrap();
+    assert!((flywheel - 0.0789).abs() < 1e-4, "{flywheel}");
+    let r = run_trial(&scene(0.0));
+    let (measured, mean) = (r.delta_measured.unwrap(), r.speed_measured.unwrap());
+    assert!(
+        (measured / predicted - 1.087).abs() < 0.005,
+        "measured {measured}, predicted {predicted}"
+    );
+    assert!((mean - 137.39).abs() < 0.01, "{mean}");
+    // With the flywheel the prediction sizes for the limit: δ still over it.
+    let r = run_trial(&scene(flywheel));
+    let measured = r.delta_measured.unwrap();
+    assert!((measured - 0.003249).abs() < 1e-5, "{measured}");
+}
+
+/// The auger's rotor (service speed 60 rad/s, load limits 2420 / 8000 N here) driven by a Kloss
+/// motor whose predicted steady state reaches ω max 150.874 rad/s. `predict` judged the
+/// supports at the service speed only ("warning, normal") with nothing said of its own drive
+/// running 2.5× faster; `run` judged them at its window's ω max: support A over its limit.
+/// `predict` now judges them at the predicted ω max too (2402.0 + 1.4e-3·150.874² = 2433.9 N
+/// at A: over) and gives the same WARNING as `run` about the service speed.
+#[test]
+fn predict_judges_the_supports_at_its_own_drive_speed() {
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    let prescribed = "model = \"speed\"\nspeed = 60.0              # rad/s, prescribed\n";
+    assert!(auger.contains(prescribed));
+    let scene = auger.replace(
+        prescribed,
+        "model = \"kloss\"\nsynchronous_speed = 157.08\nbreakdown_slip = 0.2\n\
+         breakdown_torque = 100.0\n[shaft]\ninertia = 0.05\n[load]\nmean = 60.0\n\
+         harmonics = [{ order = 1.0, amplitude = 40.0 }]\n",
+    );
+    let scene = scene.replacen(
+        "support_load_limit = [8000.0, 8000.0]",
+        "support_load_limit = [2420.0, 8000.0]",
+        1,
+    );
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(&scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let omega_max = p.irregularity.as_ref().unwrap().omega_max.unwrap();
+    assert!((omega_max - 150.874).abs() < 1e-3, "{omega_max}");
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!(u.load_level, Some(["warning", "normal"]));
+    assert_eq!(u.predicted_speed, Some(omega_max));
+    let peak = u.peak_load_at_predicted_speed.unwrap();
+    let by_hand = 2402.0 + 1.4e-3 * omega_max * omega_max;
+    assert!(
+        (peak[0] - by_hand).abs() < 0.1,
+        "{} against {by_hand}",
+        peak[0]
+    );
+    assert_eq!(u.load_level_at_predicted_speed, Some(["over", "normal"]));
+    let w = u.above_service_speed.as_deref().unwrap();
+    assert!(
+        w.contains("runs at 150.87 rad/s, above the service speed 60 rad/s"),
+        "{w}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(
+            "at the predicted ω max 150.87 rad/s: peak A 2433.8 N, B 2244.0 N (over, normal)"
+        ) && text.contains(w),
+        "{text}"
+    );
+    // `run` judges the same way at its window's ω max.
+    let r = run_trial(&scene);
+    assert_eq!(r.supports.unwrap().load_level, ["over", "normal"]);
+    // Without a drive there is no predicted speed: the service speed alone, as before.
+    let s = host_sim::app::scene::Scene::parse(auger, path).unwrap();
+    let u = host_sim::app::predict::predict(&s, path)
+        .unwrap()
+        .supports
+        .unwrap();
+    assert_eq!(u.predicted_speed, None);
+    assert_eq!(u.above_service_speed, None);
 }

@@ -84,9 +84,14 @@ pub enum Horizon {
         samples: u32,
     },
     /// Orders with no common period (not rationals with denominators ≤ [`MAX_DENOMINATOR`]) or
-    /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k`. That is the exact
-    /// supremum over an unbounded horizon for rationally independent orders (Kronecker), and a
-    /// conservative bound (δ too large, flywheel too big) for commensurate ones.
+    /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k` of the parabola
+    /// motor. For that motor it is the exact supremum over an unbounded horizon for rationally
+    /// independent orders (Kronecker), and a conservative bound (δ too large, flywheel too big)
+    /// for commensurate ones. A Kloss motor has no periodic solution to shoot for here and is
+    /// predicted through its tangent parabola at synchronous speed, which is no bound for it:
+    /// at a loaded drive's slip the curve lies below the parabola and is flatter in `w = J·ω²`,
+    /// so the drive runs slower than predicted and its δ can be larger (the flywheel sized from
+    /// it too small).
     Unbounded,
     /// The inertia depends on φ ([`DriveModel::with_inertia_harmonics`]): the periodic
     /// solution of eq. 1 in `w = J·ω²` over one common period of the load and inertia orders,
@@ -643,6 +648,13 @@ impl DriveModel {
             steps,
         );
         Some((shooter, shot))
+    }
+
+    /// The load's period in whole revolutions, the δ window its monitor needs: the
+    /// [`period_revolutions`] of every load harmonic that is there (order and amplitude
+    /// non-zero) and every inertia harmonic, the orders the periodic solution repeats over.
+    pub fn period_revolutions(&self) -> Option<u64> {
+        whole_revolutions(self.periodic_orders())
     }
 
     /// The orders the periodic solution has to repeat over: every load harmonic that is
@@ -1581,6 +1593,27 @@ fn horizon(components: &[Component]) -> Horizon {
 /// how many cycles of the fastest one it holds; `None` without one, or when it holds more than
 /// `MAX_SAMPLES/SAMPLES_PER_CYCLE` cycles, or with no orders at all.
 fn common_period(orders: impl Iterator<Item = f64> + Clone) -> Option<(f64, u64)> {
+    let Multiples { q_all, g, m_max } = multiples(orders)?;
+    if m_max / g > MAX_SAMPLES / SAMPLES_PER_CYCLE {
+        return None;
+    }
+    Some((2.0 * PI * q_all as f64 / g as f64, m_max / g))
+}
+
+/// Orders `n_k = m_k/Q` as whole multiples of `1/Q` (see [`horizon`]).
+struct Multiples {
+    /// `Q`, the lcm of the orders' denominators: the smallest whole number of revolutions
+    /// that holds a whole number of cycles of every order.
+    q_all: u64,
+    /// `G = gcd(m_k)`: the common period is `Q/G` revolutions.
+    g: u64,
+    /// `max(m_k)`.
+    m_max: u64,
+}
+
+/// `orders` as [`Multiples`]; `None` with no orders at all, when one is not a rational with
+/// denominator ≤ [`MAX_DENOMINATOR`], or when `Q` or an `m_k` overflows.
+fn multiples(orders: impl Iterator<Item = f64> + Clone) -> Option<Multiples> {
     let mut q_all: u64 = 1;
     let mut any = false;
     for o in orders.clone() {
@@ -1598,8 +1631,30 @@ fn common_period(orders: impl Iterator<Item = f64> + Clone) -> Option<(f64, u64)
         g = gcd(g, m);
         m_max = m_max.max(m);
     }
-    if g == 0 || m_max / g > MAX_SAMPLES / SAMPLES_PER_CYCLE {
-        return None;
+    (g != 0).then_some(Multiples { q_all, g, m_max })
+}
+
+/// The load's period in whole revolutions: the smallest whole number of revolutions that holds
+/// a whole number of cycles of every one of `orders` (cycles per revolution), the lcm of their
+/// denominators. That is the δ window a monitor needs
+/// ([`WindowLength::Revolutions`](crate::irregularity::WindowLength::Revolutions)): δ is
+/// defined over the whole load period, and a window of one cycle of the lowest order alone
+/// reads it low (orders 1/3 and 1/2 repeat every 6 revolutions, not 3). The orders are
+/// recognised as the prediction recognises them (rationals with denominator ≤
+/// [`MAX_DENOMINATOR`]); an order 0 (a constant) holds any window, and `1` is returned
+/// without any other. `None` when the orders have no common period (1 and √2) or it
+/// overflows `u64`. The result may exceed
+/// [`MAX_WINDOW_REVS`](crate::irregularity::MAX_WINDOW_REVS), the longest window the monitor
+/// takes.
+pub fn period_revolutions(orders: &[f64]) -> Option<u64> {
+    whole_revolutions(orders.iter().copied())
+}
+
+/// [`period_revolutions`] of an iterator.
+fn whole_revolutions(orders: impl Iterator<Item = f64> + Clone) -> Option<u64> {
+    let oscillating = orders.map(libm::fabs).filter(|o| *o != 0.0);
+    if oscillating.clone().next().is_none() {
+        return Some(1);
     }
-    Some((2.0 * PI * q_all as f64 / g as f64, m_max / g))
+    multiples(oscillating).map(|m| m.q_all)
 }

@@ -482,6 +482,37 @@ fn sensitivities_match_central_differences() {
     assert!(rel(steady(&a).delta, steady(&b).delta) < 1e-14);
 }
 
+/// The load's period in whole revolutions is the lcm of the orders' denominators: the window
+/// a monitor needs, not one cycle of the lowest order.
+#[test]
+fn period_in_revolutions() {
+    assert_eq!(period_revolutions(&[1.0 / 3.0, 0.5]), Some(6));
+    assert_eq!(period_revolutions(&[0.125, 0.5]), Some(8));
+    assert_eq!(period_revolutions(&[2.0 / 3.0, 0.75]), Some(12));
+    // Common period 1.5 revolutions: 3 whole revolutions hold two of it.
+    assert_eq!(period_revolutions(&[2.0 / 3.0, 4.0 / 3.0]), Some(3));
+    // Too many samples for the prediction's extrema (`Horizon::Unbounded`), a short window.
+    assert_eq!(period_revolutions(&[3000.0, 0.125]), Some(8));
+    assert_eq!(period_revolutions(&[1.0, 2f64.sqrt()]), None);
+    assert_eq!(period_revolutions(&[]), Some(1));
+    assert_eq!(period_revolutions(&[0.0, -0.25]), Some(4));
+    assert_eq!(
+        period_revolutions(&[1.0 / 1023.0, 1.0 / 1021.0]),
+        Some(1023 * 1021)
+    );
+    // The model's: harmonics that are there, and the inertia's orders.
+    let m = drive(
+        &[h(1.0 / 3.0, 12.0, 0.0), h(0.5, 12.0, 1.0), h(0.2, 0.0, 0.0)],
+        J,
+    );
+    assert_eq!(m.period_revolutions(), Some(6));
+    let v = drive(&[h(0.5, 12.0, 0.0)], J)
+        .with_inertia_harmonics(&[ih(1.0 / 3.0, 0.01, 0.0)])
+        .unwrap();
+    assert_eq!(v.period_revolutions(), Some(6));
+    assert_eq!(drive(&[], J).period_revolutions(), Some(1));
+}
+
 #[test]
 fn horizons() {
     let period = |orders: &[f64]| {

@@ -40,8 +40,11 @@ pub const SAMPLE_EDGES: u16 = 16;
 /// Slowest speed still counted as running, rad/s.
 pub const MIN_SPEED: f64 = 1.0;
 
-/// The load's lowest order: one load cycle per 8 revolutions (the seed's kneader), so a δ
-/// window spans 8 revolutions.
+/// The load's fundamental order: one load cycle per 8 revolutions (the seed's kneader, whose
+/// load has this one order), so a δ window spans 8 revolutions. For a load of several orders
+/// this is the largest order each of them is a whole multiple of (1/6 for orders 1/3 and 1/2,
+/// which repeat every 6 revolutions), not the lowest: a window of the lowest order's cycle
+/// alone reads δ low (`drive_monitor::drive::period_revolutions` gives the period).
 pub const LOAD_ORDER: f64 = 0.125;
 
 /// Permissible δ.

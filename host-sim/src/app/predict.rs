@@ -646,9 +646,11 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
 /// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
 /// step count. Without one (no periodic solution exists: `Horizon::Unbounded`) the Kloss curve
 /// is replaced by its tangent parabola at synchronous speed (exact there, above the curve
-/// towards breakdown) for the conservative bound, and the note says that, with the largest
-/// difference between the two over the predicted speeds `[omega_min, omega_max]` (65 points),
-/// in N·m and in % of the curve's torque there. `None` for a parabola motor.
+/// towards breakdown), and the note says that, with the largest difference between the two
+/// over the predicted speeds `[omega_min, omega_max]` (65 points), in N·m and in % of the
+/// curve's torque there, and that this is no bound for the Kloss drive: the curve is softer
+/// at a loaded drive's slip, so the drive runs slower and its δ can be larger than predicted.
+/// `None` for a parabola motor.
 pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
     use drive_monitor::drive::Horizon;
     let motor = model.motor();
@@ -679,8 +681,12 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
         p.a(),
         p.b()
     );
+    let caveat = "; this is no bound for the Kloss drive: at a loaded drive's slip the curve \
+                  lies below the parabola and is softer, so the drive runs slower than \
+                  predicted and its δ can be larger (the flywheel too small); `run` with a \
+                  `[monitor] window_revolutions` of many load cycles measures it";
     if !(omega_min > 0.0 && omega_max >= omega_min) {
-        return Some(head);
+        return Some(format!("{head}{caveat}"));
     }
     let (mut worst, mut at) = (0.0f64, omega_min);
     for i in 0..=64 {
@@ -701,7 +707,7 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
     };
     Some(format!(
         "{head}: over the predicted speeds the parabola differs from the curve by at most \
-         {worst:+.4} N·m at {at:.3} rad/s{share}"
+         {worst:+.4} N·m at {at:.3} rad/s{share}{caveat}"
     ))
 }
 
@@ -727,6 +733,20 @@ pub struct SupportsOut {
     pub unbalance_level: [&'static str; 2],
     /// Each peak load at the service speed against `support_load_limit` (null without).
     pub load_level: Option<[&'static str; 2]>,
+    /// The predicted drive's ω max, rad/s, where the supports are judged as `run` judges them
+    /// at its window's ω max (absent without a predicted steady state of the drive).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_speed: Option<f64>,
+    /// Peak support loads over one turn at `predicted_speed`, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_load_at_predicted_speed: Option<[f64; 2]>,
+    /// Each peak load at `predicted_speed` against `support_load_limit`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load_level_at_predicted_speed: Option<[&'static str; 2]>,
+    /// The WARNING when `predicted_speed` is above the service speed
+    /// ([`crate::app::run::above_service_speed`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub above_service_speed: Option<String>,
     /// How the permissible unbalance was allotted to the planes: "inboard" (ISO 21940-11's
     /// lever rule, shares held within 30–70 %) or "overhung" (this product's rule:
     /// `supports::Allocation::Overhung`).
@@ -782,6 +802,10 @@ pub struct Prediction {
     /// ([`irregularity_not_predicted`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub irregularity_not_predicted: Option<String>,
+    /// The δ monitor's default window cannot hold the load's whole period
+    /// ([`crate::app::run::window_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub window_warning: Option<String>,
     /// Support unbalances and limits (scenes with a rotor).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub supports: Option<SupportsOut>,
@@ -795,6 +819,7 @@ impl Prediction {
     pub fn is_empty(&self) -> bool {
         self.irregularity.is_none()
             && self.irregularity_not_predicted.is_none()
+            && self.window_warning.is_none()
             && self.supports.is_none()
             && self.autobalancer.is_none()
     }
@@ -831,6 +856,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     let model = drive_model(scene, file)?;
     if model.is_some() || scene.motor.is_some() {
         p.irregularity_not_predicted = irregularity_not_predicted(scene);
+        p.window_warning = crate::app::run::window_warning(scene);
     }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
@@ -920,6 +946,15 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let a = analysis(scene, &rotor, &limits, file)?;
         let r = a.report();
         let loads = rotor.loads(limits.service_speed());
+        // The drive's own prediction puts the shaft at up to ω max: judged there too, as `run`
+        // judges at its window's ω max.
+        let predicted_speed = p.irregularity.as_ref().and_then(|i| i.omega_max);
+        let at_predicted = predicted_speed.map(|w| rotor.loads(w));
+        let load_level_at = |loads: [drive_monitor::supports::LoadRange; 2]| {
+            limits
+                .support_load_limit()
+                .map(|l| [0, 1].map(|i| level_of(loads[i].peak, limits.warning_fraction(), l[i])))
+        };
         p.supports = Some(SupportsOut {
             unbalance_a: r.unbalance_a,
             unbalance_b: r.unbalance_b,
@@ -932,9 +967,12 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 level_of(r.unbalance_a, limits.warning_fraction(), r.permissible_a),
                 level_of(r.unbalance_b, limits.warning_fraction(), r.permissible_b),
             ],
-            load_level: limits
-                .support_load_limit()
-                .map(|l| [0, 1].map(|i| level_of(loads[i].peak, limits.warning_fraction(), l[i]))),
+            load_level: load_level_at(loads),
+            predicted_speed,
+            peak_load_at_predicted_speed: at_predicted.map(|l| [l[0].peak, l[1].peak]),
+            load_level_at_predicted_speed: at_predicted.and_then(load_level_at),
+            above_service_speed: predicted_speed
+                .and_then(|w| crate::app::run::above_service_speed(w, limits.service_speed())),
             allocation: match a.permissible.allocation {
                 drive_monitor::supports::Allocation::Inboard => "inboard",
                 drive_monitor::supports::Allocation::Overhung => "overhung",

@@ -90,6 +90,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         if let Some(w) = r.speed_measured {
             let _ = writeln!(s, "  mean speed {w:.3} rad/s");
         }
+        if let Some(w) = &r.window_warning {
+            let _ = writeln!(s, "  {w}");
+        }
         match (r.delta_measured, r.delta_predicted) {
             (Some(m), Some(p)) => {
                 // The speed samples average away more than 1 % of the predicted δ: say what
@@ -552,6 +555,9 @@ pub fn prediction_text(p: &Prediction) -> String {
     if let Some(why) = &p.irregularity_not_predicted {
         let _ = writeln!(s, "Running irregularity NOT PREDICTED: {why}");
     }
+    if let Some(w) = &p.window_warning {
+        let _ = writeln!(s, "  {w}");
+    }
     if let Some(u) = &p.supports {
         let _ = writeln!(s, "Support unbalance (seed 002) and limits (ISO 21940-11)");
         let _ = writeln!(
@@ -591,6 +597,19 @@ pub fn prediction_text(p: &Prediction) -> String {
             None => {
                 let _ = writeln!(s, "  maximum safe speed: not limited by the support loads");
             }
+        }
+        if let (Some(w), Some(peak)) = (u.predicted_speed, u.peak_load_at_predicted_speed) {
+            let _ = writeln!(
+                s,
+                "  at the predicted ω max {w:.2} rad/s: peak A {} N, B {} N{}",
+                fmt_force(peak[0]),
+                fmt_force(peak[1]),
+                u.load_level_at_predicted_speed
+                    .map_or(String::new(), |l| format!(" ({}, {})", l[0], l[1]))
+            );
+        }
+        if let Some(w) = &u.above_service_speed {
+            let _ = writeln!(s, "  {w}");
         }
     }
     if let Some(a) = &p.autobalancer {

@@ -166,6 +166,9 @@ pub struct RunReport {
     /// Why the core measured nothing: no valid window, or no `[encoder]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_measurement: Option<String>,
+    /// The default δ window cannot hold the load's whole period ([`window_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub window_warning: Option<String>,
     /// Tables of the scene that take no part in the run, each with why (e.g. `[load]` under a
     /// prescribed speed).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -425,31 +428,89 @@ pub fn core_encoder(scene: &Scene, file: &Path) -> Result<Option<Encoder>, Scene
     })
 }
 
-/// The δ window of a scene: `[monitor] window_revolutions`, else one load cycle (the lowest
-/// order of the load's harmonics), else one revolution.
+/// The δ window of a scene: `[monitor] window_revolutions`, else the load's period (the
+/// smallest whole number of revolutions holding a whole number of cycles of every load and
+/// inertia order, [`drive_monitor::drive::period_revolutions`], as the prediction finds it),
+/// else one revolution. Where the orders have no common period within
+/// [`MAX_WINDOW_REVS`](drive_monitor::irregularity::MAX_WINDOW_REVS) revolutions, one cycle
+/// of the lowest order, which [`window_warning`] says.
 pub fn window_config(scene: &Scene) -> WindowConfig {
     let m = scene.monitor.clone().unwrap_or_default();
-    let revs = match m.window_revolutions {
-        Some(n) => WindowLength::Revolutions(n),
-        None => {
-            // One load cycle: the lowest non-zero order of the load's harmonics.
-            let lowest = scene.load.as_ref().and_then(|l| {
-                l.harmonics
-                    .iter()
-                    .map(|h| h.order.abs())
-                    .filter(|o| *o > 0.0)
-                    .reduce(f64::min)
-            });
-            match lowest {
-                Some(o) => WindowLength::LoadOrder(o),
-                None => WindowLength::Revolutions(1),
-            }
-        }
-    };
     WindowConfig {
-        length: revs,
+        length: default_window(scene).0,
         steady_tolerance: m.steady_tolerance.unwrap_or(0.02) as f32,
     }
+}
+
+/// The WARNING for a default δ window that cannot hold the load's whole period (`None` with
+/// `[monitor] window_revolutions` or a window that holds it): the orders, the window chosen
+/// and why δ may be read low in it.
+pub fn window_warning(scene: &Scene) -> Option<String> {
+    default_window(scene).1
+}
+
+/// The orders the load's period is made of: the load's and the inertia's harmonics that are
+/// there (order and amplitude non-zero), as the prediction takes them.
+fn periodic_orders(scene: &Scene) -> Vec<f64> {
+    let load = scene.load.iter().flat_map(|l| l.harmonics.iter());
+    let inertia = scene.shaft.iter().flat_map(|s| s.inertia_harmonics.iter());
+    let mut orders: Vec<f64> = load
+        .chain(inertia)
+        .filter(|h| h.order != 0.0 && h.amplitude != 0.0)
+        .map(|h| h.order.abs())
+        .collect();
+    orders.sort_by(f64::total_cmp);
+    orders.dedup();
+    orders
+}
+
+/// The window [`window_config`] takes and [`window_warning`]'s text.
+fn default_window(scene: &Scene) -> (WindowLength, Option<String>) {
+    use drive_monitor::irregularity::MAX_WINDOW_REVS;
+    if let Some(n) = scene.monitor.as_ref().and_then(|m| m.window_revolutions) {
+        return (WindowLength::Revolutions(n), None);
+    }
+    let orders = periodic_orders(scene);
+    let Some(&lowest) = orders.first() else {
+        return (WindowLength::Revolutions(1), None);
+    };
+    let period = drive_monitor::drive::period_revolutions(&orders);
+    if let Some(n) = period.filter(|&n| n <= u64::from(MAX_WINDOW_REVS)) {
+        return (WindowLength::Revolutions(n as u16), None);
+    }
+    // No window holds the load's whole period: one cycle of the lowest order, said.
+    let length = WindowLength::LoadOrder(lowest);
+    // Six decimals, trailing zeros dropped: 0.333333, 1.414214, 0.5.
+    let short = |o: f64| {
+        let t = format!("{o:.6}");
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let list = orders
+        .iter()
+        .map(|&o| short(o))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let why = match period {
+        Some(n) => format!(
+            "repeat only every {n} revolutions, more than the longest δ window ({MAX_WINDOW_REVS})"
+        ),
+        None => format!(
+            "have no common period (that needs each to be a fraction with denominator ≤ {})",
+            drive_monitor::drive::MAX_DENOMINATOR
+        ),
+    };
+    let window = match length.revolutions() {
+        Ok(w) => format!("{w} revolution{}", if w == 1 { "" } else { "s" }),
+        Err(_) => "none".to_string(),
+    };
+    let warning = format!(
+        "WARNING: the load's orders {list} {why}, so no δ window holds the load's whole cycle: \
+         the default window is one cycle of the lowest order {} ({window}), which sees only \
+         part of the combinations of the harmonics' phases, so δ may be read low in it and the \
+         δ alarm may stay silent; `[monitor] window_revolutions` sets a longer window",
+        short(lowest)
+    );
+    (length, Some(warning))
 }
 
 /// The core's monitor for the scene's encoder.
@@ -1375,6 +1436,7 @@ pub fn run_with(
         capture_rows,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         not_simulated: not_simulated(scene, over),
+        window_warning: scene.encoder.as_ref().and_then(|_| window_warning(scene)),
         ..Default::default()
     };
     if let Some(model) = model
@@ -1443,7 +1505,7 @@ fn not_simulated(scene: &Scene, over: Overrides) -> Vec<String> {
         out.push(format!(
             "[load]: {by}, so its torque moves nothing{}; {drive}",
             if window {
-                " (its lowest harmonic order still sets the δ window: one load cycle)"
+                " (its harmonic orders still set the δ window: one load period)"
             } else {
                 ""
             }

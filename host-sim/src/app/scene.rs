@@ -661,7 +661,8 @@ fn default_estimator_edges() -> u16 {
 pub struct MonitorSpec {
     /// Permissible δ.
     pub delta_limit: Option<f64>,
-    /// δ window in revolutions (default: from the load's lowest order).
+    /// δ window in revolutions (default: the load's period, from all its and the inertia's
+    /// orders).
     pub window_revolutions: Option<u16>,
     /// Slowest running speed, rad/s (standstill below).
     pub min_speed: Option<f64>,
