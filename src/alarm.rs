@@ -5,7 +5,8 @@
 //! limit (floor ≤ `floor_fraction`·limit); a window whose floor is near the limit is flagged
 //! ([`Verdict::FloorNearLimit`]) rather than trusted. The alarm raises when at least `n` of the
 //! last `m` counted windows exceed the limit, and clears when at least `n` of the last `m` are
-//! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter.
+//! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter; each switch
+//! counts only the windows since the last one.
 
 // The per-edge path runs through this module: no integer operation here may overflow or
 // divide by zero, and no index may fail, in a debug build either (`panic-free.sh dev` in
@@ -49,7 +50,10 @@ impl AlarmConfig {
 
     /// Checks the settings.
     pub const fn validate(self) -> Result<DeltaAlarm, ConfigError> {
-        tri!(positive_f32("delta_limit", self.limit));
+        // δ = 2(ω_max − ω_min)/(ω_max + ω_min) < 2: a limit of 2 or more never raises.
+        if tri!(positive_f32("delta_limit", self.limit)) >= 2.0 {
+            return Err(ConfigError::OutOfRange("delta_limit"));
+        }
         if self.of_last == 0 || self.of_last > 32 {
             return Err(ConfigError::OutOfRange("of_last"));
         }
@@ -162,6 +166,10 @@ impl DeltaAlarm {
             return (v, None);
         }
         self.active = !self.active;
+        // The next switch counts windows from this one on: histories kept across it cleared
+        // 1 of 3 at once on windows 50 % over the limit (two below it before the raise) and
+        // raised it again on windows at half the limit.
+        (self.over, self.under) = (0, 0);
         (v, Some(event))
     }
 }
@@ -276,6 +284,36 @@ mod tests {
             AlarmConfig::new(-0.1).validate().err(),
             Some(ConfigError::NotPositive("delta_limit"))
         );
+        // δ is below 2 on any window: a limit of 2 would never raise.
+        assert_eq!(
+            AlarmConfig::new(2.0).validate().err(),
+            Some(ConfigError::OutOfRange("delta_limit"))
+        );
+        assert!(AlarmConfig::new(1.99).validate().is_ok());
+    }
+
+    #[test]
+    fn a_switch_counts_only_the_windows_since_the_last() {
+        // 1 of 3 and 2 of 5: windows below the limit before a raise cleared the alarm at
+        // once on windows 50 % over it, and windows over it before a clear raised it again
+        // on windows at half the limit. Steady over the limit it stays on; steady at half
+        // the limit it stays off.
+        for (n, m) in [(1u8, 3u8), (2, 5), (3, 10)] {
+            let mut c = AlarmConfig::new(0.06);
+            (c.raise_after, c.of_last) = (n, m);
+            let mut a = c.validate().unwrap();
+            let (low, high) = (window(0.03, true, 1e-4), window(0.09, true, 1e-4));
+            let mut events = Vec::new();
+            for w in [low; 8].iter().chain(&[high; 12]).chain(&[low; 12]) {
+                events.extend(a.update(w).1);
+            }
+            assert_eq!(
+                events,
+                [AlarmEvent::Raised, AlarmEvent::Cleared],
+                "{n} of {m}"
+            );
+            assert!(!a.active());
+        }
     }
 
     struct Pin(bool);

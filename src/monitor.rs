@@ -339,7 +339,9 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
     }
 
     /// (Re)configures the monitor in place: validates, then resets all per-edge state and the
-    /// pitch table to nominal. On error the monitor is left as it was.
+    /// pitch table to nominal. On error the monitor is left as it was. An active alarm is reset
+    /// too, with no [`AlarmEvent::Cleared`]: firmware that
+    /// drives a pin from the events sets it from `alarm_active()` after reconfiguring.
     pub fn configure(
         &mut self,
         encoder: Encoder,
@@ -360,7 +362,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
 
     /// Installs a validated configuration in place (checking only that the wheel fits `N` and
     /// the pitch table), then resets all per-edge state and the pitch table to nominal. On
-    /// error the monitor is left as it was.
+    /// error the monitor is left as it was. An active alarm is reset with no event, as by
+    /// [`DeltaMonitor::configure`].
     pub fn apply(&mut self, config: &MonitorConfig) -> Result<(), ConfigError> {
         Self::fits(&config.encoder)?;
         self.install(&config.encoder, config.window, config.alarm);

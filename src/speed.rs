@@ -1193,7 +1193,8 @@ impl SpeedTracker {
             (tol.fault_margin, f32::INFINITY)
         };
         let here = self.tooth;
-        let mut expected_cost = self.chain_cost(enc, here, next, x / p_next, [d2, d3], (cap, 1.0));
+        let (mut expected_cost, recorded_cost) =
+            self.chain_cost(enc, here, next, x / p_next, [d2, d3], cap);
         if let (Some(a), Some(b), true) = (d2, d3, in_band) {
             // A special tooth in the band: also the expected tooth with the edge after it a
             // glitch (a fault of its own, judged next: the margin). Else a noise pulse just
@@ -1201,14 +1202,16 @@ impl SpeedTracker {
             // where they cost at most the shrunk margin each, the tooth was taken as
             // unexplained beside the glitch. (Out of the band as well, it cost valid windows
             // in the sparse-fault census: 158 of 12 712 at 3 %.)
-            let later = self.chain_cost(
-                enc,
-                here,
-                next,
-                x / p_next,
-                [Some(a.wrapping_add(b)), None],
-                (cap, 1.0),
-            ) + margin;
+            let later =
+                self.chain_cost(
+                    enc,
+                    here,
+                    next,
+                    x / p_next,
+                    [Some(a.wrapping_add(b)), None],
+                    cap,
+                )
+                .0 + margin;
             if later < expected_cost {
                 expected_cost = later;
             }
@@ -1226,14 +1229,10 @@ impl SpeedTracker {
         };
         // A glitch: e1 and e2 merged are the expected tooth.
         let glitch = match d2 {
-            Some(d2) => self.chain_cost(
-                enc,
-                here,
-                next,
-                (x + d2 as f32) / p_next,
-                [d3, None],
-                (cap, 1.0),
-            ),
+            Some(d2) => {
+                self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, [d3, None], cap)
+                    .0
+            }
             None => f32::INFINITY,
         };
         consider(glitch, Verdict::Glitch);
@@ -1245,7 +1244,8 @@ impl SpeedTracker {
                 spans += pitch_ratio(enc, tooth);
                 // The frame tooth of an index disc is not skipped silently: the index decides.
                 consider(
-                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3], (cap, 1.0))
+                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3], cap)
+                        .0
                         + margin * f32::from(j.wrapping_sub(1)),
                     Verdict::Missing(j),
                 );
@@ -1263,29 +1263,23 @@ impl SpeedTracker {
                         behind,
                         x / pitch_ratio(enc, behind),
                         [d2, d3],
-                        (cap, 1.0),
-                    ) + margin,
+                        cap,
+                    )
+                    .0 + margin,
                     Verdict::Behind,
                 );
                 let ahead = tooth_after(next, 1, edges);
                 consider(
-                    self.chain_cost(
-                        enc,
-                        next,
-                        ahead,
-                        x / pitch_ratio(enc, ahead),
-                        [d2, d3],
-                        (cap, 1.0),
-                    ) + margin,
+                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3], cap)
+                        .0
+                        + margin,
                     Verdict::Ahead,
                 );
             }
         }
         if best.0 + margin < expected_cost {
             best.1
-        } else if expected_cost > margin
-            && self.chain_cost(enc, here, next, x / p_next, [d2, d3], (cap, 0.0)) > margin
-        {
+        } else if expected_cost > margin && recorded_cost > margin {
             // (Swings the recorded revolution does not hold, its teeth's intervals spanned by
             // a fault, count for the hypotheses, not here: against 1 the cranking swings after
             // a gap made the frame tooth unexplained a revolution after a noise pulse there;
@@ -1318,25 +1312,30 @@ impl SpeedTracker {
         first: u16,
         head: f32,
         rest: [Option<u32>; 2],
-        (cap, unrecorded): (f32, f32),
-    ) -> f32 {
+        cap: f32,
+    ) -> (f32, f32) {
         let mut cost = log_sq(
             head,
             self.prev as f32 * self.recorded_swing(enc, before, first, 1.0),
         );
+        // The same without the swings the recorded revolution does not hold.
+        let mut recorded = cost;
         let (mut prev, mut tooth) = (head, first);
         for d in rest.iter().flatten() {
             let next = tooth_after(tooth, 1, enc.edges());
             let v = *d as f32 / pitch_ratio(enc, next);
+            let s = self.recorded_swing(enc, tooth, next, 0.0);
+            let swing = log_sq(v, prev * if s > 0.0 { s } else { 1.0 });
             // A compare, not `f32::min` (a call of `fminf` on this FPU); never NaN.
-            // Where the recorded revolution holds no swing (`unrecorded` 0), none counted.
-            let s = self.recorded_swing(enc, tooth, next, unrecorded);
-            let swing = if s > 0.0 { log_sq(v, prev * s) } else { 0.0 };
-            cost += if swing > cap { cap } else { swing };
+            let swing = if swing > cap { cap } else { swing };
+            cost += swing;
+            if s > 0.0 {
+                recorded += swing;
+            }
             prev = v;
             tooth = next;
         }
-        cost
+        (cost, recorded)
     }
 
     /// Whether `tooth` needs the careful judgement when it comes next.
@@ -1587,21 +1586,9 @@ impl SpeedTracker {
                             self.missing_frame(t, sink);
                             self.sync = SyncState::Confirming;
                             tooth = 0;
-                        } else if indexed && tooth != 1 && tooth != edges.wrapping_sub(1) {
-                            // Two teeth or more from where the count puts the frame: a stray
-                            // pulse on the index line is likelier than as many line edges
-                            // lost or gained unseen (realigned, one stray pulse framed the
-                            // count three teeth off, blamed on the line as an extra edge). A
-                            // missing frame; the count is kept, and given up if the next index
-                            // disagrees too.
-                            self.realigned = tooth != 0;
-                            frame = tooth == 0;
-                            if tooth != 0 {
-                                self.missing_frame(t, sink);
-                            }
                         } else if indexed {
                             self.realigned = tooth != 0;
-                            if tooth != 0 {
+                            if tooth == 1 || tooth == edges.wrapping_sub(1) {
                                 // One tooth off: a line edge lost or gained unseen. The index
                                 // is authoritative: count the discrepancy, realign.
                                 let ahead = tooth <= edges / 2;
@@ -1615,8 +1602,16 @@ impl SpeedTracker {
                                 self.reset_ring();
                                 tooth = 0;
                                 realigned = true;
+                            } else if tooth != 0 {
+                                // Two teeth or more off: a stray pulse on the index line is
+                                // likelier than as many line edges lost or gained unseen
+                                // (realigned, one stray pulse framed the count three teeth
+                                // off, blamed on the line as an extra edge). A missing frame;
+                                // the count is kept, and given up if the next index disagrees
+                                // too.
+                                self.missing_frame(t, sink);
                             }
-                            frame = true;
+                            frame = tooth == 0;
                         } else if tooth == 0 {
                             // The frame by the count, its index not reported yet: it may still
                             // come at this edge's own tick, reported after it. The frame is

@@ -65,3 +65,36 @@ fn out_writes_the_same_and_errors_name_the_cause() {
     let (ok, _, err) = drive_sim(&["predict", "three-mass", "--out", path]);
     assert!(!ok && err.contains("--emit"), "{err}");
 }
+
+/// The emitted table carries the margin `run` and `sweep` classify with: the scene's
+/// `[monitor] regime_margin` (it said `TABLE_MARGIN`, 1 %, whatever the scene set, and a
+/// firmware built as told committed at speeds the host calls near-characteristic).
+#[test]
+fn the_emitted_margin_is_the_scenes() {
+    let scratch_dir = tempfile::Builder::new()
+        .prefix("drive-sim-emit-")
+        .tempdir()
+        .unwrap();
+    let scene = scratch_dir.path().join("wide.toml");
+    let bundled = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/one-mass.toml"),
+    )
+    .unwrap();
+    std::fs::write(
+        &scene,
+        format!("{bundled}\n[monitor]\nregime_margin = 0.05\n"),
+    )
+    .unwrap();
+    let (ok, out, err) = drive_sim(&["predict", scene.to_str().unwrap(), "--emit", "rust"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("pub const REGIME_MARGIN: f32 = 0.05;"),
+        "{out}"
+    );
+    assert!(out.contains("Classifier::from_table(&REGIMES, REGIME_MARGIN, REGIME_MARGIN / 2.0)"));
+    let (ok, out, err) = drive_sim(&["predict", "one-mass", "--emit", "rust"]);
+    assert!(
+        ok && out.contains("pub const REGIME_MARGIN: f32 = 0.01;"),
+        "{err}"
+    );
+}

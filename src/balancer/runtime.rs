@@ -569,7 +569,9 @@ impl RegimeTracker {
     }
 
     /// Feeds one speed in rad/s (sign ignored). A non-finite speed keeps the held segment
-    /// and reports `Unknown` without an event.
+    /// and reports `Unknown` without an event. A tracker follows one classifier: for another
+    /// table start a new tracker (a held segment the new classifier does not have is dropped,
+    /// and the next speed starts afresh).
     pub fn update(&mut self, c: &Classifier, speed: f32) -> RegimeStatus {
         if !speed.is_finite() {
             return RegimeStatus {
@@ -581,7 +583,12 @@ impl RegimeTracker {
         }
         let s = speed.abs();
         let raw = c.segment(s);
-        let before = self.held.map(usize::from);
+        // A segment beyond this classifier's (a tracker fed another table before) is no
+        // history: held, it read as gathering at every speed for good.
+        let before = self
+            .held
+            .map(usize::from)
+            .filter(|&h| h < usize::from(c.n_seg));
         let next = match before {
             None => raw,
             Some(h) if h == raw => h,

@@ -1625,6 +1625,31 @@ fn a_tracker_keeps_balanced_loads_balanced_through_a_bistable_segment() {
     assert_eq!((st.regime, st.by_history), (capture, false));
 }
 
+/// A tracker fed a classifier with fewer segments than the one it held a segment of starts
+/// afresh there (it kept the index and read every speed as gathering, for good).
+#[test]
+fn a_tracker_fed_another_table_holds_no_stale_segment() {
+    const SHORT: RegimeTable<'static> = RegimeTable {
+        segments: &[seg(0.0, Regime::Gathering), seg(1.5, Regime::Balancing)],
+    };
+    let (long, short) = (
+        Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap(),
+        Classifier::from_table(&SHORT, 0.01, 0.005).unwrap(),
+    );
+    let mut t = RegimeTracker::new();
+    assert_eq!(t.update(&long, 2.5).regime, Regime::Balancing);
+    for w in [2.0, 10.0, 1.0] {
+        let mut fresh = RegimeTracker::new();
+        assert_eq!(
+            t.update(&short, w).regime,
+            fresh.update(&short, w).regime,
+            "{w}"
+        );
+        t = RegimeTracker::new();
+        t.update(&long, 2.5);
+    }
+}
+
 #[test]
 fn table_classifier_reads_the_table() {
     let c = Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap();

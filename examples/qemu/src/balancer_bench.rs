@@ -6,10 +6,11 @@
 
 use core::hint::black_box;
 
+use crate::three_mass_table::REGIME_MARGIN;
 use cortex_m_semihosting::hprintln;
 use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, BistableReason, Classifier, Coupling, Machine, MachineConfig,
-    Platform, Regime, RegimeTracker, SearchOptions, TABLE_MARGIN,
+    Platform, Regime, RegimeTracker, SearchOptions,
 };
 
 use crate::bench::{ensure, measure, measure_each};
@@ -29,11 +30,14 @@ const FROM_TABLE: Classifier =
 
 /// The classifier of the emitted exact regime table (`REGIMES`: Floquet stability of the
 /// balancing position, the capture windows, the criterion), built by the compiler.
-const EXACT: Classifier =
-    match Classifier::from_table(&three_mass_table::REGIMES, TABLE_MARGIN, 0.5 * TABLE_MARGIN) {
-        Ok(c) => c,
-        Err(_) => panic!("three_mass_table.rs: not a valid regime table"),
-    };
+const EXACT: Classifier = match Classifier::from_table(
+    &three_mass_table::REGIMES,
+    REGIME_MARGIN,
+    0.5 * REGIME_MARGIN,
+) {
+    Ok(c) => c,
+    Err(_) => panic!("three_mass_table.rs: not a valid regime table"),
+};
 
 /// The bundled `three-mass.toml` machine.
 fn config() -> MachineConfig {
@@ -115,8 +119,8 @@ pub fn run() {
     let start = icount::instructions();
     let exact = match Classifier::from_table(
         black_box(&three_mass_table::REGIMES),
-        TABLE_MARGIN,
-        0.5 * TABLE_MARGIN,
+        REGIME_MARGIN,
+        0.5 * REGIME_MARGIN,
     ) {
         Ok(c) => c,
         Err(e) => crate::bench::fail(format_args!("table rejected: {}", e)),

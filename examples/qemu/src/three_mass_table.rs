@@ -34,7 +34,7 @@ pub const MACHINE: MachineTable<'static> = MachineTable {
 /// The exact regime table of the `three-mass` scene's machine (the balancing position's
 /// stability from the Floquet multipliers of the model, the capture windows, the
 /// criterion), speeds in the core's f32: build the classifier with
-/// `Classifier::from_table(&REGIMES, TABLE_MARGIN, TABLE_MARGIN / 2.0)`.
+/// `Classifier::from_table(&REGIMES, REGIME_MARGIN, REGIME_MARGIN / 2.0)`.
 #[rustfmt::skip]
 pub const REGIMES: RegimeTable<'static> = RegimeTable {
     segments: &[
@@ -49,3 +49,8 @@ pub const REGIMES: RegimeTable<'static> = RegimeTable {
         RegimeSegment { from: 105.82215, regime: Regime::Balancing },
     ],
 };
+
+/// The margin about each boundary of `REGIMES` within which the classifier says
+/// near-characteristic (the scene's `[monitor] regime_margin`, or the core's
+/// `TABLE_MARGIN`), as `drive-sim run` and `sweep` classify.
+pub const REGIME_MARGIN: f32 = 0.01;

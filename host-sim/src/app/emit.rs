@@ -18,7 +18,7 @@
 //! a host test compares that file with what this writes now.
 
 use crate::app::predict::machine;
-use crate::app::regimes::{core_segments, design};
+use crate::app::regimes::{core_segments, design, given_margin};
 use crate::app::scene::{resolve, SceneError};
 use drive_monitor::balancer::{BistableReason, Machine, Regime, RegimeSegment, ZoneKind};
 use std::fmt::Write as _;
@@ -53,12 +53,15 @@ pub fn literal(x: f64) -> String {
 }
 
 /// The Rust source for the machine of the scene named `scene` (as given on the command line),
-/// with its one-line `description` and its exact regime table, if it has one.
+/// with its one-line `description` and its exact regime table, if it has one, with the margin
+/// its classifier takes (`margin`: the scene's `[monitor] regime_margin`, or the core's
+/// `TABLE_MARGIN`).
 pub fn rust_table(
     scene: &str,
     description: Option<&str>,
     m: &Machine,
     regimes: Option<&[RegimeSegment]>,
+    margin: f32,
 ) -> String {
     let list = |v: &[f64]| v.iter().map(|&x| literal(x)).collect::<Vec<_>>().join(", ");
     let mut s = String::new();
@@ -152,7 +155,7 @@ pub fn rust_table(
                 "\n/// The exact regime table of the `{scene}` scene's machine (the balancing position's\n\
                  /// stability from the Floquet multipliers of the model, the capture windows, the\n\
                  /// criterion), speeds in the core's f32: build the classifier with\n\
-                 /// `Classifier::from_table(&REGIMES, TABLE_MARGIN, TABLE_MARGIN / 2.0)`.\n\
+                 /// `Classifier::from_table(&REGIMES, REGIME_MARGIN, REGIME_MARGIN / 2.0)`.\n\
                  #[rustfmt::skip]\n\
                  pub const REGIMES: RegimeTable<'static> = RegimeTable {{\n    segments: &["
             );
@@ -179,6 +182,13 @@ pub fn rust_table(
                 );
             }
             let _ = writeln!(s, "    ],\n}};");
+            let _ = writeln!(
+                s,
+                "\n/// The margin about each boundary of `REGIMES` within which the classifier says\n\
+                 /// near-characteristic (the scene's `[monitor] regime_margin`, or the core's\n\
+                 /// `TABLE_MARGIN`), as `drive-sim run` and `sweep` classify.\n\
+                 pub const REGIME_MARGIN: f32 = {margin:?};"
+            );
         }
         None => {
             let _ = writeln!(
@@ -202,8 +212,17 @@ pub fn emit_text(name: &str, format: Format) -> Result<String, EmitError> {
         Some(exact) => Some(core_segments(&exact.segments, &path)?),
         None => None,
     };
+    // The margin `run` and `sweep` classify with (a table that ignored it had the firmware
+    // commit where they say near-characteristic).
+    let margin = given_margin(&scene).unwrap_or(drive_monitor::balancer::TABLE_MARGIN);
     Ok(match format {
-        Format::Rust => rust_table(name, scene.description.as_deref(), &m, regimes.as_deref()),
+        Format::Rust => rust_table(
+            name,
+            scene.description.as_deref(),
+            &m,
+            regimes.as_deref(),
+            margin,
+        ),
     })
 }
 
@@ -221,7 +240,7 @@ mod tests {
             let Some(m) = machine(&scene, &path).unwrap() else {
                 continue;
             };
-            let text = rust_table(file, scene.description.as_deref(), &m, None);
+            let text = rust_table(file, scene.description.as_deref(), &m, None, 0.01);
             let mut values: Vec<f64> = m
                 .resonant_speeds()
                 .iter()

@@ -361,6 +361,15 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
     }))
 }
 
+/// The scene's `[monitor] regime_margin`, as the core's f32.
+pub fn given_margin(scene: &Scene) -> Option<f32> {
+    scene
+        .monitor
+        .as_ref()
+        .and_then(|m| m.regime_margin)
+        .map(|m| m as f32)
+}
+
 /// The run-time classifier of a scene's machine: from the exact table when there is one
 /// (margin: the scene's `[monitor] regime_margin`, default [`TABLE_MARGIN`]), else from the
 /// criterion (default margin [`DEFAULT_MARGIN`]); half the margin as hysteresis. Returns the
@@ -371,11 +380,7 @@ pub fn classifier(
     machine: &Machine,
     design: Option<&Design>,
 ) -> Result<(Classifier, f32, bool), SceneError> {
-    let given = scene
-        .monitor
-        .as_ref()
-        .and_then(|m| m.regime_margin)
-        .map(|m| m as f32);
+    let given = given_margin(scene);
     if let Some(exact) = design.and_then(|d| d.exact.as_ref()) {
         let margin = given.unwrap_or(TABLE_MARGIN);
         let segments = core_segments(&exact.segments, file)?;
