@@ -861,11 +861,21 @@ fn the_default_window_holds_the_whole_load_period() {
         host_sim::app::run::window_config(&s3).length,
         drive_monitor::irregularity::WindowLength::Revolutions(3)
     );
+    // ... and said, where it is no whole number of load periods (3 of 6 read δ 16 % low and
+    // raised no alarm); a multiple of the period is not warned about.
+    let w = host_sim::app::run::window_warning(&s3).unwrap_or_default();
+    assert!(
+        w.contains("`monitor.window_revolutions = 3` is not a whole number of the load's period (6 revolutions)"),
+        "{w}"
+    );
+    let twelve = format!("{scene}window_revolutions = 12\n");
+    let s12 = host_sim::app::scene::Scene::parse(&twelve, path).unwrap();
+    assert_eq!(host_sim::app::run::window_warning(&s12), None);
 }
 
 /// Load orders with no common period (1 and √2): no window holds the load's cycle. The default
 /// window is one cycle of the lowest order, and `predict` and `run` say so, naming the orders
-/// and the window; a window the scene sets is not warned about.
+/// and the window; a window the scene sets is not warned about (no period to be a multiple of).
 #[test]
 fn a_load_without_a_common_period_warns_of_its_window() {
     let scene = "[simulation]\nduration = 2\n[shaft]\ninertia = 0.2\n[motor]\nmodel = \"kloss\"\n\

@@ -442,9 +442,9 @@ pub fn window_config(scene: &Scene) -> WindowConfig {
     }
 }
 
-/// The WARNING for a default δ window that cannot hold the load's whole period (`None` with
-/// `[monitor] window_revolutions` or a window that holds it): the orders, the window chosen
-/// and why δ may be read low in it.
+/// The WARNING for a δ window that does not hold the load's whole period (`None` where it
+/// does): the default window where no window can (the orders, the window chosen and why δ may
+/// be read low in it), or a `[monitor] window_revolutions` that is no whole number of periods.
 pub fn window_warning(scene: &Scene) -> Option<String> {
     default_window(scene).1
 }
@@ -467,10 +467,20 @@ fn periodic_orders(scene: &Scene) -> Vec<f64> {
 /// The window [`window_config`] takes and [`window_warning`]'s text.
 fn default_window(scene: &Scene) -> (WindowLength, Option<String>) {
     use drive_monitor::irregularity::MAX_WINDOW_REVS;
-    if let Some(n) = scene.monitor.as_ref().and_then(|m| m.window_revolutions) {
-        return (WindowLength::Revolutions(n), None);
-    }
     let orders = periodic_orders(scene);
+    if let Some(n) = scene.monitor.as_ref().and_then(|m| m.window_revolutions) {
+        // A window set in the scene that is no whole number of load periods sees part of the
+        // load cycle in each window, as the lowest order's did: said.
+        let period = drive_monitor::drive::period_revolutions(&orders);
+        let warning = period.filter(|&p| u64::from(n) % p != 0).map(|p| {
+            format!(
+                "WARNING: `monitor.window_revolutions = {n}` is not a whole number of the load's \
+                 period ({p} revolutions), so each δ window sees part of the load cycle: δ may \
+                 be read low in it and the δ alarm may stay silent; a multiple of {p} holds it"
+            )
+        });
+        return (WindowLength::Revolutions(n), warning);
+    }
     let Some(&lowest) = orders.first() else {
         return (WindowLength::Revolutions(1), None);
     };
