@@ -1084,6 +1084,16 @@ fn a_steady_self_oscillation_of_the_loads_is_not_unsettled() {
         );
         let swing = r.regime_swing.as_deref().unwrap_or("");
         assert!(swing.contains("steady oscillation"), "{duration}: {swing}");
+        // The range README quotes: 0.1 % to 58 % of the rotor's, against 300 % gathered.
+        let detail = r.regime_detail.unwrap();
+        assert!(
+            detail.residual_min_relative < 2e-3 && (detail.residual_relative - 0.58).abs() < 0.01,
+            "{duration}: {detail:?}"
+        );
+        assert!(
+            swing.contains("gathered loads leave up to 3.00e0"),
+            "{swing}"
+        );
     }
     let r = run(20.0);
     assert_eq!(r.regime_simulated, Some("unsettled"));

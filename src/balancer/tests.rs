@@ -1636,17 +1636,12 @@ fn a_tracker_fed_another_table_holds_no_stale_segment() {
         Classifier::from_table(&SEED_TABLE, 0.01, 0.005).unwrap(),
         Classifier::from_table(&SHORT, 0.01, 0.005).unwrap(),
     );
-    let mut t = RegimeTracker::new();
-    assert_eq!(t.update(&long, 2.5).regime, Regime::Balancing);
     for w in [2.0, 10.0, 1.0] {
-        let mut fresh = RegimeTracker::new();
-        assert_eq!(
-            t.update(&short, w).regime,
-            fresh.update(&short, w).regime,
-            "{w}"
-        );
-        t = RegimeTracker::new();
-        t.update(&long, 2.5);
+        // Held the last of the long table's five segments, then fed the short table.
+        let mut t = RegimeTracker::new();
+        assert_eq!(t.update(&long, 2.5).regime, Regime::Balancing);
+        let fresh = RegimeTracker::new().update(&short, w).regime;
+        assert_eq!(t.update(&short, w).regime, fresh, "{w}");
     }
 }
 

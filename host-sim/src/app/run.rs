@@ -468,10 +468,10 @@ fn periodic_orders(scene: &Scene) -> Vec<f64> {
 fn default_window(scene: &Scene) -> (WindowLength, Option<String>) {
     use drive_monitor::irregularity::MAX_WINDOW_REVS;
     let orders = periodic_orders(scene);
+    let period = drive_monitor::drive::period_revolutions(&orders);
     if let Some(n) = scene.monitor.as_ref().and_then(|m| m.window_revolutions) {
         // A window set in the scene that is no whole number of load periods sees part of the
         // load cycle in each window, as the lowest order's did: said.
-        let period = drive_monitor::drive::period_revolutions(&orders);
         let warning = period.filter(|&p| u64::from(n) % p != 0).map(|p| {
             format!(
                 "WARNING: `monitor.window_revolutions = {n}` is not a whole number of the load's \
@@ -484,7 +484,6 @@ fn default_window(scene: &Scene) -> (WindowLength, Option<String>) {
     let Some(&lowest) = orders.first() else {
         return (WindowLength::Revolutions(1), None);
     };
-    let period = drive_monitor::drive::period_revolutions(&orders);
     if let Some(n) = period.filter(|&n| n <= u64::from(MAX_WINDOW_REVS)) {
         return (WindowLength::Revolutions(n as u16), None);
     }
