@@ -426,7 +426,7 @@ const PLACE_LATER: u8 = 1;
 const PLACE_LOST: u8 = 2;
 const PLACE_OWED: u8 = 3;
 /// What [`SpeedTracker::index_place`] needs of the edge judged.
-type PlaceAt = (u32, u32, u32, (bool, bool));
+type PlaceAt = (u32, u32, u32, u32, (bool, bool));
 
 /// What the judged edge is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1364,14 +1364,18 @@ impl SpeedTracker {
     /// Also how many of them lost their edge (counted here: a count of the bits left would be
     /// a sequence of some 30 bytes in the acceptance).
     ///
-    /// A timestamp within a tick of an edge's may lie a hair before or after that edge (a Z
-    /// gated with A, captured on the same edge, or a little jitter): which edge it frames then
-    /// depends on the order the two were reported in, or on the jitter, and flipped from
-    /// revolution to revolution, each flip a missing or extra edge on a clean disc. Synced,
-    /// the count decides (where an interval is more than two ticks): within a tick of this
-    /// edge where the count puts the frame at the next edge, it is the next edge's; within a
-    /// tick after the last edge where that edge is a frame whose index was owed
-    /// ([`SpeedTracker::owed`]), it is that frame's (the fourth result).
+    /// A timestamp near an edge's may lie before or after that edge (a Z gated with A,
+    /// captured on the same edge, or jitter of the index against the lines): which edge it
+    /// frames then depends on the order the two were reported in, or on the jitter, and
+    /// flipped from revolution to revolution, each flip a missing or extra edge on a clean
+    /// disc. Synced, the count decides within an eighth of the interval (at least a tick;
+    /// where an interval is more than two ticks): that far before this edge where the count
+    /// puts the frame at the next edge, it is the next edge's; that far either side of the
+    /// last edge where that edge is the frame, it is that frame's (the fourth result where
+    /// its index was owed, [`SpeedTracker::owed`]). Within a tick only, an index 0.04 pitch
+    /// before a line edge with jitter of 0.03 pitch (σ) counted extra and missing edges and
+    /// missing frames in most revolutions. A count a tooth off goes unseen only by an index
+    /// within that eighth of its edge, where jitter cannot tell it from one that is right.
     #[inline(never)]
     fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8, u8, bool) {
         let m = enc.mask();
@@ -1383,11 +1387,13 @@ impl SpeedTracker {
         let last = enc.edges().wrapping_sub(1);
         let before_frame = synced && d > 2 && self.tooth.wrapping_add(1) == last;
         let near_last_frame = synced && d > 2 && (self.owed || self.tooth == last);
+        // How near an edge the count decides: an eighth of the interval, at least a tick.
+        let near = (d >> 3).max(1);
         // A plain loop, not `each_bit`: it runs at every index pulse, where the set-bit loop
         // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less. Its
         // classification out of line, the rest in one word: unrolled over the four slots with
         // the classification inline it was 1.7 KB.
-        let at = (m, d, seq, (before_frame, near_last_frame));
+        let at = (m, d, seq, near, (before_frame, near_last_frame));
         let mut bits = 0u32;
         for i in 0..usize::from(self.nidx).min(INDEXES) {
             // Two bits a slot, `i` < INDEXES ≤ 8: within the word.
@@ -1406,22 +1412,28 @@ impl SpeedTracker {
     }
 
     /// Where waiting index timestamp `i` falls (see [`SpeedTracker::index_places`]), given
-    /// the counter mask, the interval of the edge judged, its arrival and where the count
-    /// puts it (the tooth before the frame; the frame or the edge after an owed frame).
+    /// the counter mask, the interval of the edge judged, its arrival, how near an edge the
+    /// count decides and where the count puts the edge (the tooth before the frame; the frame
+    /// or the edge after an owed frame).
     #[inline(never)]
-    fn index_place(&self, i: usize, &(m, d, seq, (before_frame, near_last_frame)): &PlaceAt) -> u8 {
+    fn index_place(
+        &self,
+        i: usize,
+        &(m, d, seq, near, (before_frame, near_last_frame)): &PlaceAt,
+    ) -> u8 {
         let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
         let since = x.wrapping_sub(self.last) & m;
         if !reported_before(q, seq) {
             PLACE_LATER
-        } else if near_last_frame && (since <= 1 || since == m) {
+        } else if near_last_frame && (since.wrapping_add(near) & m) <= near.wrapping_mul(2) {
+            // Within `near` either side of the last edge (`near` ≤ d / 8 < m / 4).
             if self.owed {
                 PLACE_OWED
             } else {
                 PLACE_FRAMES
             }
         } else if (since > d && since < m / 2)
-            || (before_frame && since.wrapping_add(1) >= d && since <= d)
+            || (before_frame && since.wrapping_add(near) >= d && since <= d)
         {
             PLACE_LATER
         } else if since <= d {
