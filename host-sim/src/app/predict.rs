@@ -553,6 +553,10 @@ pub struct AutobalancerOut {
     pub zones: Vec<ZoneOut>,
     /// Sommerfeld capture windows (balancing locally stable, capture also possible).
     pub capture: Vec<CaptureOut>,
+    /// Capture at every resonance, with or without a gathering zone of the criterion ending
+    /// there ([`crate::app::regimes::resonance_captures`]): the exact table says bistable in
+    /// these too.
+    pub resonance_capture: Vec<CaptureOut>,
 }
 
 /// `irregularity` member of `predict --json`.
@@ -1040,6 +1044,14 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 .collect(),
             capture: m
                 .capture_windows()
+                .iter()
+                .map(|c| CaptureOut {
+                    from: c.from,
+                    until: c.until,
+                    at: c.at,
+                })
+                .collect(),
+            resonance_capture: crate::app::regimes::resonance_captures(&m)
                 .iter()
                 .map(|c| CaptureOut {
                     from: c.from,

@@ -42,8 +42,8 @@ use crate::app::scene::{Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions, StabilityMap};
 use crate::engine::vibration::VibrationMachine;
 use drive_monitor::balancer::{
-    BistableReason, Classifier, Machine, Regime, RegimeSegment, RegimeStatus, RegimeTable,
-    RegimeTracker, ZoneKind, DEFAULT_MARGIN, TABLE_MARGIN,
+    BistableReason, CaptureWindow, Classifier, Machine, Regime, RegimeSegment, RegimeStatus,
+    RegimeTable, RegimeTracker, ZoneKind, DEFAULT_MARGIN, TABLE_MARGIN,
 };
 use serde::Serialize;
 use std::path::Path;
@@ -137,6 +137,85 @@ pub fn settle_time(sigma: f64) -> f64 {
     10.0 / sigma.abs()
 }
 
+/// Log-spaced nodes per capture band search ([`resonance_captures`]).
+const CAPTURE_NODES: usize = 2000;
+
+/// Sommerfeld capture at every resonance, whether or not the criterion has a gathering zone
+/// ending there: for each undamped resonant speed `r`, the highest interior local maximum of
+/// `Ω + D(Ω)` ([`Machine::capture_lag`], every load gathered) over `Ω` between the additional
+/// speeds either side of `r` (from `10⁻³·r` below the first, to `16·r` above the last), as a
+/// window from `min(r, Ω*)` to that maximum. The core's windows ([`Machine::capture_windows`])
+/// take the maximum only inside a gathering zone; where damping removes the sign change of
+/// `Re H` at a higher resonance there is no zone, but loads a run-up brings there are still
+/// captured (a two-platform machine with resonances at 49.6 and 124.2 rad/s kept them turning
+/// near 115–122 rad/s with the rotor at 165 for 335 s, where the balancing position is stable).
+/// No window where `Ω + D(Ω)` has no interior maximum (it only rises: a slip in proportion
+/// to the speed, no capture).
+pub fn resonance_captures(machine: &Machine) -> Vec<CaptureWindow> {
+    let extra = machine.additional_speeds();
+    let f = |w: f64| w + machine.capture_lag(w);
+    let mut out = Vec::new();
+    for &r in machine.resonant_speeds() {
+        if !(r.is_finite() && r > 0.0) {
+            continue;
+        }
+        let lo = extra
+            .iter()
+            .copied()
+            .filter(|&a| a < r)
+            .fold(1e-3 * r, f64::max);
+        let hi = extra
+            .iter()
+            .copied()
+            .filter(|&a| a > r)
+            .fold(16.0 * r, f64::min);
+        let node = |i: usize| lo * (hi / lo).powf(i as f64 / CAPTURE_NODES as f64);
+        let values: Vec<f64> = (0..=CAPTURE_NODES).map(|i| f(node(i))).collect();
+        // The highest interior local maximum of the scan (NaN, on a resonance, is none).
+        let best = (1..CAPTURE_NODES)
+            .filter(|&i| values[i] >= values[i - 1] && values[i] >= values[i + 1])
+            .filter(|&i| values[i].is_finite())
+            .max_by(|&a, &b| values[a].total_cmp(&values[b]));
+        let Some(i) = best else {
+            continue;
+        };
+        // Golden-section search between the neighbouring nodes (a unimodal bracket).
+        let (mut a, mut b) = (node(i - 1), node(i + 1));
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+        let (mut fc, mut fd) = (f(c), f(d));
+        while b - a > 1e-12 * b {
+            if fc >= fd {
+                (b, d, fd) = (d, c, fc);
+                c = b - g * (b - a);
+                fc = f(c);
+            } else {
+                (a, c, fc) = (c, d, fd);
+                d = a + g * (b - a);
+                fd = f(d);
+            }
+        }
+        let at = 0.5 * (a + b);
+        let until = f(at).max(values[i]);
+        if until.is_finite() && until > r {
+            out.push(CaptureWindow {
+                from: r.min(at),
+                until,
+                at,
+            });
+        }
+    }
+    out
+}
+
+/// Every capture window the exact table heeds: the core's ([`Machine::capture_windows`]) and
+/// those at every resonance ([`resonance_captures`]).
+pub fn capture_bands(machine: &Machine) -> Vec<CaptureWindow> {
+    let mut all = machine.capture_windows().to_vec();
+    all.extend(resonance_captures(machine));
+    all
+}
+
 /// The speeds scanned for `machine`: from a quarter of its lowest resonance to four times its
 /// highest characteristic speed, and at least 1.5 times past every capture window.
 pub fn scan_options(machine: &Machine) -> ScanOptions {
@@ -146,8 +225,7 @@ pub fn scan_options(machine: &Machine) -> ScanOptions {
         .copied()
         .unwrap_or(machine.config().dimensionless().omega_ref);
     let last = machine.zones().last().map_or(first, |z| z.from).max(first);
-    let until = machine
-        .capture_windows()
+    let until = capture_bands(machine)
         .iter()
         .fold(0.0f64, |u, w| u.max(w.until));
     ScanOptions::new(0.25 * first, (4.0 * last).max(1.5 * until))
@@ -178,12 +256,8 @@ pub fn stability_map(
 /// The regime table from the exact stability map and the machine's criterion and capture
 /// windows (module docs), as `(from rad/s, regime)` ascending from 0, neighbours different.
 pub fn table(map: &StabilityMap, family: &[StabilityMap], machine: &Machine) -> Vec<(f64, Regime)> {
-    let captured = |w: f64| {
-        machine
-            .capture_windows()
-            .iter()
-            .any(|c| c.from <= w && w < c.until)
-    };
+    let bands = capture_bands(machine);
+    let captured = |w: f64| bands.iter().any(|c| c.from <= w && w < c.until);
     let regime = |w: f64| {
         if !map.stable_at(w) {
             // Three or more loads can balance at another member of their family.
@@ -207,7 +281,7 @@ pub fn table(map: &StabilityMap, family: &[StabilityMap], machine: &Machine) -> 
         .map(|b| b.speed)
         .collect();
     cuts.extend(machine.zones().iter().skip(1).map(|z| z.from));
-    for c in machine.capture_windows() {
+    for c in &bands {
         cuts.push(c.from);
         cuts.push(c.until);
     }
@@ -492,7 +566,8 @@ mod tests {
     fn table_combines_stability_capture_and_criterion() {
         let (_, _, m) = one_mass();
         let b = m.zones()[1].from; // 61.43: the criterion's resonance
-        let until = m.capture_windows()[0].until; // 90.41
+                                   // The capture bands end together: the core's window (90.41) or the resonance's band.
+        let until = capture_bands(&m).iter().fold(0.0f64, |u, c| u.max(c.until));
         let capture = Regime::Bistable(BistableReason::Capture);
         // Stable from 72, as the Floquet analysis finds for this machine.
         let t = table(&map_with(false, &[72.0]), &[], &m);
@@ -534,6 +609,115 @@ mod tests {
             table(&map_with(false, &[]), &[], &m),
             vec![(0.0, Regime::Gathering)]
         );
+    }
+
+    /// A two-platform machine (resonances 49.6 and 124.2 rad/s) whose damping hides the second
+    /// resonance from the criterion: its only gathering zone ends at 49.6, so the core's only
+    /// capture window is there. Run up to 165 rad/s with the loads together and held for
+    /// 335 s, the loads stayed captured near 115–122 rad/s (two simulations), where the
+    /// balancing position is stable: the table committed to balancing from 154.9 rad/s up.
+    /// Now the capture at the second resonance makes it bistable there.
+    #[test]
+    fn a_resonance_without_a_criterion_zone_still_captures() {
+        let text = "[[platform]]\nmass = 54.450883282155964\nstiffness = 129756.66936812556\n\
+            damping = 381.1643992325081\n\n[[platform]]\nmass = 92.09423774712249\n\
+            stiffness = 250000.0\ndamping = 700.0150893005239\n\n[[coupling]]\n\
+            between = [1, 2]\nstiffness = 458518.6708010421\ndamping = 700.0150893005239\n\n\
+            [autobalancer]\nkind = \"ball\"\nplatform = 2\nloads = 2\n\
+            load_mass = 1.4528811264387569\nradius = 0.1\nhousing_mass = 5.0\n\
+            viscosity = 5.909176653434912\nrotor_unbalance = 0.09870443055938408\n\n\
+            [motor]\nmodel = \"speed\"\nspeed = 50.0\n";
+        let path = std::path::PathBuf::from("hidden-resonance.toml");
+        let scene = Scene::parse(text, &path).unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        assert_eq!(m.capture_windows().len(), 1);
+        let bands = resonance_captures(&m);
+        assert_eq!(bands.len(), 2, "{bands:?}");
+        let second = bands[1];
+        assert!((second.from - 124.0).abs() < 1.0, "{second:?}");
+        assert!(second.until > 165.0, "{second:?}");
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let exact = d.exact.as_ref().unwrap();
+        assert!(exact.map.stable_at(165.0));
+        let at = |w: f64| exact.segments.iter().rev().find(|s| s.0 <= w).map(|s| s.1);
+        assert_eq!(
+            at(165.0),
+            Some(Regime::Bistable(BistableReason::Capture)),
+            "{:?}",
+            exact.segments
+        );
+        // Far above every band: balancing.
+        assert_eq!(at(2.0 * second.until), Some(Regime::Balancing));
+    }
+
+    /// Each band's `until` is the maximum of `Ω + D(Ω)` near its resonance: against a scan of
+    /// 200 000 nodes over the same range (within 1e-9 relative), and no lower than the core's
+    /// window at that resonance (which maximises over the gathering zone only).
+    #[test]
+    fn resonance_bands_hold_the_local_maximum_of_the_capture_balance() {
+        for name in ["one-mass", "two-mass", "three-mass"] {
+            let (scene, path) = resolve(name).unwrap();
+            let m = predict::machine(&scene, &path).unwrap().unwrap();
+            let bands = resonance_captures(&m);
+            assert!(!bands.is_empty(), "{name}");
+            let f = |w: f64| w + m.capture_lag(w);
+            for b in &bands {
+                // The scan between the band's neighbouring additional speeds.
+                let r = m
+                    .resonant_speeds()
+                    .iter()
+                    .copied()
+                    .min_by(|x, y| (x - b.from).abs().total_cmp(&(y - b.from).abs()))
+                    .unwrap();
+                let lo = m
+                    .additional_speeds()
+                    .iter()
+                    .copied()
+                    .filter(|&a| a < r)
+                    .fold(1e-3 * r, f64::max);
+                let hi = m
+                    .additional_speeds()
+                    .iter()
+                    .copied()
+                    .filter(|&a| a > r)
+                    .fold(16.0 * r, f64::min);
+                // A scan of 200 000 nodes for the highest interior local maximum, then one of
+                // 200 000 across the two nodes either side of it (spacing 1e-9 relative).
+                let scan = |lo: f64, hi: f64, n: u32| -> Vec<(f64, f64)> {
+                    (0..=n)
+                        .map(|i| {
+                            let x = lo * (hi / lo).powf(f64::from(i) / f64::from(n));
+                            (x, f(x))
+                        })
+                        .collect()
+                };
+                let coarse = scan(lo, hi, 200_000);
+                let top = (1..coarse.len() - 1)
+                    .filter(|&i| coarse[i].1 >= coarse[i - 1].1 && coarse[i].1 >= coarse[i + 1].1)
+                    .filter(|&i| coarse[i].1.is_finite())
+                    .max_by(|&x, &y| coarse[x].1.total_cmp(&coarse[y].1))
+                    .unwrap();
+                let fine = scan(coarse[top - 1].0, coarse[top + 1].0, 200_000);
+                let peak = fine.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+                assert!((b.until / peak - 1.0).abs() < 1e-9, "{name}: {b:?} {peak}");
+                let slope = |x: f64| (f(x * (1.0 + 1e-6)) - f(x * (1.0 - 1e-6))) / (2e-6 * x);
+                assert!(
+                    f(b.at * (1.0 + 1e-4)) <= b.until && f(b.at * (1.0 - 1e-4)) <= b.until,
+                    "{name}: {b:?}"
+                );
+                assert!(
+                    slope(b.at).abs() < 1e-3 * b.until / b.at,
+                    "{name}: {b:?} slope {}",
+                    slope(b.at)
+                );
+            }
+            for w in m.capture_windows() {
+                assert!(
+                    bands.iter().any(|b| b.until >= w.until * (1.0 - 1e-9)),
+                    "{name}: {w:?} {bands:?}"
+                );
+            }
+        }
     }
 
     #[test]
@@ -624,7 +808,7 @@ mod tests {
         for (w, want) in speeds.iter().zip([61.4423, 61.6829, 72.9103]) {
             assert!((w - want).abs() < 1e-4, "{speeds:?}");
         }
-        let until = m.capture_windows()[0].until;
+        let until = capture_bands(&m).iter().fold(0.0f64, |u, c| u.max(c.until));
         assert_eq!(zero.segments.last(), Some(&(until, Regime::Balancing)));
         for d in [1e-9, 1e-8, 1e-7] {
             let e = at(d);

@@ -649,6 +649,15 @@ pub fn prediction_text(p: &Prediction) -> String {
                 c.from, c.until, c.at
             );
         }
+        for c in &a.resonance_capture {
+            let _ = writeln!(
+                s,
+                "  at the resonance near {:.3} rad/s, gathered loads can be held up to {:.3} \
+                 rad/s (near {:.3} rad/s; the exact table's capture, whether or not a zone of \
+                 the criterion ends there)",
+                c.from, c.until, c.at
+            );
+        }
         let _ = writeln!(
             s,
             "  capacity N·m·R = {:.4e} kg·m, rotor unbalance D = {:.4e} kg·m{}",
@@ -742,6 +751,16 @@ pub fn prediction_text(p: &Prediction) -> String {
                 to,
                 seg.regime,
                 seg.reason.map_or(String::new(), |r| format!(" ({r})"))
+            );
+        }
+        if a.regime_table_source == "exact"
+            && a.regime_table.iter().any(|g| g.regime == "balancing")
+        {
+            let _ = writeln!(
+                s,
+                "  (balancing: loads near the balancing position stay there; started together at \
+                 rest, on a few machines they instead keep slipping 1–9 % slower than the rotor \
+                 there: docs/criterion.md)"
             );
         }
     }

@@ -1140,7 +1140,8 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
          (`host-sim/src/app/regimes.rs`) commits to *gathering* where the balancing position is \
          unstable, to *balancing* where it is stable and no other state is known to persist, \
          and says *bistable* (with its reason) where it is stable but gathered loads can stay \
-         captured below the rotor (`capture`: inside a capture window of the core) or held \
+         captured below the rotor (`capture`: inside a capture window of the core, or of the \
+         capture balance's fold at any resonance, `regimes::resonance_captures`) or held \
          together by the criterion's `Re H > 0` (`coexisting`). Each machine is then simulated \
          at {GRID} prescribed rotor speeds from half its first damped characteristic speed to \
          twice its last (and past its capture windows), the loads started at the balancing \
@@ -1223,9 +1224,9 @@ pub fn publish(s: &Study, dir: &Path) -> Result<Vec<PathBuf>, String> {
         let _ = writeln!(
             t,
             "Of the {} speeds where loads started at rest did not balance, {near} lie within \
-             3 % of a boundary of the table, just past the end of a capture band: the capture \
-             balance's fold lies a little past the core's `until`, and loads that start at rest \
-             pass it slowly. The other {} are on {} machines (β = {}); at {} of them the loads \
+             3 % of a boundary of the table, just past the end of a capture band, the capture \
+             balance's fold, which loads that start at rest pass slowly (the delay of a slow \
+             passage through a fold). The other {} are on {} machines (β = {}); at {} of them the loads \
              still turned slower than the rotor at the end of the run (by {} to {}), slipping \
              past each other and the balancing position: a motion the capture theory does not \
              describe, reached from rest; the rest were still on their way. There the table's \
