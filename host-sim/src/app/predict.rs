@@ -586,6 +586,11 @@ pub struct IrregularityOut {
     /// fraction of `delta_limit` the core's alarm requires (its `floor_fraction`, 0.2).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alarm_floor_warning: Option<String>,
+    /// The scene also has a vibration machine (`[[platform]]`, `[autobalancer]`): the drive
+    /// prediction leaves out the torque it puts on the shaft, which `run` simulates
+    /// ([`machine_torque_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine_torque_warning: Option<String>,
     /// The flywheel the limit would need when it is beyond `shaft.flywheel`'s range (up to
     /// 1e9 kg·m²), kg·m².
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -755,6 +760,10 @@ pub struct SupportsOut {
     /// lever rule, shares held within 30–70 %) or "overhung" (this product's rule:
     /// `supports::Allocation::Overhung`).
     pub allocation: &'static str,
+    /// The scene also has an auto-balancer, which the support analysis leaves out
+    /// ([`balancer_supports_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balancer_warning: Option<String>,
 }
 
 /// The warning when the δ alarm of `scene` could judge no window at the predicted speed: the
@@ -918,6 +927,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let alarm_floor_warning = alarm_floor_warning(scene, file, limit, &prediction)?;
         p.irregularity = Some(IrregularityOut {
             alarm_floor_warning,
+            machine_torque_warning: None,
             stall,
             working_branch_warning,
             delta_through_samples: sampled.map(|s| s.delta),
@@ -981,6 +991,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 drive_monitor::supports::Allocation::Inboard => "inboard",
                 drive_monitor::supports::Allocation::Overhung => "overhung",
             },
+            balancer_warning: balancer_supports_warning(scene),
         });
     }
     if let Some(m) = machine(scene, file)? {
@@ -1061,5 +1072,91 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 .collect(),
         });
     }
+    // The drive's δ beside a vibration machine: said what it leaves out, with the regime
+    // table's segments the predicted speeds fall in where the loads need not balance.
+    if scene.autobalancer.is_some() {
+        let table = p.autobalancer.as_ref().map(|a| a.regime_table.as_slice());
+        if let Some(i) = p.irregularity.as_mut() {
+            if let (Some(lo), Some(hi), Some(_)) = (i.omega_min, i.omega_max, i.delta) {
+                i.machine_torque_warning =
+                    Some(machine_torque_warning(table.unwrap_or_default(), lo, hi));
+            }
+        }
+    }
     Ok(p)
+}
+
+/// The WARNING of a drive prediction on a scene that also has a vibration machine: the
+/// prediction (seed 000's eq. 1: motor, `[load]`, `[shaft]`) leaves out the torque the machine
+/// puts on the shaft, `τ = Σ_j b_w·R²·(φ̇_j − ω) − D·Ÿ_e·cos(φ + θ)`
+/// (`host-sim/src/engine/vibration`), which vanishes only while the loads balance and the
+/// platforms are still; `run` integrates it with the drive. The segments of the machine's
+/// regime table that the predicted speeds `[omega_min, omega_max]` fall in and that are not
+/// *balancing* are named.
+pub fn machine_torque_warning(table: &[SegmentOut], omega_min: f64, omega_max: f64) -> String {
+    let segments: Vec<String> = table
+        .iter()
+        .enumerate()
+        .filter_map(|(k, seg)| {
+            let to = table.get(k + 1).map_or(f64::INFINITY, |n| n.from);
+            let overlaps = seg.from <= omega_max && to > omega_min;
+            (overlaps && seg.regime != "balancing").then(|| {
+                format!(
+                    "{}{} ({:.3} – {} rad/s)",
+                    seg.regime,
+                    seg.reason.map_or(String::new(), |r| format!(" ({r})")),
+                    seg.from,
+                    if to.is_finite() {
+                        format!("{to:.3}")
+                    } else {
+                        "∞".to_string()
+                    }
+                )
+            })
+        })
+        .collect();
+    let (lo, hi) = (format!("{omega_min:.3}"), format!("{omega_max:.3}"));
+    let speeds = if lo == hi {
+        format!("{hi} rad/s")
+    } else {
+        format!("{lo} – {hi} rad/s")
+    };
+    let here = if segments.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; the predicted speed {speeds} lies where the regime table says {}: there the \
+             loads need not balance",
+            segments.join(", ")
+        )
+    };
+    format!(
+        "WARNING: this δ is the drive's alone ([motor], [load], [shaft]): it leaves out the \
+         torque the vibration machine ([[platform]], [autobalancer]) puts on the shaft, the \
+         drag of the auto-balancer's loads slipping against the rotor and the moment of the \
+         rotor unbalance's inertial force on the vibrating platform; ω max, ω min, δ, the \
+         flywheel for the limit and ∂δ/∂J, ∂δ/∂M_m hold only while the loads balance and the \
+         platforms are still, and where the loads gather or lag the rotor that torque swings \
+         the speed, so δ can be much larger{here}; `drive-sim run` simulates the drive \
+         and the machine coupled and measures δ with it"
+    )
+}
+
+/// The WARNING of a scene with both a rotor on supports (`[rotor]`, `[[unbalance]]`) and an
+/// auto-balancer: the support analysis (seed 002) and the balancer (seed 001) are independent
+/// models. `None` without both.
+pub fn balancer_supports_warning(scene: &Scene) -> Option<String> {
+    let ab = scene.autobalancer.as_ref()?;
+    scene.rotor.as_ref()?;
+    let capacity = f64::from(ab.loads) * ab.load_mass * ab.radius;
+    Some(format!(
+        "WARNING: the support analysis ([rotor], [[unbalance]]) leaves out the auto-balancer \
+         ([autobalancer], [[platform]]): its loads and unbalance levels are those of the \
+         [[unbalance]] list on rigid supports, as if no balancer were on the rotor, so neither \
+         the unbalance the balancer cancels when it balances nor the one its loads add when \
+         they gather (up to N·m·R = {capacity:.4e} kg·m) is in them, and the platforms' \
+         vibration does not reach the supports; the balancer's regimes are for \
+         `autobalancer.rotor_unbalance`, which [[unbalance]] does not set: the two are \
+         independent models of the rotor"
+    ))
 }

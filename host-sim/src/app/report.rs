@@ -61,6 +61,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     for why in &r.not_simulated {
         let _ = writeln!(s, "NOT SIMULATED {why}");
     }
+    for w in &r.model_warnings {
+        let _ = writeln!(s, "{w}");
+    }
     if let Some(why) = &r.no_measurement {
         let _ = writeln!(s, "NOTHING MEASURED by the core: {why}");
     }
@@ -130,6 +133,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                 );
             }
             _ => {}
+        }
+        for n in &r.delta_notes {
+            let _ = writeln!(s, "  {n}");
         }
         if let Some(l) = r.delta_limit {
             if r.alarms.is_empty() {
@@ -243,7 +249,10 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
             u.unbalance_level[1]
         ),
     };
-    if let Some(w) = &u.above_service_speed {
+    for w in [&u.above_service_speed, &u.balancer_warning]
+        .into_iter()
+        .flatten()
+    {
         text.push_str("  ");
         text.push_str(w);
         text.push('\n');
@@ -501,9 +510,13 @@ pub fn prediction_text(p: &Prediction) -> String {
                 "  ω max {max:.3} rad/s, ω min {min:.3} rad/s, δ = {}",
                 fmt_delta(d)
             );
-            for w in [&i.working_branch_warning, &i.alarm_floor_warning]
-                .into_iter()
-                .flatten()
+            for w in [
+                &i.working_branch_warning,
+                &i.alarm_floor_warning,
+                &i.machine_torque_warning,
+            ]
+            .into_iter()
+            .flatten()
             {
                 let _ = writeln!(s, "  {w}");
             }
@@ -609,6 +622,9 @@ pub fn prediction_text(p: &Prediction) -> String {
             );
         }
         if let Some(w) = &u.above_service_speed {
+            let _ = writeln!(s, "  {w}");
+        }
+        if let Some(w) = &u.balancer_warning {
             let _ = writeln!(s, "  {w}");
         }
     }

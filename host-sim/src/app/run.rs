@@ -113,6 +113,10 @@ pub struct SupportsRunOut {
     /// was allotted for: the warning the report prints.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub above_service_speed: Option<String>,
+    /// The scene also has an auto-balancer, which the support analysis and the simulated
+    /// reactions leave out ([`predict::balancer_supports_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balancer_warning: Option<String>,
 }
 
 /// What a run produced.
@@ -173,6 +177,16 @@ pub struct RunReport {
     /// prescribed speed).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub not_simulated: Vec<String>,
+    /// What the models of the run leave out of what the scene asks for, each a WARNING (a
+    /// cranking ripple on a vibration machine: [`cranking_warning`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_warnings: Vec<String>,
+    /// What the comparison of the measured δ with the predicted one leaves out, each a WARNING
+    /// or NOTE printed under it: the vibration machine's torque on the shaft, which the
+    /// prediction omits and the run simulates ([`machine_torque_note`]); the scene's encoder
+    /// errors, in the measured δ and not in its noise floor ([`encoder_errors_note`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub delta_notes: Vec<String>,
     /// The seed criterion's zone at the measured speed: "balancing" | "gathering".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_predicted: Option<&'static str>,
@@ -1445,6 +1459,7 @@ pub fn run_with(
         capture_rows,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         not_simulated: not_simulated(scene, over),
+        model_warnings: cranking_warning(scene).into_iter().collect(),
         window_warning: scene.encoder.as_ref().and_then(|_| window_warning(scene)),
         ..Default::default()
     };
@@ -1466,6 +1481,22 @@ pub fn run_with(
         col.outcome(stats.time, o);
     }
     measurement(&mut report, &mut col);
+    // The vibration machine's torque is in the run (a motor-driven shaft integrates it) and
+    // not in the prediction; the encoder's errors are in the measured δ and not its floor.
+    let coupled = vib_machine.is_some() && over.speed.is_none();
+    report.delta_notes = [
+        report
+            .delta_predicted
+            .filter(|_| coupled)
+            .map(|_| machine_torque_note()),
+        report
+            .delta_measured
+            .and(scene.encoder.as_ref())
+            .and_then(encoder_errors_note),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     regime(
         scene,
         file,
@@ -1486,6 +1517,73 @@ pub fn run_with(
     report.edge_list = col.edge_list.take().unwrap_or_default();
     report.wall_seconds = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// The WARNING under `run`'s δ line for a drive prediction beside a vibration machine whose
+/// torque on the shaft the run integrates: the prediction leaves it out
+/// ([`predict::machine_torque_warning`] says the same in `predict`).
+pub fn machine_torque_note() -> String {
+    "WARNING: the predicted δ is the drive's alone ([motor], [load], [shaft]): it leaves out \
+     the torque the vibration machine ([[platform]], [autobalancer]) puts on the shaft, the \
+     drag of the auto-balancer's loads and the moment of the rotor unbalance on the vibrating \
+     platform, which this run integrates with the drive: the measured δ includes it, so where \
+     the loads do not balance the difference from the prediction is that torque's, not the \
+     drive model's error"
+        .to_string()
+}
+
+/// The NOTE under `run`'s δ line when the scene's encoder has run-out, pitch error or jitter
+/// (`None` without any): they displace the edges the core's speed samples are read from, so
+/// the measured δ includes them, while the noise floor it quotes is the timer's quantization
+/// alone (no bound on their share is computed).
+pub fn encoder_errors_note(e: &crate::app::scene::EncoderSpec) -> Option<String> {
+    let set: Vec<String> = [
+        ("encoder.runout", e.runout, ""),
+        ("encoder.pitch_error", e.pitch_error, " rad"),
+        ("encoder.jitter", e.jitter, " s"),
+    ]
+    .into_iter()
+    .filter(|&(_, x, _)| x > 0.0)
+    .map(|(k, x, unit)| format!("{k} = {x:e}{unit}"))
+    .collect();
+    if set.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "NOTE: the scene's encoder errors ({}) displace the edges the core reads its speed \
+         samples from, so the measured δ includes them, while the noise floor quoted is the \
+         timer's quantization alone; their share of δ is not computed, so a difference from \
+         the prediction may be theirs, not the drive's (the scene without them measures the \
+         drive alone)",
+        set.join(", ")
+    ))
+}
+
+/// The WARNING for a `[cranking]` ripple on a vibration machine's rotor (`None` without a
+/// ripple or a machine): the machine's model leaves out every term in the shaft's angular
+/// acceleration ω̇ (`host-sim/src/engine/vibration`), chief among them the rotor unbalance's
+/// tangential force `D·ω̇·cos(φ + θ)` beside its centrifugal `D·ω²`. Under the ripple
+/// `ω = ω̄·(1 + a·sin(s·φ + ψ))` at a steady mean `ω̄`, `ω̇ = ω·dω/dφ`, so
+/// `ω̇/ω² = a·s·cos(s·φ + ψ)/(1 + a·sin(s·φ + ψ))`, whose largest magnitude, where
+/// `sin = −a`, is `a·s/√(1 − a²)`: the ratio the warning gives (a changing mean speed adds its
+/// own slope).
+pub fn cranking_warning(scene: &Scene) -> Option<String> {
+    let c = scene.cranking.filter(|c| c.ripple > 0.0)?;
+    scene.autobalancer.as_ref()?;
+    let ratio = c.ripple * c.strokes / (1.0 - c.ripple * c.ripple).sqrt();
+    Some(format!(
+        "WARNING: [cranking] (ripple = {}, strokes = {}) swings the rotor speed of the \
+         vibration machine ([[platform]], [autobalancer]), whose model leaves out every term in \
+         the shaft's angular acceleration ω̇: the rotor unbalance's tangential force \
+         D·ω̇·cos(φ + θ) on the platform and, for balls and rollers, the loads' rolling coupling \
+         to ω̇ with its reaction on the shaft. The ripple alone makes |ω̇| reach \
+         ripple·strokes/√(1 − ripple²) = {ratio:.3} of ω² (at a steady mean speed), so that \
+         force reaches {ratio:.3} of the centrifugal D·ω² at the same instant: the platform \
+         motion, residual unbalance and regime simulated are the model's, not the machine's at \
+         this ripple, and the regime table and the criterion, computed at a constant speed, do \
+         not describe it",
+        c.ripple, c.strokes
+    ))
 }
 
 /// The tables a prescribed speed leaves out: the load torque and the shaft's inertia move
@@ -1840,6 +1938,7 @@ fn supports(
                 max_safe_speed: status.max_safe_speed.and_then(finite),
                 simulated_reaction_level: reaction_level,
                 above_service_speed: above_service_speed(speed, limits.service_speed()),
+                balancer_warning: predict::balancer_supports_warning(scene),
             }
         }
         None => {
@@ -1854,6 +1953,7 @@ fn supports(
                 max_safe_speed: status.max_safe_speed.and_then(finite),
                 simulated_reaction_level: reaction_level,
                 above_service_speed: None,
+                balancer_warning: predict::balancer_supports_warning(scene),
             }
         }
     };

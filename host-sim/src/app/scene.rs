@@ -503,7 +503,8 @@ pub struct EncoderSpec {
     /// Missing positions (missing-tooth framing).
     #[serde(default)]
     pub missing: u8,
-    /// Edges averaged per speed sample (16 by default): a sample spanning a good part of a
+    /// Edges averaged per speed sample (16 by default; 1 to 32, and at most the edges captured
+    /// per revolution, the wheel's teeth over `prescaler`): a sample spanning a good part of a
     /// load cycle averages its ripple away (`predict` warns when more than 1 % of δ is lost).
     #[serde(default = "default_estimator_edges")]
     pub estimator_edges: u16,

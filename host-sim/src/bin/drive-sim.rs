@@ -498,6 +498,12 @@ fn sweep_cmd(
     if json {
         text.push_str(&to_json(&s)?);
     } else {
+        for why in &s.not_simulated {
+            text.push_str(&format!("NOT SIMULATED {why}\n"));
+        }
+        for w in &s.warnings {
+            text.push_str(&format!("{w}\n"));
+        }
         text.push_str(&format!(
             "{:>10}  {:<10} {:<32} {:<10} {:>10}\n",
             "speed", "criterion", "core class", "simulated", "residual"

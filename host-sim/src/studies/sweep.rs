@@ -105,6 +105,15 @@ pub struct Sweep {
     pub history_agreeing: usize,
     /// The classifier is built from the exact table (else from the criterion's).
     pub exact: bool,
+    /// Tables of the scene the sweep does not use, each with why ([`not_used`]): it
+    /// prescribes the rotor speed, so a torque motor, `[load]` and `[shaft]` move nothing.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_simulated: Vec<String>,
+    /// What the sweep's models leave out of what the scene asks for, each a NOTE or WARNING
+    /// (a cranking ripple: applied, and its ω̇ terms omitted,
+    /// [`crate::app::run::cranking_warning`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// The damped characteristic speeds (the criterion's zone boundaries), rad/s.
     #[serde(skip)]
     pub boundaries: Vec<f64>,
@@ -151,7 +160,14 @@ impl Sweep {
     /// The regime map as a Markdown table, with the agreement lines.
     pub fn markdown(&self) -> String {
         use std::fmt::Write;
-        let mut s = String::from(
+        let mut s = String::new();
+        for why in &self.not_simulated {
+            let _ = writeln!(s, "NOT SIMULATED {why}\n");
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "{w}\n");
+        }
+        s.push_str(
             "| speed, rad/s | criterion | core class | simulated | residual / rotor unbalance | reached balanced: from, rad/s → simulated |\n\
              |---:|---|---|---|---:|---|\n",
         );
@@ -455,9 +471,67 @@ pub fn sweep(
             .filter(|p| p.arrived.is_some_and(|a| a.simulated == "balancing"))
             .count(),
         exact,
+        not_simulated: not_used(scene),
+        warnings: sweep_warnings(scene),
         boundaries,
         zones,
         points,
         request: *request,
     })
+}
+
+/// The tables of `scene` a sweep leaves out, each with why: every speed of a sweep is
+/// prescribed, so a motor's own speed law or torque curve, the load torque and the shaft's
+/// inertia (and the vibration machine's reaction torque on it) move nothing. A `speed` motor's
+/// speed is what the sweep replaces by design: not listed.
+pub fn not_used(scene: &Scene) -> Vec<String> {
+    use crate::app::scene::MotorSpec;
+    let by = "the sweep prescribes the rotor speed at each of its speeds";
+    let drive = "`drive-sim run` simulates the drive";
+    let mut out = Vec::new();
+    let motor = match &scene.motor {
+        Some(MotorSpec::Parabola { .. }) => Some((
+            "parabola",
+            "its torque curve moves nothing (no slip under the load or the machine's reaction torque)",
+        )),
+        Some(MotorSpec::Kloss { .. }) => Some((
+            "kloss",
+            "its torque curve moves nothing (no slip under the load or the machine's reaction torque)",
+        )),
+        Some(MotorSpec::Ramp { .. }) => Some(("ramp", "its ramp is not followed")),
+        Some(MotorSpec::Profile { .. }) => Some(("profile", "its speed profile is not followed")),
+        Some(MotorSpec::Speed { .. }) | None => None,
+    };
+    if let Some((model, what)) = motor {
+        out.push(format!(
+            "[motor] model = \"{model}\": {by}, so {what}; {drive}"
+        ));
+    }
+    if scene.load.is_some() {
+        out.push(format!(
+            "[load]: {by}, so its torque and ripple move nothing; {drive}"
+        ));
+    }
+    if scene.shaft.is_some() {
+        out.push(format!(
+            "[shaft]: {by}, so its inertia moves nothing; {drive}"
+        ));
+    }
+    out
+}
+
+/// The NOTE and WARNING lines of a sweep: a `[cranking]` ripple is applied at every speed
+/// (the mean speed the sweep's), and its ω̇ terms are left out of the vibration machine's
+/// model ([`crate::app::run::cranking_warning`]).
+pub fn sweep_warnings(scene: &Scene) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(c) = scene.cranking.filter(|c| c.ripple > 0.0) {
+        out.push(format!(
+            "NOTE: [cranking] is applied: each speed of the sweep is the ω̄ of a prescribed \
+             speed ω̄·(1 + {}·sin({}·φ + {})), as in `drive-sim run`",
+            c.ripple, c.strokes, c.phase
+        ));
+    }
+    out.extend(crate::app::run::cranking_warning(scene));
+    out
 }
