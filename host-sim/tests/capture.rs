@@ -210,3 +210,35 @@ fn motor_driven_runup_is_captured_then_released() {
     assert!(runup::with_inertia_scaled(&scene, &path, 0.0).is_err());
     assert!(runup::with_ramp_stretched(&scene, &path, 2.0).is_err());
 }
+
+/// After the capture the loads of the bundled run-up have met bit for bit (the model has no
+/// contact between loads), and identical loads move as one for good: released at 91.6 rad/s
+/// they stayed together opposite the unbalance (residual 1.00 of the rotor's) at 130 rad/s,
+/// where the balancing position is stable and loads parted by 0.01 rad balance within
+/// seconds. `run` printed "simulation gathering" beside the core's balancing; it now says the
+/// loads are coincident and leaves the run unjudged. Where the balancing position is unstable
+/// (60 rad/s, the table's gathering) gathered loads that meet are still gathering.
+#[test]
+fn loads_that_meet_are_no_verdict_where_they_could_balance() {
+    let (scene, path) = resolve("one-mass-runup").unwrap();
+    let r = run(&scene, &path, Overrides::default()).unwrap();
+    assert_eq!(r.regime_class, Some("balancing"));
+    assert_eq!(r.regime_simulated, Some("coincident"));
+    let d = r.regime_detail.as_ref().unwrap();
+    assert!(d.coherence_min >= 1.0 - 1e-13, "{d:?}");
+    assert!((d.residual_relative - 1.0).abs() < 0.01, "{d:?}");
+    assert!(r.regime_coincident.as_ref().unwrap().contains("no contact"));
+    let (plain, path) = resolve("one-mass").unwrap();
+    let r = run(
+        &plain,
+        &path,
+        Overrides {
+            speed: Some(60.0),
+            loads_together: true,
+        },
+    )
+    .unwrap();
+    assert_eq!(r.regime_class, Some("gathering"));
+    assert_eq!(r.regime_simulated, Some("gathering"));
+    assert!(r.regime_coincident.is_none());
+}

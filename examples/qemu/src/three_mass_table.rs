@@ -40,13 +40,13 @@ pub const REGIMES: RegimeTable<'static> = RegimeTable {
     segments: &[
         RegimeSegment { from: 0.0, regime: Regime::Gathering },
         RegimeSegment { from: 50.324696, regime: Regime::Bistable(BistableReason::Capture) },
-        RegimeSegment { from: 50.95455, regime: Regime::Balancing },
+        RegimeSegment { from: 50.956127, regime: Regime::Balancing },
         RegimeSegment { from: 51.349155, regime: Regime::Bistable(BistableReason::Coexisting) },
         RegimeSegment { from: 51.435593, regime: Regime::Gathering },
         RegimeSegment { from: 70.13968, regime: Regime::Bistable(BistableReason::Capture) },
         RegimeSegment { from: 70.93867, regime: Regime::Gathering },
         RegimeSegment { from: 91.15673, regime: Regime::Bistable(BistableReason::Capture) },
-        RegimeSegment { from: 105.82215, regime: Regime::Balancing },
+        RegimeSegment { from: 106.167465, regime: Regime::Balancing },
     ],
 };
 

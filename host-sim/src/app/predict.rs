@@ -483,6 +483,16 @@ pub struct CaptureOut {
     pub at: f64,
 }
 
+impl From<&drive_monitor::balancer::CaptureWindow> for CaptureOut {
+    fn from(c: &drive_monitor::balancer::CaptureWindow) -> Self {
+        CaptureOut {
+            from: c.from,
+            until: c.until,
+            at: c.at,
+        }
+    }
+}
+
 /// A change of stability of the balancing position (Floquet).
 #[derive(Debug, Clone, Serialize)]
 pub struct StabilityBoundaryOut {
@@ -1053,22 +1063,10 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                     regime: z.kind.name(),
                 })
                 .collect(),
-            capture: m
-                .capture_windows()
-                .iter()
-                .map(|c| CaptureOut {
-                    from: c.from,
-                    until: c.until,
-                    at: c.at,
-                })
-                .collect(),
+            capture: m.capture_windows().iter().map(CaptureOut::from).collect(),
             resonance_capture: crate::app::regimes::resonance_captures(&m)
                 .iter()
-                .map(|c| CaptureOut {
-                    from: c.from,
-                    until: c.until,
-                    at: c.at,
-                })
+                .map(CaptureOut::from)
                 .collect(),
         });
     }

@@ -206,12 +206,17 @@ pub struct RunReport {
     /// Why `regime_simulated` is "unsettled": the run ended before the loads' regime showed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_unsettled: Option<String>,
+    /// The loads met to within rounding and moved as one, where the balancing position is
+    /// stable (simulated "coincident": no verdict, the model has no contact between loads).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_coincident: Option<String>,
     /// The loads settled into a steady oscillation about the balancing position (simulated
     /// "gathering": not balancing), with its residual range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_swing: Option<String>,
     /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
-    /// for its rotor, settled on the least residual it can leave) | "gathering".
+    /// for its rotor, settled on the least residual it can leave) | "gathering" | "unsettled"
+    /// | "coincident" (see `regime_coincident`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_simulated: Option<&'static str>,
     /// `N·m·R`: the largest unbalance the loads can balance, kg·m.
@@ -1831,6 +1836,27 @@ fn regime(
                         / vm.rotor_unbalance().max(f64::MIN_POSITIVE),
                 ));
             }
+            // Identical loads that met to within rounding move as one for good (the model has
+            // no contact between loads); where the balancing position is stable that is no
+            // verdict on the machine: real loads touch, and part at any imperfection (a
+            // run-up's capture merged the bundled one-mass machine's loads bit for bit, and
+            // after the release they stayed together opposite the unbalance; parted by 0.01
+            // rad they balance within seconds).
+            let coincident = r.regime == SimRegime::Gathering
+                && vm.loads() >= 2
+                && r.coherence_min >= COINCIDENT
+                && report.regime_class.is_some_and(|c| c != "gathering");
+            if coincident {
+                report.regime_coincident = Some(format!(
+                    "the loads met and move as one (within 1e-6 rad of each other over the final \
+                     quarter of the run, the residual {:.2e} of the rotor's): the model has no \
+                     contact between loads, so identical loads that meet stay together for good, \
+                     which real loads, which touch and part at any imperfection, do not; where \
+                     the balancing position is stable, as here, this is not the machine's \
+                     regime",
+                    r.residual_relative
+                ));
+            }
             report.regime_unsettled = match r.regime {
                 SimRegime::Gathering if r.residual_min_relative < UNSETTLED_AWAY && !swinging => {
                     Some(format!(
@@ -1861,6 +1887,8 @@ fn regime(
             };
             if report.regime_unsettled.is_some() {
                 report.regime_simulated = Some("unsettled");
+            } else if coincident {
+                report.regime_simulated = Some("coincident");
             }
             report.regime_detail = Some(r);
         }
@@ -1885,6 +1913,10 @@ fn balancing_growth_rate(vm: &VibrationMachine, speed: f64) -> Option<f64> {
 /// Gathering needs the residual at least this (relative to the rotor's) throughout the final
 /// quarter of a run; between 1 % and this the run has not settled.
 const UNSETTLED_AWAY: f64 = 0.1;
+
+/// Loads whose coherence stays at least this over the final quarter of a run lie within about
+/// 1e-6 rad of each other (two loads: `cos(Δ/2) ≥ 1 − 1e-13`): met, moving as one.
+const COINCIDENT: f64 = 1.0 - 1e-13;
 
 /// The warning for a shaft measured above the service speed: the permissible residual
 /// unbalance (ISO 21940-11, `U_per = 1000·G·m/ω`) was allotted for the service speed, and at a

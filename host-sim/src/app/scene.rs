@@ -750,14 +750,15 @@ pub struct AutobalancerSpec {
     pub start: LoadStart,
 }
 
-/// `[autobalancer] start`: where the loads are at `t = 0` (always at rest).
+/// `[autobalancer] start`: where the loads are at `t = 0` (near the balancing position turning
+/// with the rotor, or together at rest).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum LoadStart {
-    /// Near the auto-balancing position with a small perturbation.
+    /// Near the auto-balancing position with a small perturbation, turning with the rotor.
     #[default]
     Balanced,
-    /// Gathered together on the unbalance's side.
+    /// Gathered together (within 0.01 rad) on the unbalance's side, at rest.
     Together,
 }
 

@@ -57,7 +57,7 @@ pub struct SweepPoint {
 pub struct Arrived {
     /// Where the ramp started, rad/s.
     pub from: f64,
-    /// What the loads did: "balancing", "gathering" or "unsettled".
+    /// What the loads did: "balancing", "gathering", "unsettled" or "coincident".
     pub simulated: &'static str,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
@@ -99,6 +99,9 @@ pub struct Sweep {
     pub committed_agreeing: usize,
     /// Points where no run settled ([`settled_run`]): neither agreeing nor disagreeing.
     pub unsettled: usize,
+    /// Points where the loads met and moved as one where the balancing position is stable
+    /// (`run`'s "coincident"): neither agreeing nor disagreeing.
+    pub coincident: usize,
     /// Bistable points where the tracker commits from history ([`SweepPoint::arrived`]).
     pub history_committed: usize,
     /// Of those, where the loads brought there balanced stayed balanced.
@@ -183,6 +186,7 @@ impl Sweep {
                 p.regime_simulated,
                 if committed
                     && p.regime_simulated != "unsettled"
+                    && p.regime_simulated != "coincident"
                     && !agrees(p.regime_class, p.regime_simulated)
                 {
                     " ≠"
@@ -207,7 +211,9 @@ impl Sweep {
             "\nEach speed runs until its regime shows: at least ten e-foldings of the balancing \
              position's least stable perturbation (`10/|σ|` from the exact analysis, up to ten \
              times the scene's duration), doubled up to three times while the residual is \
-             between 1 % and 10 % of the rotor's; {} speeds did not settle (\"unsettled\").\n\n\
+             between 1 % and 10 % of the rotor's; {} speeds did not settle (\"unsettled\"); at {} \
+             the loads met and moved as one where the balancing position is stable \
+             (\"coincident\": not judged, the model has no contact between loads; see `run`).\n\n\
              The core's classifier ({} table) commits at {} of {} speeds; the simulation \
              agrees at {} of them (≠ marks the others). The seed's criterion alone, away from \
              its characteristic speeds (outside the margin band): {} of {} speeds agree.\n\n\
@@ -217,6 +223,7 @@ impl Sweep {
              also commits at {} bistable speeds, balancing from the loads' history, and the \
              loads stayed balanced at {} of them: {} of {} speeds committed with that history.",
             self.unsettled,
+            self.coincident,
             if self.exact { "exact" } else { "criterion" },
             self.committed,
             self.points.len(),
@@ -464,6 +471,10 @@ pub fn sweep(
         unsettled: points
             .iter()
             .filter(|p| p.regime_simulated == "unsettled")
+            .count(),
+        coincident: points
+            .iter()
+            .filter(|p| p.regime_simulated == "coincident")
             .count(),
         history_committed: points.iter().filter(|p| p.arrived.is_some()).count(),
         history_agreeing: points

@@ -120,7 +120,9 @@ pub const MAX_DIM: usize = 2 * MAX_PLATFORMS + 2 * MAX_LOADS;
 pub struct PlatformParams {
     /// Platform mass without the auto-balancer, kg (`M_i`).
     pub mass: f64,
-    /// Stiffness of the support to the ground, N/m (`k_i`, may be 0).
+    /// Stiffness of the support to the ground, N/m (`k_i`; the engine takes 0, but scenes and
+    /// the core's analysis need at least 1e-6: the seed's dimensionless variables are scaled by
+    /// the exciter platform's, and a platform hung only on its couplings takes 1e-6).
     pub stiffness: f64,
     /// Viscous damping of the support to the ground, N·s/m (`b_i`).
     #[serde(default)]
