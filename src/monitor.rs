@@ -1962,7 +1962,7 @@ mod tests {
     /// fault at all. Decided within a tick only, every such revolution was an extra edge and a
     /// missing edge or missing frames (on a capture, 17 missing frames and 8 line faults in
     /// 44 revolutions). An index that moves half a pitch past its edge still realigns the
-    /// count.
+    /// count, and one by its edge still finds a line edge the timing let pass.
     #[test]
     fn an_index_jittering_across_its_edge_frames_the_same_edge() {
         let per_edge = 1e6 * core::f64::consts::TAU / 256.0 / 300.0; // 81.8 ticks
@@ -2021,6 +2021,33 @@ mod tests {
         }
         let d = m.diagnostics().edges;
         assert_eq!((d.extra, d.missing_frames), (1, 1), "{d:?}");
+        // Timing tolerances so wide that a lost line edge passes as a tooth: the index, 0.04
+        // pitch before its edge, is what finds the count a tooth behind. Decided by the count
+        // within an eighth on that side too, the index was taken as the count's and none of
+        // the 9 lost edges was counted (a user's capture so had valid windows over 1.01
+        // revolutions, δ 0.67 on a steady shaft).
+        let mut wide = indexed(256, 1, 32, 1e6);
+        wide.tolerances.fault_margin = 2.0;
+        let mut m = monitor(wide, 1);
+        let mut out = Vec::new();
+        let drops = (3..21u32)
+            .step_by(2)
+            .map(|r| 256 * r + 100)
+            .collect::<Vec<_>>();
+        for k in 0..256 * 24u32 {
+            let te = f64::from(k) * per_edge;
+            if k % 256 == 0 {
+                m.on_index((te - 0.04 * per_edge) as u32);
+            }
+            if !drops.contains(&k) {
+                out.extend(m.on_edge(te as u32, Some(Direction::Forward)));
+            }
+        }
+        let d = m.diagnostics().edges;
+        assert_eq!(d.missing as usize, drops.len(), "{d:?}");
+        let valid: Vec<_> = out.iter().filter_map(|o| o.report.measurement()).collect();
+        assert!(valid.len() >= 8, "{}", valid.len());
+        assert!(valid.iter().all(|r| r.delta <= r.noise_floor), "{valid:?}");
     }
 
     /// Discs of 255 and 257 lines configured as 256, run up from rest with some ripple: the

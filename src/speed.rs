@@ -325,6 +325,10 @@ pub struct SpeedTracker {
     /// The last frame of an index disc was realigned by its index (the count was a tooth
     /// off): a second in a row says the disc has another number of lines than configured.
     realigned: bool,
+    /// The last index that framed an interval lay in its later half: by the frame edge, not
+    /// by the tooth before it (which side of an edge the count decides on, see
+    /// [`SpeedTracker::index_places`]).
+    index_late: bool,
     /// Waiting index timestamps, each with the number of edges that had arrived when it was
     /// reported: an index belongs to an edge that arrived after it. (Modulo the counter a
     /// timestamp alone cannot say which edge it falls before once intervals approach the
@@ -426,7 +430,7 @@ const PLACE_LATER: u8 = 1;
 const PLACE_LOST: u8 = 2;
 const PLACE_OWED: u8 = 3;
 /// What [`SpeedTracker::index_place`] needs of the edge judged.
-type PlaceAt = (u32, u32, u32, u32, (bool, bool));
+type PlaceAt = (u32, u32, u32, (u32, u32), (bool, bool));
 
 /// What the judged edge is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -481,6 +485,7 @@ impl SpeedTracker {
             across: false,
             owed: false,
             realigned: false,
+            index_late: false,
             index: [(0, 0); INDEXES],
             arrivals: 0,
             nidx: 0,
@@ -532,6 +537,7 @@ impl SpeedTracker {
             across,
             owed,
             realigned,
+            index_late,
             index: _,
             arrivals,
             nidx,
@@ -544,7 +550,7 @@ impl SpeedTracker {
         } = self;
         (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
         (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
-        (*across, *owed, *realigned) = (false, false, false);
+        (*across, *owed, *realigned, *index_late) = (false, false, false, false);
         (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
@@ -1368,14 +1374,18 @@ impl SpeedTracker {
     /// captured on the same edge, or jitter of the index against the lines): which edge it
     /// frames then depends on the order the two were reported in, or on the jitter, and
     /// flipped from revolution to revolution, each flip a missing or extra edge on a clean
-    /// disc. Synced, the count decides within an eighth of the interval (at least a tick;
-    /// where an interval is more than two ticks): that far before this edge where the count
-    /// puts the frame at the next edge, it is the next edge's; that far either side of the
-    /// last edge where that edge is the frame, it is that frame's (the fourth result where
-    /// its index was owed, [`SpeedTracker::owed`]). Within a tick only, an index 0.04 pitch
-    /// before a line edge with jitter of 0.03 pitch (σ) counted extra and missing edges and
-    /// missing frames in most revolutions. A count a tooth off goes unseen only by an index
-    /// within that eighth of its edge, where jitter cannot tell it from one that is right.
+    /// disc. Synced, the count decides near an edge (where an interval is more than two
+    /// ticks): an index just before this edge where the count puts the frame at the next edge
+    /// is the next edge's; one beside the last edge where the count puts the frame at this
+    /// edge frames this edge; one beside the last edge where that edge was the frame and its
+    /// index is owed is that frame's (the fourth result, [`SpeedTracker::owed`]). Near is an
+    /// eighth of the interval on the side where the framing index lies (by the frame edge or
+    /// by the tooth before it, [`SpeedTracker::index_late`]) and a tick on the other. Within a
+    /// tick only, an index 0.04 pitch before a line edge with jitter of 0.03 pitch (σ) counted
+    /// extra and missing edges and missing frames in most revolutions; within an eighth on
+    /// both sides, such an index hid a count a tooth behind (a line edge lost unseen under
+    /// wide timing tolerances) and left windows valid over 1.01 revolutions. A count a tooth
+    /// off now goes unseen only by an index within a tick of its edge.
     #[inline(never)]
     fn index_places(&self, enc: &Encoder, t: u32, seq: u32) -> (u8, u8, u8, bool) {
         let m = enc.mask();
@@ -1387,13 +1397,31 @@ impl SpeedTracker {
         let last = enc.edges().wrapping_sub(1);
         let before_frame = synced && d > 2 && self.tooth.wrapping_add(1) == last;
         let near_last_frame = synced && d > 2 && (self.owed || self.tooth == last);
-        // How near an edge the count decides: an eighth of the interval, at least a tick.
-        let near = (d >> 3).max(1);
+        // How near an edge the count decides: an eighth of the interval on the side where
+        // the index lies (`index_late`), a tick on the other. An index that normally lies
+        // just before its frame edge is near the tooth before the frame only when the count is
+        // a tooth behind (a line edge lost unseen), and one that normally lies just after the
+        // tooth before the frame is near the frame edge only when the count is a tooth ahead:
+        // there the index must realign the count, not be taken as the count's.
+        let wide = (d >> 3).max(1);
+        let (late_side, early_side) = if self.index_late {
+            (wide, 1)
+        } else {
+            (1, wide)
+        };
+        // The owed frame's index lies by the frame edge; the others by the tooth before it.
+        let after = if self.owed { late_side } else { early_side };
         // A plain loop, not `each_bit`: it runs at every index pulse, where the set-bit loop
         // cost 0.05 instructions per edge (and 10 per finished window) for 64 bytes less. Its
         // classification out of line, the rest in one word: unrolled over the four slots with
         // the classification inline it was 1.7 KB.
-        let at = (m, d, seq, near, (before_frame, near_last_frame));
+        let at = (
+            m,
+            d,
+            seq,
+            (early_side, after),
+            (before_frame, near_last_frame),
+        );
         let mut bits = 0u32;
         for i in 0..usize::from(self.nidx).min(INDEXES) {
             // Two bits a slot, `i` < INDEXES ≤ 8: within the word.
@@ -1419,21 +1447,21 @@ impl SpeedTracker {
     fn index_place(
         &self,
         i: usize,
-        &(m, d, seq, near, (before_frame, near_last_frame)): &PlaceAt,
+        &(m, d, seq, (before, after), (before_frame, near_last_frame)): &PlaceAt,
     ) -> u8 {
         let (x, q) = self.index.get(i).copied().unwrap_or((0, 0));
         let since = x.wrapping_sub(self.last) & m;
         if !reported_before(q, seq) {
             PLACE_LATER
-        } else if near_last_frame && (since.wrapping_add(near) & m) <= near.wrapping_mul(2) {
-            // Within `near` either side of the last edge (`near` ≤ d / 8 < m / 4).
+        } else if near_last_frame && (since.wrapping_add(after) & m) <= after.wrapping_mul(2) {
+            // Within `after` either side of the last edge (`after` ≤ d / 8 < m / 4).
             if self.owed {
                 PLACE_OWED
             } else {
                 PLACE_FRAMES
             }
         } else if (since > d && since < m / 2)
-            || (before_frame && since.wrapping_add(near) >= d && since <= d)
+            || (before_frame && since.wrapping_add(before) >= d && since <= d)
         {
             PLACE_LATER
         } else if since <= d {
@@ -1454,6 +1482,15 @@ impl SpeedTracker {
     /// Also whether the owed frame's index came.
     fn take_index(&mut self, enc: &Encoder, t: u32, seq: u32) -> (bool, bool) {
         let (frames, later, lost, owed) = self.index_places(enc, t, seq);
+        // Where the framing index lies in its interval, late or early (an index beside the
+        // last edge, before it, framed this edge by the count: not counted).
+        if let Some(&(x, _)) = self.index.get(frames.trailing_zeros() as usize) {
+            let m = enc.mask();
+            let (since, d) = (x.wrapping_sub(self.last) & m, t.wrapping_sub(self.last) & m);
+            if since <= d {
+                self.index_late = since > d / 2;
+            }
+        }
         if self.sync == SyncState::Synced {
             // An index that framed no edge and is no later edge's: its edge was not seen.
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(lost.into());

@@ -242,3 +242,45 @@ fn loads_that_meet_are_no_verdict_where_they_could_balance() {
     assert_eq!(r.regime_simulated, Some("gathering"));
     assert!(r.regime_coincident.is_none());
 }
+
+/// A two-platform machine (a user's random draw) at 49 rad/s, where the exact table commits to
+/// balancing: loads started near the balancing position balance, loads started together at
+/// rest keep slipping past it (residual about twice the rotor's; the user's own simulator
+/// agreed). `run` printed the two classes side by side; it now says they disagree and why.
+#[test]
+fn a_committed_class_the_simulation_contradicts_is_said() {
+    let text = "[[platform]]\nmass = 204.05053393271285\nstiffness = 396280.04908831225\n\
+        damping = 381.89571549886676\n\n[[platform]]\nmass = 234.44284439937115\n\
+        stiffness = 215886.06068954297\ndamping = 2516.1064486192704\n\n[[coupling]]\n\
+        between = [1, 2]\nstiffness = 400026.9763718342\ndamping = 585.4371712953168\n\n\
+        [autobalancer]\nkind = \"ball\"\nplatform = 1\nloads = 2\nload_mass = 5.846958146266602\n\
+        radius = 0.05798523511367669\nhousing_mass = 9.605904136727371\n\
+        viscosity = 52.53803688297544\nrotor_unbalance = 0.21413449136943358\n\n\
+        [motor]\nmodel = \"speed\"\nspeed = 100.0\n\n[encoder]\nlines = 256\ntimer_hz = 10e6\n\n\
+        [simulation]\nduration = 40.0\nrtol = 1e-8\natol = 1e-10\n";
+    let path = Path::new("slipping.toml");
+    let scene = Scene::parse(text, path).unwrap();
+    let at = |together: bool| {
+        run(
+            &scene,
+            path,
+            Overrides {
+                speed: Some(49.0),
+                loads_together: together,
+            },
+        )
+        .unwrap()
+    };
+    let r = at(true);
+    assert_eq!(r.regime_class, Some("balancing"));
+    assert_eq!(r.regime_simulated, Some("gathering"));
+    assert!(
+        r.residual_relative.unwrap() > 1.0,
+        "{:?}",
+        r.residual_relative
+    );
+    assert!(r.regime_mismatch.as_ref().unwrap().contains("slipping"));
+    let r = at(false);
+    assert_eq!(r.regime_simulated, Some("balancing"));
+    assert!(r.regime_mismatch.is_none());
+}

@@ -78,6 +78,10 @@ pub struct CaptureReport {
     pub predicted_from: f64,
     /// Rotor speed above which the core finds capture impossible, rad/s.
     pub predicted_until: f64,
+    /// The exact table's capture bands at every resonance, `[from, until]` rad/s
+    /// ([`crate::app::regimes::resonance_captures`]): loads can also be held at a resonance
+    /// the core's windows leave out.
+    pub resonance_bands: Vec<[f64; 2]>,
     /// Lag fraction used: captured when `Ω < (1 − lag_fraction)·ω`.
     pub lag_fraction: f64,
     /// Window of the speed differences, s.
@@ -176,6 +180,10 @@ pub fn analyse(samples: &[RegimeSample], machine: &Machine) -> Option<CaptureRep
         coherence_end: samples.last().map_or(f64::NAN, |s| s.coherence),
         predicted_from: window_of.from,
         predicted_until: window_of.until,
+        resonance_bands: crate::app::regimes::resonance_captures(machine)
+            .iter()
+            .map(|w| [w.from, w.until])
+            .collect(),
         lag_fraction,
         window: 2.0 * k as f64 * dt,
         ..Default::default()
@@ -260,10 +268,22 @@ pub fn analyse(samples: &[RegimeSample], machine: &Machine) -> Option<CaptureRep
 /// A capture report as text (two or three lines).
 pub fn summary(c: &CaptureReport) -> String {
     let mut s = String::new();
+    let bands = c
+        .resonance_bands
+        .iter()
+        .map(|b| format!("{:.2}–{:.2}", b[0], b[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
     let _ = write!(
         s,
-        "Sommerfeld capture (loads started together; core: capture possible from {:.2} up to {:.2} rad/s)\n  ",
-        c.predicted_from, c.predicted_until
+        "Sommerfeld capture (loads started together; core: capture possible from {:.2} up to {:.2} rad/s{})\n  ",
+        c.predicted_from,
+        c.predicted_until,
+        if bands.is_empty() {
+            String::new()
+        } else {
+            format!("; at every resonance, the exact table's bands {bands} rad/s")
+        }
     );
     match (c.captured_from, c.captured_load_speed_median) {
         (Some([_, a]), Some(x)) => {

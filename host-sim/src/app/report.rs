@@ -186,6 +186,9 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     if let Some(why) = &r.regime_unsettled {
         let _ = writeln!(s, "The simulated regime is unsettled: {why}");
     }
+    if let Some(why) = &r.regime_mismatch {
+        let _ = writeln!(s, "  ≠ the core's class and the simulation disagree: {why}");
+    }
     if let Some(why) = &r.regime_coincident {
         let _ = writeln!(s, "The simulated regime is not judged: {why}");
     }

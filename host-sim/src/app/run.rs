@@ -206,6 +206,9 @@ pub struct RunReport {
     /// Why `regime_simulated` is "unsettled": the run ended before the loads' regime showed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_unsettled: Option<String>,
+    /// The core's committed class and the settled simulation disagree: why that can be.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_mismatch: Option<String>,
     /// The loads met to within rounding and moved as one, where the balancing position is
     /// stable (simulated "coincident": no verdict, the model has no contact between loads).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -1837,19 +1840,24 @@ fn regime(
                 ));
             }
             // Identical loads that met to within rounding move as one for good (the model has
-            // no contact between loads); where the balancing position is stable that is no
-            // verdict on the machine: real loads touch, and part at any imperfection (a
+            // no contact between loads); turning with the rotor where the balancing position
+            // is stable that is no verdict on the machine: real loads touch, and part at any imperfection (a
             // run-up's capture merged the bundled one-mass machine's loads bit for bit, and
             // after the release they stayed together opposite the unbalance; parted by 0.01
             // rad they balance within seconds).
+            // Loads that lag the rotor are captured, merged or not (a user's reference with
+            // the loads apart kept one captured where the simulator's merged pair was): that
+            // stays gathering.
             let coincident = r.regime == SimRegime::Gathering
                 && vm.loads() >= 2
+                && !r.lagging
                 && r.coherence_min >= COINCIDENT
                 && report.regime_class.is_some_and(|c| c != "gathering");
             if coincident {
                 report.regime_coincident = Some(format!(
-                    "the loads met and move as one (within 1e-6 rad of each other over the final \
-                     quarter of the run, the residual {:.2e} of the rotor's): the model has no \
+                    "the loads met and move as one with the rotor (within 1e-6 rad of each other \
+                     over the final quarter of the run, the residual {:.2e} of the rotor's): the \
+                     model has no \
                      contact between loads, so identical loads that meet stay together for good, \
                      which real loads, which touch and part at any imperfection, do not; where \
                      the balancing position is stable, as here, this is not the machine's \
@@ -1889,6 +1897,26 @@ fn regime(
                 report.regime_simulated = Some("unsettled");
             } else if coincident {
                 report.regime_simulated = Some("coincident");
+            }
+            // A committed class the settled simulation contradicts is said, not left side by
+            // side with it (firmware reading the class would report it).
+            if let (Some(class), Some(sim)) = (report.regime_class, report.regime_simulated) {
+                let committed = class == "balancing" || class == "gathering";
+                let judged = matches!(sim, "balancing" | "gathering" | "saturated");
+                if committed && judged && !crate::studies::sweep::agrees(class, sim) {
+                    report.regime_mismatch = Some(if class == "balancing" {
+                        "the balancing position is stable here and nothing else is known to \
+                         persist, but the loads settled elsewhere: a state the exact table does \
+                         not describe (loads started together can keep slipping past the \
+                         balancing position on a few machines; docs/criterion.md)"
+                            .to_string()
+                    } else {
+                        "the balancing position is unstable here, yet the loads balanced over \
+                         the run: a growth too slow to show in it (lengthen \
+                         simulation.duration)"
+                            .to_string()
+                    });
+                }
             }
             report.regime_detail = Some(r);
         }
