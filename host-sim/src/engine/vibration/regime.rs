@@ -147,6 +147,10 @@ pub struct RegimeReport {
     /// a steady motion, not one still on its way. With the residual neither balanced nor
     /// gathered, a self-oscillation about the balancing position where that is unstable.
     pub steady: bool,
+    /// The residual's largest value in the last quarter of the final window is below half of
+    /// its largest in the first quarter: the loads were still on their way (a verdict of the
+    /// run's end, not of the machine's).
+    pub falling: bool,
 }
 
 /// How closely the residual's least and largest values must repeat, quarter by quarter of
@@ -211,7 +215,23 @@ pub fn classify(samples: &[RegimeSample], c: &RegimeCriteria) -> Option<RegimeRe
         rotor_speed,
         lagging: load_speed.abs() < (1.0 - c.lag_fraction) * rotor_speed.abs(),
         steady: steady(win, residual_min, residual_max),
+        falling: falling(win),
     })
+}
+
+/// Whether `win`'s residual peaks in its last quarter below half its peak in its first (see
+/// [`RegimeReport::falling`]).
+fn falling(win: &[RegimeSample]) -> bool {
+    let (Some(a), Some(b)) = (win.first(), win.last()) else {
+        return false;
+    };
+    let quarter = 0.25 * (b.t - a.t);
+    let peak = |lo: f64, hi: f64| {
+        win.iter()
+            .filter(|s| s.t >= lo && s.t <= hi)
+            .fold(f64::NAN, |m, s| m.max(s.residual))
+    };
+    peak(b.t - quarter, b.t) < 0.5 * peak(a.t, a.t + quarter)
 }
 
 /// The two auto-balancing positions' angles for `N = 2` loads of unbalance `load_unbalance`
