@@ -21,6 +21,16 @@ fn text(args: &[&str]) -> String {
 }
 
 /// Writes `body` as `name` into `dir`.
+/// Asserts that the line after the first line of `out` that `anchor` accepts starts with
+/// `prefix`.
+fn assert_next_line(out: &str, anchor: impl Fn(&str) -> bool, prefix: &str) {
+    let line = out.lines().position(anchor).expect("anchor line");
+    assert!(
+        out.lines().nth(line + 1).unwrap_or("").starts_with(prefix),
+        "{out}"
+    );
+}
+
 fn scene(dir: &Path, name: &str, body: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, body).unwrap();
@@ -115,16 +125,10 @@ fn the_drive_prediction_says_it_leaves_out_the_machines_torque() {
         "{v}"
     );
     let out = text(&["run", coupled]);
-    let line = out
-        .lines()
-        .position(|l| l.contains("δ measured"))
-        .expect("δ line");
-    assert!(
-        out.lines()
-            .nth(line + 1)
-            .unwrap()
-            .starts_with("  WARNING: the predicted δ is the drive's alone"),
-        "{out}"
+    assert_next_line(
+        &out,
+        |l| l.contains("δ measured"),
+        "  WARNING: the predicted δ is the drive's alone",
     );
     let v = json(&["run", alone, "--json"]);
     assert!(v.get("delta_notes").is_none(), "{v}");
@@ -210,16 +214,10 @@ fn the_support_analysis_says_it_leaves_out_the_auto_balancer() {
     let v = json(&["run", both, "--json"]);
     assert!(v["supports"]["balancer_warning"].as_str().is_some(), "{v}");
     let out = text(&["run", both]);
-    let line = out
-        .lines()
-        .position(|l| l.starts_with("Supports at"))
-        .expect("supports line");
-    assert!(
-        out.lines()
-            .nth(line + 1)
-            .unwrap()
-            .starts_with("  WARNING: the support analysis"),
-        "{out}"
+    assert_next_line(
+        &out,
+        |l| l.starts_with("Supports at"),
+        "  WARNING: the support analysis",
     );
     let v = json(&["predict", "auger", "--json"]);
     assert!(v["supports"].get("balancer_warning").is_none(), "{v}");
@@ -256,16 +254,10 @@ fn a_measured_delta_names_the_encoder_errors_it_includes() {
         "{n}"
     );
     let out = text(&["run", errors.to_str().unwrap()]);
-    let line = out
-        .lines()
-        .position(|l| l.contains("δ measured"))
-        .expect("δ line");
-    assert!(
-        out.lines()
-            .nth(line + 1)
-            .unwrap()
-            .starts_with("  NOTE: the scene's encoder errors"),
-        "{out}"
+    assert_next_line(
+        &out,
+        |l| l.contains("δ measured"),
+        "  NOTE: the scene's encoder errors",
     );
     let v = json(&["run", clean.to_str().unwrap(), "--json"]);
     assert!(v.get("delta_notes").is_none(), "{v}");
