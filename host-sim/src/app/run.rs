@@ -1839,40 +1839,34 @@ fn regime(
                         / vm.rotor_unbalance().max(f64::MIN_POSITIVE),
                 ));
             }
-            // Identical loads that met to within rounding move as one for good (the model has
-            // no contact between loads); turning with the rotor where the balancing position
-            // is stable that is no verdict on the machine: real loads touch, and part at any imperfection (a
-            // run-up's capture merged the bundled one-mass machine's loads bit for bit, and
-            // after the release they stayed together opposite the unbalance; parted by 0.01
-            // rad they balance within seconds).
-            // Loads that lag the rotor are captured, merged or not (a user's reference with
-            // the loads apart kept one captured where the simulator's merged pair was): that
-            // stays gathering.
-            let coincident = r.regime == SimRegime::Gathering
-                && vm.loads() >= 2
+            // Not balancing, not lagging the rotor, where the balancing position is stable: a
+            // verdict of the run that may not be the machine's (loads that lag are captured,
+            // merged or not: a user's reference with the loads apart kept one captured where
+            // the simulator's merged pair was, and that stays gathering).
+            let free = r.regime == SimRegime::Gathering
                 && !r.lagging
-                && r.coherence_min >= COINCIDENT
                 && report.regime_class.is_some_and(|c| c != "gathering");
+            // Identical loads that met to within rounding move as one for good (the model has
+            // no contact between loads), which real loads, touching and parting at any
+            // imperfection, do not (a run-up's capture merged the bundled one-mass machine's
+            // loads bit for bit, and after the release they stayed together opposite the
+            // unbalance; parted by 0.01 rad they balance within seconds).
+            let coincident = free && vm.loads() >= 2 && r.coherence_min >= COINCIDENT;
             if coincident {
                 report.regime_coincident = Some(format!(
                     "the loads met and move as one with the rotor (within 1e-6 rad of each other \
                      over the final quarter of the run, the residual {:.2e} of the rotor's): the \
-                     model has no \
-                     contact between loads, so identical loads that meet stay together for good, \
-                     which real loads, which touch and part at any imperfection, do not; where \
-                     the balancing position is stable, as here, this is not the machine's \
-                     regime",
+                     model has no contact between loads, so identical loads that meet stay \
+                     together for good, which real loads, which touch and part at any \
+                     imperfection, do not; where the balancing position is stable, as here, \
+                     this is not the machine's regime",
                     r.residual_relative
                 ));
             }
-            // Where the balancing position is stable, loads whose residual still falls over
-            // the final quarter are on their way (two machines held 60 s after a run-up read
-            // gathering at 0.85 and 0.18 of the rotor's unbalance, and balanced to 1e-8 when
-            // held 600 s).
-            let converging = r.regime == SimRegime::Gathering
-                && r.falling
-                && !r.lagging
-                && report.regime_class.is_some_and(|c| c != "gathering");
+            // Loads whose residual still falls over the final quarter are on their way (two
+            // machines held 60 s after a run-up read gathering at 0.85 and 0.18 of the rotor's
+            // unbalance, and balanced to 1e-8 when held 600 s).
+            let converging = free && r.falling;
             report.regime_unsettled = match r.regime {
                 SimRegime::Gathering if converging => Some(format!(
                     "the residual unbalance was still falling over the final quarter of the run \

@@ -758,13 +758,14 @@ impl Floquet {
 }
 
 /// Golden-section search for the maximum of `f` on `[a, b]` (in log-speed), `iters` steps:
-/// `(argmax, max)` over every point evaluated.
-fn golden(
+/// `(argmax, max)` over every point evaluated (also the capture bands' search,
+/// [`crate::app::regimes::resonance_captures`], with an `f` that cannot fail).
+pub(crate) fn golden<E>(
     a: f64,
     b: f64,
     iters: usize,
-    mut f: impl FnMut(f64) -> Result<f64, StabilityError>,
-) -> Result<(f64, f64), StabilityError> {
+    mut f: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<(f64, f64), E> {
     let r = 0.5 * (5f64.sqrt() - 1.0);
     let (mut lo, mut hi) = (a.ln(), b.ln());
     let mut x1 = hi - r * (hi - lo);
