@@ -2050,6 +2050,73 @@ mod tests {
         assert!(valid.iter().all(|r| r.delta <= r.noise_floor), "{valid:?}");
     }
 
+    /// A frame edge lost, its index there (just before or after the edge before it, or
+    /// mid-pitch): the
+    /// index lies in the interval the count spans the lost tooth with, so it agrees with the
+    /// count. It realigned the count a tooth on instead, an extra edge counted that never was,
+    /// and every later window framed a tooth late (a user's capture: 100 lines, the index
+    /// 0.04 pitch before its edge). The lines either side of the frame edge lost as well.
+    #[test]
+    fn a_lost_frame_edge_with_its_index_keeps_the_frame() {
+        let per_edge = 1e6 * core::f64::consts::TAU / 100.0 / 300.0; // 209.4 ticks
+        for offset in [-0.04, 0.04, -0.5] {
+            // The frame edge: the first after the index.
+            let f = u32::from(offset > 0.0);
+            let frame = |ticks: u32| {
+                (0..30u32).any(|r| (f64::from(r * 100 + f) * per_edge) as u32 == ticks)
+            };
+            // 30 revolutions, the edges `drops` lost: the windows and the counters.
+            let feed = |drops: &[u32]| {
+                let mut m = monitor(indexed(100, 4, 32, 1e6), 1);
+                let mut out = Vec::new();
+                for k in 0..100 * 30u32 {
+                    let te = f64::from(k) * per_edge;
+                    let ti = te + offset * per_edge;
+                    if k % 100 == 0 && offset < 0.0 {
+                        m.on_index(ti as u32);
+                    }
+                    if !drops.contains(&k) {
+                        out.extend(m.on_edge(te as u32, Some(Direction::Forward)));
+                    }
+                    if k % 100 == 0 && offset > 0.0 {
+                        m.on_index(ti as u32);
+                    }
+                }
+                (out, m.diagnostics().edges)
+            };
+            let (clean, c) = feed(&[]);
+            let clean_valid = clean.iter().filter(|o| o.report.valid()).count();
+            assert!(clean_valid >= 27, "index {offset}: {clean_valid} valid");
+            for lost in [0u32, 99, 1] {
+                // The frame edge, the one before it, the one after it.
+                let k = |r: u32| (r * 100 + f + lost) - if lost == 99 { 100 } else { 0 };
+                let (out, d) = feed(&[k(10), k(15), k(20)]);
+                let at = format!("index {offset}, tooth {lost} lost");
+                assert_eq!(
+                    (
+                        d.missing,
+                        d.extra,
+                        d.glitches,
+                        d.missing_frames,
+                        d.unexplained
+                    ),
+                    (3, 0, 0, 0, 0),
+                    "{at}: {d:?}"
+                );
+                // Every revolution is counted, those whose frame edge was lost too.
+                assert_eq!(d.revolutions, c.revolutions, "{at}: {d:?}");
+                // Every window starts at a frame edge (tooth 0), and every valid one ends at
+                // one. Those with a lost edge are invalid, and so is the one before when the
+                // edge after its frame was lost; none begins at a lost frame edge.
+                assert!(out.iter().all(|o| frame(o.report.start_ticks)), "{at}");
+                let valid = out.iter().filter(|o| o.report.valid());
+                assert!(valid.clone().all(|o| frame(o.report.end_ticks)), "{at}");
+                let fewer = if lost == 99 { 3 } else { 6 };
+                assert_eq!(valid.count(), clean_valid - fewer, "{at}");
+            }
+        }
+    }
+
     /// Discs of 255 and 257 lines configured as 256, run up from rest with some ripple: the
     /// index comes a tooth early or late every revolution, so the frame is never confirmed,
     /// missing frames are counted and no window is valid.

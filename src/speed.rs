@@ -1013,7 +1013,7 @@ impl SpeedTracker {
                         sink.fault(Fault::Unexplained, e1);
                         self.fault_in_revolution();
                     }
-                    self.accept(enc, table, e1, s1, (true, vouched), sink);
+                    self.accept(enc, table, e1, s1, (true, vouched, 0), sink);
                     continue;
                 }
                 // Teeth lost before it, and of them those within its interval (`Missing` is 1
@@ -1042,7 +1042,7 @@ impl SpeedTracker {
             } else {
                 self.advance_after_fault(enc, lost);
             }
-            self.accept(enc, table, e1, s1, (false, false), sink);
+            self.accept(enc, table, e1, s1, (false, false, within), sink);
             if within > 0 {
                 self.prev = self.per_base_over(enc, within);
             }
@@ -1586,18 +1586,19 @@ impl SpeedTracker {
         t: u32,
         sink: &mut S,
     ) {
-        self.accept(enc, table, t, self.arrivals, (true, true), sink);
+        self.accept(enc, table, t, self.arrivals, (true, true, 0), sink);
     }
 
     /// Accepts the edge at `t` as the tooth after the current one (or as framed by an index).
-    /// `clean`: its interval is its own (no fault within it); `vouched`: and may form a sample.
+    /// `clean`: its interval is its own (no fault within it); `vouched`: and may form a sample;
+    /// `lost`: teeth lost within its interval, counted already (the count is past them).
     fn accept<P: PitchTable, S: EdgeSink>(
         &mut self,
         enc: &Encoder,
         table: &P,
         t: u32,
         seq: u32,
-        (clean, vouched): (bool, bool),
+        (clean, vouched, lost): (bool, bool, u16),
         sink: &mut S,
     ) {
         let edges = enc.edges();
@@ -1635,6 +1636,13 @@ impl SpeedTracker {
                             self.missing_frame(t, sink);
                             self.sync = SyncState::Confirming;
                             tooth = 0;
+                        } else if indexed && tooth != 0 && tooth <= lost {
+                            // The frame edge was among the teeth lost within the interval, and
+                            // its index came there: the count agrees (it realigned the count a
+                            // tooth on, an extra edge counted and every later frame a tooth
+                            // late). The revolution is counted; its window ended at the fault.
+                            self.realigned = false;
+                            self.counters.revolutions = self.counters.revolutions.wrapping_add(1);
                         } else if indexed {
                             self.realigned = tooth != 0;
                             if tooth == 1 || tooth == edges.wrapping_sub(1) {
