@@ -294,8 +294,9 @@ impl WindowState {
 
     /// Adds an ordinary tooth (not a frame) of `dt` ticks with its sample to the window in
     /// progress, if any: the per-edge work of a window. Every accepted edge of a running
-    /// window brings a sample (the `K`-edge ring is full whenever a window runs: a start is a
-    /// frame at least a revolution after any reset), so the window's samples are its edges.
+    /// window brings a sample (a window whose first edge after its frame brings none, the
+    /// `K`-edge ring not full again after a fault or the sync, does not run: it starts at the
+    /// next frame), so the window's samples are its edges.
     #[inline(always)]
     pub(crate) fn add(&mut self, dt: u32, sample: Option<Sample>, uniform: bool) {
         // Before a window starts this accumulates nothing that matters: a start resets it all.
@@ -452,6 +453,16 @@ impl WindowState {
             if tooth.frame {
                 self.restart(tooth.index, tooth.time);
             }
+            return None;
+        }
+        if tooth.sample.is_none() {
+            // The ring of the last K intervals was not full again by the start: a fault (a
+            // glitch, a lost tooth, reported with the window it cut) or the sync within K
+            // edges before the frame. The window's first samples would be missing, its δ
+            // over the rest too low (a user's 12-1 wheel, K = 8: 0.068 for 0.216): it starts
+            // at the next frame instead. (Within a window, a tooth without a sample comes only
+            // after a fault, which has ended the window already.)
+            self.started = false;
             return None;
         }
         self.add(tooth.dt, tooth.sample, uniform);

@@ -2050,6 +2050,137 @@ mod tests {
         assert!(valid.iter().all(|r| r.delta <= r.noise_floor), "{valid:?}");
     }
 
+    /// A fault fewer than K edges before a frame (a line edge lost, a noise pulse): the window
+    /// that frame starts would lack its first samples, the ring of the last K intervals not
+    /// full again. Such a window read δ over the rest of its samples, valid and low (a user's
+    /// 12-1 wheel, K = 8: 0.068 for 0.216; a 64-line disc, K = 32: 0.27 for 0.39). Every
+    /// valid window of a faulted stream must measure what the same window of the clean
+    /// stream does, bit for bit (the shaft's motion repeats every revolution); the fault
+    /// costs at most the window it is in, the one before (found at the edge after its
+    /// frame) and the one after.
+    #[test]
+    fn a_window_starts_where_its_samples_are_whole() {
+        for (lines, k) in [(64u16, 32u16), (64, 8), (100, 4), (36, 16)] {
+            for ph in [0.0, 1.3, 2.6, 3.9, 5.2] {
+                let w = move |phi: f64| 100.0 * (1.0 + 0.3 * (phi + ph).sin());
+                let clean = stream(&uniform(u32::from(lines)), Some(0.0), 12, 1e6, u32::MAX, &w);
+                let feed = |evs: &[Ev]| {
+                    let mut m = monitor(indexed(lines, k, 32, 1e6), 1);
+                    (run(&mut m, evs), m.diagnostics().edges)
+                };
+                let (reference, _) = feed(&clean);
+                let delta_at = |start: u32| {
+                    reference
+                        .iter()
+                        .find(|o| o.report.start_ticks == start)
+                        .and_then(|o| o.report.measurement())
+                        .map(|r| r.delta)
+                };
+                // Where the edges are among the events, and the frame edge of revolution 6
+                // among them (the first edge after its index).
+                let edges: Vec<usize> = (0..clean.len())
+                    .filter(|&i| matches!(clean[i], Ev::Edge(_)))
+                    .collect();
+                let index = (0..clean.len())
+                    .filter(|&i| matches!(clean[i], Ev::Index(_)))
+                    .nth(6)
+                    .unwrap();
+                let frame = edges.iter().position(|&i| i > index).unwrap();
+                for back in 0..=usize::from(k) + 1 {
+                    for glitch in [false, true] {
+                        let (before, at) = (edges[frame - back - 1], edges[frame - back]);
+                        let mut evs = clean.clone();
+                        if glitch {
+                            let (t0, t1) = (time_of(evs[before]), time_of(evs[at]));
+                            evs.insert(before + 1, Ev::Edge(t0 + (t1 - t0) / 2));
+                        } else {
+                            evs.remove(at);
+                        }
+                        let what =
+                            format!(
+                            "{lines} lines, K {k}, phase {ph}, {} {back} edges before the frame",
+                            if glitch { "a noise pulse" } else { "a line edge lost" }
+                        );
+                        let (out, d) = feed(&evs);
+                        // Seen: a noise pulse mid-pitch in the accept band is taken as a tooth
+                        // on the fast path, and found as an extra edge at the frame.
+                        assert!(d.glitches + d.missing + d.extra >= 1, "{what}: {d:?}");
+                        let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
+                        for o in &valid {
+                            let got = o.report.measurement().map(|r| r.delta);
+                            assert_eq!(got, delta_at(o.report.start_ticks), "{what}: {o:?}");
+                        }
+                        let whole = reference.iter().filter(|o| o.report.valid()).count();
+                        assert!(
+                            valid.len() + 3 >= whole,
+                            "{what}: {} of {whole}",
+                            valid.len()
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// A run of captures lost (a DMA ring half overwritten before it was read): 64 or 128 line
+    /// edges of a 1024-line disc in a row. Judged as two lost teeth, a third of the gap became
+    /// the interval the next edges were judged by, and the real teeth after it glitches (8
+    /// and 17 of them, 2 and 3 unexplained edges, the sync lost). The gap's teeth are counted
+    /// as lost, the count given up and the frame found again; every valid window measures
+    /// what the same window of the clean stream does.
+    #[test]
+    fn a_run_of_lost_captures_is_counted_as_lost_teeth() {
+        let w = |phi: f64| 134.0 * (1.0 + 0.03 * phi.sin());
+        let clean = stream(&uniform(1024), Some(0.0), 10, 170e6, u32::MAX, &w);
+        // A minimum speed so low that a gap of 128 pitches at full speed is no stop.
+        let mut c = indexed(1024, 16, 32, 170e6);
+        c.min_speed = 1.0;
+        let feed = |evs: &[Ev]| {
+            let mut m = monitor(c, 1);
+            (run(&mut m, evs), m.diagnostics().edges)
+        };
+        let (reference, _) = feed(&clean);
+        for (gap, from) in [
+            (64usize, 3 * 1024 + 300),
+            (128, 3 * 1024 + 1000),
+            (5, 4 * 1024 + 10),
+        ] {
+            let mut evs = clean.clone();
+            // `gap` edges from edge `from` on (no index among them: a frame is not lost).
+            let edges: Vec<usize> = (0..evs.len())
+                .filter(|&i| matches!(evs[i], Ev::Edge(_)))
+                .skip(from)
+                .take(gap)
+                .collect();
+            for &i in edges.iter().rev() {
+                evs.remove(i);
+            }
+            let (out, d) = feed(&evs);
+            let what = format!("{gap} lost from edge {from}");
+            // As many as the last interval fits in the gap: the speed changed by 0.3 % over
+            // the 128.
+            assert!(d.missing.abs_diff(gap as u32) <= 1, "{what}: {d:?}");
+            assert_eq!(
+                (d.glitches, d.extra, d.unexplained, d.missing_frames),
+                (0, 0, 0, 0),
+                "{what}: {d:?}"
+            );
+            // Two lost teeth are the longest fault judged; more are a run, after which the count
+            // is found again.
+            assert_eq!(d.sync_losses, u32::from(gap > 2), "{what}: {d:?}");
+            let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
+            for o in &valid {
+                let want = reference
+                    .iter()
+                    .find(|r| r.report.start_ticks == o.report.start_ticks)
+                    .and_then(|r| r.report.measurement())
+                    .map(|r| r.delta);
+                assert_eq!(o.report.measurement().map(|r| r.delta), want, "{what}");
+            }
+            assert!(valid.len() >= 5, "{what}: {} valid", valid.len());
+        }
+    }
+
     /// A frame edge lost, its index there (just before or after the edge before it, or
     /// mid-pitch): the
     /// index lies in the interval the count spans the lost tooth with, so it agrees with the
@@ -2106,13 +2237,14 @@ mod tests {
                 // Every revolution is counted, those whose frame edge was lost too.
                 assert_eq!(d.revolutions, c.revolutions, "{at}: {d:?}");
                 // Every window starts at a frame edge (tooth 0), and every valid one ends at
-                // one. Those with a lost edge are invalid, and so is the one before when the
-                // edge after its frame was lost; none begins at a lost frame edge.
+                // one. Each loss costs two: the window with the lost edge, and the one before
+                // when the edge after its frame was lost, or none where the frame edge was lost,
+                // or the one after the edge before its frame was lost (its first samples would
+                // span the loss).
                 assert!(out.iter().all(|o| frame(o.report.start_ticks)), "{at}");
                 let valid = out.iter().filter(|o| o.report.valid());
                 assert!(valid.clone().all(|o| frame(o.report.end_ticks)), "{at}");
-                let fewer = if lost == 99 { 3 } else { 6 };
-                assert_eq!(valid.count(), clean_valid - fewer, "{at}");
+                assert_eq!(valid.count(), clean_valid - 6, "{at}");
             }
         }
     }

@@ -450,6 +450,9 @@ enum Verdict {
     Unexplained,
     /// Not enough edges yet to judge.
     Wait,
+    /// An interval longer than any two lost teeth explain (a run of captures lost, e.g. a DMA
+    /// ring overrun): a new time reference, the count given up.
+    Dropout,
 }
 
 impl SpeedTracker {
@@ -995,6 +998,11 @@ impl SpeedTracker {
             // careful path's code stays small.
             let (lost, within) = match verdict {
                 Verdict::Wait => return,
+                Verdict::Dropout => {
+                    self.pop();
+                    self.dropout(enc, e1, sink);
+                    continue;
+                }
                 Verdict::Glitch => {
                     self.pop();
                     self.reject(e1, sink);
@@ -1047,6 +1055,27 @@ impl SpeedTracker {
                 self.prev = self.per_base_over(enc, within);
             }
         }
+    }
+
+    /// An interval at `t` longer than any lost teeth the judgement weighs explain: the teeth
+    /// it spans counted as lost (as many as the last interval fits in it, less the edge at
+    /// `t`), the count given up, and `t` a new time reference (the next interval is the
+    /// first judged). Rare: out of line.
+    #[inline(never)]
+    fn dropout<S: EdgeSink>(&mut self, enc: &Encoder, t: u32, sink: &mut S) {
+        let d = t.wrapping_sub(self.last) & enc.mask();
+        let lost = d
+            .wrapping_add(self.prev / 2)
+            .checked_div(self.prev)
+            .unwrap_or(1)
+            .saturating_sub(1)
+            .max(1);
+        self.counters.missing = self.counters.missing.wrapping_add(lost);
+        sink.fault(Fault::MissingEdge, t);
+        self.lose_sync(false);
+        self.last = t;
+        self.prev = 0;
+        self.across = false;
     }
 
     /// The per-base interval of the tooth just accepted when its interval also spanned the
@@ -1147,6 +1176,16 @@ impl SpeedTracker {
         };
         if x + 1.0 < tol.glitch_fraction * (outright - 1.0) {
             return Verdict::Glitch;
+        }
+        if x - 1.0 > 3.0 * tol.accept * (expected + 1.0)
+            && (synced || enc.framing() != Framing::Pattern)
+        {
+            // Longer than three expected pitches by more than the accept band: the judgement's
+            // longest fault, two teeth lost, would make a third of it the interval the next
+            // edges are judged by, and the real teeth after it pairs of glitches and teeth (a
+            // run of 64 captures lost: 8 glitches, 2 unexplained edges, the sync lost; 5 lost:
+            // an unexplained edge, 3 missing frames).
+            return Verdict::Dropout;
         }
         if !synced && enc.framing() == Framing::Pattern {
             // Unsynced on a pattern wheel the expected pitch is unknown: take every edge that
@@ -1951,6 +1990,7 @@ impl SpeedTracker {
             && self.npend == 0
             && self.nidx == 0
             && !self.owed
+            && !self.across
             && !self.history
             && u16::from(self.fill) >= enc.samples_span();
         self.stop = if fast {

@@ -32,7 +32,8 @@ pub enum Step {
     },
     /// The handler ran a half late: the slots it should have fed are being overwritten.
     /// Nothing is fed; reading resumes at the start of the half the DMA is writing, and the
-    /// monitor sees the gap as missing edges.
+    /// monitor sees the gap as lost teeth (counted missing; the count is given up and the
+    /// frame found again).
     Overrun,
     /// Nothing to feed.
     Idle,
