@@ -1567,6 +1567,26 @@ fn options_out_of_range_name_their_range() {
         e.contains("--estimator-edges is out of range: a speed sample spans 1 to 32"),
         "{e}"
     );
+    // A prescaler the wheel cannot take names the wheel, not the timer.
+    let e = err(AnalyzeOptions {
+        prescaler: Some(2),
+        ..wheel("36-2")
+    });
+    assert!(
+        e.starts_with("--prescaler 2 does not fit a wheel with a pattern"),
+        "{e}"
+    );
+    assert!(!e.contains("timer"), "{e}");
+    let e = err(AnalyzeOptions {
+        lines: Some(36),
+        prescaler: Some(8),
+        framing: Some(host_sim::app::analyze::FramingArg::Index),
+        ..AnalyzeOptions::default()
+    });
+    assert!(
+        e.starts_with("--prescaler 8 does not fit a disc of 36 lines: it must divide"),
+        "{e}"
+    );
     for w in ["36-36", "36-34", "100-2"] {
         let e = err(wheel(w));
         assert!(
@@ -1575,4 +1595,54 @@ fn options_out_of_range_name_their_range() {
         );
         assert!(!e.contains("pattern."), "{w}: {e}");
     }
+}
+
+/// An index pulse a fraction of a tick after its frame edge (latched at the same tick by a
+/// 1 MHz timer): windows begin and end at the frame edge's time, not the index pulse's (a
+/// window was shown ending 0.3 µs late, at its index), and the sync list gives the time
+/// `sync_acquired` does (listed at the edge the state changed after, two edges later).
+#[test]
+fn window_and_sync_times_are_the_edges_the_core_took() {
+    // 24 lines at about 40 rad/s, each rising edge 0.2 µs into its tick, the index before
+    // line 0: 65 µs (0.01 pitch) before it, and from the fifth revolution on in every other
+    // revolution 0.3 µs after it, at its tick (a jittering index, taken as the count says once
+    // in sync).
+    let rising: Vec<f64> = (0..24 * 12u32)
+        .map(|k| (1000.0 + f64::from(k) * 6545.0 + 0.2) * 1e-6)
+        .collect();
+    let mut rows = vec![(0.0, 0u8, 0u8)];
+    for (k, &t) in rising.iter().enumerate() {
+        let (index, odd) = (k % 24 == 0, k / 24 % 2 == 1 && k / 24 > 4);
+        if index && !odd {
+            rows.push((t - 65e-6, 0, 1));
+        }
+        rows.push((t, 1, u8::from(index && !odd)));
+        if index && odd {
+            rows.push((t + 0.3e-6, 1, 1));
+        }
+        rows.push((t + 3000e-6, 0, 0));
+    }
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n");
+    for (t, a, z) in rows {
+        text.push_str(&format!("{t:.9},{a},{z}\n"));
+    }
+    let cfg = configure(&index_lines(24)).unwrap();
+    let mut reader = text_reader(text, "index-at-edge.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert!(report.valid_windows >= 8, "{}", report.valid_windows);
+    let on_edge = |t: f64| rising.iter().any(|&r| (r - t).abs() < 1e-12);
+    for w in &report.windows {
+        assert!(
+            on_edge(w.start) && on_edge(w.end),
+            "{} … {}",
+            w.start,
+            w.end
+        );
+    }
+    let synced = report
+        .sync
+        .iter()
+        .find(|s| s.state == "synced")
+        .map(|s| s.time);
+    assert_eq!(synced, report.sync_acquired);
 }

@@ -81,7 +81,8 @@ pub fn take(p: Peripherals) -> Board {
 ///
 /// TIM2's kernel clock is PCLK1 when the APB1 prescaler is 1 (×2 otherwise; RM0440 RCC clock
 /// tree, timer clock), so 170 MHz here. The firmware reads the real value back from
-/// embassy-stm32 after this setup rather than assuming it (see `capture::Capture::start`).
+/// embassy-stm32 after this setup rather than assuming it (`capture::Capture::configure`
+/// reads it, `main` compares it with `config::TIMER_HZ`).
 ///
 /// HSI16 is trimmed to ±1 % over temperature, so absolute speeds carry up to 1 % error; δ is a
 /// ratio of speeds measured with the same clock and does not.

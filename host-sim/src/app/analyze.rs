@@ -459,8 +459,9 @@ pub const MIN_POLL_INTERVAL: f64 = 1e-5;
 struct Clock {
     hz: f64,
     mask: u64,
-    /// Recent raw events: (ticks, time), newest last.
-    recent: VecDeque<(u32, f64)>,
+    /// Recent raw events: (ticks, time, whether a capture of the encoder channel), newest
+    /// last.
+    recent: VecDeque<(u32, f64, bool)>,
     latest: (u32, f64),
 }
 
@@ -471,18 +472,28 @@ impl Clock {
         (n as u64 & self.mask) as u32
     }
 
-    fn note(&mut self, ticks: u32, t: f64) {
+    fn note(&mut self, ticks: u32, t: f64, capture: bool) {
         if self.recent.len() == 64 {
             self.recent.pop_front();
         }
-        self.recent.push_back((ticks, t));
+        self.recent.push_back((ticks, t, capture));
         self.latest = (ticks, t);
     }
 
-    /// The capture time of `ticks`: the recent event latched at it, else counted back from
-    /// the latest event (the core reports times of recent edges and polls).
+    /// The capture time of `ticks`: the recent capture latched at it (an index pulse or a
+    /// poll at the same tick is not the edge the core reports: a window ending at a frame
+    /// edge was shown ending at its index pulse, 0.6 µs later, at 1 MHz), else the recent
+    /// event latched at it, else counted back from the latest event (the core reports times
+    /// of recent edges and polls).
     fn time(&self, ticks: u32) -> f64 {
-        if let Some(&(_, t)) = self.recent.iter().rev().find(|(k, _)| *k == ticks) {
+        let at = |capture: bool| {
+            self.recent
+                .iter()
+                .rev()
+                .find(|&&(k, _, c)| k == ticks && (c || !capture))
+                .map(|&(_, t, _)| t)
+        };
+        if let Some(t) = at(true).or_else(|| at(false)) {
             return t;
         }
         let back = (u64::from(self.latest.0).wrapping_sub(u64::from(ticks))) & self.mask;
@@ -775,12 +786,12 @@ pub fn analyze<R: BufRead>(
         if let Some(t0) = last_event {
             for p in polls.between(t0, t) {
                 let ticks = clock.ticks(p);
-                clock.note(ticks, p);
+                clock.note(ticks, p, false);
                 st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
             }
         }
         let ticks = clock.ticks(t);
-        clock.note(ticks, t);
+        clock.note(ticks, t, encoder_edge);
         last_event = Some(t);
         if index_edge {
             report.index_pulses += 1;
@@ -809,7 +820,7 @@ pub fn analyze<R: BufRead>(
     if let Some(t0) = last_event {
         for p in polls.between(t0, end).into_iter().chain([end]) {
             let ticks = clock.ticks(p);
-            clock.note(ticks, p);
+            clock.note(ticks, p, false);
             st.poll(&mut monitor, &clock, ticks, &mut report, on_decision);
         }
         // A window held for the edge after its frame, which the recording does not have, and
@@ -986,6 +997,8 @@ impl State {
     ) {
         let unit = f64::from(monitor.encoder().unit_rad());
         let hz = clock.hz;
+        // The first synced tooth of these events.
+        let mut synced_at = None;
         for (ticks, ev) in self.seen.events.drain(..) {
             let time = clock.time(ticks);
             let kind = match ev {
@@ -1016,6 +1029,9 @@ impl State {
                     }
                     if report.sync_acquired.is_none() && t.synced {
                         report.sync_acquired = Some(time);
+                    }
+                    if t.synced && synced_at.is_none() {
+                        synced_at = Some(time);
                     }
                     DecisionKind::Tooth {
                         tooth: t.tooth,
@@ -1061,9 +1077,15 @@ impl State {
         let s = monitor.sync_state();
         if s != self.sync {
             self.sync = s;
+            // Synced at the tooth the count begins at (judged with the edges after it: listed
+            // at the last of them, it disagreed with the time `sync_acquired` gives).
+            let time = match (s, synced_at) {
+                (SyncState::Synced, Some(t)) => t,
+                _ => clock.latest.1,
+            };
             if report.sync.len() < MAX_LISTED {
                 report.sync.push(SyncOut {
-                    time: clock.latest.1,
+                    time,
                     state: sync_name(s),
                 });
             }
@@ -1207,6 +1229,13 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         },
     }
+    let _ = writeln!(
+        s,
+        "δ is measured against the wheel's nominal tooth angles: the disc's own pitch errors \
+         (lines or teeth unevenly placed, run-out) read as irregularity, and the floor does not \
+         include them (the core's per-tooth learner, learn::ToothLearner, measures and removes \
+         them)"
+    );
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
@@ -1613,6 +1642,22 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         // A value outside a fixed range: say the range in the option's own terms.
         if let Some(range) = allowed(e) {
             return format!("{} is out of range: {range}", option_of(e.parameter()));
+        }
+        // A prescaler the wheel cannot take: the wheel is the reason, not the timer.
+        if e == drive_monitor::ConfigError::Inconsistent("prescaler") {
+            let p = enc.prescaler;
+            return match enc.wheel {
+                drive_monitor::encoder::Wheel::Indexed { lines }
+                | drive_monitor::encoder::Wheel::Unframed { lines } => format!(
+                    "--prescaler {p} does not fit a disc of {lines} lines: it must divide \
+                     the lines and leave at least 2 captures a revolution"
+                ),
+                _ => format!(
+                    "--prescaler {p} does not fit a wheel with a pattern (--wheel, or the \
+                     scene's): its teeth are captured one by one, the prescaler divides a \
+                     uniform disc's lines (--lines)"
+                ),
+            };
         }
         let mut m = format!(
             "{} does not fit: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",

@@ -187,7 +187,8 @@ struct AnalyzeArgs {
     /// Slowest speed still running, rad/s (default 1, or the scene's).
     #[arg(long)]
     min_speed: Option<f64>,
-    /// Edges per speed sample (default 1, or the scene's).
+    /// Captured edges per speed sample (with --prescaler P each capture spans P lines;
+    /// default 1, or the scene's).
     #[arg(long)]
     estimator_edges: Option<u16>,
     /// Revolutions per δ window (default 1, or the scene's).
