@@ -451,8 +451,8 @@ enum Verdict {
     /// Not enough edges yet to judge.
     Wait,
     /// An interval longer than any two lost teeth explain (a run of captures lost, e.g. a DMA
-    /// ring overrun): a new time reference, the count given up.
-    Dropout,
+    /// ring overrun), `n` teeth lost: a new time reference, the count given up.
+    Dropout(u16),
 }
 
 impl SpeedTracker {
@@ -998,11 +998,6 @@ impl SpeedTracker {
             // careful path's code stays small.
             let (lost, within) = match verdict {
                 Verdict::Wait => return,
-                Verdict::Dropout => {
-                    self.pop();
-                    self.dropout(enc, e1, sink);
-                    continue;
-                }
                 Verdict::Glitch => {
                     self.pop();
                     self.reject(e1, sink);
@@ -1028,6 +1023,8 @@ impl SpeedTracker {
                 // or 2, lost within it; `Ahead` one lost earlier, its interval the tooth's
                 // own), or none: the count was one ahead.
                 Verdict::Missing(n) => (n, n),
+                // A run of teeth lost: counted below, then the count given up.
+                Verdict::Dropout(n) => (n, 0),
                 // The count was off since some earlier edge: the swings recorded since were
                 // recorded against the wrong teeth, and would mislead the next judgements.
                 Verdict::Ahead | Verdict::Behind => {
@@ -1043,6 +1040,15 @@ impl SpeedTracker {
                 self.counters.missing = self.counters.missing.wrapping_add(u32::from(lost));
                 sink.fault(Fault::MissingEdge, e1);
             }
+            if let Verdict::Dropout(_) = verdict {
+                // The count is given up, and the edge is a new time reference: the next
+                // interval is the first judged.
+                self.lose_sync(false);
+                self.last = e1;
+                self.prev = 0;
+                self.across = false;
+                continue;
+            }
             self.fault_in_revolution();
             if lost == 0 {
                 self.tooth = tooth_back(self.tooth, 1, enc.edges());
@@ -1055,27 +1061,6 @@ impl SpeedTracker {
                 self.prev = self.per_base_over(enc, within);
             }
         }
-    }
-
-    /// An interval at `t` longer than any lost teeth the judgement weighs explain: the teeth
-    /// it spans counted as lost (as many as the last interval fits in it, less the edge at
-    /// `t`), the count given up, and `t` a new time reference (the next interval is the
-    /// first judged). Rare: out of line.
-    #[inline(never)]
-    fn dropout<S: EdgeSink>(&mut self, enc: &Encoder, t: u32, sink: &mut S) {
-        let d = t.wrapping_sub(self.last) & enc.mask();
-        let lost = d
-            .wrapping_add(self.prev / 2)
-            .checked_div(self.prev)
-            .unwrap_or(1)
-            .saturating_sub(1)
-            .max(1);
-        self.counters.missing = self.counters.missing.wrapping_add(lost);
-        sink.fault(Fault::MissingEdge, t);
-        self.lose_sync(false);
-        self.last = t;
-        self.prev = 0;
-        self.across = false;
     }
 
     /// The per-base interval of the tooth just accepted when its interval also spanned the
@@ -1185,7 +1170,8 @@ impl SpeedTracker {
             // edges are judged by, and the real teeth after it pairs of glitches and teeth (a
             // run of 64 captures lost: 8 glitches, 2 unexplained edges, the sync lost; 5 lost:
             // an unexplained edge, 3 missing frames).
-            return Verdict::Dropout;
+            // As many teeth lost as the last interval fits in it, less this edge (at least 3).
+            return Verdict::Dropout((x / r as f32 - 0.5) as u16);
         }
         if !synced && enc.framing() == Framing::Pattern {
             // Unsynced on a pattern wheel the expected pitch is unknown: take every edge that
