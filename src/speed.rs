@@ -1162,14 +1162,14 @@ impl SpeedTracker {
         if x + 1.0 < tol.glitch_fraction * (outright - 1.0) {
             return Verdict::Glitch;
         }
-        if x - 1.0 > 3.0 * tol.accept * (expected + 1.0)
-            && (synced || enc.framing() != Framing::Pattern)
-        {
+        if x - 1.0 > 3.0 * tol.accept * (expected + 1.0) && enc.is_uniform() {
             // Longer than three expected pitches by more than the accept band: the judgement's
             // longest fault, two teeth lost, would make a third of it the interval the next
             // edges are judged by, and the real teeth after it pairs of glitches and teeth (a
             // run of 64 captures lost: 8 glitches, 2 unexplained edges, the sync lost; 5 lost:
-            // an unexplained edge, 3 missing frames).
+            // an unexplained edge, 3 missing frames). On a uniform disc only: on a wheel with
+            // a pattern a gap among the teeth lost makes the pitches no count of teeth (two
+            // teeth lost before a 36-2 wheel's gap read as four, and the sync lost).
             // As many teeth lost as the last interval fits in it, less this edge (at least 3).
             return Verdict::Dropout((x / r as f32 - 0.5) as u16);
         }
@@ -1638,6 +1638,7 @@ impl SpeedTracker {
         let old_tooth = self.tooth;
         match enc.framing() {
             Framing::Index => {
+                let index_late = self.index_late;
                 let (indexed, late) = self.take_index(enc, t, seq);
                 match self.sync {
                     SyncState::Synced => {
@@ -1668,6 +1669,11 @@ impl SpeedTracker {
                             // late). The revolution is counted; its window ended at the fault.
                             self.realigned = false;
                             self.counters.revolutions = self.counters.revolutions.wrapping_add(1);
+                            // Nothing is learnt of where the index lies from an interval over
+                            // the lost frame edge: by its edge, it lay mid-interval, was learnt
+                            // early, and the next revolution's index, jittering just past its
+                            // edge, realigned the count a line late for good.
+                            self.index_late = index_late;
                         } else if indexed {
                             self.realigned = tooth != 0;
                             if tooth == 1 || tooth == edges.wrapping_sub(1) {
