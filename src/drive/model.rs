@@ -357,8 +357,11 @@ impl DriveModel {
     /// [`MAX_DENOMINATOR`] and a period of at most [`MAX_SAMPLES`]/32 cycles of the fastest
     /// order are accepted); and a drive whose periodic solution needs more than
     /// [`MAX_NODES`](crate::drive::MAX_NODES) trapezoid nodes or overflows f64 (`OutOfRange("inertia_harmonics")`:
-    /// J(φ) nearly reaching 0, or a motor so stiff against the inertia that `e^{∫2A/J}` swings
-    /// by many orders of magnitude over the period).
+    /// J(φ) nearly reaching 0, or a motor so stiff against the inertia's swing that the
+    /// integrating factor `e^{−∫2a(1/J − mean 1/J)}` swings by more than `e^12` over the
+    /// period, `4a·|J̃|/(J0²·n) ≳ 12` for one harmonic `J̃` of order `n`: its cancellation
+    /// would then leave less than about ten of f64's digits in ω², and from about `e^30` none;
+    /// see the `varying` module).
     pub fn with_inertia_harmonics(
         &self,
         harmonics: &[InertiaHarmonic],

@@ -793,6 +793,39 @@ fn inertia_harmonics_are_validated() {
     assert_eq!(edge, Err(ConfigError::OutOfRange("inertia_harmonics")));
 }
 
+/// A motor stiff against the inertia's swing: the integrating factor of the J(φ) solution
+/// would swing by more than e^12 over the period, and its cancellation would leave noise (a
+/// stall with ω² of −1e11 s⁻² for a drive that runs at δ = 0.075, or ω max = ∞). Such a drive
+/// is rejected, naming the inertia harmonics, whatever its magnitudes; below the bound the
+/// J(φ) path agrees with the shooting with the parabola.
+#[test]
+fn a_motor_too_stiff_for_the_inertia_swing_is_rejected() {
+    // 4.7e260 N·m against 332 kg·m² swinging by 7e-252 of itself: ΔP̃ ≈ 83.
+    let (w0, j) = (1009.9244741049496, 331.97392921331976);
+    let motor = Parabola::new(w0, 0.24259202387234952 * w0, 4.730776675937407e260).unwrap();
+    let m = DriveModel::new(motor.into(), Load::new(0.0, &[]).unwrap(), j, 0.0).unwrap();
+    assert_eq!(
+        m.with_inertia_harmonics(&[ih(0.5, -7.015711195067623e-252 * j, 0.0)]),
+        Err(ConfigError::OutOfRange("inertia_harmonics"))
+    );
+    // Ordinary magnitudes: 1e7 N·m on 1 kg·m² swinging by 1 % at order 1 (ΔP̃ ≈ 27) is
+    // rejected; 2e6 N·m (ΔP̃ ≈ 5) is predicted, as the shooting predicts it.
+    let at = |mm: f64| {
+        let motor = Parabola::new(100.0, 50.0, mm).unwrap();
+        let load = Load::new(0.0, &[h(1.0, 0.1 * mm, 0.0)]).unwrap();
+        DriveModel::new(motor.into(), load, 1.0, 0.0)
+            .unwrap()
+            .with_inertia_harmonics(&[ih(1.0, 0.01, 0.0)])
+    };
+    assert_eq!(at(1e7), Err(ConfigError::OutOfRange("inertia_harmonics")));
+    let m = at(2e6).unwrap();
+    assert!(matches!(m.horizon(), Horizon::Varying { .. }));
+    let (a, b) = (steady(&m), steady(&m.on_shooting_path().unwrap()));
+    assert!(rel(a.delta, b.delta) < 1e-10, "{} {}", a.delta, b.delta);
+    assert!(rel(a.omega_max, b.omega_max) < 1e-10, "{a:?} {b:?}");
+    assert!(rel(a.omega_min, b.omega_min) < 1e-10, "{a:?} {b:?}");
+}
+
 /// A press, J = 1 ± 0.4 kg·m² twice a revolution, constant load: the mean of ω² over φ is
 /// ū = (B − M1)/a as with a constant inertia (the period mean of eq. 1 in w = J·ω²), and with a
 /// motor weak against the inertia the swing is nearly the energy-conserving ω ∝ 1/√J:

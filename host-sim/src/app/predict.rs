@@ -73,7 +73,10 @@ fn not_covered(e: ConfigError) -> Option<String> {
         )),
         ConfigError::OutOfRange("inertia_harmonics") => Some(format!(
             "shaft.inertia_harmonics: J(φ) comes so close to 0, or the common period holds so \
-             many of its cycles, that the periodic solution needs more than {} trapezoid nodes",
+             many of its cycles, that the periodic solution needs more than {} trapezoid nodes; \
+             or the motor is so stiff against the inertia's swing that the solution's \
+             integrating factor swings by more than e^12 over the period (its cancellation \
+             would leave the result to rounding)",
             drive_monitor::drive::MAX_NODES
         )),
         ConfigError::OutOfRange("inertia") => Some(format!(
