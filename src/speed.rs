@@ -1162,15 +1162,17 @@ impl SpeedTracker {
         if x + 1.0 < tol.glitch_fraction * (outright - 1.0) {
             return Verdict::Glitch;
         }
-        if x - 1.0 > 3.0 * tol.accept * (expected + 1.0) && enc.is_uniform() {
-            // Longer than three expected pitches by more than the accept band: the judgement's
-            // longest fault, two teeth lost, would make a third of it the interval the next
-            // edges are judged by, and the real teeth after it pairs of glitches and teeth (a
-            // run of 64 captures lost: 8 glitches, 2 unexplained edges, the sync lost; 5 lost:
-            // an unexplained edge, 3 missing frames). On a uniform disc only: on a wheel with
-            // a pattern a gap among the teeth lost makes the pitches no count of teeth (two
-            // teeth lost before a 36-2 wheel's gap read as four, and the sync lost).
-            // As many teeth lost as the last interval fits in it, less this edge (at least 3).
+        if x - 1.0 > 3.0 * tol.accept * (r as f32 + 1.0) && enc.is_uniform() {
+            // A run of teeth lost: longer than three of the last interval by more than the
+            // accept band. The judgement's longest fault, two teeth lost, would make a third of
+            // it the interval the next edges are judged by, and the real teeth after it pairs
+            // of glitches and teeth (64 captures lost: 8 glitches, 2 unexplained edges, the
+            // sync lost; 5 lost: an unexplained edge, 3 missing frames). Against the last
+            // interval, not the expected one a recorded swing scales: at least 3 teeth lost.
+            // On a uniform disc only: on a wheel with a pattern a gap among the teeth lost
+            // makes pitches no count of teeth (two lost before a 36-2 wheel's gap read as
+            // four, and the sync lost). Lost: as many as the last interval fits in it, less
+            // this edge.
             return Verdict::Dropout((x / r as f32 - 0.5) as u16);
         }
         if !synced && enc.framing() == Framing::Pattern {
