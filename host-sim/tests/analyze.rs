@@ -1567,6 +1567,15 @@ fn options_out_of_range_name_their_range() {
         e.contains("--estimator-edges is out of range: a speed sample spans 1 to 32"),
         "{e}"
     );
+    // A sample longer than a revolution's captures says how many those are.
+    let e = err(AnalyzeOptions {
+        lines: Some(64),
+        prescaler: Some(8),
+        estimator_edges: Some(16),
+        framing: Some(host_sim::app::analyze::FramingArg::Index),
+        ..AnalyzeOptions::default()
+    });
+    assert!(e.ends_with("(8 here: 64 lines, one captured in 8)"), "{e}");
     // A prescaler the wheel cannot take names the wheel, not the timer.
     let e = err(AnalyzeOptions {
         prescaler: Some(2),

@@ -1641,7 +1641,21 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     Encoder::new(enc).map_err(|e| {
         // A value outside a fixed range: say the range in the option's own terms.
         if let Some(range) = allowed(e) {
-            return format!("{} is out of range: {range}", option_of(e.parameter()));
+            let mut m = format!("{} is out of range: {range}", option_of(e.parameter()));
+            // How many that is here, on a disc (a wheel's teeth are its own).
+            if let (
+                drive_monitor::ConfigError::OutOfRange("estimator.edges"),
+                drive_monitor::encoder::Wheel::Indexed { lines }
+                | drive_monitor::encoder::Wheel::Unframed { lines },
+            ) = (e, enc.wheel)
+            {
+                let per = lines / u16::from(enc.prescaler.max(1));
+                m.push_str(&format!(
+                    " ({per} here: {lines} lines, one captured in {})",
+                    enc.prescaler
+                ));
+            }
+            return m;
         }
         // A prescaler the wheel cannot take: the wheel is the reason, not the timer.
         if e == drive_monitor::ConfigError::Inconsistent("prescaler") {
