@@ -357,11 +357,12 @@ impl DriveModel {
     /// [`MAX_DENOMINATOR`] and a period of at most [`MAX_SAMPLES`]/32 cycles of the fastest
     /// order are accepted); and a drive whose periodic solution needs more than
     /// [`MAX_NODES`](crate::drive::MAX_NODES) trapezoid nodes or overflows f64 (`OutOfRange("inertia_harmonics")`:
-    /// J(φ) nearly reaching 0, or a motor so stiff against the inertia's swing that the
+    /// J(φ) nearly reaching 0). A motor so stiff against the inertia's swing that the
     /// integrating factor `e^{−∫2a(1/J − mean 1/J)}` swings by more than `e^12` over the
-    /// period, `4a·|J̃|/(J0²·n) ≳ 12` for one harmonic `J̃` of order `n`: its cancellation
-    /// would then leave less than about ten of f64's digits in ω², and from about `e^30` none;
-    /// see the `varying` module).
+    /// period, `4a·|J̃|/(J0²·n) ≳ 12` for one harmonic `J̃` of order `n` (its cancellation
+    /// would leave less than about ten of f64's digits in ω², and from about `e^30` none; see
+    /// the `varying` module), is shot with the parabola instead, and refused the same way
+    /// where that needs too many steps.
     pub fn with_inertia_harmonics(
         &self,
         harmonics: &[InertiaHarmonic],
@@ -502,7 +503,23 @@ impl DriveModel {
         model.horizon = if model.inertia_harmonics.is_empty() && path != Path::Varying {
             horizon(model.components())
         } else {
-            model.varying_horizon()?
+            match model.varying_horizon()? {
+                Some(h) => h,
+                None if path == Path::Auto => {
+                    // A motor too stiff against the inertia's swing for the J(φ) solution,
+                    // whose integrating factor would leave the result to rounding: shooting
+                    // with the parabola, which has no such factor (it solved these drives to
+                    // 1e-10 where both apply).
+                    // A drive neither solves (J(φ) near 0, far too many steps) is refused as
+                    // the J(φ) path refused it.
+                    let curve = Characteristic::Parabola(*model.motor.model());
+                    return match model.shoot(curve) {
+                        Ok(true) => Ok(model),
+                        _ => Err(ConfigError::OutOfRange("inertia_harmonics")),
+                    };
+                }
+                None => return Err(ConfigError::OutOfRange("inertia_harmonics")),
+            }
         };
         Ok(model)
     }
@@ -674,7 +691,9 @@ impl DriveModel {
     /// The common period of the load and inertia orders and the trapezoid nodes that resolve
     /// the periodic solution over it (out of line: see [`Self::varying_state`]).
     #[inline(never)]
-    fn varying_horizon(&self) -> Result<Horizon, ConfigError> {
+    /// `None`: the motor is too stiff against the inertia's swing for the solution (its
+    /// integrating factor swings by more than `e^MAX_FACTOR_SWING`).
+    fn varying_horizon(&self) -> Result<Option<Horizon>, ConfigError> {
         let orders = self.periodic_orders();
         let bad_order = ConfigError::Inconsistent("inertia_harmonic.order");
         let (radians, cycles) = common_period(orders).ok_or(bad_order)?;
@@ -688,12 +707,15 @@ impl DriveModel {
                 resolved_nodes::<MAX_NODES>(drive, start.max(2 * SMALL_NODES))
             }
             r => r,
+        };
+        match nodes {
+            Ok(nodes) => Ok(Some(Horizon::Varying {
+                radians,
+                nodes: nodes as u32,
+            })),
+            Err(varying::Unresolved::Stiff) => Ok(None),
+            Err(_) => Err(out_of_range),
         }
-        .map_err(|_| out_of_range)?;
-        Ok(Horizon::Varying {
-            radians,
-            nodes: nodes as u32,
-        })
     }
 
     fn varying_drive(&self, period: f64) -> varying::Drive<'_> {

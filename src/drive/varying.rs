@@ -44,7 +44,8 @@
 //! back multiplied by that span. A motor stiff against the inertia's swing (`4a·|J̃|/(J0²·n)`
 //! large, whatever the magnitudes: 1e7 N·m on 1 kg·m² swinging by 1 %, as well as 5e260 N·m on
 //! an inertia swinging by 7e-252 of itself) makes `ΔP̃` large and the result noise. A drive
-//! whose `ΔP̃` exceeds [`MAX_FACTOR_SWING`] is rejected when it is built.
+//! whose `ΔP̃` exceeds [`MAX_FACTOR_SWING`] is not solved here: the model shoots it with the
+//! parabola instead.
 //!
 //! ## Cost
 //! One solution: five FFTs of `N` points (building the model solves once more for each node
@@ -85,7 +86,7 @@ const MAX_CANDIDATES: usize = 8;
 /// −1e26 s⁻² for a drive that runs steadily at δ = 0.075). `ΔP̃ ≈ 4a·|J̃|/(J0²·n)`, so this
 /// bounds a motor stiff against the inertia (`a/J0` large against the orders) times the
 /// inertia's swing. At 12 the integrating factor costs at most about five of f64's sixteen
-/// digits; a drive beyond it is rejected when it is built.
+/// digits; a drive beyond it is shot with the parabola instead.
 pub(super) const MAX_FACTOR_SWING: f64 = 12.0;
 
 /// One harmonic `amplitude·cos(order·φ + phase)` of the reduced inertia.

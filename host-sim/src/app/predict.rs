@@ -74,9 +74,9 @@ fn not_covered(e: ConfigError) -> Option<String> {
         ConfigError::OutOfRange("inertia_harmonics") => Some(format!(
             "shaft.inertia_harmonics: J(φ) comes so close to 0, or the common period holds so \
              many of its cycles, that the periodic solution needs more than {} trapezoid nodes; \
-             or the motor is so stiff against the inertia's swing that the solution's \
-             integrating factor swings by more than e^12 over the period (its cancellation \
-             would leave the result to rounding)",
+             or the motor is so stiff against the inertia's swing that neither that solution \
+             (its integrating factor would swing by more than e^12 over the period) nor the \
+             shooting with the parabola (too many steps) resolves it",
             drive_monitor::drive::MAX_NODES
         )),
         ConfigError::OutOfRange("inertia") => Some(format!(
@@ -639,10 +639,16 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
         Horizon::Varying { radians, nodes } => (radians, nodes),
         Horizon::Shooting { radians, .. } if !model.inertia_harmonics().is_empty() => {
             let n = model.inertia_harmonics().len();
+            let curve = if model.motor().kloss_curve().is_some() {
+                "the Kloss curve"
+            } else {
+                "the parabola (the motor is so stiff against the inertia's swing that the \
+                 trapezoid solution's integrating factor would swing by more than e^12)"
+            };
             return Some(format!(
                 "J(φ) from shaft.inertia_harmonics ({n} harmonic{}): eq. 1 in w = J·ω² with \
-                 the Kloss curve, integrated over its period of {radians:.4} rad (see the \
-                 motor line); ∂δ/∂J and ∂δ/∂M_m by central differences",
+                 {curve}, integrated over its period of {radians:.4} rad (see the motor line); \
+                 ∂δ/∂J and ∂δ/∂M_m by central differences",
                 if n == 1 { "" } else { "s" }
             ));
         }
