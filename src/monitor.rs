@@ -803,6 +803,47 @@ mod tests {
         }
     }
 
+    /// A Gaussian draw (σ 1) from the sum of twelve uniforms of the LCG in `state`.
+    fn gaussian(state: &mut u32) -> f64 {
+        let sum: f64 = (0..12)
+            .map(|_| {
+                *state = state.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+                f64::from(*state >> 8) / f64::from(1u32 << 24)
+            })
+            .sum();
+        sum - 6.0
+    }
+
+    /// Where the edges are among `evs`.
+    fn edge_positions(evs: &[Ev]) -> Vec<usize> {
+        (0..evs.len())
+            .filter(|&i| matches!(evs[i], Ev::Edge(_)))
+            .collect()
+    }
+
+    /// The valid windows of `out`, each checked to measure δ bit for bit as the window of
+    /// `reference` that starts at the same tick does.
+    fn valid_as_in<'o>(
+        out: &'o [WindowOutcome],
+        reference: &[WindowOutcome],
+        what: &str,
+    ) -> Vec<&'o WindowOutcome> {
+        let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
+        for o in &valid {
+            let want = reference
+                .iter()
+                .find(|r| r.report.start_ticks == o.report.start_ticks)
+                .and_then(|r| r.report.measurement())
+                .map(|r| r.delta);
+            assert_eq!(
+                o.report.measurement().map(|r| r.delta),
+                want,
+                "{what}: {o:?}"
+            );
+        }
+        valid
+    }
+
     /// Tooth angles of a uniform disc (edges half a pitch after the index).
     fn uniform(lines: u32) -> Vec<f64> {
         (0..lines)
@@ -1969,18 +2010,12 @@ mod tests {
         for (offset, sigma) in [(-0.03, 0.03), (0.02, 0.03), (0.0, 0.05)] {
             let mut m = monitor(indexed(256, 4, 32, 1e6), 1);
             let mut seed = 99u32;
-            let mut uniform = || {
-                seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
-                f64::from(seed >> 8) / f64::from(1u32 << 24)
-            };
             let (mut out, mut across) = (Vec::new(), 0);
             for k in 0..256 * 120u32 {
                 let te = f64::from(k) * per_edge;
                 let t = te as u32;
                 if k % 256 == 0 && k > 0 {
-                    // Gaussian jitter from the sum of twelve uniforms.
-                    let g: f64 = (0..12).map(|_| uniform()).sum::<f64>() - 6.0;
-                    let ti = te + (offset + sigma * g) * per_edge;
+                    let ti = te + (offset + sigma * gaussian(&mut seed)) * per_edge;
                     across += usize::from(ti >= te);
                     if ti < te {
                         m.on_index(ti as u32);
@@ -2069,18 +2104,9 @@ mod tests {
                     (run(&mut m, evs), m.diagnostics().edges)
                 };
                 let (reference, _) = feed(&clean);
-                let delta_at = |start: u32| {
-                    reference
-                        .iter()
-                        .find(|o| o.report.start_ticks == start)
-                        .and_then(|o| o.report.measurement())
-                        .map(|r| r.delta)
-                };
                 // Where the edges are among the events, and the frame edge of revolution 6
                 // among them (the first edge after its index).
-                let edges: Vec<usize> = (0..clean.len())
-                    .filter(|&i| matches!(clean[i], Ev::Edge(_)))
-                    .collect();
+                let edges = edge_positions(&clean);
                 let index = (0..clean.len())
                     .filter(|&i| matches!(clean[i], Ev::Index(_)))
                     .nth(6)
@@ -2105,11 +2131,7 @@ mod tests {
                         // Seen: a noise pulse mid-pitch in the accept band is taken as a tooth
                         // on the fast path, and found as an extra edge at the frame.
                         assert!(d.glitches + d.missing + d.extra >= 1, "{what}: {d:?}");
-                        let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
-                        for o in &valid {
-                            let got = o.report.measurement().map(|r| r.delta);
-                            assert_eq!(got, delta_at(o.report.start_ticks), "{what}: {o:?}");
-                        }
+                        let valid = valid_as_in(&out, &reference, &what);
                         let whole = reference.iter().filter(|o| o.report.valid()).count();
                         assert!(
                             valid.len() + 3 >= whole,
@@ -2147,12 +2169,7 @@ mod tests {
         ] {
             let mut evs = clean.clone();
             // `gap` edges from edge `from` on (no index among them: a frame is not lost).
-            let edges: Vec<usize> = (0..evs.len())
-                .filter(|&i| matches!(evs[i], Ev::Edge(_)))
-                .skip(from)
-                .take(gap)
-                .collect();
-            for &i in edges.iter().rev() {
+            for &i in edge_positions(&clean).iter().skip(from).take(gap).rev() {
                 evs.remove(i);
             }
             let (out, d) = feed(&evs);
@@ -2168,15 +2185,7 @@ mod tests {
             // Two lost teeth are the longest fault judged; more are a run, after which the count
             // is found again.
             assert_eq!(d.sync_losses, u32::from(gap > 2), "{what}: {d:?}");
-            let valid: Vec<_> = out.iter().filter(|o| o.report.valid()).collect();
-            for o in &valid {
-                let want = reference
-                    .iter()
-                    .find(|r| r.report.start_ticks == o.report.start_ticks)
-                    .and_then(|r| r.report.measurement())
-                    .map(|r| r.delta);
-                assert_eq!(o.report.measurement().map(|r| r.delta), want, "{what}");
-            }
+            let valid = valid_as_in(&out, &reference, &what);
             assert!(valid.len() >= 5, "{what}: {} valid", valid.len());
         }
         // On a wheel with a pattern the rule does not apply (a gap among the teeth lost makes
@@ -2279,16 +2288,11 @@ mod tests {
         for seed in 0..40u32 {
             let mut m = monitor(indexed(100, 4, 32, 1e6), 1);
             let mut state = seed.wrapping_mul(2_654_435_761).wrapping_add(7);
-            let mut uniform = || {
-                state = state.wrapping_mul(1_103_515_245).wrapping_add(12_345);
-                f64::from(state >> 8) / f64::from(1u32 << 24)
-            };
             let mut out = Vec::new();
             for k in 0..100 * 24u32 {
                 let te = f64::from(k) * per_edge;
                 if k % 100 == 0 {
-                    let g: f64 = (0..12).map(|_| uniform()).sum::<f64>() - 6.0;
-                    let ti = te + (-0.02 + 0.02 * g) * per_edge;
+                    let ti = te + (-0.02 + 0.02 * gaussian(&mut state)) * per_edge;
                     if ti < te {
                         m.on_index(ti as u32);
                     }

@@ -505,20 +505,20 @@ impl DriveModel {
         } else {
             match model.varying_horizon()? {
                 Some(h) => h,
-                None if path == Path::Auto => {
+                None => {
                     // A motor too stiff against the inertia's swing for the J(φ) solution,
-                    // whose integrating factor would leave the result to rounding: shooting
-                    // with the parabola, which has no such factor (it solved these drives to
-                    // 1e-10 where both apply).
-                    // A drive neither solves (J(φ) near 0, far too many steps) is refused as
-                    // the J(φ) path refused it.
+                    // whose integrating factor would leave the result to rounding: shot with
+                    // the parabola, which has no such factor (it agrees to 1e-10 where both
+                    // apply). A drive neither solves (J(φ) near 0, far too many steps), or one
+                    // held to the J(φ) path, is refused as that path refused it.
                     let curve = Characteristic::Parabola(*model.motor.model());
-                    return match model.shoot(curve) {
-                        Ok(true) => Ok(model),
-                        _ => Err(ConfigError::OutOfRange("inertia_harmonics")),
+                    let shot = path == Path::Auto && matches!(model.shoot(curve), Ok(true));
+                    return if shot {
+                        Ok(model)
+                    } else {
+                        Err(ConfigError::OutOfRange("inertia_harmonics"))
                     };
                 }
-                None => return Err(ConfigError::OutOfRange("inertia_harmonics")),
             }
         };
         Ok(model)

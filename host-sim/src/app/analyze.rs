@@ -1027,9 +1027,6 @@ impl State {
                             }
                         }
                     }
-                    if report.sync_acquired.is_none() && t.synced {
-                        report.sync_acquired = Some(time);
-                    }
                     if t.synced && synced_at.is_none() {
                         synced_at = Some(time);
                     }
@@ -1078,11 +1075,15 @@ impl State {
         if s != self.sync {
             self.sync = s;
             // Synced at the tooth the count begins at (judged with the edges after it: listed
-            // at the last of them, it disagreed with the time `sync_acquired` gives).
+            // at the last of them, the list disagreed with the tooth's time); the first such
+            // is when sync was acquired.
             let time = match (s, synced_at) {
                 (SyncState::Synced, Some(t)) => t,
                 _ => clock.latest.1,
             };
+            if s == SyncState::Synced && report.sync_acquired.is_none() {
+                report.sync_acquired = Some(time);
+            }
             if report.sync.len() < MAX_LISTED {
                 report.sync.push(SyncOut {
                     time,
