@@ -688,6 +688,7 @@ impl Encoder {
     }
     /// The smallest long pitch and the largest short one, in grid positions (`u8::MAX` and 0
     /// without such a pitch; always so without a pattern).
+    #[cfg(feature = "pattern-wheels")]
     pub(crate) fn extreme_pitches(&self) -> (u8, u8) {
         if PATTERNS && matches!(self.framing, Framing::Pattern) {
             extreme_pitches(&self.pattern, self.edges, self.base)
@@ -713,6 +714,7 @@ impl Encoder {
     }
     /// Teeth that end two short pitches which together span at most one base pitch: the
     /// second half of a pitch split by an extra tooth (bit k = tooth k; pattern wheels).
+    #[cfg(feature = "pattern-wheels")]
     pub(crate) fn pair_teeth(&self) -> u64 {
         if self.short_teeth() == 0 {
             return 0;

@@ -36,8 +36,13 @@
 //!   neighbours; an interval clearly longer than both is a long pitch (a gap), one clearly
 //!   shorter a short pitch (an extra tooth), and each such observation rules out the
 //!   alignments of the pattern it contradicts (a bit mask of the teeth the last edge could
-//!   be). Once one alignment is left and the pattern's special teeth have been seen where due
-//!   for a full revolution, the revolution is framed.
+//!   be). On a wheel of 6 to 16 teeth with gaps, the last revolution of intervals is also
+//!   weighed as a whole against each alignment, a smooth speed profile taken out (see
+//!   [`SpeedTracker::fit_alignment`]): a deep cranking ripple can make a small wheel's gap no
+//!   longer than its neighbours. Once one alignment is left and the pattern's special teeth
+//!   have been seen where due for a full revolution (or the revolution has decided the same
+//!   alignment again), the revolution is framed; on such a small wheel only once its last
+//!   revolution showed no fault and swings the judgement in sync can follow.
 //! - None ([`crate::encoder::Wheel::Unframed`]): revolutions are counted in edges.
 //!
 //! # Shaft state
@@ -252,10 +257,73 @@ const _: () = assert!(INDEXES <= 8, "index places are bits of a byte");
 pub(crate) const BAND_REFRESH: u16 = 64;
 /// Faults within one revolution after which the count is no longer trusted.
 const FAULTS_TO_RESYNC: u8 = 3;
+/// Teeth of the largest wheel whose frame is also sought over a whole revolution of intervals
+/// ([`SpeedTracker::fit_alignment`]).
+const FIT_TEETH: usize = 16;
+/// The [`Revolution`]s a tracker keeps: one with pattern wheels, none without (no memory, no
+/// code).
+const FIT_KEPT: usize = if cfg!(feature = "pattern-wheels") {
+    1
+} else {
+    0
+};
+/// The fewest teeth for that: fewer leave too few intervals to tell a ripple from a gap.
+#[cfg(feature = "pattern-wheels")]
+const FIT_MIN_TEETH: u16 = 6;
+/// An interval's ratio to the same tooth's a revolution earlier follows on from the tooth
+/// before's within this (log: 1.25×).
+#[cfg(feature = "pattern-wheels")]
+const FIT_PERIODIC: f32 = 0.223;
+/// A revolution decides an alignment whose residual is at most `FIT_FITS` ln²R while every
+/// other alignment's is at least `FIT_MISFITS` ln²R (`R` the smallest long pitch over the
+/// base): a gap put one tooth off costs about 2 ln²R before the ripple's share is taken out.
+#[cfg(feature = "pattern-wheels")]
+const FIT_FITS: f32 = 0.03;
+#[cfg(feature = "pattern-wheels")]
+const FIT_MISFITS: f32 = 0.12;
+/// ... and whose profile's largest harmonic is at most this (log speed: a ripple of ±42 %).
+#[cfg(feature = "pattern-wheels")]
+const FIT_RIPPLE: f32 = 0.45;
+/// A frame is confirmed only where every swing between neighbouring teeth stays this much
+/// inside what the judgement weighs (see [`SpeedTracker::trackable`]): a swing scatters by
+/// about that from revolution to revolution under edge jitter of 1 % of a pitch.
+#[cfg(feature = "pattern-wheels")]
+const TRACK_MARGIN: f32 = 1.02;
+
+/// What a small pattern wheel's acquisition keeps of its last intervals (see
+/// [`SpeedTracker::fit_push`]).
+#[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(feature = "pattern-wheels"), allow(dead_code))]
+struct Revolution {
+    /// The log of the last unsynced intervals, the n-th since the search began in slot
+    /// `n mod edges`.
+    ln: [f32; FIT_TEETH],
+    /// The next slot; how many slots hold an interval (one more once a ratio to a revolution
+    /// before is known); how many intervals in a row followed on.
+    pos: u16,
+    len: u16,
+    run: u16,
+    /// The last interval's log ratio to its slot's, and the mean of those ratios over `run`
+    /// (the speed trend of a revolution, in log).
+    d: f32,
+    trend: f32,
+}
+
+impl Revolution {
+    const NEW: Revolution = Revolution {
+        ln: [0.0; FIT_TEETH],
+        pos: 0,
+        len: 0,
+        run: 0,
+        d: 0.0,
+        trend: 0.0,
+    };
+}
 
 /// Per-edge state of the timing front end. Total: every input sequence is handled without
-/// panicking, and every path is O(1). Memory: about 500 bytes (the 32-slot interval ring and
-/// the 64-tooth history of small wheels).
+/// panicking, and every path is O(1). Memory: about 580 bytes (the 32-slot interval ring and
+/// the 64-tooth history of small wheels); 660 with pattern wheels (a small wheel's last
+/// revolution of intervals, for its acquisition).
 #[derive(Debug, Clone)]
 pub struct SpeedTracker {
     state: ShaftState,
@@ -346,6 +414,8 @@ pub struct SpeedTracker {
     acq: [u32; 3],
     confirm: u16,
     seen_special: bool,
+    /// The last unsynced intervals of a small pattern wheel.
+    fit: [Revolution; FIT_KEPT],
     /// Edges accepted since the search for a frame began, while searching or confirming (a
     /// missing frame is counted every three revolutions' worth).
     searched: u16,
@@ -366,6 +436,10 @@ impl SpeedTracker {
             index: new.index,
             ..self.clone()
         };
+        let mut t = t;
+        for f in &mut t.fit {
+            (f.ln, f.d, f.trend) = (Revolution::NEW.ln, 0.0, 0.0);
+        }
         format!("{t:?}")
     }
 }
@@ -498,6 +572,7 @@ impl SpeedTracker {
             acq: [0; 3],
             confirm: 0,
             seen_special: false,
+            fit: [Revolution::NEW; FIT_KEPT],
             searched: 0,
             counters: EdgeCounters::ZERO,
         }
@@ -550,6 +625,7 @@ impl SpeedTracker {
             acq,
             confirm,
             seen_special,
+            fit,
             searched,
             counters,
         } = self;
@@ -561,6 +637,9 @@ impl SpeedTracker {
         (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
         (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
+        for f in fit {
+            (f.pos, f.len, f.run) = (0, 0, 0);
+        }
         counters.clear(z);
     }
 
@@ -1692,6 +1771,8 @@ impl SpeedTracker {
         let dt = t.wrapping_sub(self.last) & enc.mask();
         let clean = clean && self.across == 0;
         self.across = self.across.saturating_sub(1);
+        // (Only the acquisition of a pattern changes it.)
+        #[cfg_attr(not(feature = "pattern-wheels"), allow(unused_mut))]
         let mut vouched = clean && vouched;
         let mut tooth = tooth_after(self.tooth, 1, edges);
         let mut frame = false;
@@ -1812,6 +1893,12 @@ impl SpeedTracker {
                     frame = true;
                 }
             }
+            // Never met without pattern wheels (`framing` says so), and the acquisition is
+            // then not compiled at all: the compiler did not always leave it out, nor did
+            // the image stay the same size when it did.
+            #[cfg(not(feature = "pattern-wheels"))]
+            Framing::Pattern => {}
+            #[cfg(feature = "pattern-wheels")]
             Framing::Pattern => {
                 if self.sync == SyncState::Synced {
                     frame = tooth == 0;
@@ -1905,6 +1992,7 @@ impl SpeedTracker {
     /// Pattern acquisition on the edge at the end of interval `dt`: judges the interval before
     /// it (both neighbours known), narrows the alignments, and returns this edge's tooth (the
     /// alignment if unique, else a count).
+    #[cfg(feature = "pattern-wheels")]
     fn acquire(&mut self, enc: &Encoder, dt: u32) -> u16 {
         let edges = enc.edges();
         let all = 1u64
@@ -1915,6 +2003,9 @@ impl SpeedTracker {
         if self.viable == 0 {
             self.viable = all;
         }
+        self.fit_push(enc, dt);
+        let fit = self.fit_alignment(enc);
+        let fitted = fit.and_then(|(at, decisive)| decisive.then_some(at));
         if before > 0 && middle > 0 && dt > 0 {
             let (lo, hi) = if before < dt {
                 (before, dt)
@@ -1967,7 +2058,15 @@ impl SpeedTracker {
             // pitch on the slow stroke, and one noise pulse made such a pitch look long.
             let positive =
                 special && allowed & !(enc.long_teeth() | enc.short_teeth() | pairs) == 0;
-            let narrowed = self.viable & allowed;
+            // Where a revolution decides the alignment, evidence against a special pitch is
+            // not weighed: at ±40 % ripple an 8-1 wheel's gap can be 1.17 times both its
+            // neighbours, under `not_long`, and that ruled the true alignment out every
+            // revolution.
+            let narrowed = if fitted.is_some() && !positive {
+                self.viable
+            } else {
+                self.viable & allowed
+            };
             if narrowed == 0 {
                 // Contradiction: start over from this evidence.
                 self.viable = allowed;
@@ -1981,9 +2080,27 @@ impl SpeedTracker {
                 }
             }
         }
-        self.count_search(enc, 1);
         // Move on to this edge.
         self.viable = rotate_left(self.viable, edges) & all;
+        if let Some(at) = fitted {
+            // The revolution's alignment, of this edge: it narrows as a special pitch does,
+            // and confirms a candidate on the last edge of its revolution of confirmation (a
+            // revolution of intervals after the one that made it, none shared: a fault
+            // makes one of them wrong, not both alike).
+            let allowed = 1u64.checked_shl(u32::from(at)).unwrap_or(0);
+            let narrowed = self.viable & allowed;
+            if narrowed == 0 {
+                self.viable = allowed;
+                self.sync = SyncState::Searching;
+                self.confirm = 0;
+                self.seen_special = false;
+            } else {
+                self.viable = narrowed;
+                if self.sync == SyncState::Confirming && self.confirm == 1 {
+                    self.seen_special = true;
+                }
+            }
+        }
         if self.viable.count_ones() == 1 {
             let tooth = self.viable.trailing_zeros() as u16;
             match self.sync {
@@ -1991,10 +2108,25 @@ impl SpeedTracker {
                     self.sync = SyncState::Confirming;
                     self.confirm = edges;
                     self.seen_special = false;
+                    // The teeth are numbered anew: swings recorded under another candidate's
+                    // numbering would judge the teeth once synced (a noise pulse while an 8-1
+                    // wheel searched at ±40 % left such swings, and the first teeth in sync
+                    // were taken for glitches, the count a tooth off).
+                    self.forget_history();
                 }
                 SyncState::Confirming => {
                     self.confirm = self.confirm.saturating_sub(1);
-                    if self.confirm == 0 && self.seen_special {
+                    // A small wheel's revolution fitting another alignment best is doubtful
+                    // evidence (at ±45 % ripple with three strokes an 8-1 wheel showed a pitch
+                    // clearly long at another tooth than the gap, and was framed there, its
+                    // windows valid).
+                    let doubtful = fit.is_some_and(|(at, _)| at != tooth);
+                    if self.confirm == 0
+                        && self.seen_special
+                        && self.fit_settled(enc)
+                        && !doubtful
+                        && self.trackable(enc, tooth, dt)
+                    {
                         self.sync = SyncState::Synced;
                         self.counters.syncs = self.counters.syncs.wrapping_add(1);
                         self.searched = 0;
@@ -2004,13 +2136,278 @@ impl SpeedTracker {
                 }
                 SyncState::Synced => {}
             }
+            if self.sync != SyncState::Synced {
+                self.count_search(enc, 1);
+            }
             tooth
         } else {
             if self.sync == SyncState::Confirming {
                 self.sync = SyncState::Searching;
             }
+            self.count_search(enc, 1);
             tooth_after(self.tooth, 1, edges)
         }
+    }
+
+    /// Keeps the log of the unsynced interval `dt` of a small wheel, and its ratio to the
+    /// interval in its slot, one revolution before: the same tooth's, so that this ratio
+    /// changes little from tooth to tooth (by the speed trend and the change of the ripple),
+    /// unless an edge was lost or a noise pulse taken (the slots then hold other teeth, and
+    /// the ratio jumps by the swings between them; the interval split or merged jumps
+    /// itself). `run` counts the intervals in a row whose ratio followed on from the one
+    /// before (after a jump, the interval that jumped is not counted: it may be the fault).
+    #[cfg(feature = "pattern-wheels")]
+    fn fit_push(&mut self, enc: &Encoder, dt: u32) {
+        let edges = enc.edges();
+        let Some(f) = self.fit.first_mut() else {
+            return;
+        };
+        let slot = f.ln.get_mut(usize::from(f.pos));
+        let (Some(slot), true) = (slot, dt > 0 && edges >= FIT_MIN_TEETH) else {
+            (f.pos, f.len, f.run) = (0, 0, 0);
+            return;
+        };
+        let l = ln(dt as f32);
+        if f.len >= edges {
+            let d = l - *slot;
+            if f.len > edges && !(-FIT_PERIODIC..=FIT_PERIODIC).contains(&(d - f.d)) {
+                f.run = 0;
+            } else {
+                f.run = f.run.saturating_add(1).min(edges);
+                f.trend = if f.run == 1 {
+                    d
+                } else {
+                    f.trend + (d - f.trend) / f32::from(f.run)
+                };
+            }
+            f.d = d;
+        }
+        *slot = l;
+        // One more than the teeth: a ratio is known.
+        f.len = f.len.saturating_add(1).min(edges.saturating_add(1));
+        f.pos = tooth_after(f.pos, 1, edges);
+    }
+
+    /// Whether the teeth, numbered as the candidate numbers them, could be judged once synced:
+    /// every swing between neighbouring teeth in the revolution recorded while confirming (the
+    /// last tooth's still held) is one the judgement weighs, not one it ignores as a count
+    /// off (see [`SpeedTracker::recorded_swing`]). A 10-1 wheel at ±38 % ripple with three
+    /// strokes swings 1.89 from the gap to the tooth before it: synced, its gap was taken
+    /// for a glitch, the count went a tooth off and windows were framed there.
+    #[cfg(feature = "pattern-wheels")]
+    fn trackable(&self, enc: &Encoder, tooth: u16, dt: u32) -> bool {
+        let edges = enc.edges();
+        if usize::from(edges) > MAX_PATTERN_TEETH {
+            return true;
+        }
+        if self.hist_teeth.saturating_add(1) < edges {
+            return false;
+        }
+        let limit = enc.pattern_swing();
+        // The swing from each tooth to the next as last seen, per base pitch: the intervals
+        // recorded, the last tooth's held, and this edge's own as the one after it (from this
+        // tooth to the next, the judgement will weigh the last revolution's two recorded).
+        let own = dt as f32 / pitch_ratio(enc, tooth);
+        let at = |k: u16, second: bool| match self.held {
+            _ if second && k == tooth => own,
+            Some((t, v)) if t == k => v as f32,
+            _ => self.hist.get(usize::from(k)).copied().unwrap_or(0) as f32,
+        };
+        (0..edges).all(|k| {
+            let (a, b) = (at(k, false), at(tooth_after(k, 1, edges), true));
+            if a <= 0.0 || b <= 0.0 {
+                return true;
+            }
+            let s = b / a;
+            let s = if s > 1.0 {
+                s * TRACK_MARGIN
+            } else {
+                s / TRACK_MARGIN
+            };
+            let s2 = s * s;
+            let s10 = (s2 * s2) * (s2 * s2) * s2;
+            s10 < limit && s10 * limit > 1.0
+        })
+    }
+
+    /// Whether a frame may be confirmed now: on a wheel whose intervals are kept (see
+    /// [`SpeedTracker::fit_push`]), only once the last revolution's each followed on from the
+    /// one before, none a fault. (The swings recorded while confirming judge the teeth once
+    /// synced: a noise pulse in them, while an 8-1 wheel searched at ±40 %, made the first
+    /// teeth in sync glitches, the count a tooth off.)
+    #[cfg(feature = "pattern-wheels")]
+    fn fit_settled(&self, enc: &Encoder) -> bool {
+        let edges = enc.edges();
+        edges < FIT_MIN_TEETH
+            || usize::from(edges) > FIT_TEETH
+            || self.fit.first().is_none_or(|f| f.run >= edges)
+    }
+
+    /// The alignment a whole revolution of intervals favours on a small wheel with gaps (no
+    /// short pitches), for the last edge, and whether it decides it. For each alignment: the
+    /// log intervals over their pitches, the speed trend taken out, less the smooth speed
+    /// profile of the revolution that fits them best (a mean and harmonics, each averaged over
+    /// the pitch: with at most nine teeth the order 1, 2 or 3 alone; with more, 1 and 2
+    /// together, 3 alone or 4 alone); it decides when its residual is small, every other
+    /// alignment's large, and its profile no deeper than a ripple of ±42 %. Only a
+    /// revolution whose intervals each followed on from the revolution before counts (see
+    /// [`SpeedTracker::fit_push`]: a noise pulse or a lost tooth within it fits a wrong
+    /// alignment now and then). Where the ripple is so deep that a gap on its fast stroke is
+    /// no longer than a pitch on its slow one, the profile still tells them apart: an 8-1
+    /// wheel at ±40 %, two strokes a revolution, has its gap 1.09 times its longer neighbour
+    /// at worst, and the profile fits it to 0.005 ln²2, every other alignment to 0.15 ln²2 or
+    /// more. `None`: not such a wheel, or no such revolution yet.
+    #[cfg(feature = "pattern-wheels")]
+    fn fit_alignment(&self, enc: &Encoder) -> Option<(u16, bool)> {
+        let edges = enc.edges();
+        let e = usize::from(edges);
+        let f = self.fit.first()?;
+        if edges < FIT_MIN_TEETH
+            || e > FIT_TEETH
+            || f.run < edges
+            || enc.short_teeth() != 0
+            || enc.long_teeth() == 0
+        {
+            return None;
+        }
+        let base = enc.base_pitch() as f32;
+        let unit = ln(f32::from(enc.extreme_pitches().0) / base);
+        // Log intervals by slot and log pitch ratios by tooth, each less its mean (the
+        // constant of every profile takes the means; taken out first, f32 keeps the residuals).
+        let mut y = [0.0f32; FIT_TEETH];
+        let mut q = [0.0f32; FIT_TEETH];
+        let mut total = 0u32;
+        let (mut y_mean, mut q_mean) = (0.0f32, 0.0f32);
+        // The speed trend taken out: a revolution's ratio spread over its intervals, from the
+        // oldest (slot `pos`) to the newest (a trend of 30 % a revolution left an 8-1
+        // wheel's true alignment fitting no better than others).
+        let slope = f.trend / f32::from(edges);
+        let mid = f32::from(edges.saturating_sub(1)) / 2.0;
+        for (k, (y, q)) in y.iter_mut().zip(q.iter_mut()).take(e).enumerate() {
+            let p = enc.grid_pitch(k as u16);
+            total = total.saturating_add(p);
+            let age = tooth_back(k as u16, f.pos, edges);
+            *y = f.ln.get(k).copied().unwrap_or(0.0) - slope * (f32::from(age) - mid);
+            *q = ln(p as f32 / base);
+            y_mean += *y;
+            q_mean += *q;
+        }
+        let n = f32::from(edges);
+        each_pair(&mut y, &[y_mean / n; FIT_TEETH], |y, m| *y -= m);
+        each_pair(&mut q, &[q_mean / n; FIT_TEETH], |q, m| *q -= m);
+        let turn = core::f32::consts::TAU / total.max(1) as f32;
+        let step = (libm::cosf(turn), libm::sinf(turn));
+        // The newest interval's slot: it ends at tooth `s` under alignment `s`, and tooth `k`
+        // is in slot `newest − s + k`.
+        let newest = tooth_back(f.pos, 1, edges);
+        // Per alignment, the smallest residual and the largest harmonic of its profile.
+        let mut rss = [f32::INFINITY; FIT_TEETH];
+        let mut ripple = [0.0f32; FIT_TEETH];
+        // Bit h: the order h harmonic.
+        let models: [u8; 3] = if edges >= 10 {
+            [0b0_0110, 0b0_1000, 0b1_0000]
+        } else {
+            [0b0010, 0b0100, 0b1000]
+        };
+        for model in models {
+            // The profile's columns over the teeth, made orthonormal (Gram-Schmidt): the
+            // constant, then cos and sin of each order, averaged over each tooth's pitch.
+            let mut cols = [[0.0f32; FIT_TEETH]; 5];
+            let mut m = 0;
+            for (c, col) in cols.iter_mut().enumerate() {
+                let h = match c {
+                    0 => 0,
+                    _ => match (1..=4u8)
+                        .filter(|&h| model.checked_shr(u32::from(h)).unwrap_or(0) & 1 == 1)
+                        .nth(c.wrapping_sub(1) / 2)
+                    {
+                        Some(h) => h,
+                        None => break,
+                    },
+                };
+                // The angle a tooth's pitch starts and ends at, as e^{iθ} turned a grid
+                // position at a time (one sine and cosine a revolution, not two a tooth).
+                let mut start = (1.0f32, 0.0f32);
+                for (k, v) in col.iter_mut().take(e).enumerate() {
+                    let p = enc.grid_pitch(k as u16);
+                    let mut end = start;
+                    for _ in 0..p {
+                        end = rotate(end, step);
+                    }
+                    *v = if h == 0 {
+                        1.0
+                    } else {
+                        let (mut a, mut b) = (start, end);
+                        for _ in 1..h {
+                            (a, b) = (rotate(a, start), rotate(b, end));
+                        }
+                        // The mean of cos hθ (c odd) or sin hθ over the pitch.
+                        let w = f32::from(h) * p as f32 * turn;
+                        if c & 1 == 1 {
+                            (b.1 - a.1) / w
+                        } else {
+                            (a.0 - b.0) / w
+                        }
+                    };
+                    start = end;
+                }
+                m = c.wrapping_add(1);
+            }
+            // `tri[c][d]`: column `c` of the profile on the orthonormal column `d` (d ≤ c).
+            let mut tri = [[0.0f32; 5]; 5];
+            for (c, row) in tri.iter_mut().enumerate().take(m) {
+                let (done, rest) = cols.split_at_mut(c);
+                let Some(col) = rest.first_mut() else { break };
+                for (d, r) in done.iter().zip(row.iter_mut()) {
+                    *r = dot(d, col);
+                    each_pair(col, d, |v, u| *v -= *r * u);
+                }
+                let norm = libm::sqrtf(dot(col, col));
+                // A column the others span (never on a wheel of six teeth or more): left out.
+                let (norm, inv) = if norm > 1e-3 {
+                    (norm, 1.0 / norm)
+                } else {
+                    (0.0, 0.0)
+                };
+                col.iter_mut().for_each(|v| *v *= inv);
+                if let Some(r) = row.get_mut(c) {
+                    *r = norm;
+                }
+            }
+            for (s, (best, amp)) in rss.iter_mut().zip(ripple.iter_mut()).take(e).enumerate() {
+                let mut z = [0.0f32; FIT_TEETH];
+                for (k, (z, q)) in z.iter_mut().zip(q.iter()).take(e).enumerate() {
+                    // Tooth `k` is in slot `newest − s + k` (no wrap: `k`, `s` under `e`).
+                    let at = k.wrapping_add(e).wrapping_sub(s) as u16;
+                    *z = y
+                        .get(usize::from(tooth_after(newest, at, edges)))
+                        .copied()
+                        .unwrap_or(0.0)
+                        - q;
+                }
+                let mut g = [0.0f32; 5];
+                for (g, col) in g.iter_mut().zip(cols.iter()).take(m) {
+                    *g = dot(col, &z);
+                }
+                let r = dot(&z, &z) - dot(&g, &g);
+                if r < *best {
+                    *best = r;
+                    *amp = amplitude(&tri, g, m);
+                }
+            }
+        }
+        let (mut first, mut second, mut at) = (f32::INFINITY, f32::INFINITY, 0usize);
+        for (s, &r) in rss.iter().take(e).enumerate() {
+            if r < first {
+                (second, first, at) = (first, r, s);
+            } else if r < second {
+                second = r;
+            }
+        }
+        let scale = unit * unit;
+        let smooth = ripple.get(at).is_some_and(|&a| a <= FIT_RIPPLE);
+        let decisive = first <= FIT_FITS * scale && second >= FIT_MISFITS * scale && smooth;
+        Some((at as u16, decisive))
     }
 
     /// The tooth after which the fast path must stop (the next one is special).
@@ -2104,6 +2501,7 @@ impl SpeedTracker {
         self.across = 0;
         self.block_fast();
         self.acq = [0; 3];
+        self.forget_fit();
         self.forget_history();
         self.reset_ring();
     }
@@ -2342,8 +2740,16 @@ impl SpeedTracker {
         self.faults = 0;
         self.searched = 0;
         self.block_fast();
+        self.forget_fit();
         self.forget_history();
         self.reset_ring();
+    }
+
+    /// The intervals kept for [`SpeedTracker::fit_alignment`] no longer follow on.
+    fn forget_fit(&mut self) {
+        for f in &mut self.fit {
+            (f.pos, f.len, f.run) = (0, 0, 0);
+        }
     }
 
     fn forget_history(&mut self) {
@@ -2533,6 +2939,7 @@ impl Run {
 
 /// Two intervals at least 2^0.75 times the intervals either side are two ordinary pitches, not
 /// one split by an extra tooth; squared, 2^1.5.
+#[cfg(feature = "pattern-wheels")]
 const NOT_A_PAIR_SQ: f32 = 2.828_427;
 
 /// Evidence thresholds of pattern acquisition, from the wheel's pitches: an interval at least
@@ -2542,6 +2949,7 @@ const NOT_A_PAIR_SQ: f32 = 2.828_427;
 /// cranking 8-1 wheel), `not_long = R^0.25` (a gap seen through a swing of R^0.75 still
 /// exceeds it); with `S` the largest short pitch over the base, `short = S^0.75` (0.59 for an
 /// extra tooth halving a pitch, below the 0.63 of a 1.6 swing).
+#[cfg(feature = "pattern-wheels")]
 fn acquisition_thresholds(enc: &Encoder) -> (f32, f32, f32) {
     let base = enc.base_pitch() as f32;
     let (long, short) = enc.extreme_pitches();
@@ -2562,6 +2970,7 @@ fn acquisition_thresholds(enc: &Encoder) -> (f32, f32, f32) {
 }
 
 /// e^x for small |x| (a few units): range-reduced series. Configuration and acquisition only.
+#[cfg(feature = "pattern-wheels")]
 fn exp(x: f32) -> f32 {
     let n = (x / core::f32::consts::LN_2) as i32;
     let r = x - n as f32 * core::f32::consts::LN_2;
@@ -2582,6 +2991,43 @@ fn exp(x: f32) -> f32 {
         }
     }
     sum * scale
+}
+
+/// `a` turned by `b` (complex numbers as (re, im)).
+#[cfg(feature = "pattern-wheels")]
+fn rotate(a: (f32, f32), b: (f32, f32)) -> (f32, f32) {
+    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
+}
+
+/// The dot product of two slices (as far as the shorter goes).
+#[cfg(feature = "pattern-wheels")]
+fn dot(a: &[f32], b: &[f32]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The largest harmonic amplitude (log speed) of a profile fitted on `m` orthonormal columns
+/// with coefficients `g`, `tri` the profile's columns on them: the constant, then the cos and
+/// sin of each order (solved from the last column back).
+#[cfg(feature = "pattern-wheels")]
+fn amplitude(tri: &[[f32; 5]; 5], g: [f32; 5], m: usize) -> f32 {
+    let mut beta = [0.0f32; 5];
+    for c in (0..m.min(5)).rev() {
+        let mut v = g.get(c).copied().unwrap_or(0.0);
+        for (row, b) in tri.iter().zip(beta.iter()).skip(c.wrapping_add(1)).take(m) {
+            v -= row.get(c).copied().unwrap_or(0.0) * b;
+        }
+        let diag = tri
+            .get(c)
+            .and_then(|row| row.get(c))
+            .copied()
+            .unwrap_or(0.0);
+        if let Some(b) = beta.get_mut(c) {
+            *b = if diag > 0.0 { v / diag } else { 0.0 };
+        }
+    }
+    let [_, c1, s1, c2, s2] = beta;
+    let (a1, a2) = (c1 * c1 + s1 * s1, c2 * c2 + s2 * s2);
+    libm::sqrtf(if a1 > a2 { a1 } else { a2 })
 }
 
 /// Calls `f` on the pairs of `a` and `b` in turn, as far as the shorter goes: `zip` by slice
@@ -2614,6 +3060,7 @@ fn reported_before(index_seq: u32, edge_seq: u32) -> bool {
 }
 
 /// `bits` rotated left by one within `n` bits (nothing left of them for `n` = 0).
+#[cfg(feature = "pattern-wheels")]
 fn rotate_left(bits: u64, n: u16) -> u64 {
     if n >= 64 {
         bits.rotate_left(1)
