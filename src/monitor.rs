@@ -1644,15 +1644,111 @@ mod tests {
         }
     }
 
+    /// Each valid window of `out` measures what the window of `reference` (the same stream
+    /// without the fault) from the same tick does, or, where jitter made that one invalid,
+    /// spans one revolution from a frame to the next (`frames`, their ticks); the others are
+    /// listed in `wrong`.
+    fn framed_as_in(
+        out: &[WindowOutcome],
+        reference: &[WindowOutcome],
+        frames: &[u32],
+        what: &str,
+        wrong: &mut Vec<String>,
+    ) {
+        for o in out.iter().filter(|o| o.report.valid()) {
+            let r = &o.report;
+            let right = match reference
+                .iter()
+                .find(|q| q.report.start_ticks == r.start_ticks)
+            {
+                Some(q) if q.report.valid() => {
+                    r.measurement().map(|m| m.delta) == q.report.measurement().map(|m| m.delta)
+                }
+                _ => {
+                    frames.contains(&r.start_ticks)
+                        && frames.contains(&r.end_ticks)
+                        && r.revolutions == 1
+                }
+            };
+            if !right {
+                wrong.push(format!("{what}: {o:?}"));
+            }
+        }
+    }
+
+    #[test]
+    fn a_fault_at_a_small_wheels_gap_at_deep_ripple_frames_no_window_off() {
+        // 8-1 and 12-1 wheels cranking at ±40 %, two strokes a revolution, eight phases,
+        // edge jitter of 1 and 2 % of a pitch (σ), one- and four-edge samples: in sync, the
+        // frame tooth lost, or a noise pulse 60 to 90 % into the gap. Every valid window is
+        // framed where the wheel's frame is, with δ as in the stream without the fault. The
+        // gap and the lost tooth after it were taken for the gap alone and the next edge for
+        // the frame, with the window over a revolution and a pitch valid: a 12-1 wheel, the
+        // swing across the loss (2.3) beyond the R^0.9 the judgement trusts, δ 0.22 for 0.17
+        // with 8-edge samples; an 8-1 wheel with jitter of 1 %, and one with a pulse at 80 %
+        // of its gap (δ 0.19 for 0.14), a fault there better than the tooth by less than
+        // half the margin.
+        let (mut checked, mut wrong) = (0, Vec::new());
+        for positions in [8u8, 12] {
+            let p = Pattern::missing_teeth(positions, 1);
+            let teeth = pattern_angles(p);
+            let n = teeth.len();
+            let pitch_ticks = TAU / f64::from(positions) / 25.0 * 1e6;
+            for (phase, seed, sigma) in (0..8)
+                .flat_map(|ph| (0..4).flat_map(move |sd| [0.01, 0.02].map(move |s| (ph, sd, s))))
+            {
+                let ph = TAU * f64::from(phase) / 8.0;
+                let crank = cranking(25.0, 0.4, ph);
+                let clean = stream(&teeth, None, 12, 1e6, u32::MAX, &crank);
+                let evs = jittered(&clean, sigma * pitch_ticks, 8 * phase + seed + 5);
+                let frames: Vec<u32> = evs.iter().step_by(n).map(|e| time_of(*e)).collect();
+                for k in [1u16, 4] {
+                    let mut c = one_edge_pattern(p, 5.0);
+                    c.estimator = Estimator::Edges(k);
+                    let reference = run(&mut monitor(c, 1), &evs);
+                    if !reference.iter().any(|o| o.report.valid()) {
+                        continue;
+                    }
+                    let at = 5 * n;
+                    let mut lost = evs.clone();
+                    lost.remove(at);
+                    let mut faults = vec![("frame tooth lost".to_string(), lost)];
+                    for f in [0.6, 0.7, 0.8, 0.9] {
+                        let (t0, t1) = (time_of(evs[at - 1]), time_of(evs[at]));
+                        let mut pulsed = evs.clone();
+                        pulsed.insert(at, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+                        faults.push((format!("pulse {f} into the gap"), pulsed));
+                    }
+                    for (fault, evs) in faults {
+                        let what = format!(
+                            "{positions}-1, phase {phase}, seed {seed}, σ {sigma}, K {k}, {fault}"
+                        );
+                        let out = run(&mut monitor(c, 1), &evs);
+                        framed_as_in(&out, &reference, &frames, &what, &mut wrong);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            wrong.is_empty(),
+            "{} wrong windows: {wrong:#?}",
+            wrong.len()
+        );
+        // Most of the streams sync (the rest search on): the test checks what it says.
+        assert!(checked >= 1000, "{checked}");
+    }
+
     #[test]
     fn a_count_gone_off_in_sync_is_caught_by_the_revolutions_intervals() {
         // Small wheels cranking at ±40 %, two and three strokes a revolution, eight phases,
         // edge jitter of 2 % of a pitch (σ), one-edge samples: a noise pulse a third, half
         // or two thirds into the pitch after one of three teeth around the gap, in sync.
         // Every valid window is framed where the wheel's frame is, with δ as in the stream
-        // without the pulse. At three strokes the pulse and the faults the judgement found after it moved an 8-1
-        // wheel's count three teeth on, where the swings it had recorded under the moved
-        // numbering then vouched for it: every later window was valid, δ 0.93 for 0.62.
+        // without the pulse. At three strokes the pulse and the faults the judgement found
+        // after it moved an 8-1 wheel's count three teeth on, where the swings it had
+        // recorded under the moved numbering then vouched for it: every later window was
+        // valid, δ 0.93 for 0.62.
         let (mut checked, mut wrong) = (0, Vec::new());
         for positions in [8u8, 12] {
             let p = Pattern::missing_teeth(positions, 1);
@@ -1685,29 +1781,7 @@ mod tests {
                         "{positions}-1, {strokes} strokes, phase {phase}, seed {seed}, pulse {f} after tooth {tooth}"
                     );
                     let out = run(&mut monitor(c, 1), &pulsed);
-                    // Each valid window measures what the clean stream's window from the
-                    // same tick does, or, where jitter made that one invalid, spans the
-                    // revolution between two frames.
-                    for o in out.iter().filter(|o| o.report.valid()) {
-                        let r = &o.report;
-                        let right = match reference
-                            .iter()
-                            .find(|q| q.report.start_ticks == r.start_ticks)
-                        {
-                            Some(q) if q.report.valid() => {
-                                r.measurement().map(|m| m.delta)
-                                    == q.report.measurement().map(|m| m.delta)
-                            }
-                            _ => {
-                                frames.contains(&r.start_ticks)
-                                    && frames.contains(&r.end_ticks)
-                                    && r.revolutions == 1
-                            }
-                        };
-                        if !right {
-                            wrong.push(format!("{what}: {o:?}"));
-                        }
-                    }
+                    framed_as_in(&out, &reference, &frames, &what, &mut wrong);
                     checked += 1;
                 }
             }

@@ -1407,10 +1407,22 @@ impl SpeedTracker {
                     spans
                 };
                 // The frame tooth of an index disc is not skipped silently: the index decides.
+                let mut cost = self
+                    .chain_cost(enc, here, tooth, x / spans, [d2, d3], cap)
+                    .0;
+                if cfg!(feature = "pattern-wheels") && enc.framing() == Framing::Pattern {
+                    // The tooth before the loss against the first after it as they were
+                    // recorded, however far apart they swing: judging one tooth against the
+                    // next, a swing beyond R^0.9 is taken for a count off and not trusted, but
+                    // a tooth lost after a 12-1 wheel's gap at ±40 % spans a swing of 2.3, and
+                    // weighed without it the loss cost more than the tooth (the count went a
+                    // tooth behind, a window over a revolution and a pitch valid).
+                    let (head, prev) = (x / spans, self.prev as f32);
+                    cost += log_sq(head, prev * self.raw_swing(here, tooth))
+                        - log_sq(head, prev * self.recorded_swing(enc, here, tooth, 1.0));
+                }
                 consider(
-                    self.chain_cost(enc, here, tooth, x / spans, [d2, d3], cap)
-                        .0
-                        + margin * f32::from(j.wrapping_sub(1)),
+                    cost + margin * f32::from(j.wrapping_sub(1)),
                     Verdict::Missing(j),
                 );
             }
@@ -1444,14 +1456,16 @@ impl SpeedTracker {
         if best.0 + margin < expected_cost {
             best.1
         } else if (expected_cost > margin && recorded_cost > margin)
-            || (cfg!(feature = "pattern-wheels") && gap && best.0 + 0.5 * margin < expected_cost)
+            || (cfg!(feature = "pattern-wheels") && gap && best.0 + 0.25 * margin < expected_cost)
         {
-            // After a gap, also where a fault explains the edges better than the tooth by half
-            // the margin shrunk there: the evidence a fault leaves at a gap can be that small
-            // (a tooth lost after an 8-1 or 12-1 wheel's gap while cranking at ±30 %, the
-            // pitch after the gap fast, stretches the gap by a fifth of it), and a count a
-            // tooth behind then vouched for a window over the loss (δ 0.67 for 0.54). (The
-            // feature named: without it the compiler kept this test, 40 bytes.)
+            // After a gap, also where a fault explains the edges better than the tooth by a
+            // quarter of the margin shrunk there: the evidence a fault leaves at a gap can be
+            // that small (a tooth lost after an 8-1 or 12-1 wheel's gap while cranking at
+            // ±30 %, the pitch after the gap fast, stretches the gap by a fifth of it), and a
+            // count a tooth behind then vouched for a window over the loss (δ 0.67 for 0.54;
+            // by half the margin, at ±40 % with jitter of 1 % of a pitch a lost frame tooth
+            // of an 8-1 wheel still did, and a noise pulse late in its gap). (The feature
+            // named: without it the compiler kept this test, 40 bytes.)
             // (Swings the recorded revolution does not hold, its teeth's intervals spanned by
             // a fault, count for the hypotheses, not here: against 1 the cranking swings after
             // a gap made the frame tooth unexplained a revolution after a noise pulse there;
