@@ -1,6 +1,7 @@
 //! Host benchmarks of the core's hot paths (criterion), the counterparts of the firmware's
 //! instruction counts: the per-edge update over a 1024-line pulse stream, the window finish
-//! amortised over it, the support-load update, and the predicted δ.
+//! amortised over it, a small crank wheel's edges while its frame is sought and once synced,
+//! the support-load update, and the predicted δ.
 //!
 //! Kept quick (20 samples, short warm-up and measurement) so a full `cargo bench` stays within
 //! CI budgets; `cargo bench --no-run` only compiles them.
@@ -14,7 +15,7 @@ use drive_monitor::drive::{DriveModel, Harmonic, Load, Parabola};
 use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowLength};
 use drive_monitor::monitor::DeltaMonitor;
-use drive_monitor::speed::Direction;
+use drive_monitor::speed::{Direction, SyncState};
 use drive_monitor::supports::{
     Limits, ProcessLoad, Rotor, SupportAnalysis, Unbalance, DEFAULT_WARNING_FRACTION,
 };
@@ -98,6 +99,81 @@ fn bench_monitor(c: &mut Criterion) {
     g.finish();
 }
 
+/// Capture timestamps (1 MHz timer) of a `positions`-1 wheel cranking at ω = 25·(1 + 0.4·sin 2φ)
+/// rad/s for `revs` revolutions, each tooth's time the integral of dφ/ω (Simpson's rule, 64
+/// steps a grid position: a stream to be fed, not a reference).
+fn crank_stream(positions: u8, revs: u32) -> Vec<u32> {
+    let omega = |phi: f64| 25.0 * (1.0 + 0.4 * (2.0 * phi).sin());
+    let step = std::f64::consts::TAU / f64::from(positions) / 64.0;
+    let (mut t, mut phi, mut ticks) = (0.0f64, 0.0f64, Vec::new());
+    for k in 0..revs * u32::from(positions) {
+        for _ in 0..32 {
+            let (a, m, b) = (phi, phi + step, phi + 2.0 * step);
+            t += 2.0 * step / 6.0 * (1.0 / omega(a) + 4.0 / omega(m) + 1.0 / omega(b));
+            phi = b;
+        }
+        // Teeth half a position after the grid mark; the last position is the gap.
+        if k % u32::from(positions) != u32::from(positions) - 1 {
+            ticks.push((t * 1e6) as u32);
+        }
+    }
+    ticks
+}
+
+fn bench_crank(c: &mut Criterion) {
+    // An 8-1 wheel: the smallest a whole revolution of intervals is fitted for, edge by edge
+    // while the frame is sought (the first three revolutions, from a fresh monitor: it syncs
+    // in the third) and once synced (every edge judged against the last revolution).
+    let positions = 8u8;
+    let ticks = crank_stream(positions, 12);
+    let per_rev = usize::from(positions) - 1;
+    let mut cfg = EncoderConfig::missing_teeth(positions, 1, 1e6);
+    cfg.estimator = Estimator::Edges(1);
+    cfg.min_speed = 5.0;
+    let w = WindowConfig {
+        length: WindowLength::Revolutions(1),
+        steady_tolerance: 0.02,
+    };
+    let fresh =
+        DeltaMonitor::<64>::new(Encoder::new(cfg).expect("encoder"), w, None).expect("monitor");
+    let (seek, rest) = ticks.split_at(3 * per_rev);
+    let mut synced = fresh.clone();
+    for &t in seek {
+        synced.on_edge(t, None);
+    }
+    assert_eq!(
+        synced.sync_state(),
+        SyncState::Synced,
+        "the bench stream syncs"
+    );
+    let mut g = c.benchmark_group("crank 8-1");
+    g.throughput(Throughput::Elements(seek.len() as u64));
+    g.bench_function("on_edge seeking the frame", |b| {
+        b.iter_batched_ref(
+            || fresh.clone(),
+            |m| {
+                for &t in seek {
+                    black_box(m.on_edge(black_box(t), None));
+                }
+            },
+            BatchSize::SmallInput,
+        )
+    });
+    g.throughput(Throughput::Elements(rest.len() as u64));
+    g.bench_function("on_edge synced", |b| {
+        b.iter_batched_ref(
+            || synced.clone(),
+            |m| {
+                for &t in rest {
+                    black_box(m.on_edge(black_box(t), None));
+                }
+            },
+            BatchSize::SmallInput,
+        )
+    });
+    g.finish();
+}
+
 fn bench_supports(c: &mut Criterion) {
     let rotor: Rotor<4> = Rotor::new(
         350.0,
@@ -167,6 +243,7 @@ fn main() {
         .measurement_time(Duration::from_millis(600))
         .configure_from_args();
     bench_monitor(&mut c);
+    bench_crank(&mut c);
     bench_supports(&mut c);
     bench_drive(&mut c);
     c.final_summary();
