@@ -281,6 +281,14 @@ const FIT_PERIODIC: f32 = 0.223;
 const FIT_FITS: f32 = 0.03;
 #[cfg(feature = "pattern-wheels")]
 const FIT_MISFITS: f32 = 0.12;
+/// A frame is confirmed on such a wheel only where the alignment the revolution fits best
+/// leaves a residual of at most this (ln²R): with more strokes than the profile resolves, the
+/// speed swings between teeth can make another tooth's interval look like the gap every
+/// revolution (a 12-1 wheel at ±40 % with five strokes was framed at a wrong tooth at 2 of
+/// 12 phases, every window valid, its best residual 0.72 to 0.81). Over 3 to 6 strokes on
+/// 8-1 to 16-2 wheels this bound costs syncs only from ±30 %.
+#[cfg(feature = "pattern-wheels")]
+const FIT_EXPLAINS: f32 = 0.5;
 /// ... and whose profile's largest harmonic is at most this (log speed: a ripple of ±42 %).
 #[cfg(feature = "pattern-wheels")]
 const FIT_RIPPLE: f32 = 0.45;
@@ -2024,7 +2032,7 @@ impl SpeedTracker {
         }
         self.fit_push(enc, dt);
         let fit = self.fit_alignment(enc);
-        let fitted = fit.and_then(|(at, decisive)| decisive.then_some(at));
+        let fitted = fit.and_then(|(at, decisive, _)| decisive.then_some(at));
         if before > 0 && middle > 0 && dt > 0 {
             let (lo, hi) = if before < dt {
                 (before, dt)
@@ -2138,8 +2146,9 @@ impl SpeedTracker {
                     // A small wheel's revolution fitting another alignment best is doubtful
                     // evidence (at ±45 % ripple with three strokes an 8-1 wheel showed a pitch
                     // clearly long at another tooth than the gap, and was framed there, its
-                    // windows valid).
-                    let doubtful = fit.is_some_and(|(at, _)| at != tooth);
+                    // windows valid), and so is one that no alignment explains (see
+                    // `FIT_EXPLAINS`).
+                    let doubtful = fit.is_some_and(|(at, _, explains)| at != tooth || !explains);
                     if self.confirm == 0
                         && self.seen_special
                         && self.fit_settled(enc)
@@ -2269,7 +2278,7 @@ impl SpeedTracker {
         if tooth != 0 && !(after >= edges && before < edges) {
             return false;
         }
-        matches!(self.fit_alignment(enc), Some((at, true)) if at != tooth)
+        matches!(self.fit_alignment(enc), Some((at, true, _)) if at != tooth)
     }
 
     /// Whether a frame may be confirmed now: on a wheel whose intervals are kept (see
@@ -2298,9 +2307,10 @@ impl SpeedTracker {
     /// no longer than a pitch on its slow one, the profile still tells them apart: an 8-1
     /// wheel at ±40 %, two strokes a revolution, has its gap 1.09 times its longer neighbour
     /// at worst, and the profile fits it to 0.005 ln²2, every other alignment to 0.15 ln²2 or
-    /// more. `None`: not such a wheel, or no such revolution yet.
+    /// more. Also whether the best alignment explains the revolution at all (`FIT_EXPLAINS`).
+    /// `None`: not such a wheel, or no such revolution yet.
     #[cfg(feature = "pattern-wheels")]
-    fn fit_alignment(&self, enc: &Encoder) -> Option<(u16, bool)> {
+    fn fit_alignment(&self, enc: &Encoder) -> Option<(u16, bool, bool)> {
         let edges = enc.edges();
         let e = usize::from(edges);
         let f = self.fit.first()?;
@@ -2449,7 +2459,10 @@ impl SpeedTracker {
         let scale = unit * unit;
         let smooth = ripple.get(at).is_some_and(|&a| a <= FIT_RIPPLE);
         let decisive = first <= FIT_FITS * scale && second >= FIT_MISFITS * scale && smooth;
-        Some((at as u16, decisive))
+        // (The best alignment explains the revolution at all: the profile and the pattern
+        // leave little of it.)
+        let explains = first <= FIT_EXPLAINS * scale;
+        Some((at as u16, decisive, explains))
     }
 
     /// The tooth after which the fast path must stop (the next one is special).
