@@ -281,6 +281,13 @@ const FIT_PERIODIC: f32 = 0.223;
 const FIT_FITS: f32 = 0.03;
 #[cfg(feature = "pattern-wheels")]
 const FIT_MISFITS: f32 = 0.12;
+/// A pattern wheel's frame edge is unexplained where its squared log swing against the tooth
+/// before exceeds this many times the mean of recent frames' (see
+/// [`SpeedTracker::frame_as_usual`]) and a quarter of the margin shrunk at the gap: one
+/// squared Gaussian exceeds 20 times its mean about once in 100 000.
+const FRAME_NOISE: f32 = 20.0;
+/// Frames the mean is learnt over (a running mean, then an exponential one).
+const FRAME_MEMORY: u16 = 16;
 /// A frame is confirmed on such a wheel only where the alignment the revolution fits best
 /// leaves a residual of at most this (ln²R): with more strokes than the profile resolves, the
 /// speed swings between teeth can make another tooth's interval look like the gap every
@@ -315,6 +322,10 @@ struct Revolution {
     /// (the speed trend of a revolution, in log).
     d: f32,
     trend: f32,
+    /// The mean squared log swing of the frame edge against the tooth before (as recorded)
+    /// over about the last `FRAME_MEMORY` frames, and how many frames it has learnt from.
+    frame_noise: f32,
+    frames: u16,
 }
 
 impl Revolution {
@@ -325,6 +336,8 @@ impl Revolution {
         run: 0,
         d: 0.0,
         trend: 0.0,
+        frame_noise: 0.0,
+        frames: 0,
     };
 }
 
@@ -646,7 +659,7 @@ impl SpeedTracker {
         (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
         (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
         for f in fit {
-            (f.pos, f.len, f.run) = (0, 0, 0);
+            (f.pos, f.len, f.run, f.frames, f.frame_noise) = (0, 0, 0, 0, 0.0);
         }
         counters.clear(z);
     }
@@ -1232,7 +1245,7 @@ impl SpeedTracker {
     }
 
     /// The verdict on `pending[0]`.
-    fn judge(&self, enc: &Encoder, flushing: bool) -> Verdict {
+    fn judge(&mut self, enc: &Encoder, flushing: bool) -> Verdict {
         let e1 = self.pending[0];
         let d1 = e1.wrapping_sub(self.last) & enc.mask();
         let r = self.prev;
@@ -1465,6 +1478,11 @@ impl SpeedTracker {
             best.1
         } else if (expected_cost > margin && recorded_cost > margin)
             || (cfg!(feature = "pattern-wheels") && gap && best.0 + 0.25 * margin < expected_cost)
+            || (cfg!(feature = "pattern-wheels")
+                && gap
+                && next == 0
+                && self.history
+                && !self.frame_as_usual(enc, here, x / p_next, margin))
         {
             // After a gap, also where a fault explains the edges better than the tooth by a
             // quarter of the margin shrunk there: the evidence a fault leaves at a gap can be
@@ -1490,6 +1508,34 @@ impl SpeedTracker {
         } else {
             Verdict::Tooth
         }
+    }
+
+    /// Whether the frame edge of a pattern wheel, its interval `head` per pitch, is placed as
+    /// the recent frames were against the tooth before, as recorded a revolution earlier; and
+    /// learns from it where it is. The frame bounds the windows: a frame edge displaced within
+    /// the margin shrunk at the gap makes the sample over the gap, and the window, wrong (a
+    /// noise pulse from 0.45 of a pitch before a 12-1 wheel's frame tooth to 0.3 after it,
+    /// exclusive-or'ed with the signal, replaces the tooth's edge with one early and one late:
+    /// the early one was taken for the frame, 22 % early, within the margin, and the window
+    /// ending there valid, δ 0.25 on a steady shaft; the late one was an extra edge a
+    /// revolution on). Unexplained: a squared log swing above a quarter of the margin and
+    /// above `FRAME_NOISE` times the mean of the recent frames' (the edges' jitter sets it).
+    fn frame_as_usual(&mut self, enc: &Encoder, here: u16, head: f32, margin: f32) -> bool {
+        let swing = self.recorded_swing(enc, here, 0, 1.0);
+        let cost = log_sq(head, self.prev as f32 * swing);
+        let Some(f) = self.fit.first_mut() else {
+            return true;
+        };
+        if cost > margin {
+            // The rules on faults decide (and a fault's cost is no jitter to learn).
+            return true;
+        }
+        if cost > 0.25 * margin && cost > FRAME_NOISE * f.frame_noise {
+            return false;
+        }
+        f.frames = f.frames.saturating_add(1);
+        f.frame_noise += (cost - f.frame_noise) / f32::from(f.frames.min(FRAME_MEMORY));
+        true
     }
 
     /// The cost of a hypothesis on the pending edges: the first is tooth `first` with the
