@@ -1232,6 +1232,11 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     let _ = writeln!(
         s,
+        "δ = 2(ω_max − ω_min)/(ω_max + ω_min) over each window's speed samples (seed 000's \
+         definition); the ω mean column is the window's mean speed, not (ω_max + ω_min)/2"
+    );
+    let _ = writeln!(
+        s,
         "δ is measured against the wheel's nominal tooth angles: the disc's own pitch errors \
          (lines or teeth unevenly placed, run-out) read as irregularity, and the floor does not \
          include them (the core's per-tooth learner, learn::ToothLearner, measures and removes \
