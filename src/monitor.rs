@@ -1553,7 +1553,25 @@ mod tests {
 
     /// Cranking: ω = ω̄(1 + a·sin(2φ + phase)) (two compression strokes per turn).
     fn cranking(mean: f64, a: f64, phase: f64) -> impl Fn(f64) -> f64 {
-        move |phi: f64| mean * (1.0 + a * (2.0 * phi + phase).sin())
+        strokes(mean, 2.0, a, phase)
+    }
+
+    /// Cranking with `z` strokes per turn: ω = ω̄(1 + a·sin(zφ + phase)).
+    fn strokes(mean: f64, z: f64, a: f64, phase: f64) -> impl Fn(f64) -> f64 {
+        move |phi: f64| mean * (1.0 + a * (z * phi + phase).sin())
+    }
+
+    /// The ticks of every `n`-th edge of `evs` from the first: a wheel's frames.
+    fn frame_ticks(evs: &[Ev], n: usize) -> Vec<u32> {
+        evs.iter().step_by(n).map(|e| time_of(*e)).collect()
+    }
+
+    /// `evs` with a noise pulse the fraction `f` into the interval from edge `at` to the next.
+    fn with_pulse(evs: &[Ev], at: usize, f: f64) -> Vec<Ev> {
+        let (t0, t1) = (time_of(evs[at]), time_of(evs[at + 1]));
+        let mut pulsed = evs.to_vec();
+        pulsed.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+        pulsed
     }
 
     /// `clean` with every edge moved by a Gaussian draw of σ `sigma` ticks (seeded).
@@ -1589,10 +1607,7 @@ mod tests {
                 for (tooth, f) in [0, 1, n - 1].into_iter().flat_map(|k| {
                     [0.01, 0.05, 0.1, 0.16, 0.84, 0.9, 0.95, 0.99].map(move |f| (k, f))
                 }) {
-                    let at = 5 * n + tooth;
-                    let (t0, t1) = (time_of(evs[at]), time_of(evs[at + 1]));
-                    let mut pulsed = evs.clone();
-                    pulsed.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+                    let pulsed = with_pulse(&evs, 5 * n + tooth, f);
                     let what = format!(
                         "{positions}-{missing}, phase {phase}, σ {sigma}, pulse {f} after tooth {tooth}"
                     );
@@ -1613,7 +1628,6 @@ mod tests {
         // pitch: δ 0.254 for 0 on a 12-1 wheel, 0.162 on 36-2 and 60-2 (found on recorded
         // captures from an independent generator; the same at 600 rad/s with a pulse of 131 µs
         // every fourth revolution of a 60-2 wheel).
-        let mut wrong = Vec::new();
         for (positions, missing) in [(12u8, 1u8), (36, 1), (36, 2), (60, 2)] {
             let p = Pattern::missing_teeth(positions, missing);
             let teeth = pattern_angles(p);
@@ -1628,21 +1642,8 @@ mod tests {
             noisy[at] = Ev::Edge((t + 0.3 * pitch_ticks) as u32);
             noisy.insert(at, Ev::Edge((t - 0.45 * pitch_ticks) as u32));
             let out = run(&mut monitor(c, 1), &noisy);
-            for o in out.iter().filter(|o| o.report.valid()) {
-                let want = reference
-                    .iter()
-                    .find(|r| r.report.start_ticks == o.report.start_ticks)
-                    .and_then(|r| r.report.measurement())
-                    .map(|m| m.delta);
-                if o.report.measurement().map(|m| m.delta) != want {
-                    wrong.push(format!(
-                        "{positions}-{missing}: {:?} for {want:?}",
-                        o.report
-                    ));
-                }
-            }
+            valid_as_in(&out, &reference, &format!("{positions}-{missing}"));
         }
-        assert!(wrong.is_empty(), "{wrong:#?}");
     }
 
     #[test]
@@ -1743,7 +1744,7 @@ mod tests {
                 let crank = cranking(25.0, 0.4, ph);
                 let clean = stream(&teeth, None, 12, 1e6, u32::MAX, &crank);
                 let evs = jittered(&clean, sigma * pitch_ticks, 8 * phase + seed + 5);
-                let frames: Vec<u32> = evs.iter().step_by(n).map(|e| time_of(*e)).collect();
+                let frames = frame_ticks(&evs, n);
                 for k in [1u16, 4] {
                     let mut c = one_edge_pattern(p, 5.0);
                     c.estimator = Estimator::Edges(k);
@@ -1756,10 +1757,10 @@ mod tests {
                     lost.remove(at);
                     let mut faults = vec![("frame tooth lost".to_string(), lost)];
                     for f in [0.6, 0.7, 0.8, 0.9] {
-                        let (t0, t1) = (time_of(evs[at - 1]), time_of(evs[at]));
-                        let mut pulsed = evs.clone();
-                        pulsed.insert(at, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
-                        faults.push((format!("pulse {f} into the gap"), pulsed));
+                        faults.push((
+                            format!("pulse {f} into the gap"),
+                            with_pulse(&evs, at - 1, f),
+                        ));
                     }
                     for (fault, evs) in faults {
                         let what = format!(
@@ -1803,10 +1804,10 @@ mod tests {
                     .flat_map(move |a| (0..12).map(move |ph| (z, a, ph)))
             }) {
                 let ph = TAU * f64::from(phase) / 12.0;
-                let crank = move |phi: f64| 25.0 * (1.0 + a * (z * phi + ph).sin());
+                let crank = strokes(25.0, z, a, ph);
                 let clean = stream(&teeth, None, 30, 1e6, u32::MAX, &crank);
                 let evs = jittered(&clean, 0.005 * pitch_ticks, phase + 3);
-                let frames: Vec<u32> = evs.iter().step_by(n).map(|e| time_of(*e)).collect();
+                let frames = frame_ticks(&evs, n);
                 let mut m = monitor(c, 1);
                 let out = run(&mut m, &evs);
                 let misframed = out
@@ -1845,29 +1846,26 @@ mod tests {
             let n = teeth.len();
             let c = one_edge_pattern(p, 5.0);
             let pitch_ticks = TAU / f64::from(positions) / 25.0 * 1e6;
-            for (strokes, phase, seed) in [2.0, 3.0]
+            for (z, phase, seed) in [2.0, 3.0]
                 .into_iter()
                 .flat_map(|z| (0..8).flat_map(move |ph| (0..6).map(move |sd| (z, ph, sd))))
             {
                 let ph = TAU * f64::from(phase) / 8.0;
-                let crank = move |phi: f64| 25.0 * (1.0 + 0.4 * (strokes * phi + ph).sin());
+                let crank = strokes(25.0, z, 0.4, ph);
                 let clean = stream(&teeth, None, 16, 1e6, u32::MAX, &crank);
                 let evs = jittered(&clean, 0.02 * pitch_ticks, 8 * phase + seed + 11);
                 let reference = run(&mut monitor(c, 1), &evs);
                 if !reference.iter().any(|o| o.report.valid()) {
                     continue;
                 }
-                let frames: Vec<u32> = evs.iter().step_by(n).map(|e| time_of(*e)).collect();
+                let frames = frame_ticks(&evs, n);
                 for (tooth, f) in [0, 1, n - 1]
                     .into_iter()
                     .flat_map(|k| [0.2, 0.33, 0.5, 0.67, 0.8].map(move |f| (k, f)))
                 {
-                    let at = 5 * n + tooth;
-                    let (t0, t1) = (time_of(evs[at]), time_of(evs[at + 1]));
-                    let mut pulsed = evs.clone();
-                    pulsed.insert(at + 1, Ev::Edge(t0 + (f64::from(t1 - t0) * f) as u32));
+                    let pulsed = with_pulse(&evs, 5 * n + tooth, f);
                     let what = format!(
-                        "{positions}-1, {strokes} strokes, phase {phase}, seed {seed}, pulse {f} after tooth {tooth}"
+                        "{positions}-1, {z} strokes, phase {phase}, seed {seed}, pulse {f} after tooth {tooth}"
                     );
                     let out = run(&mut monitor(c, 1), &pulsed);
                     framed_as_in(&out, &reference, &frames, &what, &mut wrong);
@@ -2088,6 +2086,16 @@ mod tests {
         f
     }
 
+    /// Adds the fault counters of `c` to `d`.
+    fn add_faults(d: &mut EdgeCounters, c: &EdgeCounters) {
+        d.missing += c.missing;
+        d.glitches += c.glitches;
+        d.extra += c.extra;
+        d.unexplained += c.unexplained;
+        d.missing_frames += c.missing_frames;
+        d.sync_losses += c.sync_losses;
+    }
+
     /// The tooth of every edge of `evs` by its time (the stream starts at tooth 0).
     fn truth_of(evs: &[Ev], per_rev: usize) -> std::collections::HashMap<u32, usize> {
         evs.iter()
@@ -2105,7 +2113,7 @@ mod tests {
         fault: Option<(usize, bool)>,
     ) -> Framed {
         let teeth = pattern_angles(p);
-        let crank = move |phi: f64| 25.0 * (1.0 + a * (strokes * phi + phase).sin());
+        let crank = self::strokes(25.0, strokes, a, phase);
         let clean = stream(&teeth, None, revs, 1e6, u32::MAX, &crank);
         let mut evs = clean.clone();
         if let Some((at, drop)) = fault {
@@ -2232,13 +2240,7 @@ mod tests {
                         }
                         None => unsynced.push(k),
                     }
-                    let c = f.counters;
-                    d.missing += c.missing;
-                    d.glitches += c.glitches;
-                    d.extra += c.extra;
-                    d.unexplained += c.unexplained;
-                    d.missing_frames += c.missing_frames;
-                    d.sync_losses += c.sync_losses;
+                    add_faults(&mut d, &f.counters);
                     bad[0] += f.misnumbered;
                     bad[1] += f.wrong_frames;
                     bad[2] += f.wrong_windows;
@@ -2355,13 +2357,7 @@ mod tests {
                 bad[2] += usize::from(f.wrong_frames > 0);
                 bad[3] += usize::from(f.wrong_windows > 0);
                 valid += f.valid;
-                let c = f.counters;
-                d.missing += c.missing;
-                d.glitches += c.glitches;
-                d.extra += c.extra;
-                d.unexplained += c.unexplained;
-                d.missing_frames += c.missing_frames;
-                d.sync_losses += c.sync_losses;
+                add_faults(&mut d, &f.counters);
             }
             std::println!(
                 "{positions}-{missing}: {runs} runs, {synced} synced; runs with a sync at a wrong \

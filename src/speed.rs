@@ -268,7 +268,6 @@ const FIT_KEPT: usize = if cfg!(feature = "pattern-wheels") {
     0
 };
 /// The fewest teeth for that: fewer leave too few intervals to tell a ripple from a gap.
-#[cfg(feature = "pattern-wheels")]
 const FIT_MIN_TEETH: u16 = 6;
 /// An interval's ratio to the same tooth's a revolution earlier follows on from the tooth
 /// before's within this (log: 1.25×).
@@ -305,8 +304,10 @@ const FIT_RIPPLE: f32 = 0.45;
 #[cfg(feature = "pattern-wheels")]
 const TRACK_MARGIN: f32 = 1.02;
 
-/// What a small pattern wheel's acquisition keeps of its last intervals (see
-/// [`SpeedTracker::fit_push`]).
+/// What a pattern wheel's tracker keeps beyond the per-tooth history: a small wheel's last
+/// revolution of intervals, for its acquisition and the check of its count in sync (see
+/// [`SpeedTracker::fit_push`]), and any pattern wheel's recent frame swings (see
+/// [`SpeedTracker::frame_as_usual`]).
 #[derive(Debug, Clone, Copy)]
 #[cfg_attr(not(feature = "pattern-wheels"), allow(dead_code))]
 struct Revolution {
@@ -435,7 +436,7 @@ pub struct SpeedTracker {
     acq: [u32; 3],
     confirm: u16,
     seen_special: bool,
-    /// The last unsynced intervals of a small pattern wheel.
+    /// A small pattern wheel's last intervals and a pattern wheel's frame swings.
     fit: [Revolution; FIT_KEPT],
     /// Edges accepted since the search for a frame began, while searching or confirming (a
     /// missing frame is counted every three revolutions' worth).
@@ -2140,18 +2141,7 @@ impl SpeedTracker {
             } else {
                 self.viable & allowed
             };
-            if narrowed == 0 {
-                // Contradiction: start over from this evidence.
-                self.viable = allowed;
-                self.sync = SyncState::Searching;
-                self.confirm = 0;
-                self.seen_special = false;
-            } else {
-                self.viable = narrowed;
-                if self.sync == SyncState::Confirming && positive {
-                    self.seen_special = true;
-                }
-            }
+            self.narrow(narrowed, allowed, positive);
         }
         // Move on to this edge.
         self.viable = rotate_left(self.viable, edges) & all;
@@ -2161,18 +2151,7 @@ impl SpeedTracker {
             // revolution of intervals after the one that made it, none shared: a fault
             // makes one of them wrong, not both alike).
             let allowed = 1u64.checked_shl(u32::from(at)).unwrap_or(0);
-            let narrowed = self.viable & allowed;
-            if narrowed == 0 {
-                self.viable = allowed;
-                self.sync = SyncState::Searching;
-                self.confirm = 0;
-                self.seen_special = false;
-            } else {
-                self.viable = narrowed;
-                if self.sync == SyncState::Confirming && self.confirm == 1 {
-                    self.seen_special = true;
-                }
-            }
+            self.narrow(self.viable & allowed, allowed, self.confirm == 1);
         }
         if self.viable.count_ones() == 1 {
             let tooth = self.viable.trailing_zeros() as u16;
@@ -2220,6 +2199,24 @@ impl SpeedTracker {
             }
             self.count_search(enc, 1);
             tooth_after(self.tooth, 1, edges)
+        }
+    }
+
+    /// Narrows the candidate alignments to `narrowed` by the evidence `allowed`. None left: the
+    /// evidence contradicts them, and the search starts over from it; else, while confirming,
+    /// `confirms` says the candidate's special pitch was seen where due.
+    #[cfg(feature = "pattern-wheels")]
+    fn narrow(&mut self, narrowed: u64, allowed: u64, confirms: bool) {
+        if narrowed == 0 {
+            self.viable = allowed;
+            self.sync = SyncState::Searching;
+            self.confirm = 0;
+            self.seen_special = false;
+        } else {
+            self.viable = narrowed;
+            if self.sync == SyncState::Confirming && confirms {
+                self.seen_special = true;
+            }
         }
     }
 
@@ -2304,8 +2301,8 @@ impl SpeedTracker {
         })
     }
 
-    /// In sync on a small wheel whose intervals are kept (see [`SpeedTracker::fit_push`]):
-    /// whether the last revolution of intervals decides another alignment than the count's
+    /// In sync on a small wheel whose intervals are kept: keeps this edge's interval `dt` (see
+    /// [`SpeedTracker::fit_push`]) and says whether the last revolution of intervals decides another alignment than the count's
     /// for this edge (`tooth`). Weighed once a revolution, at the frame the count puts, and
     /// as soon as a revolution of intervals follows on again after a fault. The judgement in
     /// sync weighs each tooth against the same tooth a revolution earlier, which a count gone
@@ -2360,12 +2357,7 @@ impl SpeedTracker {
         let edges = enc.edges();
         let e = usize::from(edges);
         let f = self.fit.first()?;
-        if edges < FIT_MIN_TEETH
-            || e > FIT_TEETH
-            || f.run < edges
-            || enc.short_teeth() != 0
-            || enc.long_teeth() == 0
-        {
+        if !fit_kept(enc) || f.run < edges {
             return None;
         }
         let base = enc.base_pitch() as f32;
@@ -2545,7 +2537,9 @@ impl SpeedTracker {
             && !self.owed
             && self.across == 0
             && !self.history
-            && !(cfg!(feature = "pattern-wheels") && self.fit_checked(enc))
+            // (Every interval of such a wheel reaches the careful path, where its count is
+            // checked against whole revolutions, `count_contradicted`.)
+            && !fit_kept(enc)
             && u16::from(self.fill) >= enc.samples_span();
         self.stop = if fast {
             self.refresh_band(enc);
@@ -2553,18 +2547,6 @@ impl SpeedTracker {
         } else {
             self.tooth
         };
-    }
-
-    /// Whether every interval must reach the careful path, where the count is checked against
-    /// whole revolutions of them ([`SpeedTracker::count_contradicted`]).
-    fn fit_checked(&self, enc: &Encoder) -> bool {
-        #[cfg(feature = "pattern-wheels")]
-        return fit_kept(enc);
-        #[cfg(not(feature = "pattern-wheels"))]
-        {
-            let _ = enc;
-            false
-        }
     }
 
     /// The next edge takes the careful path.
@@ -3108,10 +3090,11 @@ fn exp(x: f32) -> f32 {
 }
 
 /// Whether a wheel's acquisition weighs whole revolutions of intervals (and its count in sync
-/// is checked against them): 6 to 16 teeth, gaps and no extra tooth.
-#[cfg(feature = "pattern-wheels")]
+/// is checked against them): 6 to 16 teeth, gaps and no extra tooth (never without pattern
+/// wheels).
 fn fit_kept(enc: &Encoder) -> bool {
-    matches!(enc.framing(), Framing::Pattern)
+    cfg!(feature = "pattern-wheels")
+        && matches!(enc.framing(), Framing::Pattern)
         && (FIT_MIN_TEETH..=FIT_TEETH as u16).contains(&enc.edges())
         && enc.short_teeth() == 0
         && enc.long_teeth() != 0

@@ -147,30 +147,23 @@ fn bench_crank(c: &mut Criterion) {
         "the bench stream syncs"
     );
     let mut g = c.benchmark_group("crank 8-1");
-    g.throughput(Throughput::Elements(seek.len() as u64));
-    g.bench_function("on_edge seeking the frame", |b| {
-        b.iter_batched_ref(
-            || fresh.clone(),
-            |m| {
-                for &t in seek {
-                    black_box(m.on_edge(black_box(t), None));
-                }
-            },
-            BatchSize::SmallInput,
-        )
-    });
-    g.throughput(Throughput::Elements(rest.len() as u64));
-    g.bench_function("on_edge synced", |b| {
-        b.iter_batched_ref(
-            || synced.clone(),
-            |m| {
-                for &t in rest {
-                    black_box(m.on_edge(black_box(t), None));
-                }
-            },
-            BatchSize::SmallInput,
-        )
-    });
+    for (name, start, edges) in [
+        ("on_edge seeking the frame", &fresh, seek),
+        ("on_edge synced", &synced, rest),
+    ] {
+        g.throughput(Throughput::Elements(edges.len() as u64));
+        g.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || start.clone(),
+                |m| {
+                    for &t in edges {
+                        black_box(m.on_edge(black_box(t), None));
+                    }
+                },
+                BatchSize::SmallInput,
+            )
+        });
+    }
     g.finish();
 }
 
