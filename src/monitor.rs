@@ -2379,6 +2379,95 @@ mod tests {
         }
     }
 
+    /// What `runs` runs of 40 revolutions of the missing-tooth wheel `positions`-`missing` do
+    /// under edge jitter alone (σ `sigma`, of a pitch): steady (`ripple` 0) or cranking at
+    /// ±`ripple` with two strokes, a phase drawn by `next` a run; one-edge samples,
+    /// one-revolution windows. The runs with a fault of any kind, the fault counters summed,
+    /// the valid windows, the edges numbered at a wrong tooth in sync (after a false fault,
+    /// until the count is given up or realigned), and the valid windows not framed at tooth 0.
+    fn jitter_runs(
+        (positions, missing): (u8, u8),
+        ripple: f64,
+        sigma: f64,
+        runs: u32,
+        next: &mut impl FnMut(u64) -> u64,
+    ) -> (usize, EdgeCounters, usize, usize, usize) {
+        let p = Pattern::missing_teeth(positions, missing);
+        let teeth = pattern_angles(p);
+        let pitch_ticks = TAU / f64::from(positions) / 25.0 * 1e6;
+        let (mut faulted, mut valid, mut misnumbered, mut framed_off) = (0, 0, 0, 0);
+        let mut d = EdgeCounters::default();
+        for _ in 0..runs {
+            let phase = TAU * (next(1000) as f64) / 1000.0;
+            let crank = cranking(25.0, ripple, phase);
+            let clean = stream(&teeth, None, 40, 1e6, u32::MAX, &crank);
+            let evs = jittered(&clean, sigma * pitch_ticks, next(1 << 30) as u32);
+            let f = framed(p, &evs, &truth_of(&evs, teeth.len()));
+            let c = f.counters;
+            let faults =
+                c.missing + c.glitches + c.extra + c.unexplained + c.missing_frames + c.sync_losses;
+            faulted += usize::from(faults > 0);
+            valid += f.valid;
+            misnumbered += f.misnumbered;
+            framed_off += f.wrong_windows;
+            add_faults(&mut d, &c);
+        }
+        (faulted, d, valid, misnumbered, framed_off)
+    }
+
+    #[test]
+    fn jitter_at_a_gap_is_learnt_not_taken_for_faults() {
+        // Edge jitter of 2 % of a pitch (σ) on 36-2 and 60-2 wheels, steady and cranking at
+        // ±30 %, 20 runs of 40 revolutions each: judged against the margin shrunk at the gap
+        // alone, 16 of these 80 runs had a false fault (20 faults, the tooth after the gap
+        // unexplained); held above what the recent gaps' jitter made those teeth cost, 4 (5).
+        let mut next = lcg(0x5eed_0002);
+        let (mut faulted, mut unexplained, mut valid) = (0, 0, 0);
+        for wheel in [(36u8, 2u8), (60, 2)] {
+            for ripple in [0.0, 0.3] {
+                let (f, d, v, _, off) = jitter_runs(wheel, ripple, 0.02, 20, &mut next);
+                assert_eq!(off, 0, "{wheel:?} ±{ripple}: valid windows framed off");
+                faulted += f;
+                unexplained += d.unexplained;
+                valid += v;
+            }
+        }
+        assert!(
+            faulted <= 8 && unexplained <= 8,
+            "{faulted} runs, {unexplained} faults"
+        );
+        assert!(valid >= 80 * 34, "{valid}");
+    }
+
+    /// False faults from edge jitter alone on missing-tooth wheels: per wheel, shaft (steady,
+    /// or cranking at ±30 % with two strokes, a random phase a run) and jitter (σ, of a pitch),
+    /// 20 runs of 40 revolutions (see [`jitter_runs`]): the runs with a fault of any kind, the
+    /// faults by kind summed over the runs, the valid windows, the edges numbered at a wrong
+    /// tooth in sync and the valid windows not framed at tooth 0 (asserted none).
+    /// `JITTER_RUNS` sets the runs per row.
+    #[test]
+    #[ignore]
+    fn jitter_census() {
+        let runs: u32 = std::env::var("JITTER_RUNS").map_or(20, |s| s.parse().unwrap());
+        let mut next = lcg(0x5eed_0001);
+        let mut wrong = 0;
+        println!("wheel  shaft  σ      runs-faulted  missing glitch extra unexpl mframe slost  valid  misnum off");
+        for (positions, missing) in [(8u8, 1u8), (12, 1), (24, 1), (36, 1), (36, 2), (60, 2)] {
+            for ripple in [0.0, 0.3] {
+                for sigma in [0.01, 0.02, 0.03] {
+                    let (faulted, d, valid, misnumbered, framed_off) =
+                        jitter_runs((positions, missing), ripple, sigma, runs, &mut next);
+                    println!(
+                        "{positions:>2}-{missing}  ±{ripple:.1}   {sigma:.2}   {faulted:>3} of {runs:<3}    {:>6} {:>6} {:>5} {:>6} {:>6} {:>5} {valid:>6} {misnumbered:>5} {framed_off:>3}",
+                        d.missing, d.glitches, d.extra, d.unexplained, d.missing_frames, d.sync_losses
+                    );
+                    wrong += framed_off;
+                }
+            }
+        }
+        assert_eq!(wrong, 0, "valid windows framed off");
+    }
+
     #[test]
     fn general_patterns_sync_through_cranking_and_measure_delta() {
         // Several gaps, uneven gaps, an extra tooth: zero faults while cranking at ±40 %, every

@@ -287,6 +287,17 @@ const FIT_MISFITS: f32 = 0.12;
 const FRAME_NOISE: f32 = 20.0;
 /// Frames the mean is learnt over (a running mean, then an exponential one).
 const FRAME_MEMORY: u16 = 16;
+/// Frames learnt before that rule applies: with none learnt, a quarter of the margin alone
+/// decided, and edge jitter of 3 % of a pitch (σ) made the first frame after a recorded
+/// revolution unexplained (more than half of that rule's false faults in `jitter_census`).
+const FRAME_LEARNT: u16 = 2;
+/// At a pattern wheel's gap the tooth is unexplained by its own cost (no single fault winning)
+/// only above this many times the mean cost of the recent gaps' teeth, once `GAP_LEARNT` of
+/// them are learnt (see [`SpeedTracker::gap_noise`]): under jitter alone, 1 in 500 of those
+/// teeth cost more than 8 times the mean learnt before them (heavier-tailed than a sum of
+/// three squared Gaussians: the swings recorded a revolution earlier jitter too).
+const GAP_NOISE: f32 = 8.0;
+const GAP_LEARNT: u16 = 4;
 /// A frame is confirmed on such a wheel only where the alignment the revolution fits best
 /// leaves a residual of at most this (ln²R): with more strokes than the profile resolves, the
 /// speed swings between teeth can make another tooth's interval look like the gap every
@@ -327,6 +338,11 @@ struct Revolution {
     /// over about the last `FRAME_MEMORY` frames, and how many frames it has learnt from.
     frame_noise: f32,
     frames: u16,
+    /// The mean cost of the teeth after a gap (their chain of intervals against the recorded
+    /// revolution, each at most the margin) over about the last `FRAME_MEMORY` gaps, and how
+    /// many gaps it has learnt from.
+    gap_noise: f32,
+    gaps: u16,
 }
 
 impl Revolution {
@@ -339,6 +355,8 @@ impl Revolution {
         trend: 0.0,
         frame_noise: 0.0,
         frames: 0,
+        gap_noise: 0.0,
+        gaps: 0,
     };
 }
 
@@ -661,6 +679,7 @@ impl SpeedTracker {
         (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
         for f in fit {
             (f.pos, f.len, f.run, f.frames, f.frame_noise) = (0, 0, 0, 0, 0.0);
+            (f.gaps, f.gap_noise) = (0, 0.0);
         }
         counters.clear(z);
     }
@@ -1475,10 +1494,25 @@ impl SpeedTracker {
                 );
             }
         }
+        // At a gap, what the edges' jitter makes the teeth there cost (0 until learnt): the
+        // two rules below that need no fault to win are held above it.
+        let (floor, quarter) = if cfg!(feature = "pattern-wheels") && gap && self.history {
+            let noise = self.gap_noise(margin, expected_cost, best.0);
+            (
+                if noise > margin { noise } else { margin },
+                if 0.5 * noise > 0.25 * margin {
+                    0.5 * noise
+                } else {
+                    0.25 * margin
+                },
+            )
+        } else {
+            (margin, 0.25 * margin)
+        };
         if best.0 + margin < expected_cost {
             best.1
-        } else if (expected_cost > margin && recorded_cost > margin)
-            || (cfg!(feature = "pattern-wheels") && gap && best.0 + 0.25 * margin < expected_cost)
+        } else if (expected_cost > floor && recorded_cost > floor)
+            || (cfg!(feature = "pattern-wheels") && gap && best.0 + quarter < expected_cost)
             || (cfg!(feature = "pattern-wheels")
                 && gap
                 && next == 0
@@ -1531,12 +1565,39 @@ impl SpeedTracker {
             // The rules on faults decide (and a fault's cost is no jitter to learn).
             return true;
         }
-        if cost > 0.25 * margin && cost > FRAME_NOISE * f.frame_noise {
+        if f.frames >= FRAME_LEARNT && cost > 0.25 * margin && cost > FRAME_NOISE * f.frame_noise {
             return false;
         }
         f.frames = f.frames.saturating_add(1);
         f.frame_noise += (cost - f.frame_noise) / f32::from(f.frames.min(FRAME_MEMORY));
         true
+    }
+
+    /// What the edges' jitter makes the tooth after a pattern wheel's gap cost: `GAP_NOISE`
+    /// times the mean chain cost of the recent gaps' teeth (0 until `GAP_LEARNT` are learnt);
+    /// and learns from this one (its chain cost `cost`, the best fault's `fault`). Where the
+    /// tooth is unexplained with no fault winning, its cost must exceed this as well as the
+    /// margin shrunk there, and a fault must beat it by half this as well as by a quarter of
+    /// that margin: at the shrunk margin alone, edge jitter of 3 % of a pitch (σ) made the
+    /// tooth after a 36-2 or 60-2 wheel's gap unexplained in some revolutions of nearly every
+    /// run of 40, 2 % in a third of them.
+    fn gap_noise(&mut self, margin: f32, cost: f32, fault: f32) -> f32 {
+        let Some(f) = self.fit.first_mut() else {
+            return 0.0;
+        };
+        let noise = if f.gaps >= GAP_LEARNT {
+            GAP_NOISE * f.gap_noise
+        } else {
+            0.0
+        };
+        if fault + margin >= cost {
+            // Not a fault by the hypotheses: jitter to learn from (at most the margin, so
+            // that a fault's cost moves the mean by a sixteenth of it at most).
+            f.gaps = f.gaps.saturating_add(1);
+            let c = if cost > margin { margin } else { cost };
+            f.gap_noise += (c - f.gap_noise) / f32::from(f.gaps.min(FRAME_MEMORY));
+        }
+        noise
     }
 
     /// The cost of a hypothesis on the pending edges: the first is tooth `first` with the
