@@ -608,59 +608,60 @@ impl SpeedTracker {
     /// (see [`EdgeCounters::clear`]). The list names every field, so a new one is not missed.
     /// `z` is an opaque zero (see [`EdgeCounters::clear`]).
     pub(crate) fn reset(&mut self, z: u32) {
-        const NEW: SpeedTracker = SpeedTracker::new();
+        // Most of it as a new time reference and a lost sync leave it: their out-of-line
+        // stores, not a copy of them here (code size); the counters are cleared after.
+        self.restart_at(z);
+        self.lose_sync(false);
         let SpeedTracker {
             state,
-            sync,
+            // (`restart_at`.)
             has_ref,
-            last,
-            latest,
-            prev,
+            last: _,
+            latest: _,
+            prev: _,
+            npend: _,
+            out_of_band: _,
+            across: _,
+            acq: _,
+            // (`lose_sync`.)
+            sync: _,
+            owed: _,
+            realigned: _,
+            viable: _,
+            confirm: _,
+            seen_special: _,
+            faults: _,
+            searched: _,
+            // (Both: `reset_ring`, `forget_history`.)
+            pos: _,
+            fill: _,
+            sum: _,
+            span: _,
+            hist_teeth: _,
+            history: _,
+            held: _,
             accepted,
             anchor,
             lo,
             width,
             tooth,
             stop,
-            faults,
             ring: _,
-            pos,
-            fill,
-            sum,
-            span,
             hist: _,
-            hist_teeth,
-            history,
-            held,
             pending: _,
             pending_seq: _,
-            npend,
-            out_of_band,
-            across,
-            owed,
-            realigned,
             index_late,
             index: _,
             arrivals,
             nidx,
-            viable,
-            acq,
-            confirm,
-            seen_special,
             fit,
-            searched,
             counters,
         } = self;
-        (*state, *sync, *held) = (NEW.state, NEW.sync, NEW.held);
-        (*has_ref, *history, *out_of_band, *seen_special) = (false, false, false, false);
-        *across = 0;
-        (*owed, *realigned, *index_late) = (false, false, false);
-        (*last, *latest, *prev, *accepted, *lo, *width) = (z, z, z, z, z, z);
-        (*pos, *sum, *span, *arrivals, *viable, *acq) = (z, z, z, z, u64::from(z), [z; 3]);
-        (*anchor, *tooth, *stop, *hist_teeth, *confirm, *searched) = (0, 0, 0, 0, 0, 0);
-        (*faults, *fill, *npend, *nidx) = (0, 0, 0, 0);
+        (*state, *has_ref, *index_late) = (ShaftState::NoSignal, false, false);
+        (*accepted, *lo, *width, *arrivals) = (z, z, z, z);
+        (*anchor, *tooth, *stop, *nidx) = (0, 0, 0, 0);
         for f in fit {
-            (f.pos, f.len, f.run, f.frames, f.frame_noise) = (0, 0, 0, 0, 0.0);
+            (f.frames, f.frame_noise) = (0, 0.0);
         }
         counters.clear(z);
     }
