@@ -429,10 +429,26 @@ impl WindowState {
         k: u16,
         uniform: bool,
     ) -> Option<WindowReport> {
+        let mut ended = None;
+        self.on_tooth_to(window, tooth, (unit_rad, timer_hz, k), uniform, &mut ended);
+        ended
+    }
+
+    /// [`WindowState::on_tooth`], the report of a window that ends written to `ended` (left
+    /// as it is otherwise): the monitor's slot for it, with no copy through a return value.
+    #[inline(always)]
+    pub(crate) fn on_tooth_to(
+        &mut self,
+        window: &Window,
+        tooth: &Tooth,
+        (unit_rad, timer_hz, k): (f32, f32, u16),
+        uniform: bool,
+        ended: &mut Option<WindowReport>,
+    ) {
         if uniform {
-            self.on_tooth_in::<true>(window, tooth, unit_rad, timer_hz, k)
+            self.on_tooth_in::<true>(window, tooth, unit_rad, timer_hz, k, ended)
         } else {
-            self.on_tooth_in::<false>(window, tooth, unit_rad, timer_hz, k)
+            self.on_tooth_in::<false>(window, tooth, unit_rad, timer_hz, k, ended)
         }
     }
 
@@ -444,16 +460,17 @@ impl WindowState {
         unit_rad: f32,
         timer_hz: f32,
         k: u16,
-    ) -> Option<WindowReport> {
+        ended: &mut Option<WindowReport>,
+    ) {
         let uniform = UNIFORM;
         if !tooth.synced {
-            return None;
+            return;
         }
         if !self.started {
             if tooth.frame {
                 self.restart(tooth.index, tooth.time);
             }
-            return None;
+            return;
         }
         if tooth.sample.is_none() {
             // The ring of the last K intervals was not full again by the start: a fault (a
@@ -463,20 +480,18 @@ impl WindowState {
             // at the next frame instead. (Within a window, a tooth without a sample comes only
             // after a fault, which has ended the window already.)
             self.started = false;
-            return None;
+            return;
         }
         self.add(tooth.dt, tooth.sample, uniform);
         if tooth.frame {
             self.revs = self.revs.saturating_add(1);
             if self.revs >= window.revolutions {
                 let m = self.measurement(window, tooth.index, unit_rad, timer_hz, k);
-                let r = self.report(tooth.index, tooth.time, Ok(m));
+                *ended = Some(self.report(tooth.index, tooth.time, Ok(m)));
                 self.prev_mean = m.omega_mean;
                 self.restart(tooth.index, tooth.time);
-                return Some(r);
             }
         }
-        None
     }
 
     /// Ends the window in progress as invalid with `fault`, found at `time` after the

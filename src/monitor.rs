@@ -218,17 +218,14 @@ impl<O: EdgeSink, P: PitchTable> EdgeSink for Feed<'_, O, P> {
         self.release(None);
         let e = self.encoder;
         let uniform = e.is_uniform() && P::NOMINAL;
-        if let Some(r) = self.state.on_tooth(
+        // Held for the edge after the frame (see `DeltaMonitor::held`), written in place.
+        self.state.on_tooth_to(
             self.window,
             tooth,
-            e.unit_rad(),
-            e.timer_hz(),
-            e.samples_span(),
+            (e.unit_rad(), e.timer_hz(), e.samples_span()),
             uniform,
-        ) {
-            // Held for the edge after the frame (see `DeltaMonitor::held`).
-            *self.held = Some(r);
-        }
+            self.held,
+        );
     }
 
     /// Rare (a fault ends the window): one copy, out of line, for the tracker's many callers.
@@ -516,22 +513,30 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                 return None;
             }
         }
-        self.slow_edge(ticks, direction, observer)
+        self.slow_edge(ticks, direction, false, observer)
     }
 
-    /// Everything but the fast path, out of line.
+    /// Everything but the fast path, out of line: the edge at `ticks`, or with `poll` the
+    /// standstill check at that time. One copy of the feed for both (code size).
     #[cold]
     #[inline(never)]
     fn slow_edge<O: EdgeSink>(
         &mut self,
         ticks: u32,
         direction: Option<Direction>,
+        poll: bool,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
-        // Every caller has tried the fast path (or the edge runs in reverse).
+        // Every caller of an edge has tried the fast path (or the edge runs in reverse).
         let first = self.fed(observer, |tracker, encoder, table, feed| {
-            tracker.careful(encoder, table, ticks, direction, feed);
+            if poll {
+                tracker.poll(encoder, table, ticks, feed);
+            } else {
+                tracker.careful(encoder, table, ticks, direction, feed);
+            }
         });
+        // (After a poll the fast path is closed already where a window waits: a poll that
+        // judges anything stops the shaft.)
         if self.spill.is_some() || self.held.is_some() {
             self.tracker.block_fast();
         }
@@ -596,7 +601,7 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
                 // The careful path as `on_edge` takes it (one copy of it for every caller's
                 // callback); a second window it ends is handed on at the loop's top, before
                 // the next capture, which takes the careful path, as it would after `on_edge`.
-                if let Some(o) = self.slow_edge(t, Some(Direction::Forward), observer) {
+                if let Some(o) = self.slow_edge(t, Some(Direction::Forward), false, observer) {
                     on_window(o);
                 }
             }
@@ -639,9 +644,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
         now: u32,
         observer: &mut O,
     ) -> Option<WindowOutcome> {
-        self.fed(observer, |tracker, encoder, table, feed| {
-            tracker.poll(encoder, table, now, feed);
-        })
+        // Through the careful path's feed (the direction is not read): one copy of it.
+        self.slow_edge(now, Some(Direction::Forward), true, observer)
     }
 
     /// Runs `step` on the tracker with a [`Feed`] into this monitor's window, alarm and
