@@ -250,6 +250,94 @@ pub struct IndexPeriod {
     pub expected: u16,
 }
 
+/// How much of a speed ripple's δ the windows read: a ripple of `order` cycles a revolution,
+/// read at `min` to `max` of its δ depending on its phase against the teeth.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct RippleReading {
+    /// Cycles a revolution.
+    pub order: u32,
+    /// The least of its δ read, over the ripple's phase.
+    pub min: f64,
+    /// The most of its δ read, over the ripple's phase.
+    pub max: f64,
+}
+
+/// Ripple orders [`ripple_readings`] reports.
+pub const RIPPLE_ORDERS: u32 = 12;
+
+/// The angles (radians from the frame) of the edges the core samples a revolution of `enc`'s
+/// wheel at: a pattern's present teeth, or a disc's lines, one in `prescaler`.
+fn edge_angles(enc: &EncoderConfig) -> Vec<f64> {
+    use drive_monitor::encoder::Wheel;
+    use std::f64::consts::TAU;
+    match enc.wheel {
+        Wheel::Indexed { lines } | Wheel::Unframed { lines } => {
+            let step = u16::from(enc.prescaler.max(1));
+            (0..lines / step)
+                .map(|k| TAU * f64::from(k * step) / f64::from(lines))
+                .collect()
+        }
+        Wheel::Pattern(p) => {
+            let n = u32::from(p.positions());
+            (0..n)
+                .filter(|&k| p.present() >> k & 1 == 1)
+                .map(|k| TAU * f64::from(k) / f64::from(n))
+                .collect()
+        }
+    }
+}
+
+/// The share of the δ of a small speed ripple ω̄(1 + a·sin(order·φ + phase)) that the core's
+/// windows read on `enc`'s wheel: each speed sample is the angle of the last `K` edges over
+/// their time, which to first order in `a` is ω̄(1 + a·s) with `s` the mean of the sine over
+/// the sample's angle; a window holds the samples ending at each edge of its revolutions, so
+/// it reads δ = a·(max s − min s) of the true 2a. Samples few against the ripple's cycle miss
+/// its peaks, and long ones average it away.
+pub fn ripple_reading(enc: &EncoderConfig, order: u32, phase: f64) -> f64 {
+    use drive_monitor::encoder::Estimator;
+    use std::f64::consts::TAU;
+    let angles = edge_angles(enc);
+    let n = angles.len();
+    let Estimator::Edges(k) = enc.estimator;
+    let k = usize::from(k).max(1);
+    if n == 0 || k > n {
+        return 0.0;
+    }
+    let z = f64::from(order);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for j in 0..n {
+        // The sample ending at edge j, from edge j − K (a revolution back where it wraps).
+        let end = angles[j];
+        let start = if j >= k {
+            angles[j - k]
+        } else {
+            angles[j + n - k] - TAU
+        };
+        let start = if k == n { end - TAU } else { start };
+        // The mean of sin(zφ + phase) over [start, end].
+        let s = ((z * start + phase).cos() - (z * end + phase).cos()) / (z * (end - start));
+        lo = lo.min(s);
+        hi = hi.max(s);
+    }
+    (hi - lo) / 2.0
+}
+
+/// [`ripple_reading`] for orders 1 to [`RIPPLE_ORDERS`], each at its least and most over 360
+/// phases.
+pub fn ripple_readings(enc: &EncoderConfig) -> Vec<RippleReading> {
+    (1..=RIPPLE_ORDERS)
+        .map(|order| {
+            let (mut min, mut max) = (f64::INFINITY, 0.0f64);
+            for i in 0..360 {
+                let r = ripple_reading(enc, order, std::f64::consts::TAU * f64::from(i) / 360.0);
+                min = min.min(r);
+                max = max.max(r);
+            }
+            RippleReading { order, min, max }
+        })
+        .collect()
+}
+
 /// Counts the captures between index pulses (at most [`MAX_PERIODS`] distinct counts kept).
 #[derive(Default)]
 struct IndexPeriods {
@@ -388,6 +476,9 @@ pub struct AnalyzeReport {
     /// How many encoder captures came between consecutive index pulses (with an index
     /// channel and at least two pulses).
     pub index_period: Option<IndexPeriod>,
+    /// How much of a speed ripple's δ the windows read, by its order (see
+    /// [`ripple_reading`]): few samples a revolution read high orders low.
+    pub ripple: Vec<RippleReading>,
     /// Every change of the sync state (at most [`MAX_LISTED`]).
     pub sync: Vec<SyncOut>,
     /// Valid and invalid windows.
@@ -655,6 +746,7 @@ pub fn analyze<R: BufRead>(
         prescaler: cfg.encoder.prescaler,
         sample_rate: reader.sample_rate(),
         sync_state: "searching",
+        ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
     };
     let mut clock = Clock {
@@ -1235,6 +1327,25 @@ pub fn text(r: &AnalyzeReport) -> String {
         "δ = 2(ω_max − ω_min)/(ω_max + ω_min) over each window's speed samples (seed 000's \
          definition); the ω mean column is the window's mean speed, not (ω_max + ω_min)/2"
     );
+    // Where the samples resolve a ripple less than to 5 %: said, so that a low δ is not
+    // taken for a smooth shaft.
+    if let Some(first) = r.ripple.iter().find(|q| q.min < 0.95) {
+        let listed: Vec<String> = r
+            .ripple
+            .iter()
+            .skip_while(|q| q.order < first.order)
+            .take(6)
+            .map(|q| format!("{}: {:.2}–{:.2}", q.order, q.min, q.max))
+            .collect();
+        let _ = writeln!(
+            s,
+            "resolution: δ of a speed ripple of order {} and up (cycles a revolution) reads low \
+             on this wheel's samples, by the ripple's phase against the teeth (order: share of \
+             its δ read, {}; see --json for orders to 12)",
+            first.order,
+            listed.join(", ")
+        );
+    }
     let _ = writeln!(
         s,
         "δ is measured against the wheel's nominal tooth angles: the disc's own pitch errors \
