@@ -597,14 +597,24 @@ impl Encoder {
         self.k
     }
     /// The noise floor a δ window reports at a steady mean speed `omega` rad/s (sign
-    /// ignored): `2/(K·ticks per captured edge)` = `2·ω·E/(K·2π·timer_hz)` for `E` captured
-    /// edges a revolution, one tick of quantisation at each end of a `K`-edge sample
-    /// ([`crate::irregularity::Measurement::noise_floor`]), for judging beforehand whether a
-    /// configuration resolves a δ (the alarm judges a window only when its floor is at most
-    /// [`crate::alarm::AlarmConfig::floor_fraction`] of the limit).
+    /// ignored): one tick of quantisation at each end of a `K`-edge sample, on the wheel's
+    /// shortest `K`-edge span Θ, `2·ω/(Θ·timer_hz)` (`2/(K·ticks per captured edge)` on a
+    /// uniform disc; on a wheel with gaps the ordinary teeth's, which the window's extreme
+    /// samples are on a steady shaft: [`crate::irregularity::Measurement::noise_floor`]),
+    /// for judging beforehand whether a configuration resolves a δ (the alarm judges a window
+    /// only when its floor is at most [`crate::alarm::AlarmConfig::floor_fraction`] of the
+    /// limit). Configuration-time work: one pass over the teeth.
     pub fn noise_floor_at(&self, omega: f32) -> f32 {
-        2.0 * omega.abs() * f32::from(self.edges)
-            / (f32::from(self.k.max(1)) * core::f32::consts::TAU * self.timer_hz)
+        let (e, k) = (self.edges, self.k.max(1));
+        // The K pitches ending at each tooth in turn, as a running sum (u64: no overflow).
+        let pitch = |j: u16| u64::from(self.nominal_pitch(j % e.max(1)));
+        let mut span: u64 = (0..k).map(pitch).sum();
+        let mut least = span;
+        for j in 0..e {
+            span = span + pitch(j.wrapping_add(k)) - pitch(j);
+            least = least.min(span);
+        }
+        2.0 * omega.abs() / (least as f32 * self.unit_rad * self.timer_hz)
     }
     /// Counter mask (2^bits − 1).
     pub const fn mask(&self) -> u32 {

@@ -139,7 +139,8 @@ pub struct Measurement {
     pub delta: f32,
     /// (ωmax − ωmin)/ω_mean.
     pub spread: f32,
-    /// Bound on the error of δ from timer quantization: 2 / (mean ticks per speed sample).
+    /// Bound on the error of δ from timer quantization: 1/t_max + 1/t_min, the ticks of the
+    /// fastest and the slowest speed sample (on a steady shaft 2 / (ticks per sample)).
     pub noise_floor: f32,
     /// Speed samples taken.
     pub samples: u32,
@@ -335,7 +336,6 @@ impl WindowState {
         end_edge: u32,
         unit_rad: f32,
         timer_hz: f32,
-        k: u16,
     ) -> Measurement {
         let (a1, t1) = (u64::from(self.max.span), u64::from(self.max.ticks));
         let (a2, t2) = (u64::from(self.min.span), u64::from(self.min.ticks));
@@ -373,11 +373,14 @@ impl WindowState {
         } else {
             0.0
         };
-        // Mean ticks per K-edge sample: K times the mean interval of the window's edges.
-        let edges = end_edge.wrapping_sub(self.start_edge);
-        let samples = edges;
-        let noise_floor = if self.ticks > 0 && edges > 0 {
-            2.0 * edges as f32 / (f32::from(k.max(1)) * u64_to_f32(self.ticks))
+        let samples = end_edge.wrapping_sub(self.start_edge);
+        // Each sample's ticks are off by less than one (a difference of two latched times), so
+        // δ is off by less than 1/t1 + 1/t2 to first order (dδ/d ln x ≤ 1 for x = a1·t2/(a2·t1)):
+        // the two extreme samples' own ticks, not the window's mean per sample, which a wheel's
+        // gap (one sample over three pitches) raised above the ordinary teeth's, so that timer
+        // rounding alone exceeded the floor.
+        let noise_floor = if t1 > 0 && t2 > 0 {
+            1.0 / t1 as f32 + 1.0 / t2 as f32
         } else {
             1.0
         };
@@ -426,11 +429,10 @@ impl WindowState {
         tooth: &Tooth,
         unit_rad: f32,
         timer_hz: f32,
-        k: u16,
         uniform: bool,
     ) -> Option<WindowReport> {
         let mut ended = None;
-        self.on_tooth_to(window, tooth, (unit_rad, timer_hz, k), uniform, &mut ended);
+        self.on_tooth_to(window, tooth, (unit_rad, timer_hz), uniform, &mut ended);
         ended
     }
 
@@ -441,14 +443,14 @@ impl WindowState {
         &mut self,
         window: &Window,
         tooth: &Tooth,
-        (unit_rad, timer_hz, k): (f32, f32, u16),
+        (unit_rad, timer_hz): (f32, f32),
         uniform: bool,
         ended: &mut Option<WindowReport>,
     ) {
         if uniform {
-            self.on_tooth_in::<true>(window, tooth, unit_rad, timer_hz, k, ended)
+            self.on_tooth_in::<true>(window, tooth, unit_rad, timer_hz, ended)
         } else {
-            self.on_tooth_in::<false>(window, tooth, unit_rad, timer_hz, k, ended)
+            self.on_tooth_in::<false>(window, tooth, unit_rad, timer_hz, ended)
         }
     }
 
@@ -459,7 +461,6 @@ impl WindowState {
         tooth: &Tooth,
         unit_rad: f32,
         timer_hz: f32,
-        k: u16,
         ended: &mut Option<WindowReport>,
     ) {
         let uniform = UNIFORM;
@@ -486,7 +487,7 @@ impl WindowState {
         if tooth.frame {
             self.revs = self.revs.saturating_add(1);
             if self.revs >= window.revolutions {
-                let m = self.measurement(window, tooth.index, unit_rad, timer_hz, k);
+                let m = self.measurement(window, tooth.index, unit_rad, timer_hz);
                 *ended = Some(self.report(tooth.index, tooth.time, Ok(m)));
                 self.prev_mean = m.omega_mean;
                 self.restart(tooth.index, tooth.time);
@@ -587,13 +588,12 @@ mod tests {
         ] {
             let mut st = WindowState::new();
             let span = 1 << 20;
-            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1e-6, 1e6, 16, false);
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1e-6, 1e6, false);
             st.on_tooth(
                 &w,
                 &tooth(1, 1, 1, false, Some(Sample { span, ticks: t1 })),
                 1e-6,
                 1e6,
-                16,
                 false,
             );
             let r = st
@@ -602,7 +602,6 @@ mod tests {
                     &tooth(2, 2, 1, true, Some(Sample { span, ticks: t2 })),
                     1e-6,
                     1e6,
-                    16,
                     false,
                 )
                 .unwrap();
@@ -634,13 +633,12 @@ mod tests {
             let t = 1 + next() % (1 << 20);
             let m = 1 + next() % 1000;
             let mut st = WindowState::new();
-            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1.0e-5, 84e6, 1, false);
+            st.on_tooth(&w, &tooth(0, 0, 0, true, None), 1.0e-5, 84e6, false);
             st.on_tooth(
                 &w,
                 &tooth(1, 1, t, false, Some(Sample { span: a, ticks: t })),
                 1.0e-5,
                 84e6,
-                1,
                 false,
             );
             let r = st
@@ -658,7 +656,6 @@ mod tests {
                     ),
                     1.0e-5,
                     84e6,
-                    1,
                     false,
                 )
                 .unwrap();
@@ -672,7 +669,7 @@ mod tests {
     fn an_aborted_window_carries_its_span_and_no_numbers() {
         let w = window(4);
         let mut st = WindowState::new();
-        st.on_tooth(&w, &tooth(7, 100, 0, true, None), 1e-6, 1e6, 1, false);
+        st.on_tooth(&w, &tooth(7, 100, 0, true, None), 1e-6, 1e6, false);
         st.on_tooth(
             &w,
             &tooth(
@@ -687,7 +684,6 @@ mod tests {
             ),
             1e-6,
             1e6,
-            1,
             false,
         );
         let r = st.abort(Fault::Glitch, 250, 8).unwrap();

@@ -292,9 +292,8 @@ impl ExactTrain {
             omega_max: span * f / smin as f64,
             omega_min: span * f / smax as f64,
             omega_mean: self.revs as f64 * TAU * f / (h[last] - h[last - n]) as f64,
-            // 2 / (mean ticks per K-edge sample), the mean taken as K times the window's mean
-            // interval (what the core computes without summing samples per edge).
-            noise_floor: 2.0 * n as f64 / (self.k as f64 * (h[last] - h[last - n]) as f64),
+            // One tick at each end of the two extreme samples: 1/t_fast + 1/t_slow.
+            noise_floor: 1.0 / smin as f64 + 1.0 / smax as f64,
             samples: n,
         }
     }
