@@ -644,6 +644,11 @@ fn an_index_disc_configured_with_the_wrong_lines_says_so() {
                 )),
                 "{said}"
             );
+            // The index line says why; no second line claims that nothing does.
+            assert!(
+                !said.contains("no sync: none of the usual causes"),
+                "{said}"
+            );
         }
     }
 }

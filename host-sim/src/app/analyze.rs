@@ -813,7 +813,11 @@ fn sync_hint(r: &AnalyzeReport, enc: &Encoder, intervals: &Intervals, timeout: f
             r.unexplained
         ));
     }
-    if causes.is_empty() {
+    // An index disc whose index pulses disagree with its lines has its own `index:` line.
+    let index_says = r
+        .index_period
+        .is_some_and(|p| p.captures != u64::from(p.expected));
+    if causes.is_empty() && !index_says {
         causes.push(format!(
             "no sync: none of the usual causes shows in the capture ({:.1} revolutions of edges, \
              {}no interval beyond the {:.3} s timeout, {} glitches and {} unexplained edges in \
