@@ -644,6 +644,11 @@ fn an_index_disc_configured_with_the_wrong_lines_says_so() {
                 )),
                 "{said}"
             );
+            // The index line says why; no second line claims that nothing does.
+            assert!(
+                !said.contains("no sync: none of the usual causes"),
+                "{said}"
+            );
         }
     }
 }
@@ -1753,4 +1758,189 @@ fn the_ripple_reading_analyze_states_is_what_the_core_reads() {
         }
     }
     assert_eq!(checked, 4 * 6 * 4);
+}
+
+/// The lines `analyze` prints after `sync:` on why the core never synced.
+fn hint_lines(report: &AnalyzeReport) -> Vec<String> {
+    host_sim::app::analyze::text(report)
+        .lines()
+        .filter(|l| l.starts_with("no sync: "))
+        .map(str::to_string)
+        .collect()
+}
+
+/// A 36-1 wheel analyzed as 36-2 never syncs, and the report says why: the configured wheel's
+/// 34 teeth and 3-pitch gap against the capture's gap of about twice its neighbours every 35
+/// edges, and the wheel that fits. Analyzed as 36-1, it syncs and says nothing of the kind.
+#[test]
+fn a_wrong_wheel_is_named_with_the_gaps_the_capture_shows() {
+    let (_scratch, file) = tmp("crank-36-1.csv");
+    simulate(
+        &cranking("36-1", "sample_rate = 50e6", 2.0, ""),
+        CaptureFormat::Saleae,
+        &file,
+    );
+    let (report, _) = run_analyze(&file, wheel("36-2"));
+    assert!(report.sync_acquired.is_none());
+    let hint = report.sync_hint.as_ref().expect("a hint");
+    let gaps = hint.gaps.expect("the gaps seen");
+    assert_eq!(gaps.every, 35, "{hint:?}");
+    assert!((gaps.ratio - 2.0).abs() < 0.2, "{hint:?}");
+    assert!(gaps.times * 10 >= gaps.of * 9 && gaps.of >= 4, "{hint:?}");
+    // A clean signal: no interval read as a noise pulse's.
+    assert_eq!(hint.irregular_intervals, 0, "{hint:?}");
+    let lines = hint_lines(&report);
+    println!("{}", lines.join("\n"));
+    assert!(
+        lines.iter().any(|l| l.starts_with(
+            "no sync: the configured 36-2 wheel has 34 teeth a revolution and a gap of 3 \
+             pitches; in the capture an interval about 2.0 times its neighbours comes every 35 \
+             edges"
+        ) && l.ends_with("(a 36-1 wheel?)")),
+        "{lines:?}"
+    );
+    // Printed right after the sync line.
+    let said = host_sim::app::analyze::text(&report);
+    let at = said.find("sync: never acquired").unwrap();
+    assert!(said[at..]
+        .lines()
+        .nth(1)
+        .unwrap()
+        .starts_with("no sync: the configured 36-2"));
+    let (right, _) = run_analyze(&file, wheel("36-1"));
+    assert!(right.sync_acquired.is_some());
+    assert!(right.sync_hint.is_none());
+    assert!(hint_lines(&right).is_empty());
+}
+
+/// A capture of a wheel that syncs has no hint, in the text or the JSON.
+#[test]
+fn a_capture_that_syncs_has_no_hint() {
+    let (_scratch, file) = tmp("crank-36-2.csv");
+    simulate(
+        &cranking("36-2", "sample_rate = 50e6", 2.0, ""),
+        CaptureFormat::Saleae,
+        &file,
+    );
+    let (report, _) = run_analyze(&file, wheel("36-2"));
+    assert!(report.sync_acquired.is_some());
+    assert!(report.sync_hint.is_none());
+    assert!(hint_lines(&report).is_empty());
+    let json = serde_json::to_value(&report).unwrap();
+    assert!(json["sync_hint"].is_null(), "{}", json["sync_hint"]);
+}
+
+/// A capture of just over one revolution is too short to sync: the report says how many
+/// revolutions of edges it holds, and claims no wrong wheel.
+#[test]
+fn a_capture_too_short_to_sync_says_so() {
+    // 36-2 at 40 rad/s: a revolution is 0.157 s; 0.2 s is 1.3 revolutions, 43 teeth.
+    let rising = wheel_teeth(36, 2, 40.0, 0.2);
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 0.2), "short.csv", None).unwrap();
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert!(report.sync_acquired.is_none());
+    let lines = hint_lines(&report);
+    println!("{}", lines.join("\n"));
+    assert_eq!(
+        lines,
+        [format!(
+            "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
+             the configured wheel (34 edges a revolution), and acquiring sync takes about 2–3",
+            rising.len(),
+            rising.len() as f64 / 34.0
+        )],
+    );
+    let json = serde_json::to_value(&report).unwrap();
+    let r = json["sync_hint"]["revolutions_of_edges"].as_f64().unwrap();
+    assert!((r - rising.len() as f64 / 34.0).abs() < 1e-9, "{json}");
+}
+
+/// A shaft turning below --min-speed times out at every gap and never syncs: the report names
+/// --min-speed and the slowest speed seen; with --min-speed below it, the same capture syncs.
+#[test]
+fn a_shaft_below_the_minimum_speed_says_so() {
+    // 36-2 at 0.5 rad/s: a tooth every 0.35 s, the gap 1.05 s; --min-speed 1 rad/s times out
+    // after 0.52 s.
+    let rising = wheel_teeth(36, 2, 0.5, 50.0);
+    let text = saleae_of_rising(&rising, 1e6, 50.0);
+    for (min_speed, syncs) in [(1.0, false), (0.2, true)] {
+        let cfg = configure(&AnalyzeOptions {
+            min_speed: Some(min_speed),
+            ..wheel("36-2")
+        })
+        .unwrap();
+        let mut reader = text_reader(text.clone(), "slow.csv", None).unwrap();
+        let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.sync_acquired.is_some(), syncs, "{min_speed}");
+        if syncs {
+            assert!(report.sync_hint.is_none());
+            continue;
+        }
+        let hint = report.sync_hint.as_ref().unwrap();
+        let slowest = hint.slowest_speed.unwrap();
+        assert!((slowest - 0.5).abs() < 0.01, "{hint:?}");
+        let lines = hint_lines(&report);
+        println!("{}", lines.join("\n"));
+        assert!(
+            lines.iter().any(|l| l
+                .starts_with("no sync: the shaft stopped or ran below --min-speed 1 rad/s:")
+                && l.ends_with("the slowest speed seen is about 0.500 rad/s")),
+            "{lines:?}"
+        );
+        // The gaps are the configured wheel's: no wrong wheel claimed.
+        assert!(!lines.iter().any(|l| l.contains("configured")), "{lines:?}");
+    }
+}
+
+/// A uniform disc analyzed as a 36-2 wheel shows no gap at all: the report says so and points
+/// to --lines.
+#[test]
+fn a_uniform_disc_analyzed_as_a_wheel_with_a_gap_says_no_gap_was_seen() {
+    let rising = wheel_teeth(36, 0, 40.0, 1.0);
+    let mut reader =
+        text_reader(saleae_of_rising(&rising, 50e6, 1.0), "uniform.csv", None).unwrap();
+    let cfg = configure(&wheel("36-2")).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert!(report.sync_acquired.is_none());
+    let lines = hint_lines(&report);
+    println!("{}", lines.join("\n"));
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(
+        lines[0].starts_with(
+            "no sync: the configured 36-2 wheel has 34 teeth a revolution and a gap of 3 \
+             pitches, but no gap recurs in the capture (0 interval(s)"
+        ) && lines[0].contains("use --lines N --framing index|none"),
+        "{lines:?}"
+    );
+}
+
+/// Noise pulses on a fifth of the teeth keep the core from syncing: the report says the
+/// signal is noisy, with the counts.
+#[test]
+fn a_noisy_signal_that_never_syncs_says_so() {
+    let (_scratch, file) = tmp("very-noisy.csv");
+    let text = cranking(
+        "36-2",
+        "sample_rate = 50e6\nnoise_width = 2e-6",
+        2.0,
+        "glitch_probability = 0.2\nglitch_window = [0.3, 0.7]",
+    );
+    simulate(&text, CaptureFormat::Saleae, &file);
+    let (report, _) = run_analyze(&file, wheel("36-2"));
+    let lines = hint_lines(&report);
+    println!("{}", lines.join("\n"));
+    assert!(report.sync_acquired.is_none(), "{lines:?}");
+    let hint = report.sync_hint.as_ref().unwrap();
+    // Every fifth tooth or so split by a pulse: far more than one interval in fifty.
+    assert!(hint.irregular_intervals * 20 >= report.captured, "{hint:?}");
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(
+        lines[0].starts_with(&format!(
+            "no sync: the signal is noisy: of {} captured edges, {} interval(s) are short \
+             against both neighbours and next to no gap (a noise pulse's)",
+            report.captured, hint.irregular_intervals
+        )),
+        "{lines:?}"
+    );
 }

@@ -479,6 +479,9 @@ pub struct AnalyzeReport {
     /// How much of a speed ripple's δ the windows read, by its order (see
     /// [`ripple_reading`]): few samples a revolution read high orders low.
     pub ripple: Vec<RippleReading>,
+    /// Why sync was never acquired (or was lost again and again and the capture ended
+    /// without it), from the evidence of the capture; `None` when the core synced.
+    pub sync_hint: Option<SyncHint>,
     /// Every change of the sync state (at most [`MAX_LISTED`]).
     pub sync: Vec<SyncOut>,
     /// Valid and invalid windows.
@@ -504,6 +507,344 @@ pub struct AnalyzeReport {
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
+}
+
+/// Why the core did not sync, from the capture: each cause the evidence shows, in words, and
+/// the evidence.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SyncHint {
+    /// Each cause the evidence shows, in words (or that none of them shows).
+    pub causes: Vec<String>,
+    /// The long intervals that recur in the capture (a wheel with a pattern).
+    pub gaps: Option<GapsSeen>,
+    /// Long intervals seen (each more than [`LONG_RATIO`] times both neighbours' geometric
+    /// mean).
+    pub long_intervals: u64,
+    /// The captured edges in revolutions of the configured wheel.
+    pub revolutions_of_edges: f64,
+    /// Intervals less than [`SHORT_RATIO`] times both neighbours' geometric mean and next to
+    /// no long interval (noise pulses split a tooth's interval so).
+    pub irregular_intervals: u64,
+    /// Intervals between captures longer than the timeout `--min-speed` implies.
+    pub beyond_timeout: u64,
+    /// The timeout, s.
+    pub timeout: f64,
+    /// The configured minimum speed, rad/s.
+    pub min_speed: f64,
+    /// The slowest speed of an interval, rad/s (its pitches read from its ratio to its
+    /// neighbours, at most the configured wheel's longest gap).
+    pub slowest_speed: Option<f64>,
+}
+
+/// Long intervals that recur: how many edges lie between consecutive ones, and how long they
+/// are against their neighbours.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct GapsSeen {
+    /// The most common number of edges from one long interval to the next.
+    pub every: u64,
+    /// How many of the spacings had that many.
+    pub times: u64,
+    /// Spacings between consecutive long intervals.
+    pub of: u64,
+    /// The median ratio of those long intervals to the geometric mean of their neighbours.
+    pub ratio: f64,
+}
+
+/// An interval more than this many times the geometric mean of its two neighbours is long (a
+/// gap): a 36-1 wheel's is 2, a tooth's on a cranking shaft stays well below.
+pub const LONG_RATIO: f64 = 1.5;
+
+/// The raw intervals between forward captures, as they come: the long ones and their spacing,
+/// the longest, in bounded memory.
+#[derive(Default)]
+struct Intervals {
+    last: Option<f64>,
+    /// The two intervals before the newest, older first.
+    before: Option<f64>,
+    middle: Option<f64>,
+    /// Intervals seen (the newest's number).
+    n: u64,
+    last_long: Option<u64>,
+    longs: u64,
+    /// Edges from one long interval to the next: how often, and the ratios of the long
+    /// intervals ending them (the first [`MAX_RATIOS`] of each).
+    spacings: std::collections::BTreeMap<u64, (u64, Vec<f64>)>,
+    of: u64,
+    beyond: u64,
+    /// The longest time a pitch took, s.
+    slowest_pitch: f64,
+    /// Whether the interval before the middle one was long, and whether the middle one is
+    /// short against both its neighbours (settled when the next is judged).
+    long_before: bool,
+    short_middle: bool,
+    /// Intervals short against both neighbours and next to no long one: a noise pulse's.
+    irregular: u64,
+}
+
+/// An interval less than this many times the geometric mean of its two neighbours, and next
+/// to no long one, is a noise pulse's (a tooth's next to a 3-pitch gap is 0.58 times).
+pub const SHORT_RATIO: f64 = 0.75;
+
+/// Ratios kept for each spacing (for their median).
+const MAX_RATIOS: usize = 1000;
+
+impl Intervals {
+    /// A reversal: the intervals before it are no neighbours of those after.
+    fn reset(&mut self) {
+        self.finish();
+        (self.last, self.before, self.middle) = (None, None, None);
+        self.last_long = None;
+        (self.long_before, self.short_middle) = (false, false);
+    }
+
+    /// The newest interval, never judged against a next one: taken as one pitch.
+    fn finish(&mut self) {
+        if let Some(b) = self.middle {
+            self.slowest_pitch = self.slowest_pitch.max(b);
+        }
+    }
+
+    /// A forward capture at `t`: with `timeout` (s) and `longest` (the configured wheel's
+    /// longest gap, in pitches).
+    fn capture(&mut self, t: f64, timeout: f64, longest: f64) {
+        let Some(t0) = self.last.replace(t) else {
+            return;
+        };
+        let i = t - t0;
+        self.n += 1;
+        if i > timeout {
+            self.beyond += 1;
+        }
+        match (self.before, self.middle) {
+            (Some(a), Some(b)) => {
+                let ratio = b / (a * i).sqrt();
+                // Its pitches, as its ratio reads them, up to the wheel's longest gap (a
+                // longer pause is a slow shaft, not a gap).
+                let mut pitches = 1.0;
+                let long = ratio > LONG_RATIO;
+                // The interval before the middle one: short, and neither of its neighbours
+                // long (the one before it was checked with it).
+                if self.short_middle && !long {
+                    self.irregular += 1;
+                }
+                self.short_middle = ratio < SHORT_RATIO && !self.long_before;
+                self.long_before = long;
+                if long {
+                    pitches = ratio.round().clamp(1.0, longest);
+                    self.longs += 1;
+                    // The middle one is interval n − 1.
+                    let here = self.n - 1;
+                    if let Some(prev) = self.last_long.replace(here) {
+                        let count = here - prev;
+                        if self.spacings.len() < MAX_PERIODS || self.spacings.contains_key(&count) {
+                            let e = self.spacings.entry(count).or_insert((0, Vec::new()));
+                            e.0 += 1;
+                            if e.1.len() < MAX_RATIOS {
+                                e.1.push(ratio);
+                            }
+                        }
+                        self.of += 1;
+                    }
+                }
+                self.slowest_pitch = self.slowest_pitch.max(b / pitches);
+            }
+            // The first interval has no neighbour before it: one pitch.
+            (None, Some(b)) => self.slowest_pitch = self.slowest_pitch.max(b),
+            _ => {}
+        }
+        (self.before, self.middle) = (self.middle, Some(i));
+    }
+
+    /// The most common spacing, when it recurs: at least twice, and at least a third of them.
+    fn gaps(&self) -> Option<GapsSeen> {
+        let mut best: Option<(u64, &(u64, Vec<f64>))> = None;
+        for (&count, e) in &self.spacings {
+            if best.is_none_or(|(_, b)| e.0 > b.0) {
+                best = Some((count, e));
+            }
+        }
+        let (every, (times, ratios)) = best?;
+        if *times < 2 || times * 3 < self.of {
+            return None;
+        }
+        let mut r = ratios.clone();
+        r.sort_by(f64::total_cmp);
+        Some(GapsSeen {
+            every,
+            times: *times,
+            of: self.of,
+            ratio: r[r.len() / 2],
+        })
+    }
+}
+
+/// A pattern's runs of teeth, in order round the wheel: (teeth in the run, pitches of the gap
+/// after it); empty without a gap.
+fn pattern_runs(p: &drive_monitor::encoder::Pattern) -> Vec<(u64, u64)> {
+    let n = u32::from(p.positions());
+    let present = |k: u32| p.present() >> (k % n) & 1 == 1;
+    let Some(start) = (0..n).find(|&k| present(k) && !present(k + n - 1)) else {
+        return Vec::new();
+    };
+    let mut runs = Vec::new();
+    let mut k = start;
+    while k < start + n {
+        let teeth = (k..start + n).take_while(|&j| present(j)).count() as u32;
+        k += teeth;
+        let missing = (k..start + n).take_while(|&j| !present(j)).count() as u32;
+        k += missing;
+        runs.push((u64::from(teeth), u64::from(missing) + 1));
+    }
+    runs
+}
+
+/// Why the core did not sync on this capture, from the evidence in it.
+fn sync_hint(r: &AnalyzeReport, enc: &Encoder, intervals: &Intervals, timeout: f64) -> SyncHint {
+    use drive_monitor::encoder::{Pattern, Wheel};
+    let cfg = enc.config();
+    let per_rev = f64::from(enc.edges().max(1));
+    let revolutions_of_edges = r.captured as f64 / per_rev;
+    let pattern = match cfg.wheel {
+        Wheel::Pattern(p) => Some(p),
+        _ => None,
+    };
+    let runs = pattern.as_ref().map(pattern_runs).unwrap_or_default();
+    let pitch = std::f64::consts::TAU * f64::from(cfg.prescaler.max(1))
+        / f64::from(cfg.wheel.positions().max(1));
+    let slowest_speed = (intervals.slowest_pitch > 0.0).then(|| pitch / intervals.slowest_pitch);
+    let gaps = intervals.gaps();
+    let mut causes = Vec::new();
+    let short = revolutions_of_edges < 3.0;
+    // Noise: the core's counts (while it judged edges), or the raw intervals out of step
+    // (while it searched, it judges none).
+    let counted = u64::from(r.glitches) + u64::from(r.unexplained) + u64::from(r.extra);
+    let noisy = [counted, intervals.irregular]
+        .iter()
+        .any(|&n| n >= 3 && n * 50 >= r.captured);
+    if short {
+        causes.push(format!(
+            "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
+             the configured wheel ({} edges a revolution), and acquiring sync takes about 2–3",
+            r.captured, revolutions_of_edges, per_rev
+        ));
+    }
+    if let Some(p) = pattern {
+        let name = if runs.len() == 1
+            && p == Pattern::missing_teeth(p.positions(), (runs[0].1 - 1) as u8)
+        {
+            format!("{}-{} wheel", p.positions(), runs[0].1 - 1)
+        } else {
+            format!("wheel ({})", r.wheel)
+        };
+        let expected = if runs.len() == 1 {
+            format!(
+                "has {} teeth a revolution and a gap of {} pitches",
+                p.teeth(),
+                runs[0].1
+            )
+        } else {
+            let list: Vec<String> = runs
+                .iter()
+                .map(|(t, g)| format!("{g} pitches after {t} teeth"))
+                .collect();
+            format!(
+                "has {} teeth a revolution and gaps of {}",
+                p.teeth(),
+                list.join(", ")
+            )
+        };
+        match gaps {
+            Some(g) => {
+                let pitches = g.ratio.round() as u64;
+                let agree = runs.iter().any(|&(t, _)| t == g.every)
+                    && runs.iter().any(|&(_, p)| p == pitches);
+                if !agree {
+                    let missing = pitches.saturating_sub(1);
+                    let guess = if missing >= 1 && g.every + missing <= 255 {
+                        format!(" (a {}-{missing} wheel?)", g.every + missing)
+                    } else {
+                        String::new()
+                    };
+                    causes.push(format!(
+                        "no sync: the configured {name} {expected}; in the capture an interval \
+                         about {:.1} times its neighbours comes every {} edges ({} of {} \
+                         times){guess}",
+                        g.ratio, g.every, g.times, g.of
+                    ));
+                }
+            }
+            None if !short && !noisy => causes.push(format!(
+                "no sync: the configured {name} {expected}, but no gap recurs in the capture \
+                 ({} interval(s) more than {LONG_RATIO} times their neighbours, at no regular \
+                 count of edges): the wrong channel or edge polarity (--channel, --edge), or a \
+                 uniform disc (use --lines N --framing index|none)",
+                intervals.longs
+            )),
+            None => {}
+        }
+    }
+    if intervals.beyond > 0 || r.timeouts > 1 {
+        causes.push(format!(
+            "no sync: the shaft stopped or ran below --min-speed {} rad/s: {} interval(s) \
+             between edges longer than the {:.3} s timeout it implies, {} timeout(s); the \
+             slowest speed seen is about {}",
+            cfg.min_speed,
+            intervals.beyond,
+            timeout,
+            r.timeouts,
+            slowest_speed.map_or("unknown".into(), |w| format!("{w:.3} rad/s"))
+        ));
+    }
+    if noisy {
+        causes.push(format!(
+            "no sync: the signal is noisy: of {} captured edges, {} interval(s) are short against \
+             both neighbours and next to no gap (a noise pulse's){}; the core counted {} \
+             glitches, {} extra and {} unexplained edges (check the wiring, the probe's ground \
+             and the threshold)",
+            r.captured,
+            intervals.irregular,
+            if gaps.is_none() && pattern.is_some() {
+                ", and no gap recurs among them"
+            } else {
+                ""
+            },
+            r.glitches,
+            r.extra,
+            r.unexplained
+        ));
+    }
+    // An index disc whose index pulses disagree with its lines has its own `index:` line.
+    let index_says = r
+        .index_period
+        .is_some_and(|p| p.captures != u64::from(p.expected));
+    if causes.is_empty() && !index_says {
+        causes.push(format!(
+            "no sync: none of the usual causes shows in the capture ({:.1} revolutions of edges, \
+             {}no interval beyond the {:.3} s timeout, {} glitches and {} unexplained edges in \
+             {}): see the fault list",
+            revolutions_of_edges,
+            if pattern.is_some() {
+                "gaps that agree with the wheel, "
+            } else {
+                ""
+            },
+            timeout,
+            r.glitches,
+            r.unexplained,
+            r.captured
+        ));
+    }
+    SyncHint {
+        causes,
+        gaps,
+        long_intervals: intervals.longs,
+        irregular_intervals: intervals.irregular,
+        revolutions_of_edges,
+        beyond_timeout: intervals.beyond,
+        timeout,
+        min_speed: cfg.min_speed,
+        slowest_speed,
+    }
 }
 
 /// What the observer saw during one call to the monitor.
@@ -785,6 +1126,14 @@ pub fn analyze<R: BufRead>(
     // The quadrature count of the encoder and direction channels, and whether the capture
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
+    let mut intervals = Intervals::default();
+    let longest_gap = match cfg.encoder.wheel {
+        drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p)
+            .iter()
+            .map(|&(_, g)| g as f64)
+            .fold(1.0, f64::max),
+        _ => 1.0,
+    };
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
@@ -892,6 +1241,11 @@ pub fn analyze<R: BufRead>(
         }
         if encoder_edge {
             report.captured += 1;
+            if direction == Some(Direction::Reverse) {
+                intervals.reset();
+            } else {
+                intervals.capture(t, polls.timeout, longest_gap);
+            }
             if let Some(p) = last_capture.replace(ticks) {
                 // Two captures at one tick: the timer cannot resolve the edges.
                 if ticks.wrapping_sub(p) & enc.mask() == 0 && direction != Some(Direction::Reverse)
@@ -944,6 +1298,12 @@ pub fn analyze<R: BufRead>(
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
+    intervals.finish();
+    // Never synced, or lost again and again and not synced at the end: why, from the capture.
+    if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
+    {
+        report.sync_hint = Some(sync_hint(&report, &enc, &intervals, polls.timeout));
+    }
     // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
     // or time references after a standstill or a reversal.
     report.unjudged_at_end = report
@@ -1411,6 +1771,9 @@ pub fn text(r: &AnalyzeReport) -> String {
         None => {
             let _ = writeln!(s, "sync: never acquired ({} at the end)", r.sync_state);
         }
+    }
+    for c in r.sync_hint.iter().flat_map(|h| &h.causes) {
+        let _ = writeln!(s, "{c}");
     }
     if let Some(p) = r
         .index_period
