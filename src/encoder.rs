@@ -607,11 +607,13 @@ impl Encoder {
     pub fn noise_floor_at(&self, omega: f32) -> f32 {
         let (e, k) = (self.edges, self.k.max(1));
         // The K pitches ending at each tooth in turn, as a running sum (u64: no overflow).
-        let pitch = |j: u16| u64::from(self.nominal_pitch(j % e.max(1)));
+        let pitch = |j: u16| u64::from(self.nominal_pitch(j.checked_rem(e).unwrap_or(0)));
         let mut span: u64 = (0..k).map(pitch).sum();
         let mut least = span;
         for j in 0..e {
-            span = span + pitch(j.wrapping_add(k)) - pitch(j);
+            span = span
+                .saturating_add(pitch(j.wrapping_add(k)))
+                .saturating_sub(pitch(j));
             least = least.min(span);
         }
         2.0 * omega.abs() / (least as f32 * self.unit_rad * self.timer_hz)
