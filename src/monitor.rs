@@ -2451,14 +2451,13 @@ mod tests {
             let clean = stream(&teeth, None, 40, 1e6, u32::MAX, &crank);
             let evs = jittered(&clean, sigma * pitch_ticks, next(1 << 30) as u32);
             let f = framed(p, &evs, &truth_of(&evs, teeth.len()));
-            let c = f.counters;
-            let faults =
-                c.missing + c.glitches + c.extra + c.unexplained + c.missing_frames + c.sync_losses;
-            faulted += usize::from(faults > 0);
+            let mut faults = EdgeCounters::default();
+            add_faults(&mut faults, &f.counters);
+            faulted += usize::from(faults != EdgeCounters::default());
             valid += f.valid;
             misnumbered += f.misnumbered;
             framed_off += f.wrong_windows;
-            add_faults(&mut d, &c);
+            add_faults(&mut d, &faults);
         }
         (faulted, d, valid, misnumbered, framed_off)
     }

@@ -289,13 +289,15 @@ const FRAME_NOISE: f32 = 20.0;
 const FRAME_MEMORY: u16 = 16;
 /// Frames learnt before that rule applies: with none learnt, a quarter of the margin alone
 /// decided, and edge jitter of 3 % of a pitch (σ) made the first frame after a recorded
-/// revolution unexplained (more than half of that rule's false faults in `jitter_census`).
+/// revolution unexplained (more than half of that rule's false faults in `jitter_census`,
+/// measured once with the rule's faults printed apart).
 const FRAME_LEARNT: u16 = 2;
 /// At a pattern wheel's gap the tooth is unexplained by its own cost (no single fault winning)
 /// only above this many times the mean cost of the recent gaps' teeth, once `GAP_LEARNT` of
 /// them are learnt (see [`SpeedTracker::gap_noise`]): under jitter alone, 1 in 500 of those
 /// teeth cost more than 8 times the mean learnt before them (heavier-tailed than a sum of
-/// three squared Gaussians: the swings recorded a revolution earlier jitter too).
+/// three squared Gaussians: the swings recorded a revolution earlier jitter too; measured once
+/// over `jitter_census`'s runs, with the costs printed).
 const GAP_NOISE: f32 = 8.0;
 const GAP_LEARNT: u16 = 4;
 /// A frame is confirmed on such a wheel only where the alignment the revolution fits best
@@ -334,15 +336,39 @@ struct Revolution {
     /// (the speed trend of a revolution, in log).
     d: f32,
     trend: f32,
-    /// The mean squared log swing of the frame edge against the tooth before (as recorded)
-    /// over about the last `FRAME_MEMORY` frames, and how many frames it has learnt from.
-    frame_noise: f32,
-    frames: u16,
-    /// The mean cost of the teeth after a gap (their chain of intervals against the recorded
-    /// revolution, each at most the margin) over about the last `FRAME_MEMORY` gaps, and how
-    /// many gaps it has learnt from.
-    gap_noise: f32,
-    gaps: u16,
+    /// The squared log swing of the frame edge against the tooth before (as recorded), learnt
+    /// over the recent frames.
+    frames: Learnt,
+    /// The cost of the teeth after a gap (their chain of intervals against the recorded
+    /// revolution, each at most the margin), learnt over the recent gaps.
+    gaps: Learnt,
+}
+
+/// A mean learnt from the values met: a running mean over the first `FRAME_MEMORY`, then an
+/// exponential one with that memory.
+#[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(feature = "pattern-wheels"), allow(dead_code))]
+struct Learnt {
+    mean: f32,
+    count: u16,
+}
+
+#[cfg_attr(not(feature = "pattern-wheels"), allow(dead_code))]
+impl Learnt {
+    const NEW: Learnt = Learnt {
+        mean: 0.0,
+        count: 0,
+    };
+
+    fn learn(&mut self, x: f32) {
+        self.count = self.count.saturating_add(1);
+        self.mean += (x - self.mean) / f32::from(self.count.min(FRAME_MEMORY));
+    }
+
+    /// The mean, once at least `n` values are learnt.
+    fn after(&self, n: u16) -> Option<f32> {
+        (self.count >= n).then_some(self.mean)
+    }
 }
 
 impl Revolution {
@@ -353,10 +379,8 @@ impl Revolution {
         run: 0,
         d: 0.0,
         trend: 0.0,
-        frame_noise: 0.0,
-        frames: 0,
-        gap_noise: 0.0,
-        gaps: 0,
+        frames: Learnt::NEW,
+        gaps: Learnt::NEW,
     };
 }
 
@@ -679,7 +703,7 @@ impl SpeedTracker {
         (*accepted, *lo, *width, *arrivals) = (z, z, z, z);
         (*anchor, *tooth, *stop, *nidx) = (0, 0, 0, 0);
         for f in fit {
-            (f.frames, f.frame_noise, f.gaps, f.gap_noise) = (0, 0.0, 0, 0.0);
+            (f.frames, f.gaps) = (Learnt::NEW, Learnt::NEW);
         }
         counters.clear(z);
     }
@@ -1565,11 +1589,11 @@ impl SpeedTracker {
             // The rules on faults decide (and a fault's cost is no jitter to learn).
             return true;
         }
-        if f.frames >= FRAME_LEARNT && cost > 0.25 * margin && cost > FRAME_NOISE * f.frame_noise {
+        let usual = f.frames.after(FRAME_LEARNT);
+        if usual.is_some_and(|m| cost > 0.25 * margin && cost > FRAME_NOISE * m) {
             return false;
         }
-        f.frames = f.frames.saturating_add(1);
-        f.frame_noise += (cost - f.frame_noise) / f32::from(f.frames.min(FRAME_MEMORY));
+        f.frames.learn(cost);
         true
     }
 
@@ -1585,17 +1609,11 @@ impl SpeedTracker {
         let Some(f) = self.fit.first_mut() else {
             return 0.0;
         };
-        let noise = if f.gaps >= GAP_LEARNT {
-            GAP_NOISE * f.gap_noise
-        } else {
-            0.0
-        };
+        let noise = f.gaps.after(GAP_LEARNT).map_or(0.0, |m| GAP_NOISE * m);
         if fault + margin >= cost {
             // Not a fault by the hypotheses: jitter to learn from (at most the margin, so
             // that a fault's cost moves the mean by a sixteenth of it at most).
-            f.gaps = f.gaps.saturating_add(1);
-            let c = if cost > margin { margin } else { cost };
-            f.gap_noise += (c - f.gap_noise) / f32::from(f.gaps.min(FRAME_MEMORY));
+            f.gaps.learn(if cost > margin { margin } else { cost });
         }
         noise
     }

@@ -1944,3 +1944,41 @@ fn a_noisy_signal_that_never_syncs_says_so() {
         "{lines:?}"
     );
 }
+
+/// The shares of a ripple's δ that README quotes (to two decimals), as analyze states them.
+#[test]
+fn the_ripple_readings_readme_quotes_are_analyzes() {
+    use drive_monitor::encoder::{EncoderConfig, Estimator, Pattern};
+    use host_sim::app::analyze::ripple_readings;
+    // Wheel (positions, missing teeth), K, and the orders quoted with their shares.
+    type Quoted = (u8, u8, u16, &'static [(u32, &'static str)]);
+    let quoted: [Quoted; 3] = [
+        (
+            8,
+            1,
+            1,
+            &[
+                (1, "0.87–0.97"),
+                (2, "0.64–0.90"),
+                (3, "0.67–0.78"),
+                (4, "0.00–0.64"),
+                (8, "0.00–0.00"),
+            ],
+        ),
+        (36, 2, 1, &[(6, "0.83–0.95")]),
+        (60, 2, 4, &[(6, "0.72–0.76")]),
+    ];
+    for (n, m, k, orders) in quoted {
+        let mut c = EncoderConfig::pattern(Pattern::missing_teeth(n, m), 1e6);
+        c.estimator = Estimator::Edges(k);
+        let r = ripple_readings(&c);
+        for &(order, text) in orders {
+            let q = r.iter().find(|q| q.order == order).unwrap();
+            assert_eq!(
+                format!("{:.2}–{:.2}", q.min, q.max),
+                text,
+                "{n}-{m}, K {k}, order {order}"
+            );
+        }
+    }
+}

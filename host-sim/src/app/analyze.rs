@@ -313,7 +313,6 @@ pub fn ripple_reading(enc: &EncoderConfig, order: u32, phase: f64) -> f64 {
         } else {
             angles[j + n - k] - TAU
         };
-        let start = if k == n { end - TAU } else { start };
         // The mean of sin(zφ + phase) over [start, end].
         let s = ((z * start + phase).cos() - (z * end + phase).cos()) / (z * (end - start));
         lo = lo.min(s);
@@ -698,8 +697,15 @@ fn pattern_runs(p: &drive_monitor::encoder::Pattern) -> Vec<(u64, u64)> {
     runs
 }
 
-/// Why the core did not sync on this capture, from the evidence in it.
-fn sync_hint(r: &AnalyzeReport, enc: &Encoder, intervals: &Intervals, timeout: f64) -> SyncHint {
+/// Why the core did not sync on this capture, from the evidence in it (`runs`: the pattern's,
+/// see [`pattern_runs`]).
+fn sync_hint(
+    r: &AnalyzeReport,
+    enc: &Encoder,
+    runs: &[(u64, u64)],
+    intervals: &Intervals,
+    timeout: f64,
+) -> SyncHint {
     use drive_monitor::encoder::{Pattern, Wheel};
     let cfg = enc.config();
     let per_rev = f64::from(enc.edges().max(1));
@@ -708,7 +714,6 @@ fn sync_hint(r: &AnalyzeReport, enc: &Encoder, intervals: &Intervals, timeout: f
         Wheel::Pattern(p) => Some(p),
         _ => None,
     };
-    let runs = pattern.as_ref().map(pattern_runs).unwrap_or_default();
     let pitch = std::f64::consts::TAU * f64::from(cfg.prescaler.max(1))
         / f64::from(cfg.wheel.positions().max(1));
     let slowest_speed = (intervals.slowest_pitch > 0.0).then(|| pitch / intervals.slowest_pitch);
@@ -1127,13 +1132,12 @@ pub fn analyze<R: BufRead>(
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
-    let longest_gap = match cfg.encoder.wheel {
-        drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p)
-            .iter()
-            .map(|&(_, g)| g as f64)
-            .fold(1.0, f64::max),
-        _ => 1.0,
+    // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
+    let runs = match cfg.encoder.wheel {
+        drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
+        _ => Vec::new(),
     };
+    let longest_gap = runs.iter().map(|&(_, g)| g as f64).fold(1.0, f64::max);
     while let Some((t, levels)) = reader.next_row()? {
         if report.rows == 0 {
             report.span[0] = t;
@@ -1302,7 +1306,7 @@ pub fn analyze<R: BufRead>(
     // Never synced, or lost again and again and not synced at the end: why, from the capture.
     if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
     {
-        report.sync_hint = Some(sync_hint(&report, &enc, &intervals, polls.timeout));
+        report.sync_hint = Some(sync_hint(&report, &enc, &runs, &intervals, polls.timeout));
     }
     // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
     // or time references after a standstill or a reversal.
@@ -1689,11 +1693,10 @@ pub fn text(r: &AnalyzeReport) -> String {
     );
     // Where the samples resolve a ripple less than to 5 %: said, so that a low δ is not
     // taken for a smooth shaft.
-    if let Some(first) = r.ripple.iter().find(|q| q.min < 0.95) {
-        let listed: Vec<String> = r
-            .ripple
+    if let Some(at) = r.ripple.iter().position(|q| q.min < 0.95) {
+        let first = &r.ripple[at];
+        let listed: Vec<String> = r.ripple[at..]
             .iter()
-            .skip_while(|q| q.order < first.order)
             .take(6)
             .map(|q| format!("{}: {:.2}–{:.2}", q.order, q.min, q.max))
             .collect();
