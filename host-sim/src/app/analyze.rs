@@ -287,13 +287,11 @@ fn edge_angles(enc: &EncoderConfig) -> Vec<f64> {
     }
 }
 
-/// The share of the δ of a small speed ripple ω̄(1 + a·sin(order·φ + phase)) that the core's
-/// windows read on `enc`'s wheel: each speed sample is the angle of the last `K` edges over
-/// their time, which to first order in `a` is ω̄(1 + a·s) with `s` the mean of the sine over
-/// the sample's angle; a window holds the samples ending at each edge of its revolutions, so
-/// it reads δ = a·(max s − min s) of the true 2a. Samples few against the ripple's cycle miss
-/// its peaks, and long ones average it away.
-pub fn ripple_reading(enc: &EncoderConfig, order: u32, phase: f64) -> f64 {
+/// The mean of sin(order·φ + ψ) over each speed sample's angle, as `(c, d)` with the mean
+/// `c·cos ψ + d·sin ψ`: each sample is the angle of the last `K` edges over their time, so to
+/// first order in a ripple's amplitude it reads the ripple's mean over that angle. Empty where
+/// the wheel has fewer sampled edges than `K`.
+fn sample_means(enc: &EncoderConfig, order: u32) -> Vec<(f64, f64)> {
     use drive_monitor::encoder::Estimator;
     use std::f64::consts::TAU;
     let angles = edge_angles(enc);
@@ -301,34 +299,63 @@ pub fn ripple_reading(enc: &EncoderConfig, order: u32, phase: f64) -> f64 {
     let Estimator::Edges(k) = enc.estimator;
     let k = usize::from(k).max(1);
     if n == 0 || k > n {
-        return 0.0;
+        return Vec::new();
     }
     let z = f64::from(order);
+    (0..n)
+        .map(|j| {
+            // The sample ending at edge j, from edge j − K (a revolution back where it wraps).
+            let end = angles[j];
+            let start = if j >= k {
+                angles[j - k]
+            } else {
+                angles[j + n - k] - TAU
+            };
+            // (cos(zs + ψ) − cos(ze + ψ)) / (z(e − s)), split over cos ψ and sin ψ.
+            let w = z * (end - start);
+            let ((ss, cs), (se, ce)) = ((z * start).sin_cos(), (z * end).sin_cos());
+            ((cs - ce) / w, (se - ss) / w)
+        })
+        .collect()
+}
+
+/// Half the spread of the samples' means at ripple phase `phase`: the share of the ripple's
+/// δ they read.
+fn spread_at(means: &[(f64, f64)], phase: f64) -> f64 {
+    let (sin, cos) = phase.sin_cos();
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for j in 0..n {
-        // The sample ending at edge j, from edge j − K (a revolution back where it wraps).
-        let end = angles[j];
-        let start = if j >= k {
-            angles[j - k]
-        } else {
-            angles[j + n - k] - TAU
-        };
-        // The mean of sin(zφ + phase) over [start, end].
-        let s = ((z * start + phase).cos() - (z * end + phase).cos()) / (z * (end - start));
+    for &(c, d) in means {
+        let s = c * cos + d * sin;
         lo = lo.min(s);
         hi = hi.max(s);
     }
-    (hi - lo) / 2.0
+    if means.is_empty() {
+        0.0
+    } else {
+        (hi - lo) / 2.0
+    }
+}
+
+/// The share of the δ of a small speed ripple ω̄(1 + a·sin(order·φ + phase)) that the core's
+/// windows read on `enc`'s wheel: each speed sample is the angle of the last `K` edges over
+/// their time, which to first order in `a` is ω̄(1 + a·s) with `s` the mean of the sine over
+/// the sample's angle; a window holds the samples ending at each edge of its revolutions, so
+/// it reads δ = a·(max s − min s) of the true 2a. Samples few against the ripple's cycle miss
+/// its peaks, and long ones average it away.
+pub fn ripple_reading(enc: &EncoderConfig, order: u32, phase: f64) -> f64 {
+    spread_at(&sample_means(enc, order), phase)
 }
 
 /// [`ripple_reading`] for orders 1 to [`RIPPLE_ORDERS`], each at its least and most over 360
-/// phases.
+/// phases (the samples' means worked out once an order: a phase costs two multiplies a
+/// sample, no trigonometry).
 pub fn ripple_readings(enc: &EncoderConfig) -> Vec<RippleReading> {
     (1..=RIPPLE_ORDERS)
         .map(|order| {
+            let means = sample_means(enc, order);
             let (mut min, mut max) = (f64::INFINITY, 0.0f64);
             for i in 0..360 {
-                let r = ripple_reading(enc, order, std::f64::consts::TAU * f64::from(i) / 360.0);
+                let r = spread_at(&means, std::f64::consts::TAU * f64::from(i) / 360.0);
                 min = min.min(r);
                 max = max.max(r);
             }
@@ -537,7 +564,7 @@ pub struct SyncHint {
 
 /// Long intervals that recur: how many edges lie between consecutive ones, and how long they
 /// are against their neighbours.
-#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct GapsSeen {
     /// The most common number of edges from one long interval to the next.
     pub every: u64,
@@ -546,6 +573,21 @@ pub struct GapsSeen {
     /// Spacings between consecutive long intervals.
     pub of: u64,
     /// The median ratio of those long intervals to the geometric mean of their neighbours.
+    pub ratio: f64,
+    /// Every spacing that recurs about as often as the most common one (a wheel with several
+    /// gaps has one a gap), in the order they came round the wheel; the most common alone on a
+    /// wheel with one gap.
+    pub spacings: Vec<SpacingSeen>,
+}
+
+/// One recurring number of edges from one long interval to the next.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct SpacingSeen {
+    /// Edges from the long interval before.
+    pub every: u64,
+    /// How many of the spacings had that many.
+    pub times: u64,
+    /// The median ratio of the long intervals ending them to their neighbours' geometric mean.
     pub ratio: f64,
 }
 
@@ -568,6 +610,8 @@ struct Intervals {
     /// Edges from one long interval to the next: how often, and the ratios of the long
     /// intervals ending them (the first [`MAX_RATIOS`] of each).
     spacings: std::collections::BTreeMap<u64, (u64, Vec<f64>)>,
+    /// The first [`MAX_ORDER`] spacings, as they came.
+    order: Vec<u64>,
     of: u64,
     beyond: u64,
     /// The longest time a pitch took, s.
@@ -586,6 +630,9 @@ pub const SHORT_RATIO: f64 = 0.75;
 
 /// Ratios kept for each spacing (for their median).
 const MAX_RATIOS: usize = 1000;
+
+/// Spacings kept in the order they came (for the order of a wheel's gaps).
+const MAX_ORDER: usize = 256;
 
 impl Intervals {
     /// A reversal: the intervals before it are no neighbours of those after.
@@ -642,6 +689,9 @@ impl Intervals {
                                 e.1.push(ratio);
                             }
                         }
+                        if self.order.len() < MAX_ORDER {
+                            self.order.push(count);
+                        }
                         self.of += 1;
                     }
                 }
@@ -654,8 +704,14 @@ impl Intervals {
         (self.before, self.middle) = (self.middle, Some(i));
     }
 
-    /// The most common spacing, when it recurs: at least twice, and at least a third of them.
+    /// The most common spacing, when it recurs: at least twice, and at least a third of them;
+    /// with it every spacing that recurs at least half as often (a wheel with several gaps).
     fn gaps(&self) -> Option<GapsSeen> {
+        let median = |ratios: &[f64]| {
+            let mut r = ratios.to_vec();
+            r.sort_by(f64::total_cmp);
+            r[r.len() / 2]
+        };
         let mut best: Option<(u64, &(u64, Vec<f64>))> = None;
         for (&count, e) in &self.spacings {
             if best.is_none_or(|(_, b)| e.0 > b.0) {
@@ -666,13 +722,30 @@ impl Intervals {
         if *times < 2 || times * 3 < self.of {
             return None;
         }
-        let mut r = ratios.clone();
-        r.sort_by(f64::total_cmp);
+        // The others, in the order they first came after the most common one's first.
+        let first = self.order.iter().position(|&c| c == every).unwrap_or(0);
+        let mut spacings: Vec<SpacingSeen> = Vec::new();
+        let (head, tail) = self.order.split_at(first);
+        let by_order = tail.iter().chain(head).copied();
+        let rest = self.spacings.keys().copied();
+        for count in by_order.chain(rest) {
+            let Some((t, r)) = self.spacings.get(&count) else {
+                continue;
+            };
+            if *t >= 2 && t * 2 >= *times && !spacings.iter().any(|s| s.every == count) {
+                spacings.push(SpacingSeen {
+                    every: count,
+                    times: *t,
+                    ratio: median(r),
+                });
+            }
+        }
         Some(GapsSeen {
             every,
             times: *times,
             of: self.of,
-            ratio: r[r.len() / 2],
+            ratio: median(ratios),
+            spacings,
         })
     }
 }
@@ -697,6 +770,51 @@ fn pattern_runs(p: &drive_monitor::encoder::Pattern) -> Vec<(u64, u64)> {
     runs
 }
 
+/// "a, b and c".
+fn in_words(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
+}
+
+/// The recurring gaps of a capture in words, with the wheel they suggest.
+fn seen_gaps(g: &GapsSeen) -> String {
+    let pitches = |s: &SpacingSeen| s.ratio.round() as u64;
+    if let [s] = g.spacings.as_slice() {
+        let missing = pitches(s).saturating_sub(1);
+        let guess = if missing >= 1 && s.every + missing <= 255 {
+            format!(" (a {}-{missing} wheel?)", s.every + missing)
+        } else {
+            String::new()
+        };
+        return format!(
+            "an interval about {:.1} times its neighbours comes every {} edges ({} of {} \
+             times){guess}",
+            s.ratio, s.every, s.times, g.of
+        );
+    }
+    let words = |f: &dyn Fn(&SpacingSeen) -> String| {
+        in_words(&g.spacings.iter().map(f).collect::<Vec<_>>())
+    };
+    let positions: u64 = g
+        .spacings
+        .iter()
+        .map(|s| s.every + pitches(s).saturating_sub(1))
+        .sum();
+    let gaps = g.spacings.len();
+    format!(
+        "intervals about {} times their neighbours come after {} edges in turn ({} of {} \
+         times) (a wheel of {positions} positions with {gaps} gaps? describe it in a scene's \
+         [encoder] by lines and gaps, and analyze with --scene)",
+        words(&|s| format!("{:.1}", s.ratio)),
+        words(&|s| s.every.to_string()),
+        words(&|s| s.times.to_string()),
+        g.of
+    )
+}
+
 /// Why the core did not sync on this capture, from the evidence in it (`runs`: the pattern's,
 /// see [`pattern_runs`]).
 fn sync_hint(
@@ -717,7 +835,6 @@ fn sync_hint(
     let pitch = std::f64::consts::TAU * f64::from(cfg.prescaler.max(1))
         / f64::from(cfg.wheel.positions().max(1));
     let slowest_speed = (intervals.slowest_pitch > 0.0).then(|| pitch / intervals.slowest_pitch);
-    let gaps = intervals.gaps();
     let mut causes = Vec::new();
     let short = revolutions_of_edges < 3.0;
     // Noise: the core's counts (while it judged edges), or the raw intervals out of step
@@ -726,6 +843,13 @@ fn sync_hint(
     let noisy = [counted, intervals.irregular]
         .iter()
         .any(|&n| n >= 3 && n * 50 >= r.captured);
+    // In a noisy signal the half of a tooth's interval a pulse leaves is long against the
+    // other: such "gaps" recur too (every other edge under a pulse a tooth), so there the
+    // recurring spacings must account for two thirds of all to name a wheel by them.
+    let gaps = intervals.gaps().filter(|g| {
+        let recurring: u64 = g.spacings.iter().map(|s| s.times).sum();
+        !noisy || recurring * 3 >= g.of * 2
+    });
     if short {
         causes.push(format!(
             "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
@@ -758,23 +882,19 @@ fn sync_hint(
                 list.join(", ")
             )
         };
-        match gaps {
+        match &gaps {
             Some(g) => {
-                let pitches = g.ratio.round() as u64;
-                let agree = runs.iter().any(|&(t, _)| t == g.every)
-                    && runs.iter().any(|&(_, p)| p == pitches);
+                let pitches = |s: &SpacingSeen| s.ratio.round() as u64;
+                // Each recurring gap the wheel has: a run of as many teeth ending in a gap of
+                // as many pitches.
+                let agree = g
+                    .spacings
+                    .iter()
+                    .all(|s| runs.contains(&(s.every, pitches(s))));
                 if !agree {
-                    let missing = pitches.saturating_sub(1);
-                    let guess = if missing >= 1 && g.every + missing <= 255 {
-                        format!(" (a {}-{missing} wheel?)", g.every + missing)
-                    } else {
-                        String::new()
-                    };
                     causes.push(format!(
-                        "no sync: the configured {name} {expected}; in the capture an interval \
-                         about {:.1} times its neighbours comes every {} edges ({} of {} \
-                         times){guess}",
-                        g.ratio, g.every, g.times, g.of
+                        "no sync: the configured {name} {expected}; in the capture {}",
+                        seen_gaps(g)
                     ));
                 }
             }
@@ -809,7 +929,7 @@ fn sync_hint(
             r.captured,
             intervals.irregular,
             if gaps.is_none() && pattern.is_some() {
-                ", and no gap recurs among them"
+                ", and no wheel's gaps can be told among them"
             } else {
                 ""
             },
