@@ -2075,6 +2075,163 @@ fn sync_lost_again_and_again_says_why() {
     assert!(once.sync_hint.is_none() && hint_lines(&once).is_empty());
 }
 
+/// `t` as C's `%g` writes it: six significant digits, trailing zeros dropped.
+fn six_digits(t: f64) -> String {
+    if t == 0.0 {
+        return "0".into();
+    }
+    let decimals = (5 - t.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{t:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// A plain capture of rising edges at `rising` (written by `time`), falling halfway.
+fn plain_of_rising(rising: &[f64], time: impl Fn(f64) -> String) -> String {
+    let mut s = String::from("time_s,level\n");
+    for (i, &t) in rising.iter().enumerate() {
+        let next = rising.get(i + 1).copied().unwrap_or(t + 1e-3);
+        s.push_str(&format!("{},1\n{},0\n", time(t), time(0.5 * (t + next))));
+    }
+    s
+}
+
+/// Times written to six significant digits (C's `%g`): a steady 36-1 wheel at 100 rad/s (δ 0)
+/// resolves its times to 10 µs from 1 s and to 100 µs from 10 s, where a pitch is 1745 µs. The
+/// windows there read δ 0.057 (two steps of a pitch); their floor includes the resolution of
+/// their own rows, so none is resolved, every δ lies within its floor, and a line says where
+/// the times coarsen. (With the file's finest grid alone, 10 ns, they were resolved, δ 50
+/// times the floor.)
+#[test]
+fn times_written_to_fixed_significant_digits_widen_the_floor() {
+    let rising = wheel_teeth(36, 1, 100.0, 19.0);
+    let text = plain_of_rising(&rising, six_digits);
+    let cfg = configure(&wheel("36-1")).unwrap();
+    let mut reader = text_reader(text, "g.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() > 250, "{}", valid.len());
+    let mut late = 0;
+    for w in &valid {
+        let (d, f) = (w.delta.unwrap(), w.floor_with_sampling.unwrap());
+        assert!(d <= f, "{w:?}");
+        assert_eq!(w.resolved, Some(false), "{w:?}");
+        if w.start > 10.0 {
+            assert_eq!(w.time_resolution, Some(1e-4), "{w:?}");
+            late += 1;
+        }
+    }
+    assert!(late > 100, "{late}");
+    let (worst, from) = report.coarser_times.expect("said");
+    assert_eq!(worst, 1e-4);
+    assert!((9.9..=10.1).contains(&from), "{from}");
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("sampling: the times resolve less finely in places: to 1.000e-4 s"),
+        "{said}"
+    );
+}
+
+/// Exact decimal Unix times after a first row at 0 s: counted from 0 (the first row's whole
+/// seconds), they are f64 numbers near 1.7e9 s, 0.24 µs apart (20 ticks of an 84 MHz timer),
+/// and their products with the clock near 1.43e17 ticks, 16 ticks apart. Every valid window's
+/// δ of a steady shaft (0) lies within its floor, which includes both spacings (it was up to
+/// 19 times the timer's floor alone); a line says so.
+#[test]
+fn times_far_from_their_origin_widen_the_floor() {
+    let rising = wheel_teeth(36, 1, 40.0, 3.0);
+    let unix = |t: f64| {
+        let ns = (t * 1e9).round() as u64;
+        format!(
+            "{}.{:09}",
+            1_700_000_000 + ns / 1_000_000_000,
+            ns % 1_000_000_000
+        )
+    };
+    let text = format!(
+        "time_s,level\n0.0,0\n{}",
+        plain_of_rising(&rising, unix).trim_start_matches("time_s,level\n")
+    );
+    let cfg = configure(&AnalyzeOptions {
+        timer_hz: Some(84e6),
+        ..wheel("36-1")
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "unix.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.time_origin, 0);
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 15, "{}", valid.len());
+    for w in &valid {
+        let (d, f) = (w.delta.unwrap(), w.floor_with_sampling.unwrap());
+        assert!(d <= f, "{w:?}");
+    }
+    let (worst, _) = report.coarser_times.expect("said");
+    assert_eq!(worst, 2f64.powi(-22) + 16.0 / 84e6, "{worst}");
+}
+
+/// A scene knows its load: `analyze --scene` says, as `run` and `predict` do, when the window
+/// does not hold the load's cycle (the kneader's repeats every 8 revolutions), whether the
+/// scene or `--window-revolutions` sets it; a whole number of cycles is not warned of.
+#[test]
+fn analyze_with_a_scene_warns_of_a_window_shorter_than_the_load_cycle() {
+    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kneader.toml"));
+    let scene = Scene::parse(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let with = |revolutions: Option<u16>| {
+        configure(&AnalyzeOptions {
+            scene: Some((scene.clone(), path.clone())),
+            window_revolutions: revolutions,
+            ..AnalyzeOptions::default()
+        })
+        .unwrap()
+        .warnings
+    };
+    assert!(with(None).is_empty(), "{:?}", with(None));
+    assert!(with(Some(16)).is_empty());
+    let w = with(Some(3));
+    assert_eq!(w.len(), 1);
+    assert!(
+        w[0].starts_with(
+            "WARNING: `--window-revolutions 3` is not a whole number of the load's period (8 \
+             revolutions)"
+        ),
+        "{w:?}"
+    );
+    // A load of no common period: the default window (one cycle of the lowest order) said;
+    // a window set is the answer to that, as in `run`.
+    let text = "[motor]\nmodel = \"speed\"\nspeed = 40.0\n[load]\nmean = 10.0\n\
+                harmonics = [{ order = 1.0, amplitude = 5.0 }, { order = 1.4142135623730951, \
+                amplitude = 5.0 }]\n[encoder]\ntimer_hz = 1e6\nlines = 36\nframing = \"none\"\n";
+    let odd = Scene::parse(text, &path).unwrap();
+    for n in [None, Some(40)] {
+        let w = configure(&AnalyzeOptions {
+            scene: Some((odd.clone(), path.clone())),
+            window_revolutions: n,
+            ..AnalyzeOptions::default()
+        })
+        .unwrap()
+        .warnings;
+        assert_eq!(
+            w.len() == 1 && w[0].contains("have no common period"),
+            n.is_none(),
+            "{n:?}: {w:?}"
+        );
+    }
+    // In the report's text, whatever the capture.
+    let cfg = configure(&AnalyzeOptions {
+        scene: Some((odd, path)),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let rising = wheel_teeth(36, 0, 40.0, 0.5);
+    let mut reader = text_reader(saleae_of_rising(&rising, 50e6, 0.5), "k.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert!(host_sim::app::analyze::text(&report).contains(&cfg.warnings[0]));
+}
+
 /// The shares of a ripple's δ that README quotes (to two decimals), as analyze states them.
 #[test]
 fn the_ripple_readings_readme_quotes_are_analyzes() {

@@ -84,6 +84,9 @@ pub struct AnalyzeConfig {
     pub direction: Option<(Channel, Lead)>,
     /// The edges taken.
     pub edge: Polarity,
+    /// What the configuration leaves out, each a WARNING (a window that does not hold the
+    /// scene's load cycle).
+    pub warnings: Vec<String>,
 }
 
 /// Which channel of a quadrature pair leads when the shaft runs forward.
@@ -208,6 +211,11 @@ pub struct WindowOut {
     /// grid its times lie on): each timestamp is known to a sample period besides the timer's
     /// tick, so the floor is `noise_floor · (1 + timer_hz / sample_rate)`.
     pub floor_with_sampling: Option<f64>,
+    /// The resolution of the times, s, that `floor_with_sampling` takes: the sample period
+    /// (stated, or the grid of the whole file) or, where coarser, the coarsest of the
+    /// window's rows (each block of [`BLOCK_ROWS`] rows: the step its times lie on, or the
+    /// spacing of f64 numbers at them and at their products with the timer clock).
+    pub time_resolution: Option<f64>,
     /// The mean speed was within the steady tolerance (2 % unless the scene says otherwise)
     /// of the previous valid window's (valid windows; never the first one after sync). δ of
     /// a window that is not steady includes the change of speed (a run-up or run-down).
@@ -450,6 +458,14 @@ pub struct AnalyzeReport {
     /// row's (in whole nanoseconds, when 2 ns or more: the analyzer's sample period, as a
     /// Saleae export's nine decimals show it), taken as the sampling for the floor.
     pub time_grid: Option<f64>,
+    /// The coarsest resolution of the times in a block of rows, s, where it is coarser than
+    /// the sampling above (half again, and at least 0.1 timer tick), and the time of the first
+    /// block so coarse: a file written to a fixed number of significant digits resolves its later times
+    /// less finely, and an f64 resolves times far from their origin only so far (see
+    /// [`WindowOut::time_resolution`]).
+    pub coarser_times: Option<(f64, f64)>,
+    /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
+    pub warnings: Vec<String>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s, counted from `time_origin`.
@@ -1241,6 +1257,10 @@ pub fn analyze<R: BufRead>(
     let mut end = 0.0;
     let mut changes = vec![0u64; channels.len()];
     let mut grid = TimeGrid::default();
+    let mut resolution = Resolution {
+        hz: cfg.encoder.timer_hz,
+        ..Resolution::default()
+    };
     // A stated sample rate (a sigrok file's, or --sample-rate) cannot have recorded two rows
     // less than a sample period apart: the rate or the file is wrong.
     let period = reader.sample_rate().map(|r| 1.0 / r);
@@ -1264,6 +1284,7 @@ pub fn analyze<R: BufRead>(
             prev = levels.to_vec();
         }
         grid.row(t);
+        resolution.row(t);
         for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
                 *n += 1;
@@ -1384,6 +1405,7 @@ pub fn analyze<R: BufRead>(
     }
     report.span[1] = end;
     report.time_origin = reader.time_origin();
+    report.warnings.clone_from(&cfg.warnings);
     // The end of the recording: the periodic task up to it (a shaft that stopped before the
     // recording did times out where a firmware's poll would see it, not at the end of the
     // file), and a last poll there.
@@ -1436,14 +1458,39 @@ pub fn analyze<R: BufRead>(
     if report.sample_rate.is_none() {
         report.time_grid = grid.step();
     }
-    if let Some(rate) = report
+    // Each window's floor takes the file's sampling, or the resolution of its own rows where
+    // that is coarser (a time is known to no better than either).
+    let file_step = report
         .sample_rate
-        .or_else(|| report.time_grid.map(|g| 1.0 / g))
-    {
-        let widen = 1.0 + cfg.encoder.timer_hz / rate;
-        for w in &mut report.windows {
-            w.floor_with_sampling = w.noise_floor.map(|f| f * widen);
+        .map(|r| 1.0 / r)
+        .or(report.time_grid)
+        .unwrap_or(0.0);
+    let tick = 1.0 / cfg.encoder.timer_hz;
+    for w in &mut report.windows {
+        let local = resolution.over(w.start, w.end);
+        let res = if local > file_step && local >= 0.1 * tick {
+            local
+        } else {
+            file_step
+        };
+        if res > 0.0 {
+            w.time_resolution = Some(res);
+            w.floor_with_sampling = w.noise_floor.map(|f| f * (1.0 + res / tick));
         }
+    }
+    // Said where a block's resolution is coarser than the sampling (half again, and at least a
+    // tenth of a tick): the coarsest, and from where it holds.
+    let worst = resolution
+        .changes
+        .iter()
+        .fold(0.0f64, |m, &(_, r)| m.max(r));
+    if worst > 1.5 * file_step && worst >= 0.1 * tick {
+        let from = resolution
+            .changes
+            .iter()
+            .find(|&&(_, r)| r == worst)
+            .map_or(0.0, |&(t, _)| t);
+        report.coarser_times = Some((worst, from));
     }
     for w in &mut report.windows {
         if let (Some(d), Some(f)) = (w.delta, w.floor_with_sampling.or(w.noise_floor)) {
@@ -1504,6 +1551,69 @@ impl TimeGrid {
     /// The step, s, when it is at least 2 ns.
     fn step(&self) -> Option<f64> {
         self.gcd.filter(|&g| g >= 2).map(|g| g as f64 * 1e-9)
+    }
+}
+
+/// Rows a block of [`Resolution`] holds: few enough to follow a resolution that changes along
+/// the file, enough that whole-nanosecond times on a fine grid seldom share a coarser step by
+/// chance (fifteen offsets all even: 1 in 32 768).
+pub const BLOCK_ROWS: usize = 16;
+
+/// The resolution of the times along the file, block by block of [`BLOCK_ROWS`] rows: the step
+/// the block's times lie on ([`TimeGrid`]), or what f64 numbers resolve at its largest time,
+/// whichever is coarser. Kept where it changes (memory bounded by the changes).
+#[derive(Default)]
+struct Resolution {
+    /// The timer clock, Hz.
+    hz: f64,
+    block: TimeGrid,
+    rows: usize,
+    start: f64,
+    largest: f64,
+    /// (the first row's time of a block, its resolution) where the resolution changes.
+    changes: Vec<(f64, f64)>,
+}
+
+impl Resolution {
+    fn row(&mut self, t: f64) {
+        if self.rows == 0 {
+            self.block = TimeGrid::default();
+            (self.start, self.largest) = (t, 0.0);
+        }
+        self.block.row(t);
+        self.largest = self.largest.max(t.abs());
+        self.rows += 1;
+        if self.rows == BLOCK_ROWS {
+            self.close();
+        }
+    }
+
+    /// Ends a whole block (a shorter one at the end of the file is left out: a few offsets
+    /// share a coarser step by chance too often).
+    fn close(&mut self) {
+        if self.rows == BLOCK_ROWS && self.largest.is_finite() {
+            // A time read to the nearest f64, and its ticks the floor of its product with the
+            // clock rounded to the nearest f64: the spacings at both (in s).
+            let spacing = |x: f64| f64::from_bits(x.to_bits() + 1) - x;
+            let f64s = spacing(self.largest) + spacing(self.largest * self.hz) / self.hz;
+            let res = self.block.step().unwrap_or(0.0).max(f64s);
+            if self.changes.last().is_none_or(|&(_, r)| r != res) {
+                self.changes.push((self.start, res));
+            }
+        }
+        self.rows = 0;
+    }
+
+    /// The coarsest resolution of the blocks over `[start, end]` (0 when none is known).
+    fn over(&self, start: f64, end: f64) -> f64 {
+        let from = self
+            .changes
+            .partition_point(|&(t, _)| t <= start)
+            .saturating_sub(1);
+        self.changes[from..]
+            .iter()
+            .take_while(|&&(t, _)| t <= end)
+            .fold(0.0, |r, &(_, x)| r.max(x))
     }
 }
 
@@ -1703,6 +1813,7 @@ impl State {
             omega_min: m.and_then(|m| f(m.omega_min)),
             noise_floor: m.and_then(|m| f(m.noise_floor)),
             floor_with_sampling: None,
+            time_resolution: None,
             steady: m.map(|m| m.steady),
             resolved: None,
         });
@@ -1745,6 +1856,9 @@ pub fn text(r: &AnalyzeReport) -> String {
             _ => String::new(),
         }
     );
+    for w in &r.warnings {
+        let _ = writeln!(s, "{w}");
+    }
     if r.captures_at_one_tick > 0 {
         let _ = writeln!(
             s,
@@ -1805,6 +1919,16 @@ pub fn text(r: &AnalyzeReport) -> String {
                 );
             }
         },
+    }
+    if let Some((worst, from)) = r.coarser_times {
+        let _ = writeln!(
+            s,
+            "sampling: the times resolve less finely in places: to {worst:.3e} s ({:.3} timer \
+             ticks) from {from:.6} s on (times written to a fixed number of significant digits, \
+             or far from their origin, where an f64 resolves them so); each window's floor \
+             includes the resolution of its own rows",
+            worst * r.timer_hz
+        );
     }
     let _ = writeln!(
         s,
@@ -2234,9 +2358,21 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     if let Some(n) = o.window_revolutions {
         window = Some(WindowConfig {
             length: WindowLength::Revolutions(n),
-            steady_tolerance: 0.02,
+            // (A scene's tolerance kept.)
+            steady_tolerance: window.map_or(0.02, |w| w.steady_tolerance),
         });
     }
+    // A scene knows its load: a window that does not hold the load's cycle is said, as `run`
+    // and `predict` say it.
+    let warnings: Vec<String> = match (&o.scene, o.window_revolutions) {
+        (Some((scene, _)), Some(n)) => {
+            crate::app::run::window_warning_for(scene, n, &format!("`--window-revolutions {n}`"))
+                .into_iter()
+                .collect()
+        }
+        (Some((scene, _)), None) => crate::app::run::window_warning(scene).into_iter().collect(),
+        _ => Vec::new(),
+    };
     let window = window.unwrap_or(WindowConfig {
         length: WindowLength::Revolutions(1),
         steady_tolerance: 0.02,
@@ -2321,6 +2457,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         },
         index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
+        warnings,
     })
 }
 

@@ -488,17 +488,35 @@ fn periodic_orders(scene: &Scene) -> Vec<f64> {
 
 /// The window [`window_config`] takes and [`window_warning`]'s text.
 fn default_window(scene: &Scene) -> (WindowLength, Option<String>) {
+    let given = scene.monitor.as_ref().and_then(|m| m.window_revolutions);
+    window_for(
+        scene,
+        given.map(|n| (n, format!("`monitor.window_revolutions = {n}`"))),
+    )
+}
+
+/// The WARNING for a window of `revolutions` set by `given` (an option's words, e.g.
+/// `` `--window-revolutions 3` ``) on the scene's load: `None` where it holds the load's
+/// whole period.
+pub fn window_warning_for(scene: &Scene, revolutions: u16, given: &str) -> Option<String> {
+    window_for(scene, Some((revolutions, given.to_string()))).1
+}
+
+/// The window for the scene's load, `given` a window's revolutions and the words that set it
+/// (else the default), and the WARNING where it does not hold the load's whole period.
+fn window_for(scene: &Scene, given: Option<(u16, String)>) -> (WindowLength, Option<String>) {
     use drive_monitor::irregularity::MAX_WINDOW_REVS;
     let orders = periodic_orders(scene);
     let period = drive_monitor::drive::period_revolutions(&orders);
-    if let Some(n) = scene.monitor.as_ref().and_then(|m| m.window_revolutions) {
-        // A window set in the scene that is no whole number of load periods sees part of the
-        // load cycle in each window, as the lowest order's did: said.
+    if let Some((n, what)) = given {
+        // A window set that is no whole number of load periods sees part of the load cycle in
+        // each window, as the lowest order's did: said. (Where the orders have no common
+        // period, setting a window is how the default's warning is answered: not said.)
         let warning = period.filter(|&p| u64::from(n) % p != 0).map(|p| {
             format!(
-                "WARNING: `monitor.window_revolutions = {n}` is not a whole number of the load's \
-                 period ({p} revolutions), so each δ window sees part of the load cycle: δ may \
-                 be read low in it and the δ alarm may stay silent; a multiple of {p} holds it"
+                "WARNING: {what} is not a whole number of the load's period ({p} revolutions), \
+                 so each δ window sees part of the load cycle: δ may be read low in it and the \
+                 δ alarm may stay silent; a multiple of {p} holds it"
             )
         });
         return (WindowLength::Revolutions(n), warning);
