@@ -2516,6 +2516,39 @@ mod tests {
         assert!(valid >= 80 * 34, "{valid}");
     }
 
+    #[test]
+    fn small_wheels_cranking_under_jitter_sync_within_a_few_revolutions() {
+        // `jitter_census`'s runs of 8-1 and 12-1 wheels cranking at ±30 % with jitter of 2
+        // and 3 % of a pitch (σ), 20 runs each at random phases (the other rows' draws
+        // skipped): with the revolution's fit confirming a candidate on the last edge of its
+        // revolution of confirmation alone, and its bounds those set for 1 % jitter, a 12-1
+        // run at 2 % synced at revolution 35 and an 8-1 run at 3 % never did.
+        let mut next = lcg(0x5eed_0001);
+        for wheel in [(8u8, 1u8), (12, 1)] {
+            for ripple in [0.0, 0.3] {
+                for sigma in [0.01, 0.02, 0.03] {
+                    if ripple == 0.0 || sigma < 0.015 {
+                        for _ in 0..20 {
+                            next(1000);
+                            next(1 << 30);
+                        }
+                        continue;
+                    }
+                    let r = jitter_runs(wheel, ripple, sigma, 20, &mut next);
+                    let (_, latest, never) = r.syncs();
+                    assert_eq!(r.framed_off, 0, "{wheel:?} ±{ripple} {sigma}");
+                    assert_eq!(never, 0, "{wheel:?} ±{ripple} {sigma}");
+                    assert!(latest <= 6.0, "{wheel:?} ±{ripple} {sigma}: {latest}");
+                    assert!(
+                        r.valid >= 20 * 33,
+                        "{wheel:?} ±{ripple} {sigma}: {}",
+                        r.valid
+                    );
+                }
+            }
+        }
+    }
+
     /// False faults from edge jitter alone on missing-tooth wheels: per wheel, shaft (steady,
     /// or cranking at ±30 % with two strokes, a random phase a run) and jitter (σ, of a pitch),
     /// 20 runs of 40 revolutions (see [`jitter_runs`]): the runs with a fault of any kind, the
