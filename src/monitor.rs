@@ -2427,24 +2427,50 @@ mod tests {
         }
     }
 
+    /// What runs of 40 revolutions of a missing-tooth wheel did under edge jitter alone (see
+    /// [`jitter_runs`]).
+    #[derive(Default)]
+    struct JitterRuns {
+        /// The runs with a fault of any kind, and the fault counters summed.
+        faulted: usize,
+        counters: EdgeCounters,
+        /// The valid windows, the edges numbered at a wrong tooth in sync (after a false
+        /// fault, until the count is given up or realigned), and the valid windows not framed
+        /// at tooth 0.
+        valid: usize,
+        misnumbered: usize,
+        framed_off: usize,
+        /// Each run's first sync, in revolutions of edges (none: never).
+        synced: Vec<Option<f64>>,
+    }
+
+    impl JitterRuns {
+        /// The median and the latest first sync of the runs that synced (0 if none did), and
+        /// the runs that never synced.
+        fn syncs(&self) -> (f64, f64, usize) {
+            let mut at: Vec<f64> = self.synced.iter().flatten().copied().collect();
+            at.sort_by(f64::total_cmp);
+            let median = at.get(at.len() / 2).copied().unwrap_or(0.0);
+            let worst = at.last().copied().unwrap_or(0.0);
+            (median, worst, self.synced.len() - at.len())
+        }
+    }
+
     /// What `runs` runs of 40 revolutions of the missing-tooth wheel `positions`-`missing` do
     /// under edge jitter alone (σ `sigma`, of a pitch): steady (`ripple` 0) or cranking at
     /// ±`ripple` with two strokes, a phase drawn by `next` a run; one-edge samples,
-    /// one-revolution windows. The runs with a fault of any kind, the fault counters summed,
-    /// the valid windows, the edges numbered at a wrong tooth in sync (after a false fault,
-    /// until the count is given up or realigned), and the valid windows not framed at tooth 0.
+    /// one-revolution windows.
     fn jitter_runs(
         (positions, missing): (u8, u8),
         ripple: f64,
         sigma: f64,
         runs: u32,
         next: &mut impl FnMut(u64) -> u64,
-    ) -> (usize, EdgeCounters, usize, usize, usize) {
+    ) -> JitterRuns {
         let p = Pattern::missing_teeth(positions, missing);
         let teeth = pattern_angles(p);
         let pitch_ticks = TAU / f64::from(positions) / 25.0 * 1e6;
-        let (mut faulted, mut valid, mut misnumbered, mut framed_off) = (0, 0, 0, 0);
-        let mut d = EdgeCounters::default();
+        let mut r = JitterRuns::default();
         for _ in 0..runs {
             let phase = TAU * (next(1000) as f64) / 1000.0;
             let crank = cranking(25.0, ripple, phase);
@@ -2453,13 +2479,14 @@ mod tests {
             let f = framed(p, &evs, &truth_of(&evs, teeth.len()));
             let mut faults = EdgeCounters::default();
             add_faults(&mut faults, &f.counters);
-            faulted += usize::from(faults != EdgeCounters::default());
-            valid += f.valid;
-            misnumbered += f.misnumbered;
-            framed_off += f.wrong_windows;
-            add_faults(&mut d, &faults);
+            r.faulted += usize::from(faults != EdgeCounters::default());
+            r.valid += f.valid;
+            r.misnumbered += f.misnumbered;
+            r.framed_off += f.wrong_windows;
+            r.synced.push(f.synced);
+            add_faults(&mut r.counters, &faults);
         }
-        (faulted, d, valid, misnumbered, framed_off)
+        r
     }
 
     #[test]
@@ -2472,11 +2499,14 @@ mod tests {
         let (mut faulted, mut unexplained, mut valid) = (0, 0, 0);
         for wheel in [(36u8, 2u8), (60, 2)] {
             for ripple in [0.0, 0.3] {
-                let (f, d, v, _, off) = jitter_runs(wheel, ripple, 0.02, 20, &mut next);
-                assert_eq!(off, 0, "{wheel:?} ±{ripple}: valid windows framed off");
-                faulted += f;
-                unexplained += d.unexplained;
-                valid += v;
+                let r = jitter_runs(wheel, ripple, 0.02, 20, &mut next);
+                assert_eq!(
+                    r.framed_off, 0,
+                    "{wheel:?} ±{ripple}: valid windows framed off"
+                );
+                faulted += r.faulted;
+                unexplained += r.counters.unexplained;
+                valid += r.valid;
             }
         }
         assert!(
@@ -2486,29 +2516,64 @@ mod tests {
         assert!(valid >= 80 * 34, "{valid}");
     }
 
+    #[test]
+    fn small_wheels_cranking_under_jitter_sync_within_a_few_revolutions() {
+        // `jitter_census`'s runs of 8-1 and 12-1 wheels cranking at ±30 % with jitter of 2
+        // and 3 % of a pitch (σ), 20 runs each at random phases (the other rows' draws
+        // skipped): with the revolution's fit confirming a candidate on the last edge of its
+        // revolution of confirmation alone, and its bounds those set for 1 % jitter, a 12-1
+        // run at 2 % synced at revolution 35 and an 8-1 run at 3 % never did.
+        let mut next = lcg(0x5eed_0001);
+        for wheel in [(8u8, 1u8), (12, 1)] {
+            for ripple in [0.0, 0.3] {
+                for sigma in [0.01, 0.02, 0.03] {
+                    if ripple == 0.0 || sigma < 0.015 {
+                        for _ in 0..20 {
+                            next(1000);
+                            next(1 << 30);
+                        }
+                        continue;
+                    }
+                    let r = jitter_runs(wheel, ripple, sigma, 20, &mut next);
+                    let (_, latest, never) = r.syncs();
+                    assert_eq!(r.framed_off, 0, "{wheel:?} ±{ripple} {sigma}");
+                    assert_eq!(never, 0, "{wheel:?} ±{ripple} {sigma}");
+                    assert!(latest <= 6.0, "{wheel:?} ±{ripple} {sigma}: {latest}");
+                    assert!(
+                        r.valid >= 20 * 33,
+                        "{wheel:?} ±{ripple} {sigma}: {}",
+                        r.valid
+                    );
+                }
+            }
+        }
+    }
+
     /// False faults from edge jitter alone on missing-tooth wheels: per wheel, shaft (steady,
     /// or cranking at ±30 % with two strokes, a random phase a run) and jitter (σ, of a pitch),
     /// 20 runs of 40 revolutions (see [`jitter_runs`]): the runs with a fault of any kind, the
     /// faults by kind summed over the runs, the valid windows, the edges numbered at a wrong
-    /// tooth in sync and the valid windows not framed at tooth 0 (asserted none).
-    /// `JITTER_RUNS` sets the runs per row.
+    /// tooth in sync and the valid windows not framed at tooth 0 (asserted none); the
+    /// revolution of the first sync, median and latest over the runs that synced, and the runs
+    /// that never did. `JITTER_RUNS` sets the runs per row.
     #[test]
     #[ignore]
     fn jitter_census() {
         let runs: u32 = std::env::var("JITTER_RUNS").map_or(20, |s| s.parse().unwrap());
         let mut next = lcg(0x5eed_0001);
         let mut wrong = 0;
-        println!("wheel  shaft  σ      runs-faulted  missing glitch extra unexpl mframe slost  valid  misnum off");
+        println!("wheel  shaft  σ      runs-faulted  missing glitch extra unexpl mframe slost  valid  misnum off  sync-median latest never");
         for (positions, missing) in [(8u8, 1u8), (12, 1), (24, 1), (36, 1), (36, 2), (60, 2)] {
             for ripple in [0.0, 0.3] {
                 for sigma in [0.01, 0.02, 0.03] {
-                    let (faulted, d, valid, misnumbered, framed_off) =
-                        jitter_runs((positions, missing), ripple, sigma, runs, &mut next);
+                    let r = jitter_runs((positions, missing), ripple, sigma, runs, &mut next);
+                    let (d, (median, latest, never)) = (r.counters, r.syncs());
                     println!(
-                        "{positions:>2}-{missing}  ±{ripple:.1}   {sigma:.2}   {faulted:>3} of {runs:<3}    {:>6} {:>6} {:>5} {:>6} {:>6} {:>5} {valid:>6} {misnumbered:>5} {framed_off:>3}",
-                        d.missing, d.glitches, d.extra, d.unexplained, d.missing_frames, d.sync_losses
+                        "{positions:>2}-{missing}  ±{ripple:.1}   {sigma:.2}   {:>3} of {runs:<3}    {:>6} {:>6} {:>5} {:>6} {:>6} {:>5} {:>6} {:>5} {:>3}  {median:>11.1} {latest:>6.1} {never:>5}",
+                        r.faulted, d.missing, d.glitches, d.extra, d.unexplained, d.missing_frames,
+                        d.sync_losses, r.valid, r.misnumbered, r.framed_off
                     );
-                    wrong += framed_off;
+                    wrong += r.framed_off;
                 }
             }
         }

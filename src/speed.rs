@@ -275,7 +275,9 @@ const FIT_MIN_TEETH: u16 = 6;
 const FIT_PERIODIC: f32 = 0.223;
 /// A revolution decides an alignment whose residual is at most `FIT_FITS` ln²R while every
 /// other alignment's is at least `FIT_MISFITS` ln²R (`R` the smallest long pitch over the
-/// base): a gap put one tooth off costs about 2 ln²R before the ripple's share is taken out.
+/// base), both raised by what the edge jitter learnt leaves of a revolution (see
+/// [`SpeedTracker::fit_alignment`]): a gap put one tooth off costs about 2 ln²R before the
+/// ripple's share is taken out.
 #[cfg(feature = "pattern-wheels")]
 const FIT_FITS: f32 = 0.03;
 #[cfg(feature = "pattern-wheels")]
@@ -342,6 +344,10 @@ struct Revolution {
     /// The cost of the teeth after a gap (their chain of intervals against the recorded
     /// revolution, each at most the margin), learnt over the recent gaps.
     gaps: Learnt,
+    /// The square of each step of `d` that followed on (the ratio to the revolution before,
+    /// from tooth to tooth), learnt over the recent intervals: the edge jitter, as the fit sees
+    /// it.
+    scatter: Learnt,
 }
 
 /// A mean learnt from the values met: a running mean over the first `FRAME_MEMORY`, then an
@@ -381,6 +387,7 @@ impl Revolution {
         trend: 0.0,
         frames: Learnt::NEW,
         gaps: Learnt::NEW,
+        scatter: Learnt::NEW,
     };
 }
 
@@ -703,7 +710,7 @@ impl SpeedTracker {
         (*accepted, *lo, *width, *arrivals) = (z, z, z, z);
         (*anchor, *tooth, *stop, *nidx) = (0, 0, 0, 0);
         for f in fit {
-            (f.frames, f.gaps) = (Learnt::NEW, Learnt::NEW);
+            (f.frames, f.gaps, f.scatter) = (Learnt::NEW, Learnt::NEW, Learnt::NEW);
         }
         counters.clear(z);
     }
@@ -2221,11 +2228,14 @@ impl SpeedTracker {
         self.viable = rotate_left(self.viable, edges) & all;
         if let Some(at) = fitted {
             // The revolution's alignment, of this edge: it narrows as a special pitch does,
-            // and confirms a candidate on the last edge of its revolution of confirmation (a
-            // revolution of intervals after the one that made it, none shared: a fault
-            // makes one of them wrong, not both alike).
+            // and confirms a candidate from the last edge of its revolution of confirmation on
+            // (a revolution of intervals after the one that made it, none shared: a fault
+            // makes one of them wrong, not both alike). Not on that edge alone: where edge
+            // jitter left that one revolution undecided, only a pitch clearly special by its
+            // neighbours could confirm, and a 12-1 wheel cranking at ±30 % with jitter of 2 %
+            // of a pitch (σ) showed one 32 revolutions later.
             let allowed = 1u64.checked_shl(u32::from(at)).unwrap_or(0);
-            self.narrow(self.viable & allowed, allowed, self.confirm == 1);
+            self.narrow(self.viable & allowed, allowed, self.confirm <= 1);
         }
         if self.viable.count_ones() == 1 {
             let tooth = self.viable.trailing_zeros() as u16;
@@ -2318,6 +2328,10 @@ impl SpeedTracker {
             if f.len > edges && !(-FIT_PERIODIC..=FIT_PERIODIC).contains(&(d - f.d)) {
                 f.run = 0;
             } else {
+                if f.len > edges {
+                    let step = d - f.d;
+                    f.scatter.learn(step * step);
+                }
                 f.run = f.run.saturating_add(1).min(edges);
                 f.trend = if f.run == 1 {
                     d
@@ -2570,7 +2584,14 @@ impl SpeedTracker {
         }
         let scale = unit * unit;
         let smooth = ripple.get(at).is_some_and(|&a| a <= FIT_RIPPLE);
-        let decisive = first <= FIT_FITS * scale && second >= FIT_MISFITS * scale && smooth;
+        // What edge jitter of σ (of a pitch) alone leaves of a revolution: each interval's log
+        // scatters by 2σ², each step of `d` by 12σ² (three edges' second difference, in two
+        // revolutions), and the profile takes little of either, so about `edges`/6 steps' worth.
+        let jitter = f.scatter.mean * n / 6.0;
+        // Both bounds raised alike: a wrong alignment's residual carries the jitter too, so
+        // the gap between them that tells one from the other stays as it was set.
+        let decisive =
+            first <= FIT_FITS * scale + jitter && second >= FIT_MISFITS * scale + jitter && smooth;
         // (The best alignment explains the revolution at all: the profile and the pattern
         // leave little of it.)
         let explains = first <= FIT_EXPLAINS * scale;
