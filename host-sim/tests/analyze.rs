@@ -832,6 +832,37 @@ fn scene_wheel_keys_are_checked_by_name() {
     );
     let e = err("lines = 36\ngaps = [[40, 2]]");
     assert!(e.contains("`encoder.gaps[1][1] = 40`"), "{e}");
+    // Gaps that overlap, repeat or touch are one gap of another length: refused, both named
+    // (they were merged into a 36-3 or a 36-2 wheel without a word).
+    for (gaps, second, how) in [
+        (
+            "[[0, 2], [1, 2]]",
+            "[1, 2]",
+            "overlaps encoder.gaps[1] = [0, 2]",
+        ),
+        (
+            "[[0, 2], [0, 2]]",
+            "[0, 2]",
+            "overlaps encoder.gaps[1] = [0, 2]",
+        ),
+        (
+            "[[0, 2], [2, 1]]",
+            "[2, 1]",
+            "touches encoder.gaps[1] = [0, 2]",
+        ),
+        (
+            "[[34, 2], [0, 1]]",
+            "[0, 1]",
+            "touches encoder.gaps[1] = [34, 2]",
+        ),
+    ] {
+        let e = err(&format!("lines = 36\ngaps = {gaps}"));
+        assert!(
+            e.contains(&format!("`encoder.gaps[2] = {second}`")) && e.contains(how),
+            "{gaps}: {e}"
+        );
+    }
+    assert!(err("lines = 36\ngaps = [[0, 2], [3, 1]]").is_empty());
     let e = err("lines = 24\nteeth = [0, 2, 2]");
     assert!(
         e.contains("`encoder.teeth[3] = 2`") && e.contains("twice"),
@@ -1561,17 +1592,64 @@ fn options_out_of_range_name_their_range() {
         ..AnalyzeOptions::default()
     });
     assert!(
-        e.contains("--lines is out of range: a disc has 2 to 8192 lines"),
+        e.contains("--lines 0 is out of range: a disc has 2 to 8192 lines"),
         "{e}"
+    );
+    // More lines than the analysis's monitor holds (the core's bound is wider): refused here,
+    // with the range (was: "`edges per revolution` exceeds the fixed capacity").
+    let e = err(AnalyzeOptions {
+        lines: Some(9000),
+        ..AnalyzeOptions::default()
+    });
+    assert_eq!(
+        e,
+        "--lines 9000 is out of range: a disc has 2 to 8192 lines"
     );
     let e = err(AnalyzeOptions {
         estimator_edges: Some(40),
         ..wheel("36-1")
     });
     assert!(
-        e.contains("--estimator-edges is out of range: a speed sample spans 1 to 32"),
+        e.contains("--estimator-edges 40 is out of range: a speed sample spans 1 to 32"),
         "{e}"
     );
+    let e = err(AnalyzeOptions {
+        estimator_edges: Some(8),
+        ..wheel("8-1")
+    });
+    assert!(e.ends_with("(7 here: the wheel's teeth)"), "{e}");
+    for (o, said) in [
+        (
+            AnalyzeOptions {
+                counter_bits: Some(8),
+                ..wheel("36-1")
+            },
+            "--counter-bits 8 is out of range: the counter is 16 to 32 bits wide",
+        ),
+        (
+            AnalyzeOptions {
+                window_revolutions: Some(0),
+                ..wheel("36-1")
+            },
+            "--window-revolutions 0 is out of range: a window is 1 to 1024 revolutions",
+        ),
+        (
+            AnalyzeOptions {
+                window_revolutions: Some(5000),
+                ..wheel("36-1")
+            },
+            "--window-revolutions 5000 is out of range: a window is 1 to 1024 revolutions",
+        ),
+        (
+            AnalyzeOptions {
+                prescaler: Some(3),
+                ..wheel("36-1")
+            },
+            "--prescaler 3 is out of range: the input prescaler is 1, 2, 4 or 8",
+        ),
+    ] {
+        assert_eq!(err(o), said);
+    }
     // A sample longer than a revolution's captures says how many those are.
     let e = err(AnalyzeOptions {
         lines: Some(64),
@@ -1604,7 +1682,9 @@ fn options_out_of_range_name_their_range() {
     for w in ["36-36", "36-34", "100-2"] {
         let e = err(wheel(w));
         assert!(
-            e.starts_with("--wheel is out of range: a wheel N-M has 3 to 128 positions"),
+            e.starts_with(&format!(
+                "--wheel {w} is out of range: a wheel N-M has 3 to 128 positions"
+            )),
             "{w}: {e}"
         );
         assert!(!e.contains("pattern."), "{w}: {e}");

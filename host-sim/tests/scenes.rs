@@ -1027,3 +1027,22 @@ fn predict_judges_the_supports_at_its_own_drive_speed() {
     assert_eq!(u.predicted_speed, None);
     assert_eq!(u.above_service_speed, None);
 }
+
+/// A minimum speed above the shaft's: every interval is a standstill, and the run says so,
+/// naming `monitor.min_speed` (it said only that no window was completed, "the run is shorter
+/// than one window, or never framed a revolution").
+#[test]
+fn a_minimum_speed_above_the_shafts_is_named_when_nothing_is_measured() {
+    let scene = "[simulation]\nduration = 1\n[motor]\nmodel = \"speed\"\nspeed = 100.0\n\
+                 [encoder]\nlines = 360\ntimer_hz = 1e6\n[monitor]\nmin_speed = 200.0\n";
+    let r = run_trial(scene);
+    let why = r.no_measurement.expect("nothing measured");
+    assert!(
+        why.contains("the core took no edge as running")
+            && why.contains("`monitor.min_speed = 200` rad/s")
+            && !why.contains("the run is shorter"),
+        "{why}"
+    );
+    let r = run_trial(&scene.replace("min_speed = 200.0", "min_speed = 50.0"));
+    assert!(r.no_measurement.is_none(), "{:?}", r.no_measurement);
+}

@@ -2272,6 +2272,35 @@ fn option_of(parameter: &str) -> &'static str {
     }
 }
 
+/// The option a core parameter comes from with the value it has (`--wheel 36-40`,
+/// `--estimator-edges 33`), or where the scene gives it, the option alone.
+fn option_given(o: &AnalyzeOptions, enc: &EncoderConfig, parameter: &str) -> String {
+    use drive_monitor::encoder::{Estimator, Wheel};
+    let option = option_of(parameter);
+    let value = match parameter {
+        p if p.starts_with("pattern") => o.wheel.clone(),
+        "lines" => o.lines.map(|n| n.to_string()),
+        "estimator.edges" => o.estimator_edges.map(|_| {
+            let Estimator::Edges(k) = enc.estimator;
+            k.to_string()
+        }),
+        "prescaler" => o.prescaler.map(|p| p.to_string()),
+        "counter_bits" => o.counter_bits.map(|b| b.to_string()),
+        "timer_hz" => o.timer_hz.map(|h| h.to_string()),
+        "min_speed" => o.min_speed.map(|w| w.to_string()),
+        "window.revolutions" => o.window_revolutions.map(|n| n.to_string()),
+        _ => None,
+    };
+    match (value, enc.wheel) {
+        (Some(v), _) => format!("{option} {v}"),
+        // From a scene: its key, with the value.
+        (None, Wheel::Indexed { lines } | Wheel::Unframed { lines }) if parameter == "lines" => {
+            format!("the scene's `encoder.lines = {lines}`")
+        }
+        (None, _) => option.to_string(),
+    }
+}
+
 /// The allowed values of an encoder parameter with a fixed range, as the options give them.
 fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
     use drive_monitor::encoder::{MAX_PATTERN_POSITIONS, MAX_PATTERN_TEETH, MAX_SPAN};
@@ -2286,6 +2315,12 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
              a revolution"
         )),
         OutOfRange("prescaler") => Some("the input prescaler is 1, 2, 4 or 8".into()),
+        OutOfRange("counter_bits") => Some("the counter is 16 to 32 bits wide".into()),
+        OutOfRange("timer_hz") => Some("the timer clock is 1 Hz to 10 GHz".into()),
+        OutOfRange("window.revolutions") => Some(format!(
+            "a window is 1 to {} revolutions",
+            drive_monitor::irregularity::MAX_WINDOW_REVS
+        )),
         OutOfRange("pattern.positions" | "pattern.teeth" | "pattern.gaps")
         | Capacity("pattern.teeth") => Some(format!(
             "a wheel N-M has 3 to {MAX_PATTERN_POSITIONS} positions, of which M are missing and \
@@ -2377,10 +2412,25 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         length: WindowLength::Revolutions(1),
         steady_tolerance: 0.02,
     });
+    // A disc of more lines than the analysis's monitor holds (the core's own bound is wider).
+    if let drive_monitor::encoder::Wheel::Indexed { lines }
+    | drive_monitor::encoder::Wheel::Unframed { lines } = enc.wheel
+    {
+        if usize::from(lines) > MAX_LINES {
+            return Err(format!(
+                "{} is out of range: {}",
+                option_given(o, &enc, "lines"),
+                allowed(drive_monitor::ConfigError::OutOfRange("lines")).unwrap_or_default()
+            ));
+        }
+    }
     Encoder::new(enc).map_err(|e| {
         // A value outside a fixed range: say the range in the option's own terms.
         if let Some(range) = allowed(e) {
-            let mut m = format!("{} is out of range: {range}", option_of(e.parameter()));
+            let mut m = format!(
+                "{} is out of range: {range}",
+                option_given(o, &enc, e.parameter())
+            );
             // How many that is here, on a disc (a wheel's teeth are its own).
             if let (
                 drive_monitor::ConfigError::OutOfRange("estimator.edges"),
@@ -2393,6 +2443,13 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
                     " ({per} here: {lines} lines, one captured in {})",
                     enc.prescaler
                 ));
+            }
+            if let (
+                drive_monitor::ConfigError::OutOfRange("estimator.edges"),
+                drive_monitor::encoder::Wheel::Pattern(p),
+            ) = (e, enc.wheel)
+            {
+                m.push_str(&format!(" ({} here: the wheel's teeth)", p.teeth()));
             }
             return m;
         }
@@ -2432,9 +2489,13 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         }
         m
     })?;
-    window
-        .validate()
-        .map_err(|e| format!("{}: {e}", option_of(e.parameter())))?;
+    window.validate().map_err(|e| match allowed(e) {
+        Some(range) => format!(
+            "{} is out of range: {range}",
+            option_given(o, &enc, e.parameter())
+        ),
+        None => format!("{}: {e}", option_of(e.parameter())),
+    })?;
     let index = matches!(enc.wheel, drive_monitor::encoder::Wheel::Indexed { .. });
     if o.index_channel.is_some() && !index {
         return Err("--index-channel goes with an index disc (--lines N --framing index, or a scene whose framing is \"index\")".into());

@@ -635,7 +635,7 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
     let both = |a: &str, b: &str, why: &str| {
         c.bad(
             b,
-            c.shown(b, "?"),
+            "?",
             format!("not together with `{a} = {}`: {why}", c.shown(a, "?")),
         )
     };
@@ -762,7 +762,7 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
                 if m == 0 || u16::from(m) + 3 > lines {
                     return Err(c.bad(
                         key,
-                        c.shown(key, m),
+                        m,
                         format!(
                             "missing teeth: 1 to {} on {lines} positions (3 teeth at least)",
                             lines.saturating_sub(3)
@@ -790,6 +790,8 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
                     }
                     (Some(gaps), None) => {
                         let mut present = vec![true; usize::from(lines)];
+                        // The gap each missing position belongs to.
+                        let mut owner: Vec<Option<usize>> = vec![None; usize::from(lines)];
                         for (i, &[start, count]) in gaps.iter().enumerate() {
                             let k = format!("encoder.gaps[{}]", i + 1);
                             if start >= lines {
@@ -806,8 +808,36 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
                                     format!("missing positions, 1 to {}", lines - 1),
                                 ));
                             }
+                            // Each gap once, with a tooth after it before the next: gaps
+                            // that overlap or touch are one gap of another length, a
+                            // different wheel than the list says.
+                            let at = |p: u16| usize::from(p % lines);
+                            let before = start + lines - 1;
+                            let after = start + count;
+                            let clash = (start..start + count)
+                                .map(|p| (owner[at(p)], "overlaps"))
+                                .chain([
+                                    (owner[at(before)], "touches"),
+                                    (owner[at(after)], "touches"),
+                                ])
+                                .find_map(|(o, how)| o.map(|j| (j, how)));
+                            if let Some((j, how)) = clash {
+                                return Err(c.bad(
+                                    &k,
+                                    format!("[{start}, {count}]"),
+                                    format!(
+                                        "{how} encoder.gaps[{}] = [{}, {}]: list each gap once, \
+                                         with at least one tooth between two gaps (gaps that \
+                                         meet are one gap of their positions together)",
+                                        j + 1,
+                                        gaps[j][0],
+                                        gaps[j][1]
+                                    ),
+                                ));
+                            }
                             for p in start..start + count {
-                                present[usize::from(p % lines)] = false;
+                                present[at(p)] = false;
+                                owner[at(p)] = Some(i);
                             }
                         }
                         all.into_iter()
@@ -857,7 +887,7 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
     if matches!(framing, FramingSpec::MissingTooth) && teeth.len() > most {
         return Err(c.bad(
             lines_key,
-            c.shown(lines_key, lines),
+            lines,
             format!("a missing-tooth wheel has at most {most} teeth"),
         ));
     }

@@ -1749,7 +1749,29 @@ fn measurement(report: &mut RunReport, col: &mut Collector) {
     report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
     report.speed_peak_measured = col.last_window.map(|w| w.omega_max as f64);
     if d.valid_windows == 0 {
-        report.no_measurement = Some(nothing_measured(report, col.edges, col.reverse_edges));
+        let mut why = nothing_measured(report, col.edges, col.reverse_edges);
+        // Edges slower than the minimum speed allows are a shaft at rest (never running, or
+        // timed out): no window completes, and the run is not too short.
+        let min_speed = m.encoder().config().min_speed;
+        if col.edges > 0 && d.edges.accepted == 0 {
+            // (In place of the general "no window was completed".)
+            why = why.replace(
+                "no window was completed (the run is shorter than one window, or never framed a \
+                 revolution)",
+                "no window was completed",
+            );
+            why.push_str(&format!(
+                ": the core took no edge as running, every interval between edges was longer \
+                 than the standstill timeout `monitor.min_speed = {min_speed}` rad/s sets"
+            ));
+        } else if d.edges.timeouts > 0 {
+            why.push_str(&format!(
+                "; the core timed out {} time(s), taking the shaft for stopped: it turned slower \
+                 than `monitor.min_speed = {min_speed}` rad/s between edges",
+                d.edges.timeouts
+            ));
+        }
+        report.no_measurement = Some(why);
     }
 }
 

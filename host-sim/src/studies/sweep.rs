@@ -354,7 +354,7 @@ pub fn sweep(
     if !(from.is_finite() && to.is_finite() && from > 0.0 && to > from) {
         return Err(bad(
             "--from/--to",
-            format!("need 0 < from < to, got {from} and {to}"),
+            format!("need finite speeds 0 < from < to, got {from} and {to}"),
         ));
     }
     let max = crate::app::check::MAX_SPEED;

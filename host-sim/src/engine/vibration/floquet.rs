@@ -653,7 +653,7 @@ impl Floquet {
         } = *opts;
         if !(from.is_finite() && to.is_finite() && from > 0.0 && to > from) {
             return Err(StabilityError::Input(format!(
-                "need 0 < from < to, got {from} and {to}"
+                "need finite speeds 0 < from < to, got {from} and {to}"
             )));
         }
         if per_octave < 2 || !(1e-12..=1e-2).contains(&rel_tol) {
