@@ -1046,3 +1046,27 @@ fn a_minimum_speed_above_the_shafts_is_named_when_nothing_is_measured() {
     let r = run_trial(&scene.replace("min_speed = 200.0", "min_speed = 50.0"));
     assert!(r.no_measurement.is_none(), "{:?}", r.no_measurement);
 }
+
+/// A mean load above the motor's torque at standstill: no speed carries it, and started at rest
+/// the shaft ran backwards until the integration failed, naming the step size. Refused naming
+/// `load.mean`, the standstill torque and `shaft.initial_speed` (a run-down's start).
+#[test]
+fn a_load_the_motor_cannot_start_is_named() {
+    let kneader = include_str!("../scenes/kneader.toml");
+    let stalled = kneader.replace("mean = 24.0", "mean = 200.0");
+    assert_ne!(
+        stalled, kneader,
+        "the kneader's mean load is written as 24.0"
+    );
+    let path = std::path::Path::new("stall.toml");
+    let scene = host_sim::app::scene::Scene::parse(&stalled, path).unwrap();
+    let e = host_sim::app::run::run(&scene, path, host_sim::app::run::Overrides::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`load.mean = 200.0`")
+            && e.contains("the motor's torque at standstill (168.")
+            && e.contains("shaft.initial_speed"),
+        "{e}"
+    );
+}

@@ -1133,6 +1133,23 @@ fn shaft_model(
             })?;
             effects.push(Box::new(model.motor));
             names.push("motor");
+            // No speed carries a mean load at or above the torque at standstill: started at
+            // rest the shaft is driven backwards without bound (the integration failed, naming
+            // the step size, not the load). Said, unless a start is given (a run-down).
+            let mean = scene.load.as_ref().map_or(0.0, |l| l.mean);
+            let standstill = model.motor.torque(0.0);
+            if shaft.initial_speed.is_none() && model.u_start <= 0.0 && standstill <= mean {
+                return Err(scene.checker(file).bad(
+                    "load.mean",
+                    mean,
+                    format!(
+                        "the mean load is at least the motor's torque at standstill ({standstill:.4} \
+                         N·m): started at rest the shaft would be driven backwards, and no speed \
+                         the drive model finds carries it (`drive-sim predict` shows the drive); \
+                         give `shaft.initial_speed` to simulate a run-down"
+                    ),
+                ));
+            }
             // Start at the predicted mean speed (or the given one) to shorten the transient.
             let omega0 = shaft
                 .initial_speed

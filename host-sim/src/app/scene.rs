@@ -198,7 +198,8 @@ pub struct ShaftSpec {
     /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase).
     #[serde(default)]
     pub inertia_harmonics: Vec<Harmonic>,
-    /// Initial speed, rad/s (default: the motor's no-load or prescribed speed).
+    /// Initial speed, rad/s (default: the drive model's mean speed, where the motor carries
+    /// the mean load; without one, a run needs it).
     #[serde(default)]
     pub initial_speed: Option<f64>,
 }
