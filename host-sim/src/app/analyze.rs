@@ -1555,9 +1555,10 @@ impl TimeGrid {
 }
 
 /// Rows a block of [`Resolution`] holds: few enough to follow a resolution that changes along
-/// the file, enough that whole-nanosecond times on a fine grid seldom share a coarser step by
-/// chance (fifteen offsets all even: 1 in 32 768).
-pub const BLOCK_ROWS: usize = 16;
+/// the file, enough that times on a fine grid practically never share a coarser step by chance
+/// (31 offsets all even: 1 in 2·10⁹; with 16 rows, 1 in 32 768 blocks, and a capture of 10
+/// minutes has some 40 000).
+pub const BLOCK_ROWS: usize = 32;
 
 /// The resolution of the times along the file, block by block of [`BLOCK_ROWS`] rows: the step
 /// the block's times lie on ([`TimeGrid`]), or what f64 numbers resolve at its largest time,
