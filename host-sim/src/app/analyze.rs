@@ -1562,7 +1562,7 @@ pub const BLOCK_ROWS: usize = 32;
 
 /// The resolution of the times along the file, block by block of [`BLOCK_ROWS`] rows: the step
 /// the block's times lie on ([`TimeGrid`]), or what f64 numbers resolve at its largest time,
-/// whichever is coarser. Kept where it changes (memory bounded by the changes).
+/// whichever is coarser. Kept where it changes, for at most [`MAX_LISTED`] changes.
 #[derive(Default)]
 struct Resolution {
     /// The timer clock, Hz.
@@ -1598,8 +1598,13 @@ impl Resolution {
             let spacing = |x: f64| f64::from_bits(x.to_bits() + 1) - x;
             let f64s = spacing(self.largest) + spacing(self.largest * self.hz) / self.hz;
             let res = self.block.step().unwrap_or(0.0).max(f64s);
-            if self.changes.last().is_none_or(|&(_, r)| r != res) {
-                self.changes.push((self.start, res));
+            let full = self.changes.len() >= MAX_LISTED;
+            match self.changes.last_mut() {
+                Some((_, r)) if *r == res => {}
+                // Memory bounded whatever the file's length: past the last entry kept, the
+                // coarsest is kept (a floor only widens).
+                Some((_, r)) if full => *r = r.max(res),
+                _ => self.changes.push((self.start, res)),
             }
         }
         self.rows = 0;
@@ -2525,4 +2530,37 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
 
 fn unreachable_wheel() -> Result<(EncoderConfig, Option<WindowConfig>), String> {
     Err("name the wheel: --wheel, --lines or --scene".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Resolution, BLOCK_ROWS, MAX_LISTED};
+
+    /// Blocks whose grid alternates (1 µs, then 2 µs) change the resolution every block: the
+    /// changes kept stop at [`MAX_LISTED`], the last of them the coarsest met since, and each
+    /// span reads the coarsest of its blocks.
+    #[test]
+    fn the_resolution_kept_is_bounded_and_the_coarsest() {
+        let mut r = Resolution {
+            hz: 1e6,
+            ..Resolution::default()
+        };
+        let (mut t, mut us) = (0.0f64, 0u64);
+        let blocks = MAX_LISTED + 100;
+        for b in 0..blocks {
+            // 1 µs steps in even blocks (offsets 1, 2, 3 ... µs), 2 µs in odd ones.
+            let step = if b % 2 == 0 { 1 } else { 2 };
+            for _ in 0..BLOCK_ROWS {
+                us += step;
+                t = us as f64 * 1e-6;
+                r.row(t);
+            }
+        }
+        assert_eq!(r.changes.len(), MAX_LISTED);
+        assert!((r.changes[0].1 - 1e-6).abs() < 1e-12, "{:?}", r.changes[0]);
+        assert!((r.changes[1].1 - 2e-6).abs() < 1e-12, "{:?}", r.changes[1]);
+        assert!((r.changes[MAX_LISTED - 1].1 - 2e-6).abs() < 1e-12);
+        assert!((r.over(0.0, t) - 2e-6).abs() < 1e-12);
+        assert!((r.over(0.0, 1e-6) - 1e-6).abs() < 1e-12);
+    }
 }
