@@ -147,6 +147,15 @@ struct Params {
 }
 
 impl Params {
+    /// The case's first eight `CRANK_CASE` arguments: n m a z ph nphase σ seed.
+    fn case_args(&self) -> String {
+        let p = self;
+        format!(
+            "{} {} {} {} {} {} {} {}",
+            p.n, p.m, p.a, p.z, p.ph, p.nphase, p.sigma, p.seed
+        )
+    }
+
     fn phase(&self) -> f64 {
         TAU * f64::from(self.ph) / f64::from(self.nphase)
     }
@@ -479,7 +488,7 @@ fn check_run(
         lines.push(format!(
             "WRONG wheel {}-{} a={} z={} phase={}/{}·2π σ={} seed={} K={k} W={w} fault: {} | \
              window start {} end {} edges {}..{} δ={got:.5} | {} | expected: {expected} | \
-             CRANK_CASE='{} {} {} {} {} {} {} {} {k} {w} {}'",
+             CRANK_CASE='{} {k} {w} {}'",
             p.n,
             p.m,
             p.a,
@@ -494,14 +503,7 @@ fn check_run(
             r.start_edge,
             r.end_edge,
             bad.join("; "),
-            p.n,
-            p.m,
-            p.a,
-            p.z,
-            p.ph,
-            p.nphase,
-            p.sigma,
-            p.seed,
+            p.case_args(),
             f.arg(),
         ));
     }

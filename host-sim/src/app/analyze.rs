@@ -607,6 +607,13 @@ pub struct SpacingSeen {
     pub ratio: f64,
 }
 
+impl SpacingSeen {
+    /// The pitches of the long interval ending it, as its ratio reads them.
+    fn pitches(&self) -> u64 {
+        self.ratio.round() as u64
+    }
+}
+
 /// An interval more than this many times the geometric mean of its two neighbours is long (a
 /// gap): a 36-1 wheel's is 2, a tooth's on a cranking shaft stays well below.
 pub const LONG_RATIO: f64 = 1.5;
@@ -797,9 +804,8 @@ fn in_words(items: &[String]) -> String {
 
 /// The recurring gaps of a capture in words, with the wheel they suggest.
 fn seen_gaps(g: &GapsSeen) -> String {
-    let pitches = |s: &SpacingSeen| s.ratio.round() as u64;
     if let [s] = g.spacings.as_slice() {
-        let missing = pitches(s).saturating_sub(1);
+        let missing = s.pitches().saturating_sub(1);
         let guess = if missing >= 1 && s.every + missing <= 255 {
             format!(" (a {}-{missing} wheel?)", s.every + missing)
         } else {
@@ -817,7 +823,7 @@ fn seen_gaps(g: &GapsSeen) -> String {
     let positions: u64 = g
         .spacings
         .iter()
-        .map(|s| s.every + pitches(s).saturating_sub(1))
+        .map(|s| s.every + s.pitches().saturating_sub(1))
         .sum();
     let gaps = g.spacings.len();
     format!(
@@ -900,13 +906,12 @@ fn sync_hint(
         };
         match &gaps {
             Some(g) => {
-                let pitches = |s: &SpacingSeen| s.ratio.round() as u64;
                 // Each recurring gap the wheel has: a run of as many teeth ending in a gap of
                 // as many pitches.
                 let agree = g
                     .spacings
                     .iter()
-                    .all(|s| runs.contains(&(s.every, pitches(s))));
+                    .all(|s| runs.contains(&(s.every, s.pitches())));
                 if !agree {
                     causes.push(format!(
                         "no sync: the configured {name} {expected}; in the capture {}",

@@ -1766,34 +1766,21 @@ fn measurement(report: &mut RunReport, col: &mut Collector) {
     report.speed_measured = col.last_window.map(|w| w.omega_mean as f64);
     report.speed_peak_measured = col.last_window.map(|w| w.omega_max as f64);
     if d.valid_windows == 0 {
-        let mut why = nothing_measured(report, col.edges, col.reverse_edges);
-        // Edges slower than the minimum speed allows are a shaft at rest (never running, or
-        // timed out): no window completes, and the run is not too short.
         let min_speed = m.encoder().config().min_speed;
-        if col.edges > 0 && d.edges.accepted == 0 {
-            // (In place of the general "no window was completed".)
-            why = why.replace(
-                "no window was completed (the run is shorter than one window, or never framed a \
-                 revolution)",
-                "no window was completed",
-            );
-            why.push_str(&format!(
-                ": the core took no edge as running, every interval between edges was longer \
-                 than the standstill timeout `monitor.min_speed = {min_speed}` rad/s sets"
-            ));
-        } else if d.edges.timeouts > 0 {
-            why.push_str(&format!(
-                "; the core timed out {} time(s), taking the shaft for stopped: it turned slower \
-                 than `monitor.min_speed = {min_speed}` rad/s between edges",
-                d.edges.timeouts
-            ));
-        }
+        let why = nothing_measured(report, col, &d.edges, min_speed);
         report.no_measurement = Some(why);
     }
 }
 
-/// Why the core measured no valid window, from what the run saw.
-fn nothing_measured(r: &RunReport, edges: u64, reverse: u64) -> String {
+/// Why the core measured no valid window, from what the run saw and the core counted
+/// (`min_speed` the core's, rad/s).
+fn nothing_measured(
+    r: &RunReport,
+    col: &Collector,
+    core: &drive_monitor::speed::EdgeCounters,
+    min_speed: f64,
+) -> String {
+    let (edges, reverse) = (col.edges, col.reverse_edges);
     let mut why = Vec::new();
     if edges == 0 {
         why.push("the encoder produced no edge (the shaft did not turn)".to_string());
@@ -1822,8 +1809,23 @@ fn nothing_measured(r: &RunReport, edges: u64, reverse: u64) -> String {
             r.invalid_windows,
             reasons.join(", ")
         ));
+    } else if edges > 0 && core.accepted == 0 {
+        // Edges slower than the minimum speed allows are a shaft at rest: no window completes,
+        // and the run is not too short.
+        why.push(format!(
+            "no window was completed: the core took no edge as running, every interval between \
+             edges was longer than the standstill timeout `monitor.min_speed = {min_speed}` rad/s \
+             sets"
+        ));
     } else if edges > 0 {
         why.push("no window was completed (the run is shorter than one window, or never framed a revolution)".to_string());
+    }
+    if core.accepted > 0 && core.timeouts > 0 {
+        why.push(format!(
+            "the core timed out {} time(s), taking the shaft for stopped: it turned slower than \
+             `monitor.min_speed = {min_speed}` rad/s between edges",
+            core.timeouts
+        ));
     }
     format!("no valid δ window: {}", why.join("; "))
 }
