@@ -1103,3 +1103,95 @@ fn a_steady_self_oscillation_of_the_loads_is_not_unsettled() {
         "{why}"
     );
 }
+
+/// A one-platform machine (530 kg on 34 074 N/m, three rollers, resonance 7.956 rad/s) whose
+/// balancing position grows or decays at a few 1e-4 1/s at most: an e-folding of 4 600 s and
+/// more. Started near the balancing position (one load 0.05 rad forward, a residual of
+/// 2.94e-2 of the rotor's), its loads have hardly moved in 200 s.
+fn slow_machine(speed: f64, duration: f64) -> host_sim::app::scene::Scene {
+    let text = format!(
+        "description = \"slow machine\"\n[[platform]]\nmass = 530.388\nstiffness = 34073.7\n\
+         damping = 102.703\n[autobalancer]\nkind = \"roller\"\nplatform = 1\nloads = 3\n\
+         load_mass = 0.158\nradius = 0.181\nhousing_mass = 7.42\nviscosity = 34.38\n\
+         rotor_unbalance = 0.04858\n[motor]\nmodel = \"speed\"\nspeed = {speed:?}\n\
+         [simulation]\nduration = {duration:?}\nrtol = 1e-8\natol = 1e-10\n"
+    );
+    host_sim::app::scene::Scene::parse(&text, std::path::Path::new("slow.toml")).unwrap()
+}
+
+/// At 12 rad/s the slow machine's balancing position is stable (σ = −2.16e-4 1/s). `run`
+/// held it 200 s (0.04 e-foldings) and called the residual, still at its starting offset
+/// (2.78e-2 to 2.82e-2 of the rotor's, against 2.94e-2 at the start), a steady
+/// self-oscillation about an unstable balancing position: gathering. A residual that never
+/// reached the 10 % gathering needs is unsettled, and `run` says how short the run was.
+#[test]
+fn a_residual_still_at_its_starting_offset_is_unsettled_not_a_self_oscillation() {
+    use host_sim::app::run::{run_with, Overrides, RunOptions};
+    let scene = slow_machine(12.0, 200.0);
+    let options = RunOptions {
+        progress: false,
+        keep_windows: false,
+        ..RunOptions::default()
+    };
+    let r = run_with(
+        &scene,
+        std::path::Path::new("slow.toml"),
+        Overrides::default(),
+        options,
+    )
+    .unwrap();
+    assert_eq!(
+        r.regime_simulated,
+        Some("unsettled"),
+        "{:?}",
+        r.regime_swing
+    );
+    assert!(r.regime_swing.is_none(), "{:?}", r.regime_swing);
+    let d = r.regime_detail.unwrap();
+    // The residual where it started: one load 0.05 rad forward leaves m·R·0.05/D.
+    let start = 0.158 * 0.181 * 0.05 / 0.04858;
+    assert!(
+        (d.residual_initial_relative / start - 1.0).abs() < 0.01,
+        "{d:?}"
+    );
+    assert!(
+        d.residual_relative < 0.1 && d.residual_relative > 0.9 * start,
+        "{d:?}"
+    );
+    let why = r.regime_unsettled.unwrap_or_default();
+    assert!(
+        why.contains("under the 10 % gathering needs")
+            && why.contains("decays")
+            && why.contains("the 200 s run spans 0.04 of them"),
+        "{why}"
+    );
+}
+
+/// A sweep of the slow machine at 6 rad/s (core class gathering, σ = +5.6e-5 1/s) and 12
+/// rad/s (balancing, σ = −2.16e-4 1/s), the scene's 5 s base lengthened to at most 400 s:
+/// far short of an e-folding. It said gathering at both, agreeing at 6 and ≠ at 12; neither
+/// is decided, and neither counts as agreeing or disagreeing.
+#[test]
+fn a_sweep_judges_no_speed_its_runs_are_too_short_for() {
+    use host_sim::studies::sweep::{sweep, SweepRequest};
+    let scene = slow_machine(12.0, 5.0);
+    let request = SweepRequest {
+        from: 6.0,
+        to: 12.0,
+        steps: 2,
+        together: false,
+    };
+    let s = sweep(&scene, std::path::Path::new("slow.toml"), &request, false).unwrap();
+    let classes: Vec<_> = s.points.iter().map(|p| p.regime_class).collect();
+    assert_eq!(classes, ["gathering", "balancing"]);
+    for p in &s.points {
+        assert_eq!(p.regime_simulated, "unsettled", "{p:?}");
+        assert!(!p.contradicts(), "{p:?}");
+        assert!(p.residual_relative < 0.1, "{p:?}");
+        let why = p.regime_unsettled.as_deref().unwrap_or("");
+        assert!(why.contains("e-folding"), "{why}");
+    }
+    assert_eq!((s.committed, s.committed_agreeing, s.unsettled), (2, 0, 2));
+    assert_eq!((s.away_from_characteristic, s.agreeing), (2, 0));
+    assert!(s.markdown().contains("2 speeds did not settle"));
+}

@@ -19,6 +19,7 @@ use crate::engine::rotor_loads::{RotorLoads, RotorLoadsParams, StaticLoadParams,
 use crate::engine::system::{
     DynamicShaft, InertiaHarmonic, Observer, ShaftModel, Simulation, SpeedLaw, StepView, System,
 };
+use crate::engine::vibration::regime::{AWAY, BALANCED};
 use crate::engine::vibration::{
     classify, AutoBalancerParams, CouplingParams, InitialParams, LoadKind, LoadPlacement,
     PlatformParams, Regime as SimRegime, RegimeCriteria, RegimeReport, RegimeSample,
@@ -214,7 +215,8 @@ pub struct RunReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_coincident: Option<String>,
     /// The loads settled into a steady oscillation about the balancing position (simulated
-    /// "gathering": not balancing), with its residual range.
+    /// "gathering": not balancing, the residual reaching 10 % of the rotor's and back), with
+    /// its residual range.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub regime_swing: Option<String>,
     /// What the loads did in the simulation: "balancing" | "saturated" (a balancer too small
@@ -1876,12 +1878,17 @@ fn regime(
                 None
             };
             let duration = scene.simulation.duration;
-            // A residual that comes back below 10 % but swings alike in every quarter of the
-            // final window has settled: a self-oscillation about an unstable balancing
-            // position (not balancing: it reaches 10 % and more), which a longer run leaves
-            // as it is.
+            // Not balancing is gathering only once the residual reaches 10 % in the final
+            // quarter: a run started near the balancing position begins below that, and one
+            // that never got there may just not have moved yet (a growth or decay of 1/4700 s
+            // left a 200 s run's residual at its starting offset, steady to 3 %).
+            let reached = r.residual_relative >= AWAY;
+            // A residual that reaches 10 % and comes back below it, swinging alike in every
+            // quarter of the final window, has settled: a self-oscillation about an unstable
+            // balancing position, which a longer run leaves as it is.
             let swinging = r.regime == SimRegime::Gathering
-                && r.residual_min_relative < UNSETTLED_AWAY
+                && reached
+                && r.residual_min_relative < AWAY
                 && r.steady
                 && !r.gathered
                 && !r.lagging;
@@ -1934,7 +1941,8 @@ fn regime(
                      stable: the loads were still on their way (lengthen simulation.duration)",
                     r.residual_relative
                 )),
-                SimRegime::Gathering if r.residual_min_relative < UNSETTLED_AWAY && !swinging => {
+                SimRegime::Gathering if !reached => Some(short_of_away(vm, &r, duration)),
+                SimRegime::Gathering if r.residual_min_relative < AWAY && !swinging => {
                     Some(format!(
                         "the residual unbalance over the final quarter went from {:.2e} to \
                          {:.2e} of the rotor's: up to {:.0} % and more, and back below it, \
@@ -1942,7 +1950,7 @@ fn regime(
                          before the loads settled (lengthen simulation.duration)",
                         r.residual_min_relative,
                         r.residual_relative,
-                        100.0 * UNSETTLED_AWAY,
+                        100.0 * AWAY,
                     ))
                 }
                 SimRegime::Balancing
@@ -1994,12 +2002,22 @@ fn regime(
 }
 
 /// The growth rate σ (1/s) of the least stable perturbation of two loads' balancing position
-/// at `speed` rad/s (Floquet, one monodromy at the stability map's tolerance). `None` for three
-/// or more loads, which can balance at another member of their family than the fan analysed,
-/// and where there is no balancing position.
+/// at `speed` rad/s ([`fan_growth_rate`]). `None` for three or more loads, which can balance
+/// at another member of their family than the fan analysed, and where there is no balancing
+/// position.
 fn balancing_growth_rate(vm: &VibrationMachine, speed: f64) -> Option<f64> {
+    (vm.loads() == 2)
+        .then(|| fan_growth_rate(vm, speed))
+        .flatten()
+}
+
+/// The growth rate σ (1/s) of the least stable perturbation of the balancing position the
+/// simulator starts the loads near (for three or more loads, the fan) at `speed` rad/s
+/// (Floquet, one monodromy at the stability map's tolerance). `None` where there is no
+/// balancing position.
+fn fan_growth_rate(vm: &VibrationMachine, speed: f64) -> Option<f64> {
     use crate::engine::vibration::floquet::{Floquet, ScanOptions};
-    if vm.loads() != 2 || speed.is_nan() || speed <= 0.0 {
+    if speed.is_nan() || speed <= 0.0 {
         return None;
     }
     let f = Floquet::new(vm).ok()?;
@@ -2007,9 +2025,41 @@ fn balancing_growth_rate(vm: &VibrationMachine, speed: f64) -> Option<f64> {
     f.multipliers(speed, rtol).ok().map(|m| m.growth_rate())
 }
 
-/// Gathering needs the residual at least this (relative to the rotor's) throughout the final
-/// quarter of a run; between 1 % and this the run has not settled.
-const UNSETTLED_AWAY: f64 = 0.1;
+/// Why run `r` of `duration` seconds, its residual above [`BALANCED`] and below [`AWAY`] of
+/// the rotor's throughout the final quarter, shows no regime: where it stayed against where
+/// it started and, with the balancing position's growth rate σ ([`fan_growth_rate`]), how
+/// many e-foldings `1/|σ|` the run spans.
+fn short_of_away(vm: &VibrationMachine, r: &RegimeReport, duration: f64) -> String {
+    use std::fmt::Write as _;
+    let mut why = format!(
+        "the residual unbalance over the final quarter of the run stayed between {:.2e} and \
+         {:.2e} of the rotor's, above the {:.0} % balancing allows and under the {:.0} % \
+         gathering needs, its largest {:.2} times the {:.2e} it started at",
+        r.residual_min_relative,
+        r.residual_relative,
+        100.0 * BALANCED,
+        100.0 * AWAY,
+        r.residual_relative / r.residual_initial_relative,
+        r.residual_initial_relative,
+    );
+    let speed = r.rotor_speed.abs();
+    if let Some(g) = fan_growth_rate(vm, speed).filter(|g| g.is_finite() && *g != 0.0) {
+        let _ = write!(
+            why,
+            "; at {speed:.2} rad/s the balancing position's least stable perturbation {} \
+             (Floquet growth rate {g:.2e} 1/s): one e-folding takes {:.0} s, and the \
+             {duration} s run spans {:.2} of them (ten take {:.0} s)",
+            if g > 0.0 { "grows" } else { "decays" },
+            1.0 / g.abs(),
+            duration * g.abs(),
+            crate::app::regimes::settle_time(g),
+        );
+    }
+    why.push_str(
+        ": the run ended before the loads showed where they go (lengthen simulation.duration)",
+    );
+    why
+}
 
 /// Loads whose coherence stays at least this over the final quarter of a run lie within about
 /// 1e-6 rad of each other (two loads: `cos(Δ/2) ≥ 1 − 1e-13`): met, moving as one.

@@ -86,6 +86,12 @@ enum Command {
     },
     /// Run a vibration-machine scene at prescribed rotor speeds from A to B rad/s, in
     /// parallel: the criterion's regime against what the loads did.
+    ///
+    /// Each speed runs at least the scene's duration and 10/|σ| (σ the balancing position's
+    /// Floquet growth rate; at most ten times the duration), doubled up to three times while
+    /// the residual unbalance is between 1 % (balancing) and 10 % (gathering) of the
+    /// rotor's. A speed still between them is "unsettled": counted neither agreeing nor
+    /// disagreeing, its reason in the JSON's `regime_unsettled`.
     Sweep {
         /// The name of a bundled scene (`drive-sim scenes`), or a scene file's path.
         scene: String,
@@ -510,14 +516,7 @@ fn sweep_cmd(
             "speed", "criterion", "core class", "simulated", "residual"
         ));
         for p in &s.points {
-            let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
-            let mark = if committed
-                && !host_sim::studies::sweep::agrees(p.regime_class, p.regime_simulated)
-            {
-                "  ≠"
-            } else {
-                ""
-            };
+            let mark = if p.contradicts() { "  ≠" } else { "" };
             let class = match p.regime_reason {
                 Some(r) => format!("{} ({r})", p.regime_class),
                 None => p.regime_class.to_string(),
@@ -542,6 +541,13 @@ fn sweep_cmd(
             s.agreeing,
             s.away_from_characteristic
         ));
+        // Runs without a verdict are left out of both counts, and said so.
+        if s.unsettled + s.coincident > 0 {
+            text.push_str(&format!(
+                "not judged, in neither count: {} unsettled (the longest run showed no regime; why in --json's regime_unsettled), {} coincident\n",
+                s.unsettled, s.coincident
+            ));
+        }
     }
     write_out(&text)
 }

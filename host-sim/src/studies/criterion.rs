@@ -58,7 +58,9 @@ use crate::app::regimes::{self, balanced_start, tracked, Design};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{MotorSpec, Scene, SceneError};
 use crate::engine::vibration::floquet::{Floquet, ScanOptions};
-use crate::engine::vibration::regime::RegimeReport;
+// Balancing: the residual at most `BALANCED` of `D` over the final quarter; gathering: it
+// reaches `AWAY` there (the thresholds `run` and `sweep` judge by too).
+use crate::engine::vibration::regime::{RegimeReport, AWAY, BALANCED};
 use drive_monitor::balancer::{
     BistableReason, Classifier, Machine, Regime, RegimeTable, ZoneKind, DEFAULT_MARGIN,
     TABLE_MARGIN,
@@ -262,11 +264,6 @@ pub struct Outcome {
     /// `1 − Ω/ω` over the final quarter: how much slower the loads turn than the rotor.
     pub slip: f64,
 }
-
-/// Balancing: the residual stays at most this (relative to `D`) over the final quarter.
-const BALANCED: f64 = 0.01;
-/// Gathering: the residual reaches this over the final quarter.
-const AWAY: f64 = 0.1;
 
 /// Simulates `scene` at `speed` for at least `min_duration` seconds (and the scene's own
 /// duration), doubling the run until the residual has settled (module docs).

@@ -33,6 +33,11 @@ pub struct SweepPoint {
     /// (or together at rest with `--together`): "balancing" | "saturated" | "gathering", or
     /// "unsettled" when no run up to [`settled_run`]'s longest decided it.
     pub regime_simulated: &'static str,
+    /// Why the last run is "unsettled" (`run`'s `regime_unsettled`): e.g. its residual stayed
+    /// between 1 % and 10 % of the rotor's, near where it started, the run a fraction of an
+    /// e-folding of the growth rate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regime_unsettled: Option<String>,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
     /// Length of the (last) run, s: see [`settled_run`].
@@ -61,6 +66,16 @@ pub struct Arrived {
     pub simulated: &'static str,
     /// Final residual unbalance relative to the rotor's.
     pub residual_relative: f64,
+}
+
+impl SweepPoint {
+    /// The core's class committed (balancing or gathering) and a judged simulation says
+    /// otherwise (the ≠ of the tables): an unsettled or coincident run contradicts nothing.
+    pub fn contradicts(&self) -> bool {
+        matches!(self.regime_class, "balancing" | "gathering")
+            && !matches!(self.regime_simulated, "unsettled" | "coincident")
+            && !agrees(self.regime_class, self.regime_simulated)
+    }
 }
 
 /// Whether a simulated outcome is the predicted regime: "balancing" is met by "balancing",
@@ -175,7 +190,6 @@ impl Sweep {
              |---:|---|---|---|---:|---|\n",
         );
         for p in &self.points {
-            let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
             let _ = writeln!(
                 s,
                 "| {:.2} | {} | {}{} | {}{} | {:.2e} | {} |",
@@ -184,15 +198,7 @@ impl Sweep {
                 p.regime_class,
                 p.regime_reason.map_or(String::new(), |r| format!(" ({r})")),
                 p.regime_simulated,
-                if committed
-                    && p.regime_simulated != "unsettled"
-                    && p.regime_simulated != "coincident"
-                    && !agrees(p.regime_class, p.regime_simulated)
-                {
-                    " ≠"
-                } else {
-                    ""
-                },
+                if p.contradicts() { " ≠" } else { "" },
                 p.residual_relative,
                 p.arrived.map_or("—".to_string(), |a| format!(
                     "{:.1} → {}{}",
@@ -211,7 +217,8 @@ impl Sweep {
             "\nEach speed runs until its regime shows: at least ten e-foldings of the balancing \
              position's least stable perturbation (`10/|σ|` from the exact analysis, up to ten \
              times the scene's duration), doubled up to three times while the residual is \
-             between 1 % and 10 % of the rotor's; {} speeds did not settle (\"unsettled\"); at {} \
+             between 1 % and 10 % of the rotor's; {} speeds did not settle (\"unsettled\": \
+             neither agreeing nor disagreeing, why in the JSON's `regime_unsettled`); at {} \
              the loads met and moved as one where the balancing position is stable \
              (\"coincident\": not judged, the model has no contact between loads; see `run`).\n\n\
              The core's classifier ({} table) commits at {} of {} speeds; the simulation \
@@ -295,10 +302,12 @@ const DOUBLINGS: u32 = 3;
 /// `10/|σ|` (ten e-foldings of the least stable perturbation, `sigma` from the exact
 /// analysis; at most [`SETTLE_CAP`] times the scene's duration), doubled up to
 /// [`DOUBLINGS`] times while `run` says the loads have not settled (the residual between 1 %
-/// and 10 % of the rotor's over the final quarter, or a balancing verdict from a run shorter
-/// than `10/σ` where the balancing position is unstable). Returns the last run, its duration and whether it
-/// settled. A fixed-length run judged a slowly growing residual still under 1 % as
-/// balancing, and a slowly decaying one as gathering.
+/// and 10 % of the rotor's over the final quarter, unless it reached 10 % and swings there
+/// steadily, or a balancing verdict from a run shorter than `10/σ` where the balancing
+/// position is unstable). Returns the last run, its duration and whether it settled. A
+/// fixed-length run judged a slowly growing residual still under 1 % as balancing, and a
+/// slowly decaying one as gathering; a residual still at its starting offset, between the
+/// two, stays unsettled however steady it is (an e-folding of 4700 s against 1600 s).
 pub fn settled_run(
     scene: &Scene,
     file: &Path,
@@ -427,6 +436,7 @@ pub fn sweep(
                 } else {
                     "unsettled"
                 },
+                regime_unsettled: r.regime_unsettled.clone(),
                 residual_relative: r.residual_relative.unwrap_or(f64::NAN),
                 duration,
                 growth_rate: sigma,

@@ -83,6 +83,17 @@ pub struct RegimeSample {
     pub rotor_angle: f64,
 }
 
+/// Balancing: the residual stays at most this fraction of the reference over the final window
+/// ([`RegimeCriteria::residual_fraction`]'s default).
+pub const BALANCED: f64 = 0.01;
+
+/// Gathering: the residual reaches at least this fraction of the reference. A run started near
+/// the balancing position begins below it (its perturbation leaves a few %), so a residual
+/// between [`BALANCED`] and this is a run that has not shown its regime yet, whatever it is
+/// called by [`classify`] (which knows only "balanced or not"); `run`, `sweep` and the
+/// criterion study judge by both.
+pub const AWAY: f64 = 0.1;
+
 /// Thresholds of the classification (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RegimeCriteria {
@@ -110,7 +121,7 @@ impl RegimeCriteria {
             reference,
             floor: 0.0,
             window_fraction: 0.25,
-            residual_fraction: 0.01,
+            residual_fraction: BALANCED,
             gathered_coherence: 0.95,
             lag_fraction: 0.02,
         }
