@@ -415,6 +415,80 @@ fn dropped_teeth_are_counted_as_missing() {
     assert_eq!((report.glitches, report.extra), (0, 0));
 }
 
+/// A capture sampled too slowly for the pulses of a shaft that runs up (from 20 rad/s, where
+/// 800 S/s takes five samples of a level, to 134 rad/s, where a level lasts less than one): the
+/// file lacks level changes, and the run counts them exactly (each channel's changes in the
+/// file and those lost add up to the edges the encoder delivered) and says so in a WARNING;
+/// at 50 MS/s nothing is lost and nothing is said.
+#[test]
+fn level_changes_lost_to_the_sampling_are_counted_exactly() {
+    let scene = |rate: &str| {
+        format!(
+            "[simulation]\nduration = 3.0\nsettle = 2.0\n\
+             [shaft]\ninertia = 0.323\ninitial_speed = 20.0\n\
+             [motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+             breakdown_torque = 158.0\n\
+             [load]\nmean = 24.0\n\
+             [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n\
+             [capture]\nsample_rate = {rate}\n"
+        )
+    };
+    for (rate, lossy) in [("800", true), ("50e6", false)] {
+        let (_scratch, file) = tmp("runup.csv");
+        let run = simulate(&scene(rate), CaptureFormat::Saleae, &file);
+        // The level changes of the signal the encoder delivered (a pulse the shaft starts in
+        // ends without having begun).
+        let delivered = |index: bool| {
+            let mut edges: Vec<&Edge> = run
+                .edge_list
+                .iter()
+                .filter(|e| !e.dropped && e.index == index)
+                .collect();
+            edges.sort_by(|a, b| a.seen_time.total_cmp(&b.seen_time));
+            let mut high = false;
+            edges
+                .iter()
+                .filter(|e| std::mem::replace(&mut high, e.rising) != e.rising)
+                .count() as u64
+        };
+        // The level changes the file shows, channel by channel.
+        let mut reader = CaptureReader::open(&file, None, None).unwrap();
+        let (mut prev, mut shown) = (Vec::new(), [0u64; 2]);
+        while let Some((_, levels)) = reader.next_row().unwrap() {
+            for (c, n) in shown.iter_mut().enumerate() {
+                if prev.get(c).is_some_and(|p| *p != levels[c]) {
+                    *n += 1;
+                }
+            }
+            prev = levels.to_vec();
+        }
+        assert_eq!(run.capture_channels.len(), 2, "{:?}", run.capture_channels);
+        for (c, ch) in run.capture_channels.iter().enumerate() {
+            assert_eq!(ch.changes, delivered(c == 1), "{rate}: {ch:?}");
+            assert_eq!(shown[c] + ch.lost, ch.changes, "{rate}: {ch:?}");
+        }
+        let encoder = &run.capture_channels[0];
+        if lossy {
+            assert!(encoder.lost * 10 > encoder.changes, "{encoder:?}");
+            let warning = run.capture_warning.as_deref().unwrap();
+            assert!(
+                warning.contains(&format!(
+                    "{} of the {} level changes of channel `Channel 0`",
+                    encoder.lost, encoder.changes
+                )) && warning.contains("`capture.sample_rate = 800`"),
+                "{warning}"
+            );
+        } else {
+            assert!(
+                run.capture_channels.iter().all(|c| c.lost == 0),
+                "{:?}",
+                run.capture_channels
+            );
+            assert_eq!(run.capture_warning, None);
+        }
+    }
+}
+
 /// A scene of a 24-line disc with an index pulse on its own channel, at 40 rad/s for
 /// `duration` s, captured at 10 MS/s.
 fn index_disc(duration: f64) -> String {

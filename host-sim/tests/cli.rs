@@ -703,6 +703,98 @@ fn run_writes_a_capture_that_analyze_reads() {
     );
 }
 
+/// The kneader's drive for `duration` s on a 1024-line index disc, captured at `rate`.
+fn kneader_captured(duration: f64, rate: &str) -> String {
+    format!(
+        "[simulation]\nduration = {duration}\nsettle = 0.5\n\
+         [shaft]\ninertia = 0.323\n\
+         [motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+         breakdown_torque = 158.0\n\
+         [load]\nmean = 24.0\nharmonics = [{{ order = 0.125, amplitude = 12.0, phase = 0.0 }}]\n\
+         [encoder]\nlines = 1024\ntimer_hz = 84e6\n\
+         [capture]\nsample_rate = {rate}\n"
+    )
+}
+
+/// A capture sampled too slowly for the pulses at the speed the run starts at is refused
+/// before anything is simulated, naming the key, its value and the rate needed (it wrote a
+/// file with 56 k of 656 k pulses at 10 kS/s, without a word); one that becomes too slow only
+/// as the shaft runs up is written with a WARNING counting the level changes it lacks.
+#[test]
+fn a_capture_too_slow_for_the_pulses_is_refused_or_its_losses_counted() {
+    let scratch_dir = scratch("capture-rate");
+    let dir = scratch_dir.path();
+    let scene = dir.join("slow.toml");
+    std::fs::write(&scene, kneader_captured(1.0, "10000")).unwrap();
+    let capture = dir.join("slow.csv");
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(err.contains("`capture.sample_rate = 10000`"), "{err}");
+    assert!(!capture.exists(), "{err}");
+    // Two samples of half a pitch of 1024 lines at the predicted speeds: 2·1024·ω/π.
+    let needed: f64 = err
+        .split("needs at least ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    let at = |w: f64| 2.0 * 1024.0 * w / std::f64::consts::PI;
+    assert!(
+        needed > at(132.196) && needed < at(136.311),
+        "{needed}: {err}"
+    );
+    // At the rate named, the file is written and nothing is lost.
+    std::fs::write(&scene, kneader_captured(1.0, &format!("{}", needed.ceil()))).unwrap();
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with("capture: wrote") && !out.contains("WARNING capture"),
+        "{out}"
+    );
+    // Started at 20 rad/s, where 2 kS/s is plenty, the shaft runs up to 134 rad/s, where a
+    // pulse of a 64-line disc lasts 0.37 ms: merged away, and counted.
+    let text = kneader_captured(3.0, "2000")
+        .replace(
+            "inertia = 0.323\n",
+            "inertia = 0.323\ninitial_speed = 20.0\n",
+        )
+        .replace("lines = 1024", "lines = 64");
+    std::fs::write(&scene, text).unwrap();
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let warning = out
+        .lines()
+        .find(|l| l.starts_with("WARNING capture:"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        warning.contains("level changes of channel `Channel 0`")
+            && warning.contains("`capture.sample_rate = 2000`"),
+        "{warning}"
+    );
+    let lost: u64 = warning
+        .trim_start_matches("WARNING capture: ")
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{warning}"));
+    assert!(lost > 1000, "{warning}");
+}
+
 #[test]
 fn predict_says_a_prescribed_speed_gives_no_delta() {
     // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]

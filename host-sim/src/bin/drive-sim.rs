@@ -37,7 +37,10 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Write the encoder signal (and the index channel, if any) as a logic analyzer
-        /// records it: a CSV of levels over time (the scene's [capture] settings).
+        /// records it: levels over time (the scene's [capture] settings). A sample_rate that
+        /// takes fewer than 2 samples of the shortest pulse at the speed the scene prescribes
+        /// or starts at is refused; level changes lost to the sampling later in the run are
+        /// counted in a WARNING.
         #[arg(long)]
         capture: Option<PathBuf>,
         /// Format of the capture file.
@@ -446,6 +449,9 @@ fn run_cmd(
     let mut text = String::new();
     if let (Some(f), Some(rows), false) = (&report.capture_file, report.capture_rows, json) {
         text.push_str(&format!("capture: wrote {f} ({rows} rows)\n"));
+        if let Some(w) = &report.capture_warning {
+            text.push_str(&format!("{w}\n"));
+        }
     }
     if let Some(dir) = out {
         let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
