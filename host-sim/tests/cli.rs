@@ -795,6 +795,68 @@ fn a_capture_too_slow_for_the_pulses_is_refused_or_its_losses_counted() {
     assert!(lost > 1000, "{warning}");
 }
 
+/// Without --capture-format the capture's format follows the file's extension (`x.vcd` was
+/// written as Saleae CSV); a format the extension contradicts is refused before simulating.
+#[test]
+fn the_capture_format_follows_the_files_extension() {
+    let scratch_dir = scratch("capture-format");
+    let dir = scratch_dir.path();
+    let scene = dir.join("disc.toml");
+    std::fs::write(
+        &scene,
+        "[simulation]\nduration = 0.5\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+         [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n",
+    )
+    .unwrap();
+    let run = |file: &str, format: Option<&str>| {
+        let path = dir.join(file);
+        let mut args = vec![
+            "run".to_string(),
+            scene.to_str().unwrap().to_string(),
+            "--capture".to_string(),
+            path.to_str().unwrap().to_string(),
+        ];
+        if let Some(f) = format {
+            args.extend(["--capture-format".to_string(), f.to_string()]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, _, err) = drive_sim(&args);
+        (ok, err, std::fs::read_to_string(&path).ok())
+    };
+    let (ok, err, text) = run("x.vcd", None);
+    assert!(ok, "{err}");
+    let text = text.unwrap();
+    assert!(
+        text.starts_with("$version drive-sim") && text.contains("$timescale"),
+        "{text:.200}"
+    );
+    let (ok, err, text) = run("X.VCD", Some("vcd"));
+    assert!(ok && text.unwrap().starts_with("$version"), "{err}");
+    let (ok, err, text) = run("x.csv", None);
+    assert!(ok, "{err}");
+    assert!(
+        text.unwrap().starts_with("Time [s],Channel 0,Channel 1\n"),
+        "{err}"
+    );
+    let (ok, err, text) = run("y.csv", Some("plain"));
+    assert!(
+        ok && text.unwrap().starts_with("time_s,level,index\n"),
+        "{err}"
+    );
+    for (file, format, says) in [
+        ("z.vcd", "saleae", "ends in .vcd"),
+        ("z.vcd", "plain", "ends in .vcd"),
+        ("z.csv", "vcd", "ends in .csv"),
+    ] {
+        let (ok, err, text) = run(file, Some(format));
+        assert!(!ok && text.is_none(), "{file} {format}: {err}");
+        assert!(
+            err.contains(&format!("--capture-format {format}")) && err.contains(says),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn predict_says_a_prescribed_speed_gives_no_delta() {
     // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]

@@ -77,6 +77,34 @@ impl CaptureFormat {
         }
     }
 
+    /// The format of a capture written to `path`: `given` (`--capture-format`), else the one
+    /// the file's extension names (`.vcd`: a value change dump; `.csv` or any other: Saleae's
+    /// CSV). A format the extension contradicts (a CSV format to a `.vcd` file, a value change
+    /// dump to a `.csv` one) is refused, naming both: what reads the file goes by its name.
+    pub fn for_file(path: &Path, given: Option<CaptureFormat>) -> Result<CaptureFormat, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let (vcd, csv) = (ext.as_deref() == Some("vcd"), ext.as_deref() == Some("csv"));
+        match given {
+            None if vcd => Ok(CaptureFormat::Vcd),
+            None => Ok(CaptureFormat::Saleae),
+            Some(g) if vcd && g != CaptureFormat::Vcd => Err(format!(
+                "--capture-format {}: {} ends in .vcd, a value change dump: give --capture-format \
+                 vcd (or leave it out), or a file ending in .csv",
+                g.name(),
+                path.display()
+            )),
+            Some(CaptureFormat::Vcd) if csv => Err(format!(
+                "--capture-format vcd: {} ends in .csv, a comma-separated file: give a file \
+                 ending in .vcd, or --capture-format saleae|sigrok|plain",
+                path.display()
+            )),
+            Some(g) => Ok(g),
+        }
+    }
+
     /// The names this format gives to the encoder channel and the index channel.
     pub fn channel_names(self, index: bool) -> Vec<String> {
         let n = if index { 2 } else { 1 };

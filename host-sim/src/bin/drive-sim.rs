@@ -43,9 +43,11 @@ enum Command {
         /// counted in a WARNING.
         #[arg(long)]
         capture: Option<PathBuf>,
-        /// Format of the capture file.
-        #[arg(long, value_enum, default_value = "saleae", requires = "capture")]
-        capture_format: CaptureFormat,
+        /// Format of the capture file (default: the file's extension: .vcd a value change
+        /// dump, .csv or any other Saleae's CSV). A format the extension contradicts (saleae,
+        /// sigrok or plain to a .vcd file, vcd to a .csv file) is refused.
+        #[arg(long, value_enum, requires = "capture")]
+        capture_format: Option<CaptureFormat>,
     },
     /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV, or a
     /// value change dump):
@@ -283,13 +285,16 @@ fn main() -> ExitCode {
             out,
             capture,
             capture_format,
-        }) => {
-            let capture = capture.map(|path| host_sim::app::run::CaptureTarget {
-                path,
-                format: capture_format,
-            });
+        }) => (|| {
+            let capture = match capture {
+                Some(path) => Some(host_sim::app::run::CaptureTarget {
+                    format: CaptureFormat::for_file(&path, capture_format)?,
+                    path,
+                }),
+                None => None,
+            };
             run_cmd(&scene, json, plot.as_deref(), out.as_deref(), capture)
-        }
+        })(),
         Some(Command::Analyze {
             capture,
             format,
