@@ -793,6 +793,23 @@ fn a_capture_too_slow_for_the_pulses_is_refused_or_its_losses_counted() {
         .and_then(|n| n.parse().ok())
         .unwrap_or_else(|| panic!("{warning}"));
     assert!(lost > 1000, "{warning}");
+    // Without an [encoder] there is no signal to record (it wrote one edge of the run's
+    // internal encoder).
+    let text = kneader_captured(1.0, "1e6");
+    let text = &text[..text.find("[encoder]").unwrap()];
+    std::fs::write(&scene, text).unwrap();
+    let capture = dir.join("none.csv");
+    let (ok, _, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("`encoder`") && err.contains("--capture"),
+        "{err}"
+    );
+    assert!(!capture.exists());
 }
 
 /// Without --capture-format the capture's format follows the file's extension (`x.vcd` was

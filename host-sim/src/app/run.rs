@@ -1375,7 +1375,7 @@ pub fn run_with(
     check_work(scene, file, over, &integ)?;
     let encoder = sim_encoder(scene, file, options.capture.is_some())?;
     if options.capture.is_some() {
-        check_capture_rate(
+        check_capture(
             scene,
             file,
             over,
@@ -1771,12 +1771,13 @@ fn shortest_level(encoder: &SimEncoder) -> Option<(f64, &'static str)> {
     shortest
 }
 
-/// Refuses, before anything is simulated, a capture whose `[capture] sample_rate` takes fewer
-/// than [`CAPTURE_SAMPLES_PER_LEVEL`] samples of the encoder signal's shortest level at a
-/// speed the run is sure to reach ([`sure_speed`]): its pulses would fall between samples and
-/// vanish from the file. (Faster speeds reached only as the run goes are counted as the file
-/// is written: [`capture_loss_warning`].)
-fn check_capture_rate(
+/// Refuses, before anything is simulated, a capture of a scene without `[encoder]` (there is no
+/// signal to record: the run's internal encoder is no scene's), and one whose `[capture]
+/// sample_rate` takes fewer than [`CAPTURE_SAMPLES_PER_LEVEL`] samples of the encoder signal's
+/// shortest level at a speed the run is sure to reach ([`sure_speed`]): its pulses would fall
+/// between samples and vanish from the file. (Faster speeds reached only as the run goes are
+/// counted as the file is written: [`capture_loss_warning`].)
+fn check_capture(
     scene: &Scene,
     file: &Path,
     over: Overrides,
@@ -1784,7 +1785,12 @@ fn check_capture_rate(
     u_start: Option<f64>,
 ) -> Result<(), SceneError> {
     let Some(e) = &scene.encoder else {
-        return Ok(());
+        return Err(SceneError::value(
+            file,
+            "encoder",
+            "missing: `--capture` records the encoder's signal, and the scene has no [encoder] \
+             table",
+        ));
     };
     let (Some((w, from)), Some((angle, what))) =
         (sure_speed(scene, over, u_start), shortest_level(encoder))
