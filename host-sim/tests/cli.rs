@@ -874,6 +874,56 @@ fn the_capture_format_follows_the_files_extension() {
     }
 }
 
+/// `run` counts the line edges and the index pulses apart, as `analyze` of its capture counts
+/// them (it said 656 961 edges for the kneader, its 656 321 line edges and 640 index pulses
+/// together), noise pulses among the line edges.
+#[test]
+fn run_counts_line_edges_and_index_pulses_as_analyze_does() {
+    let scratch_dir = scratch("run-edges");
+    let dir = scratch_dir.path();
+    let scene = dir.join("disc.toml");
+    std::fs::write(
+        &scene,
+        "[simulation]\nduration = 2.0\nseed = 5\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+         [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n\
+         glitch_probability = 0.02\nglitch_window = [0.3, 0.7]\n",
+    )
+    .unwrap();
+    let capture = dir.join("disc.csv");
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let run = json(&["run", scene.to_str().unwrap(), "--json"]);
+    let a = json(&[
+        "analyze",
+        capture.to_str().unwrap(),
+        "--lines",
+        "24",
+        "--framing",
+        "index",
+        "--json",
+    ]);
+    let (line, noise, index) = (
+        run["line_edges"].as_u64().unwrap(),
+        run["noise_pulses"].as_u64().unwrap(),
+        run["index_pulses"].as_u64().unwrap(),
+    );
+    assert!(noise > 0 && index > 0, "{run}");
+    assert_eq!(line, a["edges"].as_u64().unwrap(), "{a}");
+    assert_eq!(index, a["index_pulses"].as_u64().unwrap(), "{a}");
+    assert_eq!(run["edges"].as_u64().unwrap(), line + index);
+    assert!(
+        out.contains(&format!(
+            "{line} line edges ({noise} of them noise pulses) and {index} index pulses"
+        )),
+        "{out}"
+    );
+}
+
 #[test]
 fn predict_says_a_prescribed_speed_gives_no_delta() {
     // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]

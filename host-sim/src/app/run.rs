@@ -138,8 +138,15 @@ pub struct RunReport {
     pub component_evaluations: BTreeMap<&'static str, u64>,
     /// Accepted and rejected integrator steps.
     pub steps: [u64; 2],
-    /// Edges generated (line, index and glitch); 0 without an `[encoder]`.
+    /// Rising edges generated (line, index and glitch); 0 without an `[encoder]`.
     pub edges: u64,
+    /// Of them, the rising edges on the encoder's line channel, noise pulses included (what
+    /// `analyze` of the run's capture counts as the channel's edges).
+    pub line_edges: u64,
+    /// Of the line edges, the noise pulses (`encoder.glitch_probability`).
+    pub noise_pulses: u64,
+    /// Of them, the index pulses (an index disc's own channel).
+    pub index_pulses: u64,
     /// Median δ of the valid steady windows after the settling time.
     pub delta_measured: Option<f64>,
     /// δ predicted by the drive model.
@@ -1508,6 +1515,13 @@ pub fn run_with(
         } else {
             0
         },
+        line_edges: if scene.encoder.is_some() {
+            stats.encoder.edges - stats.encoder.index_pulses
+        } else {
+            0
+        },
+        noise_pulses: stats.encoder.glitches,
+        index_pulses: stats.encoder.index_pulses,
         settle,
         capture_file: options
             .capture
