@@ -528,6 +528,64 @@ fn an_index_disc_from_two_channels() {
     assert!(frames >= 4);
 }
 
+/// `--lines N` without `--framing` takes the disc as unframed, as a capture need not hold an
+/// index channel, where a scene's `lines = N` is framed by its index: the report says so, and
+/// names a channel whose pulses come once every N edges (an index pulse's), not the quadrature
+/// B channel's; with `--framing` given it says nothing.
+#[test]
+fn lines_without_framing_say_the_disc_is_taken_unframed() {
+    use host_sim::app::analyze::{Channel, FramingArg};
+    let (_scratch, file) = tmp("index.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
+    let bare = AnalyzeOptions {
+        lines: Some(24),
+        ..AnalyzeOptions::default()
+    };
+    let (report, _) = run_analyze(&file, bare.clone());
+    assert_eq!(report.wheel, "24 lines, no frame marker");
+    let note = report.framing_note.as_deref().unwrap();
+    assert!(
+        note.starts_with("framing: none, the default without --framing"),
+        "{note}"
+    );
+    assert!(
+        note.contains("`Channel 1` pulses 6 times")
+            && note.contains("--framing index frames each revolution")
+            && !note.contains("--index-channel"),
+        "{note}"
+    );
+    let said = host_sim::app::analyze::text(&report);
+    assert!(said.contains(note), "{said}");
+    for framing in [FramingArg::None, FramingArg::Index] {
+        let (report, _) = run_analyze(
+            &file,
+            AnalyzeOptions {
+                framing: Some(framing),
+                ..bare.clone()
+            },
+        );
+        assert_eq!(report.framing_note, None);
+    }
+    // A quadrature capture: B pulses every pitch, the index Z once a revolution.
+    let rev = std::f64::consts::TAU;
+    let (text, _, _) = quadrature(50, 40.0, &[8.0 * rev]);
+    let cfg = configure(&AnalyzeOptions {
+        channel: Some(Channel::Name("A".into())),
+        lines: Some(50),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "q.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let note = report.framing_note.unwrap();
+    assert!(
+        note.contains("`Z` pulses 7 times in the 399 edges of `A`, 8.0 revolutions")
+            && note.contains("--framing index --index-channel 2"),
+        "{note}"
+    );
+    assert!(!note.contains("`B`"), "{note}");
+}
+
 /// A capture taken through the timer's input prescaler (one capture in 4 line edges): the
 /// simulation and the analysis of its recording (which holds every line edge) capture one edge
 /// in four, so the speed is the shaft's and every revolution is framed by its index. (Every

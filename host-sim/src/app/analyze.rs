@@ -87,6 +87,9 @@ pub struct AnalyzeConfig {
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
+    /// The disc of `--lines` is unframed because `--framing` was not given (the report says
+    /// so, and names a channel that pulses once a revolution).
+    pub framing_default: bool,
 }
 
 /// Which channel of a quadrature pair leads when the shaft runs forward.
@@ -448,6 +451,10 @@ pub struct AnalyzeReport {
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
     pub wheel: String,
+    /// When `--lines` was given without `--framing`: that the disc was taken as unframed, and
+    /// a channel not read that pulses once every revolution of edges (an index channel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub framing_note: Option<String>,
     /// Emulated capture timer clock, Hz.
     pub timer_hz: f64,
     /// Emulated counter width, bits.
@@ -1510,8 +1517,53 @@ pub fn analyze<R: BufRead>(
             changes,
         })
         .collect();
+    if cfg.framing_default {
+        report.framing_note = Some(framing_note(&report, enc.config().wheel, ch));
+    }
     report.speed_trace.shrink_to_fit();
     Ok(report)
+}
+
+/// The line saying that a disc of `--lines` without `--framing` was taken as unframed, naming
+/// each other channel whose pulses come once every revolution of the encoder channel's edges
+/// (within a revolution over the capture), as an index pulse does.
+fn framing_note(r: &AnalyzeReport, wheel: drive_monitor::encoder::Wheel, ch: usize) -> String {
+    let lines = u64::from(wheel.positions());
+    let index_like: Vec<String> = r
+        .channel_changes
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != ch)
+        .filter_map(|(k, c)| {
+            let pulses = c.changes / 2;
+            (pulses >= 2 && (pulses * lines).abs_diff(r.edges) <= lines).then(|| {
+                format!(
+                    "`{}` pulses {pulses} times in the {} edges of `{}`, {:.1} revolutions of \
+                     {lines} lines: once a revolution, as an index does; --framing index{} \
+                     frames each revolution by it",
+                    c.name,
+                    r.edges,
+                    r.channel,
+                    r.edges as f64 / lines as f64,
+                    // The index channel's default is the second column.
+                    if k == 1 {
+                        String::new()
+                    } else {
+                        format!(" --index-channel {k}")
+                    }
+                )
+            })
+        })
+        .collect();
+    let mut s = "framing: none, the default without --framing: no index channel is read and the \
+                 revolutions are counted from the first edges (a scene's [encoder] lines = N is \
+                 framed by its index)"
+        .to_string();
+    for c in index_like {
+        s.push_str("; ");
+        s.push_str(&c);
+    }
+    s
 }
 
 /// The step every row's time lies on, from the first row's, in whole nanoseconds (the
@@ -1899,6 +1951,9 @@ pub fn text(r: &AnalyzeReport) -> String {
         "wheel: {}; timer {} Hz, {}-bit counter",
         r.wheel, r.timer_hz, r.counter_bits
     );
+    if let Some(f) = &r.framing_note {
+        let _ = writeln!(s, "{f}");
+    }
     match r.sample_rate {
         Some(rate) => {
             let _ = writeln!(
@@ -2237,7 +2292,7 @@ pub struct AnalyzeOptions {
     pub wheel: Option<String>,
     /// `--lines N`.
     pub lines: Option<u16>,
-    /// `--framing` (with `--lines`).
+    /// `--framing` (with `--lines`; `None`: unframed, and the report says so).
     pub framing: Option<FramingArg>,
     /// `--scene`: the scene and the path its errors name.
     pub scene: Option<(crate::app::scene::Scene, std::path::PathBuf)>,
@@ -2348,8 +2403,8 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     let given = [o.wheel.is_some(), o.lines.is_some(), o.scene.is_some()];
     if given.iter().filter(|&&g| g).count() != 1 {
         return Err(
-            "name the wheel once: --wheel N-M (a missing-tooth wheel), --lines N with --framing \
-             index|none, or --scene FILE (its [encoder])"
+            "name the wheel once: --wheel N-M (a missing-tooth wheel), --lines N (with \
+             --framing index|none, none by default), or --scene FILE (its [encoder])"
                 .into(),
         );
     }
@@ -2530,6 +2585,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
         warnings,
+        framing_default: o.lines.is_some() && o.framing.is_none(),
     })
 }
 

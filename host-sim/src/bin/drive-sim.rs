@@ -168,10 +168,12 @@ struct AnalyzeArgs {
     /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
     #[arg(long)]
     wheel: Option<String>,
-    /// A uniform disc of N lines (with --framing).
+    /// A uniform disc of N lines (framed as --framing says).
     #[arg(long)]
     lines: Option<u16>,
-    /// How the uniform disc of --lines is framed.
+    /// How the uniform disc of --lines is framed (default none: no index channel is read, as
+    /// a capture need not have one, and the report says so; a scene's [encoder] lines = N is
+    /// framed by its index).
     #[arg(long, value_enum)]
     framing: Option<FramingArg>,
     /// Take the wheel, the timer, the tolerances and the window from a scene's [encoder]
