@@ -1348,13 +1348,76 @@ fn a_shaft_rocking_across_a_line_edge_is_not_running() {
             assert!(w.end <= turns[0] + 1e-3, "centre {centre}: {w:?}");
         }
         assert!(r.no_pitch >= 90, "centre {centre}: {r:?}");
+        assert_eq!(r.backward_pitches, 0, "centre {centre}");
         assert!(r.reversals <= 1, "centre {centre}: {:?}", r.faults);
         let said = host_sim::app::analyze::text(&r);
         assert!(
-            said.contains("no step forward of the quadrature count"),
+            said.contains("no step forward of the quadrature count")
+                && !said.contains("turned the other way"),
             "{said}"
         );
     }
+}
+
+/// A disc turning steadily the other way than `--forward` says (a forward run read with B
+/// leading, or a reverse run): every capture is a pitch backward of the one before, which the
+/// report says, with the `--forward` that reads it as forward, and not as a shaft at rest
+/// rocking across a line edge (which it said of every capture). A run that turns back for a
+/// while only says it turned the other way there.
+#[test]
+fn a_disc_turning_the_other_way_is_not_taken_for_rocking() {
+    use host_sim::app::analyze::{Channel, Lead};
+    let rev = std::f64::consts::TAU;
+    let off = 0.37 * rev / 50.0;
+    let analyze_with = |stops: &[f64], forward: Lead| {
+        let (text, _, backwards) = quadrature(50, 40.0, stops);
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            direction_channel: Some(Channel::Name("B".into())),
+            forward: Some(forward),
+            lines: Some(50),
+            framing: Some(host_sim::app::analyze::FramingArg::None),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut reader = text_reader(text, "q.csv", None).unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        let said = host_sim::app::analyze::text(&r);
+        (r, said, backwards)
+    };
+    // Forward for 8 revolutions, read with B leading: every edge backward.
+    let (r, said, _) = analyze_with(&[8.0 * rev + off], Lead::BLeads);
+    assert_eq!(r.accepted, 0);
+    assert!(r.backward_pitches + 1 >= r.captured, "{r:?}");
+    assert_eq!(r.no_pitch, 0, "{r:?}");
+    assert!(!said.contains("rocking across a line edge), fed"), "{said}");
+    assert!(
+        said.contains("the disc turned the other way for most of the capture")
+            && said.contains("if it turned forward, give --forward a-leads"),
+        "{said}"
+    );
+    let hint = r.sync_hint.unwrap().causes.join("\n");
+    assert!(
+        hint.contains("the edges ran backward") && !hint.contains("none of the usual causes"),
+        "{hint}"
+    );
+    // Read as wired, it runs forward: nothing backward.
+    let (r, said, _) = analyze_with(&[8.0 * rev + off], Lead::ALeads);
+    assert_eq!((r.backward_pitches, r.reverse_edges), (0, 0), "{said}");
+    // Forward 8 revolutions, back 4, forward to 12: the 4 back are said, no --forward offered.
+    let (r, said, backwards) = analyze_with(
+        &[8.0 * rev + off, 4.0 * rev + off, 12.0 * rev + off],
+        Lead::ALeads,
+    );
+    assert!(
+        r.backward_pitches + 2 >= backwards as u64 && r.backward_pitches <= backwards as u64,
+        "{} of {backwards}",
+        r.backward_pitches
+    );
+    assert!(
+        said.contains("the disc turned the other way\n") && !said.contains("--forward b-leads"),
+        "{said}"
+    );
 }
 
 /// A reversal on a quadrature capture: with the B channel named, the core sees the direction

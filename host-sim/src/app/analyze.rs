@@ -148,11 +148,12 @@ impl Quadrature {
         }
     }
 
-    /// Whether the count moved forward since the last capture (this one now the last).
-    fn moved(&mut self) -> bool {
-        let moved = self.count > self.at_capture;
+    /// The steps the count moved since the last capture (this one now the last): 4 a pitch
+    /// forward, −4 a pitch backward, about 0 across a line edge and back.
+    fn since_capture(&mut self) -> i64 {
+        let steps = self.count - self.at_capture;
         self.at_capture = self.count;
-        moved
+        steps
     }
 }
 
@@ -544,9 +545,13 @@ pub struct AnalyzeReport {
     /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
     pub reverse_edges: u64,
     /// Of them, captures with no step forward of the quadrature count (the encoder and
-    /// direction channels) since the capture before, itself so (no pitch: a shaft rocking
-    /// across a line edge), fed as reverse.
+    /// direction channels) since the capture before, itself so, and less than a pitch back
+    /// (no pitch: a shaft rocking across a line edge), fed as reverse.
     pub no_pitch: u64,
+    /// Of them, captures a pitch or more backward of the capture before (the quadrature count
+    /// stepped back by 4 or more): the disc turning the other way, or a `--forward` the wrong
+    /// way round for the wiring when it is most of the capture.
+    pub backward_pitches: u64,
     /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
     /// the last edges of the capture, waiting for the two that would confirm them, and the
     /// first edge after a standstill or a reversal (a time reference only).
@@ -966,6 +971,11 @@ fn sync_hint(
             r.unexplained
         ));
     }
+    if let Some(why) = other_way(r) {
+        causes.push(format!(
+            "no sync: the edges ran backward, a pitch at each capture,{why}"
+        ));
+    }
     // An index disc whose index pulses disagree with its lines has its own `index:` line.
     let index_says = r
         .index_period
@@ -1343,10 +1353,19 @@ pub fn analyze<R: BufRead>(
                 // not captured), which read as a steady forward pulse train. Fed as reverse:
                 // no tooth, and no running until the shaft moves on. (One such capture alone
                 // is left to the core: a noise pulse just before a real edge.)
-                let moved = quadrature.moved();
+                let steps = quadrature.since_capture();
+                let moved = steps > 0;
+                // A pitch or more backward: the disc turns the other way (B says so too),
+                // which is no rocking at rest.
+                let backward = steps <= -4;
                 if !moved && !moved_before {
                     direction = Some(Direction::Reverse);
-                    report.no_pitch += 1;
+                    if !backward {
+                        report.no_pitch += 1;
+                    }
+                }
+                if backward && direction == Some(Direction::Reverse) {
+                    report.backward_pitches += 1;
                 }
                 moved_before = moved;
             }
@@ -1522,6 +1541,31 @@ pub fn analyze<R: BufRead>(
     }
     report.speed_trace.shrink_to_fit();
     Ok(report)
+}
+
+/// When most of a capture's edges came a pitch backward each (steadily the other way, not
+/// rocking): that the disc may turn forward with the direction the other way round, and the
+/// `--forward` that reads it so.
+fn other_way(r: &AnalyzeReport) -> Option<String> {
+    let lead = r.forward?;
+    if r.backward_pitches * 2 <= r.captured {
+        return None;
+    }
+    let d = r.direction_channel.as_deref().unwrap_or("B");
+    let (a_leads, b_leads) = (
+        format!("`{}` leading `{d}`", r.channel),
+        format!("`{d}` leading `{}`", r.channel),
+    );
+    let (taken, other, option) = match lead {
+        Lead::ALeads => (a_leads, b_leads, "b-leads"),
+        Lead::BLeads => (b_leads, a_leads, "a-leads"),
+    };
+    Some(format!(
+        " for most of the capture ({} of {} captures): a disc turning in reverse, or one turning \
+         forward with {other} where the analysis took {taken}: if it turned forward, give \
+         --forward {option}",
+        r.backward_pitches, r.captured
+    ))
 }
 
 /// The line saying that a disc of `--lines` without `--framing` was taken as unframed, naming
@@ -2113,12 +2157,22 @@ pub fn text(r: &AnalyzeReport) -> String {
             r.reverse_edges
         );
     }
+    if r.backward_pitches > 0 {
+        let _ = writeln!(
+            s,
+            "{} of them came a pitch or more backward of the capture before (the quadrature \
+             count stepped back by 4 or more, as the direction channel says): the disc turned \
+             the other way{}",
+            r.backward_pitches,
+            other_way(r).unwrap_or_default()
+        );
+    }
     if r.no_pitch > 0 {
         let _ = writeln!(
             s,
             "{} of them came with no step forward of the quadrature count since the capture \
-             before, itself so: no pitch (a shaft at rest rocking across a line edge), fed as \
-             reverse",
+             before, itself so, and less than a pitch back: no pitch (a shaft at rest rocking \
+             across a line edge, or turning back across one), fed as reverse",
             r.no_pitch
         );
     }

@@ -159,7 +159,9 @@ struct AnalyzeArgs {
     /// direction, so a reversal is seen (without it every edge counts as forward).
     #[arg(long)]
     direction_channel: Option<Channel>,
-    /// Which channel leads when the shaft runs forward (with --direction-channel).
+    /// Which channel leads when the shaft runs forward (with --direction-channel; default A
+    /// leads). A capture that runs backward a pitch at a time for most of its edges is said
+    /// to, with the --forward that reads it as forward.
     #[arg(long, value_enum)]
     forward: Option<Lead>,
     /// The edges the capture unit takes.
