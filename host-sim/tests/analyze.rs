@@ -2410,6 +2410,46 @@ fn times_written_to_fixed_significant_digits_widen_the_floor() {
     );
 }
 
+/// The kneader's own capture (Saleae, 50 MS/s), analyzed with its scene: where the speed
+/// turns, 32 rows come 1166 samples apart, which is no coarser resolution of the times (it was
+/// read as 23.32 µs, and every window of δ 0.031 as within a floor of 0.064, not resolved).
+#[test]
+fn a_steady_signal_on_a_fine_grid_is_not_taken_for_coarse_times() {
+    let (_scratch, file) = tmp("kneader.csv");
+    let text = host_sim::app::scene::BUNDLED
+        .iter()
+        .find(|(f, _)| *f == "kneader.toml")
+        .unwrap()
+        .1
+        .replace("duration = 30.0", "duration = 3.0")
+        .replace("settle = 10.0", "settle = 1.0");
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let scene = Scene::parse(&text, Path::new("kneader.toml")).unwrap();
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            scene: Some((scene, PathBuf::from("kneader.toml"))),
+            ..AnalyzeOptions::default()
+        },
+    );
+    assert_eq!(report.time_grid, Some(2e-8));
+    assert_eq!(report.coarser_times, None, "{:?}", report.coarser_times);
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 2, "{:?}", report.windows);
+    for w in &valid {
+        assert_eq!(w.resolved, Some(true), "{w:?}");
+        // Steady, the run's own measurement of the same shaft.
+        let d = w.delta.unwrap();
+        if w.steady == Some(true) {
+            assert!(
+                (d / run.delta_measured.unwrap() - 1.0).abs() < 0.05,
+                "{d} {w:?}"
+            );
+        }
+    }
+    assert!(valid.iter().any(|w| w.steady == Some(true)));
+}
+
 /// Exact decimal Unix times after a first row at 0 s: counted from 0 (the first row's whole
 /// seconds), they are f64 numbers near 1.7e9 s, 0.24 µs apart (20 ticks of an 84 MHz timer),
 /// and their products with the clock near 1.43e17 ticks, 16 ticks apart. Every valid window's

@@ -1662,8 +1662,17 @@ impl TimeGrid {
 pub const BLOCK_ROWS: usize = 32;
 
 /// The resolution of the times along the file, block by block of [`BLOCK_ROWS`] rows: the step
-/// the block's times lie on ([`TimeGrid`]), or what f64 numbers resolve at its largest time,
-/// whichever is coarser. Kept where it changes, for at most [`MAX_LISTED`] changes.
+/// the block's times lie on ([`TimeGrid`]) as decimal times written to fewer digits resolve
+/// (the largest power of ten of nanoseconds dividing it), or what f64 numbers resolve at its
+/// largest time, whichever is coarser. Kept where it changes, for at most [`MAX_LISTED`]
+/// changes.
+///
+/// A block whose rows come equally spaced says nothing of the step: a steady signal on a fine
+/// grid lies on its own spacing (the kneader's capture at 50 MS/s, 1166 samples between rows
+/// where the speed turns, read as times resolved to 23.32 µs, and every window of δ 0.031 as
+/// within a floor of 0.064); nor does a step of such a signal's few spacings that no power of
+/// ten divides. (A steady signal whose spacings are all multiples of a power of ten coarser
+/// than the grid still reads as resolved to it: 20 and 40 µs to 10 µs.)
 #[derive(Default)]
 struct Resolution {
     /// The timer clock, Hz.
@@ -1672,6 +1681,11 @@ struct Resolution {
     rows: usize,
     start: f64,
     largest: f64,
+    /// The block's previous row's time, the spacing before it (whole ns; rows at one time
+    /// left out), and whether two spacings differ.
+    previous: Option<f64>,
+    spacing: Option<i64>,
+    varied: bool,
     /// (the first row's time of a block, its resolution) where the resolution changes.
     changes: Vec<(f64, f64)>,
 }
@@ -1681,6 +1695,14 @@ impl Resolution {
         if self.rows == 0 {
             self.block = TimeGrid::default();
             (self.start, self.largest) = (t, 0.0);
+            (self.previous, self.spacing, self.varied) = (None, None, false);
+        }
+        if let Some(t0) = self.previous.replace(t) {
+            let ns = ((t - t0) * 1e9).round() as i64;
+            if ns != 0 {
+                self.varied |= self.spacing.is_some_and(|s| s != ns);
+                self.spacing = Some(ns);
+            }
         }
         self.block.row(t);
         self.largest = self.largest.max(t.abs());
@@ -1698,7 +1720,12 @@ impl Resolution {
             // clock rounded to the nearest f64: the spacings at both (in s).
             let spacing = |x: f64| f64::from_bits(x.to_bits() + 1) - x;
             let f64s = spacing(self.largest) + spacing(self.largest * self.hz) / self.hz;
-            let res = self.block.step().unwrap_or(0.0).max(f64s);
+            let step = self
+                .block
+                .gcd
+                .filter(|_| self.varied)
+                .map_or(0.0, |g| decimal_step(g) as f64 * 1e-9);
+            let res = step.max(f64s);
             let full = self.changes.len() >= MAX_LISTED;
             match self.changes.last_mut() {
                 Some((_, r)) if *r == res => {}
@@ -1722,6 +1749,15 @@ impl Resolution {
             .take_while(|&&(t, _)| t <= end)
             .fold(0.0, |r, &(_, x)| r.max(x))
     }
+}
+
+/// The largest power of ten dividing `ns` (1 for 0).
+fn decimal_step(mut ns: u64) -> u64 {
+    let mut p = 1;
+    while ns != 0 && ns % 10 == 0 {
+        (ns, p) = (ns / 10, p * 10);
+    }
+    p
 }
 
 /// The firmware's periodic task between two events.
@@ -2649,9 +2685,9 @@ fn unreachable_wheel() -> Result<(EncoderConfig, Option<WindowConfig>), String> 
 
 #[cfg(test)]
 mod tests {
-    use super::{Resolution, BLOCK_ROWS, MAX_LISTED};
+    use super::{decimal_step, Resolution, BLOCK_ROWS, MAX_LISTED};
 
-    /// Blocks whose grid alternates (1 µs, then 2 µs) change the resolution every block: the
+    /// Blocks whose grid alternates (1 µs, then 10 µs) change the resolution every block: the
     /// changes kept stop at [`MAX_LISTED`], the last of them the coarsest met since, and each
     /// span reads the coarsest of its blocks.
     #[test]
@@ -2663,19 +2699,45 @@ mod tests {
         let (mut t, mut us) = (0.0f64, 0u64);
         let blocks = MAX_LISTED + 100;
         for b in 0..blocks {
-            // 1 µs steps in even blocks (offsets 1, 2, 3 ... µs), 2 µs in odd ones.
-            let step = if b % 2 == 0 { 1 } else { 2 };
-            for _ in 0..BLOCK_ROWS {
-                us += step;
+            // Rows 1 and 2 steps apart in turn, of 1 µs in even blocks and 10 µs in odd ones.
+            let step = if b % 2 == 0 { 1 } else { 10 };
+            for k in 0..BLOCK_ROWS {
+                us += step * (1 + k as u64 % 2);
                 t = us as f64 * 1e-6;
                 r.row(t);
             }
         }
         assert_eq!(r.changes.len(), MAX_LISTED);
         assert!((r.changes[0].1 - 1e-6).abs() < 1e-12, "{:?}", r.changes[0]);
-        assert!((r.changes[1].1 - 2e-6).abs() < 1e-12, "{:?}", r.changes[1]);
-        assert!((r.changes[MAX_LISTED - 1].1 - 2e-6).abs() < 1e-12);
-        assert!((r.over(0.0, t) - 2e-6).abs() < 1e-12);
+        assert!((r.changes[1].1 - 1e-5).abs() < 1e-12, "{:?}", r.changes[1]);
+        assert!((r.changes[MAX_LISTED - 1].1 - 1e-5).abs() < 1e-12);
+        assert!((r.over(0.0, t) - 1e-5).abs() < 1e-12);
         assert!((r.over(0.0, 1e-6) - 1e-6).abs() < 1e-12);
+    }
+
+    /// Rows equally spaced (a steady signal on a fine grid) say nothing of the step; rows
+    /// whose few spacings share a step no power of ten divides neither: the block resolves no
+    /// more coarsely than its 20 ns grid. Times on a decimal grid, unequally spaced, resolve
+    /// to it.
+    #[test]
+    fn a_steady_signal_is_no_coarse_grid() {
+        let resolution = |spacings: &[u64]| {
+            let mut r = Resolution {
+                hz: 1e6,
+                ..Resolution::default()
+            };
+            let mut ns = 1_000_000_000u64;
+            for k in 0..BLOCK_ROWS {
+                ns += spacings[k % spacings.len()];
+                r.row(ns as f64 * 1e-9);
+            }
+            r.changes[0].1
+        };
+        // 1166 and 700/1633 samples of 20 ns; 0.8 and 0.9 ms on a 100 µs grid.
+        assert!(resolution(&[23_320]) < 1e-9);
+        assert!(resolution(&[14_000, 32_660]) <= 2e-8);
+        assert!((resolution(&[800_000, 900_000]) - 1e-4).abs() < 1e-15);
+        assert_eq!(decimal_step(23_320), 10);
+        assert_eq!(decimal_step(900_000), 100_000);
     }
 }
