@@ -415,6 +415,80 @@ fn dropped_teeth_are_counted_as_missing() {
     assert_eq!((report.glitches, report.extra), (0, 0));
 }
 
+/// A capture sampled too slowly for the pulses of a shaft that runs up (from 20 rad/s, where
+/// 800 S/s takes five samples of a level, to 134 rad/s, where a level lasts less than one): the
+/// file lacks level changes, and the run counts them exactly (each channel's changes in the
+/// file and those lost add up to the edges the encoder delivered) and says so in a WARNING;
+/// at 50 MS/s nothing is lost and nothing is said.
+#[test]
+fn level_changes_lost_to_the_sampling_are_counted_exactly() {
+    let scene = |rate: &str| {
+        format!(
+            "[simulation]\nduration = 3.0\nsettle = 2.0\n\
+             [shaft]\ninertia = 0.323\ninitial_speed = 20.0\n\
+             [motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+             breakdown_torque = 158.0\n\
+             [load]\nmean = 24.0\n\
+             [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n\
+             [capture]\nsample_rate = {rate}\n"
+        )
+    };
+    for (rate, lossy) in [("800", true), ("50e6", false)] {
+        let (_scratch, file) = tmp("runup.csv");
+        let run = simulate(&scene(rate), CaptureFormat::Saleae, &file);
+        // The level changes of the signal the encoder delivered (a pulse the shaft starts in
+        // ends without having begun).
+        let delivered = |index: bool| {
+            let mut edges: Vec<&Edge> = run
+                .edge_list
+                .iter()
+                .filter(|e| !e.dropped && e.index == index)
+                .collect();
+            edges.sort_by(|a, b| a.seen_time.total_cmp(&b.seen_time));
+            let mut high = false;
+            edges
+                .iter()
+                .filter(|e| std::mem::replace(&mut high, e.rising) != e.rising)
+                .count() as u64
+        };
+        // The level changes the file shows, channel by channel.
+        let mut reader = CaptureReader::open(&file, None, None).unwrap();
+        let (mut prev, mut shown) = (Vec::new(), [0u64; 2]);
+        while let Some((_, levels)) = reader.next_row().unwrap() {
+            for (c, n) in shown.iter_mut().enumerate() {
+                if prev.get(c).is_some_and(|p| *p != levels[c]) {
+                    *n += 1;
+                }
+            }
+            prev = levels.to_vec();
+        }
+        assert_eq!(run.capture_channels.len(), 2, "{:?}", run.capture_channels);
+        for (c, ch) in run.capture_channels.iter().enumerate() {
+            assert_eq!(ch.changes, delivered(c == 1), "{rate}: {ch:?}");
+            assert_eq!(shown[c] + ch.lost, ch.changes, "{rate}: {ch:?}");
+        }
+        let encoder = &run.capture_channels[0];
+        if lossy {
+            assert!(encoder.lost * 10 > encoder.changes, "{encoder:?}");
+            let warning = run.capture_warning.as_deref().unwrap();
+            assert!(
+                warning.contains(&format!(
+                    "{} of the {} level changes of channel `Channel 0`",
+                    encoder.lost, encoder.changes
+                )) && warning.contains("`capture.sample_rate = 800`"),
+                "{warning}"
+            );
+        } else {
+            assert!(
+                run.capture_channels.iter().all(|c| c.lost == 0),
+                "{:?}",
+                run.capture_channels
+            );
+            assert_eq!(run.capture_warning, None);
+        }
+    }
+}
+
 /// A scene of a 24-line disc with an index pulse on its own channel, at 40 rad/s for
 /// `duration` s, captured at 10 MS/s.
 fn index_disc(duration: f64) -> String {
@@ -452,6 +526,64 @@ fn an_index_disc_from_two_channels() {
         .count();
     assert_eq!(report.revolutions as usize, frames);
     assert!(frames >= 4);
+}
+
+/// `--lines N` without `--framing` takes the disc as unframed, as a capture need not hold an
+/// index channel, where a scene's `lines = N` is framed by its index: the report says so, and
+/// names a channel whose pulses come once every N edges (an index pulse's), not the quadrature
+/// B channel's; with `--framing` given it says nothing.
+#[test]
+fn lines_without_framing_say_the_disc_is_taken_unframed() {
+    use host_sim::app::analyze::{Channel, FramingArg};
+    let (_scratch, file) = tmp("index.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
+    let bare = AnalyzeOptions {
+        lines: Some(24),
+        ..AnalyzeOptions::default()
+    };
+    let (report, _) = run_analyze(&file, bare.clone());
+    assert_eq!(report.wheel, "24 lines, no frame marker");
+    let note = report.framing_note.as_deref().unwrap();
+    assert!(
+        note.starts_with("framing: none, the default without --framing"),
+        "{note}"
+    );
+    assert!(
+        note.contains("`Channel 1` pulses 6 times")
+            && note.contains("--framing index frames each revolution")
+            && !note.contains("--index-channel"),
+        "{note}"
+    );
+    let said = host_sim::app::analyze::text(&report);
+    assert!(said.contains(note), "{said}");
+    for framing in [FramingArg::None, FramingArg::Index] {
+        let (report, _) = run_analyze(
+            &file,
+            AnalyzeOptions {
+                framing: Some(framing),
+                ..bare.clone()
+            },
+        );
+        assert_eq!(report.framing_note, None);
+    }
+    // A quadrature capture: B pulses every pitch, the index Z once a revolution.
+    let rev = std::f64::consts::TAU;
+    let (text, _, _) = quadrature(50, 40.0, &[8.0 * rev]);
+    let cfg = configure(&AnalyzeOptions {
+        channel: Some(Channel::Name("A".into())),
+        lines: Some(50),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "q.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let note = report.framing_note.unwrap();
+    assert!(
+        note.contains("`Z` pulses 7 times in the 399 edges of `A`, 8.0 revolutions")
+            && note.contains("--framing index --index-channel 2"),
+        "{note}"
+    );
+    assert!(!note.contains("`B`"), "{note}");
 }
 
 /// A capture taken through the timer's input prescaler (one capture in 4 line edges): the
@@ -1216,13 +1348,76 @@ fn a_shaft_rocking_across_a_line_edge_is_not_running() {
             assert!(w.end <= turns[0] + 1e-3, "centre {centre}: {w:?}");
         }
         assert!(r.no_pitch >= 90, "centre {centre}: {r:?}");
+        assert_eq!(r.backward_pitches, 0, "centre {centre}");
         assert!(r.reversals <= 1, "centre {centre}: {:?}", r.faults);
         let said = host_sim::app::analyze::text(&r);
         assert!(
-            said.contains("no step forward of the quadrature count"),
+            said.contains("no step forward of the quadrature count")
+                && !said.contains("turned the other way"),
             "{said}"
         );
     }
+}
+
+/// A disc turning steadily the other way than `--forward` says (a forward run read with B
+/// leading, or a reverse run): every capture is a pitch backward of the one before, which the
+/// report says, with the `--forward` that reads it as forward, and not as a shaft at rest
+/// rocking across a line edge (which it said of every capture). A run that turns back for a
+/// while only says it turned the other way there.
+#[test]
+fn a_disc_turning_the_other_way_is_not_taken_for_rocking() {
+    use host_sim::app::analyze::{Channel, Lead};
+    let rev = std::f64::consts::TAU;
+    let off = 0.37 * rev / 50.0;
+    let analyze_with = |stops: &[f64], forward: Lead| {
+        let (text, _, backwards) = quadrature(50, 40.0, stops);
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            direction_channel: Some(Channel::Name("B".into())),
+            forward: Some(forward),
+            lines: Some(50),
+            framing: Some(host_sim::app::analyze::FramingArg::None),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut reader = text_reader(text, "q.csv", None).unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        let said = host_sim::app::analyze::text(&r);
+        (r, said, backwards)
+    };
+    // Forward for 8 revolutions, read with B leading: every edge backward.
+    let (r, said, _) = analyze_with(&[8.0 * rev + off], Lead::BLeads);
+    assert_eq!(r.accepted, 0);
+    assert!(r.backward_pitches + 1 >= r.captured, "{r:?}");
+    assert_eq!(r.no_pitch, 0, "{r:?}");
+    assert!(!said.contains("rocking across a line edge), fed"), "{said}");
+    assert!(
+        said.contains("the disc turned the other way for most of the capture")
+            && said.contains("if it turned forward, give --forward a-leads"),
+        "{said}"
+    );
+    let hint = r.sync_hint.unwrap().causes.join("\n");
+    assert!(
+        hint.contains("the edges ran backward") && !hint.contains("none of the usual causes"),
+        "{hint}"
+    );
+    // Read as wired, it runs forward: nothing backward.
+    let (r, said, _) = analyze_with(&[8.0 * rev + off], Lead::ALeads);
+    assert_eq!((r.backward_pitches, r.reverse_edges), (0, 0), "{said}");
+    // Forward 8 revolutions, back 4, forward to 12: the 4 back are said, no --forward offered.
+    let (r, said, backwards) = analyze_with(
+        &[8.0 * rev + off, 4.0 * rev + off, 12.0 * rev + off],
+        Lead::ALeads,
+    );
+    assert!(
+        r.backward_pitches + 2 >= backwards as u64 && r.backward_pitches <= backwards as u64,
+        "{} of {backwards}",
+        r.backward_pitches
+    );
+    assert!(
+        said.contains("the disc turned the other way\n") && !said.contains("--forward b-leads"),
+        "{said}"
+    );
 }
 
 /// A reversal on a quadrature capture: with the B channel named, the core sees the direction
@@ -2213,6 +2408,46 @@ fn times_written_to_fixed_significant_digits_widen_the_floor() {
         said.contains("sampling: the times resolve less finely in places: to 1.000e-4 s"),
         "{said}"
     );
+}
+
+/// The kneader's own capture (Saleae, 50 MS/s), analyzed with its scene: where the speed
+/// turns, 32 rows come 1166 samples apart, which is no coarser resolution of the times (it was
+/// read as 23.32 µs, and every window of δ 0.031 as within a floor of 0.064, not resolved).
+#[test]
+fn a_steady_signal_on_a_fine_grid_is_not_taken_for_coarse_times() {
+    let (_scratch, file) = tmp("kneader.csv");
+    let text = host_sim::app::scene::BUNDLED
+        .iter()
+        .find(|(f, _)| *f == "kneader.toml")
+        .unwrap()
+        .1
+        .replace("duration = 30.0", "duration = 3.0")
+        .replace("settle = 10.0", "settle = 1.0");
+    let run = simulate(&text, CaptureFormat::Saleae, &file);
+    let scene = Scene::parse(&text, Path::new("kneader.toml")).unwrap();
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            scene: Some((scene, PathBuf::from("kneader.toml"))),
+            ..AnalyzeOptions::default()
+        },
+    );
+    assert_eq!(report.time_grid, Some(2e-8));
+    assert_eq!(report.coarser_times, None, "{:?}", report.coarser_times);
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 2, "{:?}", report.windows);
+    for w in &valid {
+        assert_eq!(w.resolved, Some(true), "{w:?}");
+        // Steady, the run's own measurement of the same shaft.
+        let d = w.delta.unwrap();
+        if w.steady == Some(true) {
+            assert!(
+                (d / run.delta_measured.unwrap() - 1.0).abs() < 0.05,
+                "{d} {w:?}"
+            );
+        }
+    }
+    assert!(valid.iter().any(|w| w.steady == Some(true)));
 }
 
 /// Exact decimal Unix times after a first row at 0 s: counted from 0 (the first row's whole

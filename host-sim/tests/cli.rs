@@ -703,6 +703,227 @@ fn run_writes_a_capture_that_analyze_reads() {
     );
 }
 
+/// The kneader's drive for `duration` s on a 1024-line index disc, captured at `rate`.
+fn kneader_captured(duration: f64, rate: &str) -> String {
+    format!(
+        "[simulation]\nduration = {duration}\nsettle = 0.5\n\
+         [shaft]\ninertia = 0.323\n\
+         [motor]\nmodel = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+         breakdown_torque = 158.0\n\
+         [load]\nmean = 24.0\nharmonics = [{{ order = 0.125, amplitude = 12.0, phase = 0.0 }}]\n\
+         [encoder]\nlines = 1024\ntimer_hz = 84e6\n\
+         [capture]\nsample_rate = {rate}\n"
+    )
+}
+
+/// A capture sampled too slowly for the pulses at the speed the run starts at is refused
+/// before anything is simulated, naming the key, its value and the rate needed (it wrote a
+/// file with 56 k of 656 k pulses at 10 kS/s, without a word); one that becomes too slow only
+/// as the shaft runs up is written with a WARNING counting the level changes it lacks.
+#[test]
+fn a_capture_too_slow_for_the_pulses_is_refused_or_its_losses_counted() {
+    let scratch_dir = scratch("capture-rate");
+    let dir = scratch_dir.path();
+    let scene = dir.join("slow.toml");
+    std::fs::write(&scene, kneader_captured(1.0, "10000")).unwrap();
+    let capture = dir.join("slow.csv");
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(err.contains("`capture.sample_rate = 10000`"), "{err}");
+    assert!(!capture.exists(), "{err}");
+    // Two samples of half a pitch of 1024 lines at the predicted speeds: 2·1024·ω/π.
+    let needed: f64 = err
+        .split("needs at least ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    let at = |w: f64| 2.0 * 1024.0 * w / std::f64::consts::PI;
+    assert!(
+        needed > at(132.196) && needed < at(136.311),
+        "{needed}: {err}"
+    );
+    // At the rate named, the file is written and nothing is lost.
+    std::fs::write(&scene, kneader_captured(1.0, &format!("{}", needed.ceil()))).unwrap();
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with("capture: wrote") && !out.contains("WARNING capture"),
+        "{out}"
+    );
+    // Started at 20 rad/s, where 2 kS/s is plenty, the shaft runs up to 134 rad/s, where a
+    // pulse of a 64-line disc lasts 0.37 ms: merged away, and counted.
+    let text = kneader_captured(3.0, "2000")
+        .replace(
+            "inertia = 0.323\n",
+            "inertia = 0.323\ninitial_speed = 20.0\n",
+        )
+        .replace("lines = 1024", "lines = 64");
+    std::fs::write(&scene, text).unwrap();
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let warning = out
+        .lines()
+        .find(|l| l.starts_with("WARNING capture:"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        warning.contains("level changes of channel `Channel 0`")
+            && warning.contains("`capture.sample_rate = 2000`"),
+        "{warning}"
+    );
+    let lost: u64 = warning
+        .trim_start_matches("WARNING capture: ")
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{warning}"));
+    assert!(lost > 1000, "{warning}");
+    // Without an [encoder] there is no signal to record (it wrote one edge of the run's
+    // internal encoder).
+    let text = kneader_captured(1.0, "1e6");
+    let text = &text[..text.find("[encoder]").unwrap()];
+    std::fs::write(&scene, text).unwrap();
+    let capture = dir.join("none.csv");
+    let (ok, _, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("`encoder`") && err.contains("--capture"),
+        "{err}"
+    );
+    assert!(!capture.exists());
+}
+
+/// Without --capture-format the capture's format follows the file's extension (`x.vcd` was
+/// written as Saleae CSV); a format the extension contradicts is refused before simulating.
+#[test]
+fn the_capture_format_follows_the_files_extension() {
+    let scratch_dir = scratch("capture-format");
+    let dir = scratch_dir.path();
+    let scene = dir.join("disc.toml");
+    std::fs::write(
+        &scene,
+        "[simulation]\nduration = 0.5\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+         [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n",
+    )
+    .unwrap();
+    let run = |file: &str, format: Option<&str>| {
+        let path = dir.join(file);
+        let mut args = vec![
+            "run".to_string(),
+            scene.to_str().unwrap().to_string(),
+            "--capture".to_string(),
+            path.to_str().unwrap().to_string(),
+        ];
+        if let Some(f) = format {
+            args.extend(["--capture-format".to_string(), f.to_string()]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (ok, _, err) = drive_sim(&args);
+        (ok, err, std::fs::read_to_string(&path).ok())
+    };
+    let (ok, err, text) = run("x.vcd", None);
+    assert!(ok, "{err}");
+    let text = text.unwrap();
+    assert!(
+        text.starts_with("$version drive-sim") && text.contains("$timescale"),
+        "{text:.200}"
+    );
+    let (ok, err, text) = run("X.VCD", Some("vcd"));
+    assert!(ok && text.unwrap().starts_with("$version"), "{err}");
+    let (ok, err, text) = run("x.csv", None);
+    assert!(ok, "{err}");
+    assert!(
+        text.unwrap().starts_with("Time [s],Channel 0,Channel 1\n"),
+        "{err}"
+    );
+    let (ok, err, text) = run("y.csv", Some("plain"));
+    assert!(
+        ok && text.unwrap().starts_with("time_s,level,index\n"),
+        "{err}"
+    );
+    for (file, format, says) in [
+        ("z.vcd", "saleae", "ends in .vcd"),
+        ("z.vcd", "plain", "ends in .vcd"),
+        ("z.csv", "vcd", "ends in .csv"),
+    ] {
+        let (ok, err, text) = run(file, Some(format));
+        assert!(!ok && text.is_none(), "{file} {format}: {err}");
+        assert!(
+            err.contains(&format!("--capture-format {format}")) && err.contains(says),
+            "{err}"
+        );
+    }
+}
+
+/// `run` counts the line edges and the index pulses apart, as `analyze` of its capture counts
+/// them (it said 656 961 edges for the kneader, its 656 321 line edges and 640 index pulses
+/// together), noise pulses among the line edges.
+#[test]
+fn run_counts_line_edges_and_index_pulses_as_analyze_does() {
+    let scratch_dir = scratch("run-edges");
+    let dir = scratch_dir.path();
+    let scene = dir.join("disc.toml");
+    std::fs::write(
+        &scene,
+        "[simulation]\nduration = 2.0\nseed = 5\n[motor]\nmodel = \"speed\"\nspeed = 40.0\n\
+         [encoder]\nlines = 24\ntimer_hz = 1e6\nestimator_edges = 1\n\
+         glitch_probability = 0.02\nglitch_window = [0.3, 0.7]\n",
+    )
+    .unwrap();
+    let capture = dir.join("disc.csv");
+    let (ok, out, err) = drive_sim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--capture",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let run = json(&["run", scene.to_str().unwrap(), "--json"]);
+    let a = json(&[
+        "analyze",
+        capture.to_str().unwrap(),
+        "--lines",
+        "24",
+        "--framing",
+        "index",
+        "--json",
+    ]);
+    let (line, noise, index) = (
+        run["line_edges"].as_u64().unwrap(),
+        run["noise_pulses"].as_u64().unwrap(),
+        run["index_pulses"].as_u64().unwrap(),
+    );
+    assert!(noise > 0 && index > 0, "{run}");
+    assert_eq!(line, a["edges"].as_u64().unwrap(), "{a}");
+    assert_eq!(index, a["index_pulses"].as_u64().unwrap(), "{a}");
+    assert_eq!(run["edges"].as_u64().unwrap(), line + index);
+    assert!(
+        out.contains(&format!(
+            "{line} line edges ({noise} of them noise pulses) and {index} index pulses"
+        )),
+        "{out}"
+    );
+}
+
 #[test]
 fn predict_says_a_prescribed_speed_gives_no_delta() {
     // A prescribed speed with [load] and [shaft]: the message said the scene had no [motor]

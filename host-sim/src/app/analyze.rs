@@ -87,6 +87,9 @@ pub struct AnalyzeConfig {
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
+    /// The disc of `--lines` is unframed because `--framing` was not given (the report says
+    /// so, and names a channel that pulses once a revolution).
+    pub framing_default: bool,
 }
 
 /// Which channel of a quadrature pair leads when the shaft runs forward.
@@ -145,11 +148,12 @@ impl Quadrature {
         }
     }
 
-    /// Whether the count moved forward since the last capture (this one now the last).
-    fn moved(&mut self) -> bool {
-        let moved = self.count > self.at_capture;
+    /// The steps the count moved since the last capture (this one now the last): 4 a pitch
+    /// forward, −4 a pitch backward, about 0 across a line edge and back.
+    fn since_capture(&mut self) -> i64 {
+        let steps = self.count - self.at_capture;
         self.at_capture = self.count;
-        moved
+        steps
     }
 }
 
@@ -448,6 +452,10 @@ pub struct AnalyzeReport {
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
     pub wheel: String,
+    /// When `--lines` was given without `--framing`: that the disc was taken as unframed, and
+    /// a channel not read that pulses once every revolution of edges (an index channel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub framing_note: Option<String>,
     /// Emulated capture timer clock, Hz.
     pub timer_hz: f64,
     /// Emulated counter width, bits.
@@ -537,9 +545,13 @@ pub struct AnalyzeReport {
     /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
     pub reverse_edges: u64,
     /// Of them, captures with no step forward of the quadrature count (the encoder and
-    /// direction channels) since the capture before, itself so (no pitch: a shaft rocking
-    /// across a line edge), fed as reverse.
+    /// direction channels) since the capture before, itself so, and less than a pitch back
+    /// (no pitch: a shaft rocking across a line edge), fed as reverse.
     pub no_pitch: u64,
+    /// Of them, captures a pitch or more backward of the capture before (the quadrature count
+    /// stepped back by 4 or more): the disc turning the other way, or a `--forward` the wrong
+    /// way round for the wiring when it is most of the capture.
+    pub backward_pitches: u64,
     /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
     /// the last edges of the capture, waiting for the two that would confirm them, and the
     /// first edge after a standstill or a reversal (a time reference only).
@@ -959,6 +971,11 @@ fn sync_hint(
             r.unexplained
         ));
     }
+    if let Some(why) = other_way(r) {
+        causes.push(format!(
+            "no sync: the edges ran backward, a pitch at each capture,{why}"
+        ));
+    }
     // An index disc whose index pulses disagree with its lines has its own `index:` line.
     let index_says = r
         .index_period
@@ -1336,10 +1353,19 @@ pub fn analyze<R: BufRead>(
                 // not captured), which read as a steady forward pulse train. Fed as reverse:
                 // no tooth, and no running until the shaft moves on. (One such capture alone
                 // is left to the core: a noise pulse just before a real edge.)
-                let moved = quadrature.moved();
+                let steps = quadrature.since_capture();
+                let moved = steps > 0;
+                // A pitch or more backward: the disc turns the other way (B says so too),
+                // which is no rocking at rest.
+                let backward = steps <= -4;
                 if !moved && !moved_before {
                     direction = Some(Direction::Reverse);
-                    report.no_pitch += 1;
+                    if !backward {
+                        report.no_pitch += 1;
+                    }
+                }
+                if backward && direction == Some(Direction::Reverse) {
+                    report.backward_pitches += 1;
                 }
                 moved_before = moved;
             }
@@ -1510,8 +1536,78 @@ pub fn analyze<R: BufRead>(
             changes,
         })
         .collect();
+    if cfg.framing_default {
+        report.framing_note = Some(framing_note(&report, enc.config().wheel, ch));
+    }
     report.speed_trace.shrink_to_fit();
     Ok(report)
+}
+
+/// When most of a capture's edges came a pitch backward each (steadily the other way, not
+/// rocking): that the disc may turn forward with the direction the other way round, and the
+/// `--forward` that reads it so.
+fn other_way(r: &AnalyzeReport) -> Option<String> {
+    let lead = r.forward?;
+    if r.backward_pitches * 2 <= r.captured {
+        return None;
+    }
+    let d = r.direction_channel.as_deref().unwrap_or("B");
+    let (a_leads, b_leads) = (
+        format!("`{}` leading `{d}`", r.channel),
+        format!("`{d}` leading `{}`", r.channel),
+    );
+    let (taken, other, option) = match lead {
+        Lead::ALeads => (a_leads, b_leads, "b-leads"),
+        Lead::BLeads => (b_leads, a_leads, "a-leads"),
+    };
+    Some(format!(
+        " for most of the capture ({} of {} captures): a disc turning in reverse, or one turning \
+         forward with {other} where the analysis took {taken}: if it turned forward, give \
+         --forward {option}",
+        r.backward_pitches, r.captured
+    ))
+}
+
+/// The line saying that a disc of `--lines` without `--framing` was taken as unframed, naming
+/// each other channel whose pulses come once every revolution of the encoder channel's edges
+/// (within a revolution over the capture), as an index pulse does.
+fn framing_note(r: &AnalyzeReport, wheel: drive_monitor::encoder::Wheel, ch: usize) -> String {
+    let lines = u64::from(wheel.positions());
+    let index_like: Vec<String> = r
+        .channel_changes
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != ch)
+        .filter_map(|(k, c)| {
+            let pulses = c.changes / 2;
+            (pulses >= 2 && (pulses * lines).abs_diff(r.edges) <= lines).then(|| {
+                format!(
+                    "`{}` pulses {pulses} times in the {} edges of `{}`, {:.1} revolutions of \
+                     {lines} lines: once a revolution, as an index does; --framing index{} \
+                     frames each revolution by it",
+                    c.name,
+                    r.edges,
+                    r.channel,
+                    r.edges as f64 / lines as f64,
+                    // The index channel's default is the second column.
+                    if k == 1 {
+                        String::new()
+                    } else {
+                        format!(" --index-channel {k}")
+                    }
+                )
+            })
+        })
+        .collect();
+    let mut s = "framing: none, the default without --framing: no index channel is read and the \
+                 revolutions are counted from the first edges (a scene's [encoder] lines = N is \
+                 framed by its index)"
+        .to_string();
+    for c in index_like {
+        s.push_str("; ");
+        s.push_str(&c);
+    }
+    s
 }
 
 /// The step every row's time lies on, from the first row's, in whole nanoseconds (the
@@ -1566,8 +1662,17 @@ impl TimeGrid {
 pub const BLOCK_ROWS: usize = 32;
 
 /// The resolution of the times along the file, block by block of [`BLOCK_ROWS`] rows: the step
-/// the block's times lie on ([`TimeGrid`]), or what f64 numbers resolve at its largest time,
-/// whichever is coarser. Kept where it changes, for at most [`MAX_LISTED`] changes.
+/// the block's times lie on ([`TimeGrid`]) as decimal times written to fewer digits resolve
+/// (the largest power of ten of nanoseconds dividing it), or what f64 numbers resolve at its
+/// largest time, whichever is coarser. Kept where it changes, for at most [`MAX_LISTED`]
+/// changes.
+///
+/// A block whose rows come equally spaced says nothing of the step: a steady signal on a fine
+/// grid lies on its own spacing (the kneader's capture at 50 MS/s, 1166 samples between rows
+/// where the speed turns, read as times resolved to 23.32 µs, and every window of δ 0.031 as
+/// within a floor of 0.064); nor does a step of such a signal's few spacings that no power of
+/// ten divides. (A steady signal whose spacings are all multiples of a power of ten coarser
+/// than the grid still reads as resolved to it: 20 and 40 µs to 10 µs.)
 #[derive(Default)]
 struct Resolution {
     /// The timer clock, Hz.
@@ -1576,6 +1681,11 @@ struct Resolution {
     rows: usize,
     start: f64,
     largest: f64,
+    /// The block's previous row's time, the spacing before it (whole ns; rows at one time
+    /// left out), and whether two spacings differ.
+    previous: Option<f64>,
+    spacing: Option<i64>,
+    varied: bool,
     /// (the first row's time of a block, its resolution) where the resolution changes.
     changes: Vec<(f64, f64)>,
 }
@@ -1585,6 +1695,14 @@ impl Resolution {
         if self.rows == 0 {
             self.block = TimeGrid::default();
             (self.start, self.largest) = (t, 0.0);
+            (self.previous, self.spacing, self.varied) = (None, None, false);
+        }
+        if let Some(t0) = self.previous.replace(t) {
+            let ns = ((t - t0) * 1e9).round() as i64;
+            if ns != 0 {
+                self.varied |= self.spacing.is_some_and(|s| s != ns);
+                self.spacing = Some(ns);
+            }
         }
         self.block.row(t);
         self.largest = self.largest.max(t.abs());
@@ -1602,7 +1720,12 @@ impl Resolution {
             // clock rounded to the nearest f64: the spacings at both (in s).
             let spacing = |x: f64| f64::from_bits(x.to_bits() + 1) - x;
             let f64s = spacing(self.largest) + spacing(self.largest * self.hz) / self.hz;
-            let res = self.block.step().unwrap_or(0.0).max(f64s);
+            let step = self
+                .block
+                .gcd
+                .filter(|_| self.varied)
+                .map_or(0.0, |g| decimal_step(g) as f64 * 1e-9);
+            let res = step.max(f64s);
             let full = self.changes.len() >= MAX_LISTED;
             match self.changes.last_mut() {
                 Some((_, r)) if *r == res => {}
@@ -1626,6 +1749,15 @@ impl Resolution {
             .take_while(|&&(t, _)| t <= end)
             .fold(0.0, |r, &(_, x)| r.max(x))
     }
+}
+
+/// The largest power of ten dividing `ns` (1 for 0).
+fn decimal_step(mut ns: u64) -> u64 {
+    let mut p = 1;
+    while ns != 0 && ns % 10 == 0 {
+        (ns, p) = (ns / 10, p * 10);
+    }
+    p
 }
 
 /// The firmware's periodic task between two events.
@@ -1899,6 +2031,9 @@ pub fn text(r: &AnalyzeReport) -> String {
         "wheel: {}; timer {} Hz, {}-bit counter",
         r.wheel, r.timer_hz, r.counter_bits
     );
+    if let Some(f) = &r.framing_note {
+        let _ = writeln!(s, "{f}");
+    }
     match r.sample_rate {
         Some(rate) => {
             let _ = writeln!(
@@ -2058,12 +2193,22 @@ pub fn text(r: &AnalyzeReport) -> String {
             r.reverse_edges
         );
     }
+    if r.backward_pitches > 0 {
+        let _ = writeln!(
+            s,
+            "{} of them came a pitch or more backward of the capture before (the quadrature \
+             count stepped back by 4 or more, as the direction channel says): the disc turned \
+             the other way{}",
+            r.backward_pitches,
+            other_way(r).unwrap_or_default()
+        );
+    }
     if r.no_pitch > 0 {
         let _ = writeln!(
             s,
             "{} of them came with no step forward of the quadrature count since the capture \
-             before, itself so: no pitch (a shaft at rest rocking across a line edge), fed as \
-             reverse",
+             before, itself so, and less than a pitch back: no pitch (a shaft at rest rocking \
+             across a line edge, or turning back across one), fed as reverse",
             r.no_pitch
         );
     }
@@ -2237,7 +2382,7 @@ pub struct AnalyzeOptions {
     pub wheel: Option<String>,
     /// `--lines N`.
     pub lines: Option<u16>,
-    /// `--framing` (with `--lines`).
+    /// `--framing` (with `--lines`; `None`: unframed, and the report says so).
     pub framing: Option<FramingArg>,
     /// `--scene`: the scene and the path its errors name.
     pub scene: Option<(crate::app::scene::Scene, std::path::PathBuf)>,
@@ -2348,8 +2493,8 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
     let given = [o.wheel.is_some(), o.lines.is_some(), o.scene.is_some()];
     if given.iter().filter(|&&g| g).count() != 1 {
         return Err(
-            "name the wheel once: --wheel N-M (a missing-tooth wheel), --lines N with --framing \
-             index|none, or --scene FILE (its [encoder])"
+            "name the wheel once: --wheel N-M (a missing-tooth wheel), --lines N (with \
+             --framing index|none, none by default), or --scene FILE (its [encoder])"
                 .into(),
         );
     }
@@ -2530,6 +2675,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
         warnings,
+        framing_default: o.lines.is_some() && o.framing.is_none(),
     })
 }
 
@@ -2539,9 +2685,9 @@ fn unreachable_wheel() -> Result<(EncoderConfig, Option<WindowConfig>), String> 
 
 #[cfg(test)]
 mod tests {
-    use super::{Resolution, BLOCK_ROWS, MAX_LISTED};
+    use super::{decimal_step, Resolution, BLOCK_ROWS, MAX_LISTED};
 
-    /// Blocks whose grid alternates (1 µs, then 2 µs) change the resolution every block: the
+    /// Blocks whose grid alternates (1 µs, then 10 µs) change the resolution every block: the
     /// changes kept stop at [`MAX_LISTED`], the last of them the coarsest met since, and each
     /// span reads the coarsest of its blocks.
     #[test]
@@ -2553,19 +2699,45 @@ mod tests {
         let (mut t, mut us) = (0.0f64, 0u64);
         let blocks = MAX_LISTED + 100;
         for b in 0..blocks {
-            // 1 µs steps in even blocks (offsets 1, 2, 3 ... µs), 2 µs in odd ones.
-            let step = if b % 2 == 0 { 1 } else { 2 };
-            for _ in 0..BLOCK_ROWS {
-                us += step;
+            // Rows 1 and 2 steps apart in turn, of 1 µs in even blocks and 10 µs in odd ones.
+            let step = if b % 2 == 0 { 1 } else { 10 };
+            for k in 0..BLOCK_ROWS {
+                us += step * (1 + k as u64 % 2);
                 t = us as f64 * 1e-6;
                 r.row(t);
             }
         }
         assert_eq!(r.changes.len(), MAX_LISTED);
         assert!((r.changes[0].1 - 1e-6).abs() < 1e-12, "{:?}", r.changes[0]);
-        assert!((r.changes[1].1 - 2e-6).abs() < 1e-12, "{:?}", r.changes[1]);
-        assert!((r.changes[MAX_LISTED - 1].1 - 2e-6).abs() < 1e-12);
-        assert!((r.over(0.0, t) - 2e-6).abs() < 1e-12);
+        assert!((r.changes[1].1 - 1e-5).abs() < 1e-12, "{:?}", r.changes[1]);
+        assert!((r.changes[MAX_LISTED - 1].1 - 1e-5).abs() < 1e-12);
+        assert!((r.over(0.0, t) - 1e-5).abs() < 1e-12);
         assert!((r.over(0.0, 1e-6) - 1e-6).abs() < 1e-12);
+    }
+
+    /// Rows equally spaced (a steady signal on a fine grid) say nothing of the step; rows
+    /// whose few spacings share a step no power of ten divides neither: the block resolves no
+    /// more coarsely than its 20 ns grid. Times on a decimal grid, unequally spaced, resolve
+    /// to it.
+    #[test]
+    fn a_steady_signal_is_no_coarse_grid() {
+        let resolution = |spacings: &[u64]| {
+            let mut r = Resolution {
+                hz: 1e6,
+                ..Resolution::default()
+            };
+            let mut ns = 1_000_000_000u64;
+            for k in 0..BLOCK_ROWS {
+                ns += spacings[k % spacings.len()];
+                r.row(ns as f64 * 1e-9);
+            }
+            r.changes[0].1
+        };
+        // 1166 and 700/1633 samples of 20 ns; 0.8 and 0.9 ms on a 100 µs grid.
+        assert!(resolution(&[23_320]) < 1e-9);
+        assert!(resolution(&[14_000, 32_660]) <= 2e-8);
+        assert!((resolution(&[800_000, 900_000]) - 1e-4).abs() < 1e-15);
+        assert_eq!(decimal_step(23_320), 10);
+        assert_eq!(decimal_step(900_000), 100_000);
     }
 }

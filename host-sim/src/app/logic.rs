@@ -30,7 +30,8 @@
 //!
 //! Writing follows the sampling of a real analyzer: a transition at time `t` is recorded at the
 //! first sample at or after it (`⌈t·rate⌉ / rate`), two transitions of a channel within one
-//! sample period collapse (a noise pulse shorter than a sample can vanish), and a noise pulse
+//! sample period collapse (a noise pulse shorter than a sample can vanish; the writer counts
+//! the transitions the file lacks, [`Written::channels`]), and a noise pulse
 //! is the exclusive-or of a short pulse with the tooth signal (a spike between teeth, a dip on
 //! a tooth: either way one extra rising and one extra falling edge). A last row at the end of
 //! the recording (levels unchanged) marks its length.
@@ -73,6 +74,34 @@ impl CaptureFormat {
             CaptureFormat::Sigrok => "sigrok",
             CaptureFormat::Plain => "plain",
             CaptureFormat::Vcd => "vcd",
+        }
+    }
+
+    /// The format of a capture written to `path`: `given` (`--capture-format`), else the one
+    /// the file's extension names (`.vcd`: a value change dump; `.csv` or any other: Saleae's
+    /// CSV). A format the extension contradicts (a CSV format to a `.vcd` file, a value change
+    /// dump to a `.csv` one) is refused, naming both: what reads the file goes by its name.
+    pub fn for_file(path: &Path, given: Option<CaptureFormat>) -> Result<CaptureFormat, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let (vcd, csv) = (ext.as_deref() == Some("vcd"), ext.as_deref() == Some("csv"));
+        match given {
+            None if vcd => Ok(CaptureFormat::Vcd),
+            None => Ok(CaptureFormat::Saleae),
+            Some(g) if vcd && g != CaptureFormat::Vcd => Err(format!(
+                "--capture-format {}: {} ends in .vcd, a value change dump: give --capture-format \
+                 vcd (or leave it out), or a file ending in .csv",
+                g.name(),
+                path.display()
+            )),
+            Some(CaptureFormat::Vcd) if csv => Err(format!(
+                "--capture-format vcd: {} ends in .csv, a comma-separated file: give a file \
+                 ending in .vcd, or --capture-format saleae|sigrok|plain",
+                path.display()
+            )),
+            Some(g) => Ok(g),
         }
     }
 
@@ -793,6 +822,32 @@ pub struct CaptureSettings {
     pub index: bool,
 }
 
+/// What the sampling did to one channel of a capture: the level changes of the signal, those
+/// the file lacks, and the shortest level the signal held.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelSampling {
+    /// The channel's name in the file.
+    pub channel: String,
+    /// Level changes of the signal (both edges of every pulse, noise pulses included).
+    pub changes: u64,
+    /// Of them, changes that fell within one sample period of another of the channel and are
+    /// not in the file (a pulse shorter than a sample vanishes, or is merged into a level).
+    pub lost: u64,
+    /// The shortest time the signal held a level, s (`None` with fewer than two changes).
+    pub shortest_level: Option<f64>,
+}
+
+/// A capture written: its rows and what the sampling did to each channel.
+#[derive(Debug)]
+pub struct Written<W> {
+    /// The output.
+    pub out: W,
+    /// Rows written.
+    pub rows: u64,
+    /// Each channel, the encoder's first.
+    pub channels: Vec<ChannelSampling>,
+}
+
 /// Writes encoder edges as a logic analyzer records them (see the module docs).
 pub struct CaptureWriter<W: Write> {
     out: W,
@@ -812,6 +867,15 @@ pub struct CaptureWriter<W: Write> {
     line: String,
     /// Rows written.
     pub rows_written: u64,
+    /// Per channel: the level at the start of the sample being assembled, the changes within
+    /// it, every change of the signal, those the file lacks, and the last change's time with
+    /// the shortest level so far.
+    sample_start: Vec<bool>,
+    in_sample: Vec<u64>,
+    changes: Vec<u64>,
+    lost: Vec<u64>,
+    last_change: Vec<Option<f64>>,
+    shortest: Vec<Option<f64>>,
 }
 
 impl<W: Write> CaptureWriter<W> {
@@ -840,6 +904,12 @@ impl<W: Write> CaptureWriter<W> {
             written: vec![false; n],
             line: String::new(),
             rows_written: 0,
+            sample_start: vec![false; n],
+            in_sample: vec![0; n],
+            changes: vec![0; n],
+            lost: vec![0; n],
+            last_change: vec![None; n],
+            shortest: vec![None; n],
         };
         let names = s.format.channel_names(s.index);
         let mut head = String::new();
@@ -943,6 +1013,7 @@ impl<W: Write> CaptureWriter<W> {
             // A change that jitter placed before the sample already written is recorded there.
             let n = n.max(self.sample);
             if n > self.sample {
+                self.close_sample();
                 self.commit()?;
                 self.sample = n;
             }
@@ -950,9 +1021,30 @@ impl<W: Write> CaptureWriter<W> {
                 What::Tooth(l) => self.tooth[t.channel] = l,
                 What::Noise(on) => self.noise[t.channel] = on,
             }
-            self.levels[t.channel] = self.tooth[t.channel] ^ self.noise[t.channel];
+            let c = t.channel;
+            let level = self.tooth[c] ^ self.noise[c];
+            if level != self.levels[c] {
+                self.changes[c] += 1;
+                self.in_sample[c] += 1;
+                if let Some(t0) = self.last_change[c].replace(t.time) {
+                    let held = t.time - t0;
+                    self.shortest[c] = Some(self.shortest[c].map_or(held, |s| s.min(held)));
+                }
+            }
+            self.levels[c] = level;
         }
         Ok(())
+    }
+
+    /// Counts the changes of each channel within the sample being assembled that its row
+    /// cannot show: all but the one that leaves the level changed, or all of them.
+    fn close_sample(&mut self) {
+        for c in 0..self.levels.len() {
+            let shown = u64::from(self.levels[c] != self.sample_start[c]);
+            self.lost[c] += self.in_sample[c] - shown;
+            self.in_sample[c] = 0;
+            self.sample_start[c] = self.levels[c];
+        }
     }
 
     /// Writes the rows up to the sample being assembled.
@@ -1026,9 +1118,11 @@ impl<W: Write> CaptureWriter<W> {
         self.out.write_all(self.line.as_bytes())
     }
 
-    /// Writes what is pending and a last row at `end` (s), and returns the output.
-    pub fn finish(mut self, end: f64) -> std::io::Result<W> {
+    /// Writes what is pending and a last row at `end` (s), and returns the output with what
+    /// the sampling did to each channel.
+    pub fn finish(mut self, end: f64) -> std::io::Result<Written<W>> {
         self.flush(f64::INFINITY)?;
+        self.close_sample();
         self.commit()?;
         let n_end = ((end * self.s.sample_rate).ceil() as i64).max(self.sample);
         let levels = self.levels.clone();
@@ -1045,7 +1139,24 @@ impl<W: Write> CaptureWriter<W> {
             }
         }
         self.out.flush()?;
-        Ok(self.out)
+        let channels = self
+            .s
+            .format
+            .channel_names(self.s.index)
+            .into_iter()
+            .enumerate()
+            .map(|(c, channel)| ChannelSampling {
+                channel,
+                changes: self.changes[c],
+                lost: self.lost[c],
+                shortest_level: self.shortest[c],
+            })
+            .collect();
+        Ok(Written {
+            out: self.out,
+            rows: self.rows_written,
+            channels,
+        })
     }
 }
 

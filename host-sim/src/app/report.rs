@@ -38,6 +38,19 @@ fn alarm_judged(r: &RunReport) -> String {
     }
 }
 
+/// The edges a run produced: the line edges (as `analyze` of its capture counts the channel's
+/// edges), with the noise pulses among them, and the index pulses on their own channel.
+fn edges_text(r: &RunReport) -> String {
+    let mut s = format!("{} line edges", r.line_edges);
+    if r.noise_pulses > 0 {
+        let _ = write!(s, " ({} of them noise pulses)", r.noise_pulses);
+    }
+    if r.index_pulses > 0 {
+        let _ = write!(s, " and {} index pulses", r.index_pulses);
+    }
+    s
+}
+
 /// A run as text.
 pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     let mut s = String::new();
@@ -47,7 +60,7 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     }
     let _ = writeln!(
         s,
-        "Simulated {:.1} s with {} ({} effects: {}) in {:.3} s wall: {} RHS evaluations, {} steps ({} rejected), {} edges",
+        "Simulated {:.1} s with {} ({} effects: {}) in {:.3} s wall: {} RHS evaluations, {} steps ({} rejected), {}",
         r.simulated_seconds,
         r.integrator,
         r.effects.len(),
@@ -56,7 +69,7 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         r.rhs_evaluations,
         r.steps[0],
         r.steps[1],
-        r.edges
+        edges_text(r)
     );
     for why in &r.not_simulated {
         let _ = writeln!(s, "NOT SIMULATED {why}");

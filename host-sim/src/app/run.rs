@@ -139,8 +139,15 @@ pub struct RunReport {
     pub component_evaluations: BTreeMap<&'static str, u64>,
     /// Accepted and rejected integrator steps.
     pub steps: [u64; 2],
-    /// Edges generated (line, index and glitch); 0 without an `[encoder]`.
+    /// Rising edges generated (line, index and glitch); 0 without an `[encoder]`.
     pub edges: u64,
+    /// Of them, the rising edges on the encoder's line channel, noise pulses included (what
+    /// `analyze` of the run's capture counts as the channel's edges).
+    pub line_edges: u64,
+    /// Of the line edges, the noise pulses (`encoder.glitch_probability`).
+    pub noise_pulses: u64,
+    /// Of them, the index pulses (an index disc's own channel).
+    pub index_pulses: u64,
     /// Median δ of the valid steady windows after the settling time.
     pub delta_measured: Option<f64>,
     /// δ predicted by the drive model.
@@ -260,6 +267,14 @@ pub struct RunReport {
     /// Rows written to it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub capture_rows: Option<u64>,
+    /// What the capture's sampling did to each channel: the level changes of the signal and
+    /// those the file lacks (merged within a sample period).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub capture_channels: Vec<crate::app::logic::ChannelSampling>,
+    /// A WARNING when the file lacks level changes of the signal: how many, on which channel,
+    /// and the sample rate that would keep them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture_warning: Option<String>,
     /// Every edge the encoder produced ([`RunOptions::keep_edges`]).
     #[serde(skip)]
     pub edge_list: Vec<crate::engine::encoder::Edge>,
@@ -1367,12 +1382,18 @@ pub fn run_with(
         .validate()
         .map_err(|e| core_error(scene, file, "simulation", e))?;
     check_work(scene, file, over, &integ)?;
-    let mut sim = Simulation::new(
-        system,
-        integ.clone(),
-        sim_encoder(scene, file, options.capture.is_some())?,
-    )
-    .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
+    let encoder = sim_encoder(scene, file, options.capture.is_some())?;
+    if options.capture.is_some() {
+        check_capture(
+            scene,
+            file,
+            over,
+            &encoder,
+            parts.as_ref().map(|p| p.u_start),
+        )?;
+    }
+    let mut sim = Simulation::new(system, integ.clone(), encoder)
+        .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
     let duration = scene.simulation.duration;
     let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
     let lines = scene
@@ -1465,19 +1486,19 @@ pub fn run_with(
         return Err(stopped(scene, file, stop, stats.time));
     }
     let mut capture_rows = None;
+    let mut capture_channels = Vec::new();
     if let (Some(w), Some(t)) = (col.capture.take(), &options.capture) {
-        let rows = w.rows_written;
-        let written = w.finish(stats.time);
-        let total = written.as_ref().map(|_| ()).map_err(|e| {
+        let written = w.finish(stats.time).map_err(|e| {
             SceneError::value(
                 file,
                 "capture",
                 format!("cannot write {}: {e}", t.path.display()),
             )
-        });
-        total?;
-        capture_rows = Some(rows);
+        })?;
+        capture_rows = Some(written.rows);
+        capture_channels = written.channels;
     }
+    let capture_warning = capture_loss_warning(scene, file, &capture_channels);
     let mut report = RunReport {
         scene: file.display().to_string(),
         effects: names,
@@ -1496,12 +1517,21 @@ pub fn run_with(
         } else {
             0
         },
+        line_edges: if scene.encoder.is_some() {
+            stats.encoder.edges - stats.encoder.index_pulses
+        } else {
+            0
+        },
+        noise_pulses: stats.encoder.glitches,
+        index_pulses: stats.encoder.index_pulses,
         settle,
         capture_file: options
             .capture
             .as_ref()
             .map(|t| t.path.display().to_string()),
         capture_rows,
+        capture_channels,
+        capture_warning,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         not_simulated: not_simulated(scene, over),
         model_warnings: cranking_warning(scene).into_iter().collect(),
@@ -1669,6 +1699,187 @@ fn not_simulated(scene: &Scene, over: Overrides) -> Vec<String> {
         ));
     }
     out
+}
+
+/// Samples a capture takes of the shortest level of the encoder signal at the least: with
+/// fewer than one a level can fall between two samples and vanish from the file, and two keep
+/// every level with a sample to spare for the run's speed swings and the edges' jitter.
+pub const CAPTURE_SAMPLES_PER_LEVEL: f64 = 2.0;
+
+/// A speed the shaft is sure to reach in the run, rad/s, and where the scene gives it: the
+/// prescribed speed (the largest a ramp or a profile reaches within the duration; the mean of
+/// a cranking ripple, whose peaks are faster), or the speed a motor-driven shaft starts at.
+/// `u_start` is the drive model's mean ω², where a motor-driven shaft starts by default.
+fn sure_speed(scene: &Scene, over: Overrides, u_start: Option<f64>) -> Option<(f64, String)> {
+    let d = scene.simulation.duration;
+    let (w, from) = match (&scene.motor, over.speed) {
+        (_, Some(w)) => (w.abs(), "the sweep's speed".to_string()),
+        (Some(MotorSpec::Speed { speed }), None) => (speed.abs(), "`motor.speed`".to_string()),
+        (Some(MotorSpec::Ramp { from, to, duration }), None) => {
+            let reached = from + (to - from) * (d / duration).min(1.0);
+            (
+                from.abs().max(reached.abs()),
+                "the ramp of `motor.from` and `motor.to`".to_string(),
+            )
+        }
+        (Some(MotorSpec::Profile { points }), None) => {
+            // ω̄ is linear between the points and held before the first and after the last.
+            let at = |t: f64| -> f64 {
+                let k = points.partition_point(|p| p[0] <= t);
+                match (k.checked_sub(1).and_then(|i| points.get(i)), points.get(k)) {
+                    (Some(a), Some(b)) => a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0]),
+                    (Some(a), None) => a[1],
+                    (None, Some(b)) => b[1],
+                    (None, None) => 0.0,
+                }
+            };
+            let inside = points
+                .iter()
+                .filter(|p| p[0] > 0.0 && p[0] < d)
+                .map(|p| p[1]);
+            let w = inside
+                .chain([at(0.0), at(d)])
+                .map(f64::abs)
+                .fold(0.0, f64::max);
+            (w, "`motor.points`".to_string())
+        }
+        (Some(MotorSpec::Parabola { .. } | MotorSpec::Kloss { .. }), None) => {
+            match scene.shaft.as_ref().and_then(|s| s.initial_speed) {
+                Some(w) => (
+                    w.abs(),
+                    "`shaft.initial_speed`, where the run starts".into(),
+                ),
+                None => (
+                    u_start?.max(0.0).sqrt(),
+                    "the drive model's mean speed, where the run starts".into(),
+                ),
+            }
+        }
+        (None, None) => return None,
+    };
+    (w.is_finite() && w > 0.0).then_some((w, from))
+}
+
+/// The shortest level of the encoder signal a capture records, as a shaft angle, rad, and
+/// what it is: each channel's marks in turn round the disc (both edges of every pulse, with
+/// the disc's pitch errors and run-out).
+fn shortest_level(encoder: &SimEncoder) -> Option<(f64, &'static str)> {
+    let e = crate::engine::encoder::Encoder::new(encoder.clone()).ok()?;
+    let mut shortest: Option<(f64, &'static str)> = None;
+    for index in [false, true] {
+        let marks: Vec<_> = e.marks().iter().filter(|m| m.index == index).collect();
+        for (i, m) in marks.iter().enumerate() {
+            let next = marks
+                .get(i + 1)
+                .map_or(marks[0].angle + std::f64::consts::TAU, |n| n.angle);
+            let what = match (index, m.rising) {
+                (false, true) => "a tooth's pulse",
+                (false, false) => "the low level between two teeth",
+                (true, true) => "the index pulse",
+                (true, false) => "the low level between index pulses",
+            };
+            let held = next - m.angle;
+            if shortest.is_none_or(|(s, _)| held < s) {
+                shortest = Some((held, what));
+            }
+        }
+    }
+    shortest
+}
+
+/// Refuses, before anything is simulated, a capture of a scene without `[encoder]` (there is no
+/// signal to record: the run's internal encoder is no scene's), and one whose `[capture]
+/// sample_rate` takes fewer than [`CAPTURE_SAMPLES_PER_LEVEL`] samples of the encoder signal's
+/// shortest level at a speed the run is sure to reach ([`sure_speed`]): its pulses would fall
+/// between samples and vanish from the file. (Faster speeds reached only as the run goes are
+/// counted as the file is written: [`capture_loss_warning`].)
+fn check_capture(
+    scene: &Scene,
+    file: &Path,
+    over: Overrides,
+    encoder: &SimEncoder,
+    u_start: Option<f64>,
+) -> Result<(), SceneError> {
+    let Some(e) = &scene.encoder else {
+        return Err(SceneError::value(
+            file,
+            "encoder",
+            "missing: `--capture` records the encoder's signal, and the scene has no [encoder] \
+             table",
+        ));
+    };
+    let (Some((w, from)), Some((angle, what))) =
+        (sure_speed(scene, over, u_start), shortest_level(encoder))
+    else {
+        return Ok(());
+    };
+    let spec = scene.capture.unwrap_or_default();
+    let held = angle / w;
+    let needed = CAPTURE_SAMPLES_PER_LEVEL / held;
+    if spec.sample_rate >= needed {
+        return Ok(());
+    }
+    let c = scene.checker(file);
+    let pitch = std::f64::consts::TAU / f64::from(e.grid_lines().max(1));
+    Err(c.bad(
+        "capture.sample_rate",
+        spec.sample_rate,
+        format!(
+            "too slow for the encoder signal: its shortest level, {what} ({:.3} of a grid pitch: \
+             encoder.lines = {}, capture.duty = {}), lasts {:.3e} s at {w:.4} rad/s ({from}), so \
+             the capture needs at least {} Hz ({CAPTURE_SAMPLES_PER_LEVEL} samples a level); \
+             slower, pulses fall between samples and vanish from the file",
+            angle / pitch,
+            c.shown("encoder.lines", e.grid_lines()),
+            c.shown("capture.duty", spec.duty),
+            held,
+            needed.ceil()
+        ),
+    ))
+}
+
+/// The WARNING of a capture file that lacks level changes of the signal (merged within a
+/// sample period as the file was written): how many, on which channel, and the sample rate
+/// that keeps the shortest level the signal held.
+fn capture_loss_warning(
+    scene: &Scene,
+    file: &Path,
+    channels: &[crate::app::logic::ChannelSampling],
+) -> Option<String> {
+    let lossy: Vec<_> = channels.iter().filter(|c| c.lost > 0).collect();
+    if lossy.is_empty() {
+        return None;
+    }
+    let rate = scene.capture.unwrap_or_default().sample_rate;
+    let each: Vec<String> = lossy
+        .iter()
+        .map(|c| {
+            format!(
+                "{} of the {} level changes of channel `{}`",
+                c.lost, c.changes, c.channel
+            )
+        })
+        .collect();
+    let shortest = lossy
+        .iter()
+        .filter_map(|c| c.shortest_level)
+        .fold(f64::INFINITY, f64::min);
+    let keep = if shortest.is_finite() && shortest > 0.0 {
+        format!(
+            "; the shortest level lasted {shortest:.3e} s: at least {} Hz \
+             ({CAPTURE_SAMPLES_PER_LEVEL} samples a level) keeps every change",
+            (CAPTURE_SAMPLES_PER_LEVEL / shortest).ceil()
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "WARNING capture: {} fell within one sample period of another at `capture.sample_rate = \
+         {}` and are not in the file (a pulse shorter than a sample vanishes, and is not \
+         counted by what reads the file){keep}",
+        each.join(" and "),
+        scene.checker(file).shown("capture.sample_rate", rate)
+    ))
 }
 
 /// The capture writer of a run: the scene's `[capture]` settings (or their defaults).

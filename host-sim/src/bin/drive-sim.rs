@@ -37,12 +37,17 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Write the encoder signal (and the index channel, if any) as a logic analyzer
-        /// records it: a CSV of levels over time (the scene's [capture] settings).
+        /// records it: levels over time (the scene's [capture] settings). A sample_rate that
+        /// takes fewer than 2 samples of the shortest pulse at the speed the scene prescribes
+        /// or starts at is refused; level changes lost to the sampling later in the run are
+        /// counted in a WARNING.
         #[arg(long)]
         capture: Option<PathBuf>,
-        /// Format of the capture file.
-        #[arg(long, value_enum, default_value = "saleae", requires = "capture")]
-        capture_format: CaptureFormat,
+        /// Format of the capture file (default: the file's extension: .vcd a value change
+        /// dump, .csv or any other Saleae's CSV). A format the extension contradicts (saleae,
+        /// sigrok or plain to a .vcd file, vcd to a .csv file) is refused.
+        #[arg(long, value_enum, requires = "capture")]
+        capture_format: Option<CaptureFormat>,
     },
     /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV, or a
     /// value change dump):
@@ -160,7 +165,9 @@ struct AnalyzeArgs {
     /// direction, so a reversal is seen (without it every edge counts as forward).
     #[arg(long)]
     direction_channel: Option<Channel>,
-    /// Which channel leads when the shaft runs forward (with --direction-channel).
+    /// Which channel leads when the shaft runs forward (with --direction-channel; default A
+    /// leads). A capture that runs backward a pitch at a time for most of its edges is said
+    /// to, with the --forward that reads it as forward.
     #[arg(long, value_enum)]
     forward: Option<Lead>,
     /// The edges the capture unit takes.
@@ -169,10 +176,12 @@ struct AnalyzeArgs {
     /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
     #[arg(long)]
     wheel: Option<String>,
-    /// A uniform disc of N lines (with --framing).
+    /// A uniform disc of N lines (framed as --framing says).
     #[arg(long)]
     lines: Option<u16>,
-    /// How the uniform disc of --lines is framed.
+    /// How the uniform disc of --lines is framed (default none: no index channel is read, as
+    /// a capture need not have one, and the report says so; a scene's [encoder] lines = N is
+    /// framed by its index).
     #[arg(long, value_enum)]
     framing: Option<FramingArg>,
     /// Take the wheel, the timer, the tolerances and the window from a scene's [encoder]
@@ -286,13 +295,16 @@ fn main() -> ExitCode {
             out,
             capture,
             capture_format,
-        }) => {
-            let capture = capture.map(|path| host_sim::app::run::CaptureTarget {
-                path,
-                format: capture_format,
-            });
+        }) => (|| {
+            let capture = match capture {
+                Some(path) => Some(host_sim::app::run::CaptureTarget {
+                    format: CaptureFormat::for_file(&path, capture_format)?,
+                    path,
+                }),
+                None => None,
+            };
             run_cmd(&scene, json, plot.as_deref(), out.as_deref(), capture)
-        }
+        })(),
         Some(Command::Analyze {
             capture,
             format,
@@ -452,6 +464,9 @@ fn run_cmd(
     let mut text = String::new();
     if let (Some(f), Some(rows), false) = (&report.capture_file, report.capture_rows, json) {
         text.push_str(&format!("capture: wrote {f} ({rows} rows)\n"));
+        if let Some(w) = &report.capture_warning {
+            text.push_str(&format!("{w}\n"));
+        }
     }
     if let Some(dir) = out {
         let files = host_sim::studies::runup::publish(name, &scene, &path, &report, dir)?;
