@@ -113,10 +113,12 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                     r.settle,
                     fmt_delta(p),
                     // A drive without load ripple is predicted δ = 0: no relative difference.
-                    // Both below the noise floor: the difference is the quantization's.
+                    // Neither above the noise floor: the difference is the quantization's. At
+                    // the floor counts as within it, as `analyze` judges a window (a steady
+                    // quantised speed reads δ equal to its floor).
                     match r.noise_floor {
-                        Some(f) if m < f && p < f => {
-                            ": both below the noise floor, not resolved".to_string()
+                        Some(f) if m <= f && p <= f => {
+                            ": neither above the noise floor, not resolved".to_string()
                         }
                         _ if p > 0.0 => format!(": {:+.2} %", 100.0 * (m / p - 1.0)),
                         _ => String::new(),
