@@ -1101,6 +1101,13 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
 /// regime table that the predicted speeds `[omega_min, omega_max]` fall in and that are not
 /// *balancing* are named.
 pub fn machine_torque_warning(table: &[SegmentOut], omega_min: f64, omega_max: f64) -> String {
+    let ends = crate::app::report::fmt_speeds(
+        &table
+            .iter()
+            .map(|g| g.from)
+            .chain([f64::INFINITY])
+            .collect::<Vec<_>>(),
+    );
     let segments: Vec<String> = table
         .iter()
         .enumerate()
@@ -1109,20 +1116,16 @@ pub fn machine_torque_warning(table: &[SegmentOut], omega_min: f64, omega_max: f
             let overlaps = seg.from <= omega_max && to > omega_min;
             (overlaps && seg.regime != "balancing").then(|| {
                 format!(
-                    "{}{} ({:.3} – {} rad/s)",
+                    "{}{} ({} – {} rad/s)",
                     seg.regime,
                     seg.reason.map_or(String::new(), |r| format!(" ({r})")),
-                    seg.from,
-                    if to.is_finite() {
-                        format!("{to:.3}")
-                    } else {
-                        "∞".to_string()
-                    }
+                    ends[k],
+                    ends[k + 1]
                 )
             })
         })
         .collect();
-    let (lo, hi) = (format!("{omega_min:.3}"), format!("{omega_max:.3}"));
+    let (lo, hi) = crate::app::report::fmt_speed_pair(omega_min, omega_max);
     let speeds = if lo == hi {
         format!("{hi} rad/s")
     } else {

@@ -509,7 +509,10 @@ fn sweep_cmd(
             "{:>10}  {:<10} {:<32} {:<10} {:>10}\n",
             "speed", "criterion", "core class", "simulated", "residual"
         ));
-        for p in &s.points {
+        let speeds = host_sim::app::report::fmt_speeds(
+            &s.points.iter().map(|p| p.speed).collect::<Vec<_>>(),
+        );
+        for (p, speed) in s.points.iter().zip(&speeds) {
             let committed = p.regime_class == "balancing" || p.regime_class == "gathering";
             let mark = if committed
                 && !host_sim::studies::sweep::agrees(p.regime_class, p.regime_simulated)
@@ -529,8 +532,8 @@ fn sweep_cmd(
                 "–".to_string()
             };
             text.push_str(&format!(
-                "{:>10.3}  {:<10} {:<32} {:<10} {:>10}{mark}\n",
-                p.speed, p.regime_predicted, class, p.regime_simulated, residual
+                "{speed:>10}  {:<10} {:<32} {:<10} {:>10}{mark}\n",
+                p.regime_predicted, class, p.regime_simulated, residual
             ));
         }
         text.push_str(&format!(
