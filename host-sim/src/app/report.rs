@@ -663,7 +663,11 @@ pub fn prediction_text(p: &Prediction) -> String {
         );
         match u.max_speed {
             Some(w) => {
-                let _ = writeln!(s, "  maximum safe speed {w:.1} rad/s");
+                let why = u
+                    .no_safe_speed
+                    .as_ref()
+                    .map_or(String::new(), |why| format!(": {why}"));
+                let _ = writeln!(s, "  maximum safe speed {w:.1} rad/s{why}");
             }
             None => {
                 let _ = writeln!(s, "  maximum safe speed: not limited by the support loads");
