@@ -662,7 +662,36 @@ fn a_delta_below_the_noise_floor_is_printed_as_such() {
     let text = host_sim::app::report::run_text(&s, &r);
     assert!(text.contains("predicted 9.974e-6"), "{text}");
     assert!(
-        text.contains("both below the noise floor, not resolved"),
+        text.contains("neither above the noise floor, not resolved"),
+        "{text}"
+    );
+    assert!(!text.contains(" %, noise floor"), "{text}");
+}
+
+/// A steady quantised speed reads δ equal to its noise floor, bit for bit: 1024 lines at
+/// 84 MHz and 243 rad/s gave `δ measured 5.904e-5 ..., predicted 8.778e-6: +572.56 %, noise
+/// floor 5.9e-5`. A δ at its floor is not resolved (as `analyze` judges a window), so no
+/// percentage.
+#[test]
+fn a_delta_at_the_noise_floor_is_not_resolved() {
+    let scene = "[simulation]\nduration = 30.0\nintegrator = \"dp5\"\nrtol = 1e-9\natol = 1e-9\n\
+                 settle = 10.0\n[shaft]\ninertia = 1.4275\n[motor]\nmodel = \"parabola\"\n\
+                 no_load_speed = 258.8\nbreakdown_speed = 91.21\nbreakdown_torque = 42.32\n\
+                 [load]\nmean = 5.564\n\
+                 harmonics = [{ order = 1.5, amplitude = 0.557, phase = 1.351 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84e6\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    let r = run_trial(scene);
+    let (m, p, f) = (
+        r.delta_measured.unwrap(),
+        r.delta_predicted.unwrap(),
+        r.noise_floor.unwrap(),
+    );
+    assert!(m == f && p < f, "{m} {p} {f}");
+    let text = host_sim::app::report::run_text(&s, &r);
+    assert!(
+        text.contains("neither above the noise floor, not resolved"),
         "{text}"
     );
     assert!(!text.contains(" %, noise floor"), "{text}");
@@ -1068,5 +1097,45 @@ fn a_load_the_motor_cannot_start_is_named() {
             && e.contains("the motor's torque at standstill (168.")
             && e.contains("shaft.initial_speed"),
         "{e}"
+    );
+}
+
+/// A 1548 kg rotor whose centre of mass sits over support A: A carries its whole weight,
+/// 15 181.1 N, against a 7260.5 N limit, so `predict` printed "maximum safe speed 0.0 rad/s"
+/// and left the reader to find why. It now names the support and both figures, in the text and
+/// in `no_safe_speed`; support B, under its limit, is not named.
+#[test]
+fn a_static_load_over_its_limit_is_named_as_why_no_speed_is_safe() {
+    let scene = "[rotor]\nmass = 1548.04\ncentre_of_mass = 0.636\nsupport_a = 0.636\n\
+                 support_b = 0.6554\ngrade = 40\nservice_speed = 45.59\n\
+                 support_load_limit = [7260.5, 2938.0]\n\
+                 [[unbalance]]\nz = 0.6554\namount = 0.0001485\nangle = 405.08\n\
+                 [motor]\nmodel = \"speed\"\nspeed = 45.59\n[simulation]\nduration = 2.0\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!(u.max_speed, Some(0.0));
+    let why = u.no_safe_speed.as_deref().unwrap();
+    for part in [
+        "support A's static load alone, 15181.1 N, exceeds",
+        "`rotor.support_load_limit[1]` = 7260.5 N",
+    ] {
+        assert!(why.contains(part), "{why}");
+    }
+    assert!(!why.contains("support B"), "{why}");
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(&format!("maximum safe speed 0.0 rad/s: {why}")),
+        "{text}"
+    );
+    // Under its limit, no reason is given and the field is left out.
+    let light = scene.replace("[7260.5, 2938.0]", "[17260.5, 2938.0]");
+    let s = host_sim::app::scene::Scene::parse(&light, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    let u = p.supports.as_ref().unwrap();
+    assert!(
+        u.max_speed.unwrap() > 0.0 && u.no_safe_speed.is_none(),
+        "{u:?}"
     );
 }

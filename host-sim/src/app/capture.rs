@@ -271,14 +271,15 @@ pub fn summary(c: &CaptureReport) -> String {
     let bands = c
         .resonance_bands
         .iter()
-        .map(|b| format!("{:.2}–{:.2}", b[0], b[1]))
+        .map(|b| crate::app::report::fmt_speeds_from(b, 2).join("–"))
         .collect::<Vec<_>>()
         .join(", ");
+    let predicted = crate::app::report::fmt_speeds_from(&[c.predicted_from, c.predicted_until], 2);
     let _ = write!(
         s,
-        "Sommerfeld capture (loads started together; core: capture possible from {:.2} up to {:.2} rad/s{})\n  ",
-        c.predicted_from,
-        c.predicted_until,
+        "Sommerfeld capture (loads started together; core: capture possible from {} up to {} rad/s{})\n  ",
+        predicted[0],
+        predicted[1],
         if bands.is_empty() {
             String::new()
         } else {
@@ -386,7 +387,10 @@ pub fn write_capture_svg(
         .first()
         .map(|w| {
             Mark::Band(
-                format!("core: capture window {:.2}–{:.2} rad/s", w.from, w.until),
+                format!(
+                    "core: capture window {} rad/s",
+                    crate::app::report::fmt_speeds_from(&[w.from, w.until], 2).join("–")
+                ),
                 w.from,
                 w.until,
                 true,

@@ -752,6 +752,10 @@ pub struct SupportsOut {
     pub permissible_b: f64,
     /// Largest safe speed, rad/s (null without load limits, or when no unbalance limits it).
     pub max_speed: Option<f64>,
+    /// Why `max_speed` is 0: the supports whose static load alone reaches their limit, each
+    /// named with both figures ([`static_overload`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub no_safe_speed: Option<String>,
     /// Static support loads (weight and process load), N.
     pub static_load: [f64; 2],
     /// Peak support loads over one turn at the service speed, N.
@@ -783,6 +787,35 @@ pub struct SupportsOut {
     /// ([`balancer_supports_warning`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub balancer_warning: Option<String>,
+}
+
+/// Why the supports allow no speed at all: each support whose static load (weight and
+/// process load) alone reaches its `rotor.support_load_limit`, where any unbalance load puts
+/// it over ([`drive_monitor::supports::max_safe_speed`] is 0 there). `None` when some speed is
+/// safe or there are no limits.
+pub fn static_overload(a: &drive_monitor::supports::SupportAnalysis) -> Option<String> {
+    let (limit, speed) = (a.load_limit?, a.max_speed?);
+    let over: Vec<String> = (0..2)
+        .filter(|&k| speed[k] == 0.0)
+        .map(|k| {
+            let load = a.static_load[k].norm();
+            format!(
+                "support {}'s static load alone, {} N, {} its limit `rotor.support_load_limit[{}]` \
+                 = {} N{}",
+                ["A", "B"][k],
+                crate::app::report::fmt_force(load),
+                if load > limit[k] { "exceeds" } else { "reaches" },
+                k + 1,
+                crate::app::report::fmt_force(limit[k]),
+                if load > limit[k] {
+                    " (over at standstill)"
+                } else {
+                    " (any unbalance load puts it over)"
+                }
+            )
+        })
+        .collect();
+    (!over.is_empty()).then(|| format!("{}: no speed is safe", over.join("; ")))
 }
 
 /// The warning when the δ alarm of `scene` could judge no window at the predicted speed: the
@@ -994,6 +1027,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             permissible_a: r.permissible_a,
             permissible_b: r.permissible_b,
             max_speed: r.max_speed.filter(|v| v.is_finite()),
+            no_safe_speed: static_overload(&a),
             static_load: [a.static_load[0].norm(), a.static_load[1].norm()],
             peak_load_at_service_speed: [loads[0].peak, loads[1].peak],
             unbalance_level: [
@@ -1101,6 +1135,13 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
 /// regime table that the predicted speeds `[omega_min, omega_max]` fall in and that are not
 /// *balancing* are named.
 pub fn machine_torque_warning(table: &[SegmentOut], omega_min: f64, omega_max: f64) -> String {
+    let ends = crate::app::report::fmt_speeds(
+        &table
+            .iter()
+            .map(|g| g.from)
+            .chain([f64::INFINITY])
+            .collect::<Vec<_>>(),
+    );
     let segments: Vec<String> = table
         .iter()
         .enumerate()
@@ -1109,20 +1150,16 @@ pub fn machine_torque_warning(table: &[SegmentOut], omega_min: f64, omega_max: f
             let overlaps = seg.from <= omega_max && to > omega_min;
             (overlaps && seg.regime != "balancing").then(|| {
                 format!(
-                    "{}{} ({:.3} – {} rad/s)",
+                    "{}{} ({} – {} rad/s)",
                     seg.regime,
                     seg.reason.map_or(String::new(), |r| format!(" ({r})")),
-                    seg.from,
-                    if to.is_finite() {
-                        format!("{to:.3}")
-                    } else {
-                        "∞".to_string()
-                    }
+                    ends[k],
+                    ends[k + 1]
                 )
             })
         })
         .collect();
-    let (lo, hi) = (format!("{omega_min:.3}"), format!("{omega_max:.3}"));
+    let (lo, hi) = crate::app::report::fmt_speed_pair(omega_min, omega_max);
     let speeds = if lo == hi {
         format!("{hi} rad/s")
     } else {

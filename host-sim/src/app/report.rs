@@ -126,10 +126,12 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                     r.settle,
                     fmt_delta(p),
                     // A drive without load ripple is predicted δ = 0: no relative difference.
-                    // Both below the noise floor: the difference is the quantization's.
+                    // Neither above the noise floor: the difference is the quantization's. At
+                    // the floor counts as within it, as `analyze` judges a window (a steady
+                    // quantised speed reads δ equal to its floor).
                     match r.noise_floor {
-                        Some(f) if m < f && p < f => {
-                            ": both below the noise floor, not resolved".to_string()
+                        Some(f) if m <= f && p <= f => {
+                            ": neither above the noise floor, not resolved".to_string()
                         }
                         _ if p > 0.0 => format!(": {:+.2} %", 100.0 * (m / p - 1.0)),
                         _ => String::new(),
@@ -215,6 +217,56 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         s.push_str(&supports_text(u));
     }
     s
+}
+
+/// Speeds in rad/s, each with at least three decimals and three significant digits, and with
+/// as many more as it takes to differ from its neighbours in `v` where the values differ: a
+/// segment whose ends differ never prints as `0.254 – 0.254`. A boundary gets the same digits
+/// wherever it appears (its decimals are the most either neighbour needs); `∞` for infinity.
+pub fn fmt_speeds(v: &[f64]) -> Vec<String> {
+    fmt_speeds_from(v, 3)
+}
+
+/// [`fmt_speeds`] with at least `min` decimals.
+pub fn fmt_speeds_from(v: &[f64], min: usize) -> Vec<String> {
+    // Beyond 40 decimals a difference is no speed anyone sets.
+    const MAX: usize = 40;
+    let min = min.min(MAX);
+    let significant = |x: f64| {
+        if x == 0.0 || !x.is_finite() {
+            min
+        } else {
+            (2 - x.abs().log10().floor() as i64).clamp(min as i64, MAX as i64) as usize
+        }
+    };
+    let apart = |a: f64, b: f64| {
+        (min..=MAX)
+            .find(|&d| a == b || format!("{a:.d$}") != format!("{b:.d$}"))
+            .unwrap_or(MAX)
+    };
+    (0..v.len())
+        .map(|k| {
+            let x = v[k];
+            if x.is_infinite() {
+                return "∞".to_string();
+            }
+            let mut d = significant(x);
+            if k > 0 && v[k - 1].is_finite() {
+                d = d.max(apart(v[k - 1], x));
+            }
+            if let Some(&n) = v.get(k + 1).filter(|n| n.is_finite()) {
+                d = d.max(apart(x, n));
+            }
+            format!("{x:.d$}")
+        })
+        .collect()
+}
+
+/// Two speeds, `from` and `to`, as [`fmt_speeds`] prints them.
+pub fn fmt_speed_pair(from: f64, to: f64) -> (String, String) {
+    let mut v = fmt_speeds(&[from, to]).into_iter();
+    let a = v.next().unwrap_or_default();
+    (a, v.next().unwrap_or_default())
 }
 
 /// A support load in N: one decimal from 100 N up (`2407.0`), four significant digits below
@@ -624,7 +676,11 @@ pub fn prediction_text(p: &Prediction) -> String {
         );
         match u.max_speed {
             Some(w) => {
-                let _ = writeln!(s, "  maximum safe speed {w:.1} rad/s");
+                let why = u
+                    .no_safe_speed
+                    .as_ref()
+                    .map_or(String::new(), |why| format!(": {why}"));
+                let _ = writeln!(s, "  maximum safe speed {w:.1} rad/s{why}");
             }
             None => {
                 let _ = writeln!(s, "  maximum safe speed: not limited by the support loads");
@@ -667,30 +723,42 @@ pub fn prediction_text(p: &Prediction) -> String {
                 list(&a.additional_speeds)
             );
         }
-        for z in &a.zones {
-            match z.to {
-                Some(to) => {
-                    let _ = writeln!(s, "  {:>9.3} – {:<9.3} rad/s  {}", z.from, to, z.regime);
-                }
-                None => {
-                    let _ = writeln!(s, "  {:>9.3} – ∞         rad/s  {}", z.from, z.regime);
-                }
-            }
+        // The zones are contiguous: each boundary printed once with the digits both its
+        // zones need.
+        let ends = fmt_speeds(
+            &a.zones
+                .iter()
+                .map(|z| z.from)
+                .chain([a.zones.last().and_then(|z| z.to).unwrap_or(f64::INFINITY)])
+                .collect::<Vec<_>>(),
+        );
+        for (k, z) in a.zones.iter().enumerate() {
+            let to = match (z.to, a.zones.get(k + 1)) {
+                (Some(to), Some(n)) if to != n.from => fmt_speed_pair(z.from, to).1,
+                _ => ends[k + 1].clone(),
+            };
+            let _ = writeln!(s, "  {:>9} – {to:<9} rad/s  {}", ends[k], z.regime);
         }
         for c in &a.capture {
+            let v = fmt_speeds(&[c.from, c.until]);
             let _ = writeln!(
                 s,
-                "  capture possible from {:.3} up to {:.3} rad/s (loads held near {:.3} rad/s)",
-                c.from, c.until, c.at
+                "  capture possible from {} up to {} rad/s (loads held near {} rad/s)",
+                v[0],
+                v[1],
+                fmt_speeds(&[c.at])[0]
             );
         }
         for c in &a.resonance_capture {
+            let v = fmt_speeds(&[c.from, c.until]);
             let _ = writeln!(
                 s,
-                "  at the resonance near {:.3} rad/s, gathered loads can be held up to {:.3} \
-                 rad/s (near {:.3} rad/s; the exact table's capture, whether or not a zone of \
+                "  at the resonance near {} rad/s, gathered loads can be held up to {} \
+                 rad/s (near {} rad/s; the exact table's capture, whether or not a zone of \
                  the criterion ends there)",
-                c.from, c.until, c.at
+                v[0],
+                v[1],
+                fmt_speeds(&[c.at])[0]
             );
         }
         let _ = writeln!(
@@ -720,14 +788,15 @@ pub fn prediction_text(p: &Prediction) -> String {
             );
         }
         if let Some(st) = &a.stability {
+            let scanned = fmt_speeds_from(&st.scanned, 2);
             let _ =
                 writeln!(
                 s,
                 "  exact stability of the balancing position (Floquet, {} monodromy matrices over \
-                 {:.2}–{:.2} rad/s): {} at the lowest speed",
+                 {}–{} rad/s): {} at the lowest speed",
                 st.evaluations,
-                st.scanned[0],
-                st.scanned[1],
+                scanned[0],
+                scanned[1],
                 if st.stable_at_start { "stable" } else { "unstable" }
             );
             if let Some(u) = &st.drift_treated_as_neutral {
@@ -735,20 +804,23 @@ pub fn prediction_text(p: &Prediction) -> String {
                     s,
                     "  the loads' slow drift along the balancing positions (neutral at D = 0) has a \
                      multiplier within {:.0e} of 1, the integration's resolution, at {} of those \
-                     speeds ({:.2}–{:.2} rad/s; |ρ − 1| at most {:.1e}): treated there as \
+                     speeds ({}–{} rad/s; |ρ − 1| at most {:.1e}): treated there as \
                      neutral, as at D = 0",
                     u.resolution,
                     u.evaluations,
-                    u.speeds[0],
-                    u.speeds[1],
+                    fmt_speeds_from(&u.speeds, 2)[0],
+                    fmt_speeds_from(&u.speeds, 2)[1],
                     u.largest
                 );
             }
-            for b in &st.boundaries {
+            let speeds = fmt_speeds_from(
+                &st.boundaries.iter().map(|b| b.speed).collect::<Vec<_>>(),
+                4,
+            );
+            for (b, speed) in st.boundaries.iter().zip(&speeds) {
                 let _ = writeln!(
                     s,
-                    "    {:>10.4} rad/s  becomes {}",
-                    b.speed,
+                    "    {speed:>10} rad/s  becomes {}",
                     if b.stable_above { "stable" } else { "unstable" }
                 );
             }
@@ -774,16 +846,19 @@ pub fn prediction_text(p: &Prediction) -> String {
             }
         }
         let _ = writeln!(s, "  regime table ({}):", a.regime_table_source);
+        let ends = fmt_speeds(
+            &a.regime_table
+                .iter()
+                .map(|g| g.from)
+                .chain([f64::INFINITY])
+                .collect::<Vec<_>>(),
+        );
         for (k, seg) in a.regime_table.iter().enumerate() {
-            let to = a
-                .regime_table
-                .get(k + 1)
-                .map_or("∞".to_string(), |n| format!("{:.3}", n.from));
             let _ = writeln!(
                 s,
-                "    {:>9.3} – {:<9} rad/s  {}{}",
-                seg.from,
-                to,
+                "    {:>9} – {:<9} rad/s  {}{}",
+                ends[k],
+                ends[k + 1],
                 seg.regime,
                 seg.reason.map_or(String::new(), |r| format!(" ({r})"))
             );
@@ -800,4 +875,53 @@ pub fn prediction_text(p: &Prediction) -> String {
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The regime table of a two-platform machine (`predict` printed `21.905 – 21.905 rad/s
+    /// bistable (coexisting)`): every segment's ends now differ in print, a boundary prints
+    /// alike in both its segments, and each figure is the speed rounded to its digits.
+    #[test]
+    fn segment_ends_that_differ_print_differently() {
+        let ends = [
+            0.0,
+            19.03310146892505,
+            19.033845894172092,
+            21.905342837271974,
+            21.905368333620213,
+            37.363870225711594,
+            37.40573958339075,
+            f64::INFINITY,
+        ];
+        let text = fmt_speeds(&ends);
+        assert_eq!(
+            text,
+            ["0.000", "19.033", "19.034", "21.9053", "21.9054", "37.364", "37.406", "∞"]
+        );
+        for (x, t) in ends.iter().zip(&text).filter(|(x, _)| x.is_finite()) {
+            let decimals = t.split('.').nth(1).map_or(0, str::len) as i32;
+            let printed: f64 = t.parse().unwrap();
+            assert!(
+                (printed - x).abs() <= 0.5 * 10f64.powi(-decimals),
+                "{x} {t}"
+            );
+        }
+        // A capture window 2.6e-7 rad/s wide at 0.254 rad/s, and a speed far below a
+        // thousandth keeps three significant digits rather than printing as 0.000.
+        let (a, b) = fmt_speed_pair(0.25400012, 0.25400038);
+        assert!(
+            a != b && a.starts_with("0.254") && b.starts_with("0.254"),
+            "{a} {b}"
+        );
+        assert_eq!(fmt_speeds(&[2.53e-5])[0], "0.0000253");
+        // Equal ends keep the usual digits; a single speed too.
+        assert_eq!(
+            fmt_speed_pair(0.802, 0.802),
+            ("0.802".into(), "0.802".into())
+        );
+        assert_eq!(fmt_speeds_from(&[61.4312, 90.4149], 2), ["61.43", "90.41"]);
+    }
 }

@@ -530,7 +530,10 @@ fn sweep_cmd(
             "{:>10}  {:<10} {:<32} {:<10} {:>10}\n",
             "speed", "criterion", "core class", "simulated", "residual"
         ));
-        for p in &s.points {
+        let speeds = host_sim::app::report::fmt_speeds(
+            &s.points.iter().map(|p| p.speed).collect::<Vec<_>>(),
+        );
+        for (p, speed) in s.points.iter().zip(&speeds) {
             let mark = if p.contradicts() { "  ≠" } else { "" };
             let class = match p.regime_reason {
                 Some(r) => format!("{} ({r})", p.regime_class),
@@ -543,8 +546,8 @@ fn sweep_cmd(
                 "–".to_string()
             };
             text.push_str(&format!(
-                "{:>10.3}  {:<10} {:<32} {:<10} {:>10}{mark}\n",
-                p.speed, p.regime_predicted, class, p.regime_simulated, residual
+                "{speed:>10}  {:<10} {:<32} {:<10} {:>10}{mark}\n",
+                p.regime_predicted, class, p.regime_simulated, residual
             ));
         }
         text.push_str(&format!(

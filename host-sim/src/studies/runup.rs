@@ -251,18 +251,19 @@ pub fn markdown(
     } else {
         "the rotor's speed is prescribed, ramped through the first resonance and then held"
     };
+    let predicted = crate::app::report::fmt_speeds_from(&[c.predicted_from, c.predicted_until], 2);
     let _ = writeln!(
         s,
         "The loads start together at rest; {drive}. The core predicts that gathered loads can \
          stay captured \
-         near the resonance (turning at Ω < ω) for rotor speeds from {:.2} up to {:.2} rad/s \
+         near the resonance (turning at Ω < ω) for rotor speeds from {} up to {} rad/s \
          (`Machine::capture_windows`), turning at `Machine::capture_speed(ω)`. The simulation \
-         counts the loads captured while the rotor is above {:.2} rad/s and the loads lag it by \
+         counts the loads captured while the rotor is above {} rad/s and the loads lag it by \
          more than {:.0} % (speeds from the unwrapped angles over {:.2} s windows); the release \
          is where the lag falls back through {:.0} % for good.\n",
-        c.predicted_from,
-        c.predicted_until,
-        c.predicted_from,
+        predicted[0],
+        predicted[1],
+        predicted[0],
         100.0 * c.lag_fraction,
         c.window,
         100.0 * c.lag_fraction

@@ -189,11 +189,14 @@ impl Sweep {
             "| speed, rad/s | criterion | core class | simulated | residual / rotor unbalance | reached balanced: from, rad/s → simulated |\n\
              |---:|---|---|---|---:|---|\n",
         );
-        for p in &self.points {
+        let speeds = crate::app::report::fmt_speeds_from(
+            &self.points.iter().map(|p| p.speed).collect::<Vec<_>>(),
+            2,
+        );
+        for (p, speed) in self.points.iter().zip(&speeds) {
             let _ = writeln!(
                 s,
-                "| {:.2} | {} | {}{} | {}{} | {:.2e} | {} |",
-                p.speed,
+                "| {speed} | {} | {}{} | {}{} | {:.2e} | {} |",
                 p.regime_predicted,
                 p.regime_class,
                 p.regime_reason.map_or(String::new(), |r| format!(" ({r})")),
