@@ -800,6 +800,7 @@ pub fn prediction_text(p: &Prediction) -> String {
                 if st.stable_at_start { "stable" } else { "unstable" }
             );
             if let Some(u) = &st.drift_treated_as_neutral {
+                let speeds = fmt_speeds_from(&u.speeds, 2);
                 let _ = writeln!(
                     s,
                     "  the loads' slow drift along the balancing positions (neutral at D = 0) has a \
@@ -808,8 +809,8 @@ pub fn prediction_text(p: &Prediction) -> String {
                      neutral, as at D = 0",
                     u.resolution,
                     u.evaluations,
-                    fmt_speeds_from(&u.speeds, 2)[0],
-                    fmt_speeds_from(&u.speeds, 2)[1],
+                    speeds[0],
+                    speeds[1],
                     u.largest
                 );
             }

@@ -1723,22 +1723,18 @@ fn sure_speed(scene: &Scene, over: Overrides, u_start: Option<f64>) -> Option<(f
             )
         }
         (Some(MotorSpec::Profile { points }), None) => {
-            // ω̄ is linear between the points and held before the first and after the last.
-            let at = |t: f64| -> f64 {
-                let k = points.partition_point(|p| p[0] <= t);
-                match (k.checked_sub(1).and_then(|i| points.get(i)), points.get(k)) {
-                    (Some(a), Some(b)) => a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0]),
-                    (Some(a), None) => a[1],
-                    (None, Some(b)) => b[1],
-                    (None, None) => 0.0,
-                }
+            // ω̄ is linear between the points: its largest within the run is at a point or
+            // at an end.
+            let profile = SpeedProfile {
+                mean: points.iter().map(|p| (p[0], p[1])).collect(),
+                ripple: None,
             };
             let inside = points
                 .iter()
                 .filter(|p| p[0] > 0.0 && p[0] < d)
                 .map(|p| p[1]);
             let w = inside
-                .chain([at(0.0), at(d)])
+                .chain([profile.mean_at(0.0), profile.mean_at(d)])
                 .map(f64::abs)
                 .fold(0.0, f64::max);
             (w, "`motor.points`".to_string())
