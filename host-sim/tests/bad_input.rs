@@ -524,3 +524,43 @@ fn a_stability_scan_that_would_run_for_minutes_stops_naming_the_loads() {
         "{e}"
     );
 }
+
+#[test]
+fn a_sweep_below_the_lowest_integrable_speed_is_refused_naming_from() {
+    // The two-mass machine hung only on its coupling (platforms at 1e-6 N/m): a revolution
+    // below 0.0447 rad/s lasts over 1000 periods of the coupling's motion. `--from 1e-6`
+    // ran the stability analysis into a million steps and blamed `autobalancer`, `--from
+    // 1e-300` ended in "step size underflow"; both are refused naming `--from` and the speed.
+    use host_sim::studies::sweep::{sweep, SweepRequest};
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two-mass.toml"))
+            .unwrap()
+            .replace("stiffness = 4.0e5", "stiffness = 1e-6");
+    let path = Path::new("hung.toml");
+    let scene = Scene::parse(&text, path).unwrap();
+    for from in [1e-6, 1e-300] {
+        let request = SweepRequest {
+            from,
+            to: 100.0,
+            steps: 3,
+            together: false,
+        };
+        let e = sweep(&scene, path, &request, false)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains("`--from`")
+                && e.contains("below 4.4721e-2 rad/s")
+                && e.contains("platform[1].stiffness"),
+            "{e}"
+        );
+    }
+    // predict says where its scan starts and why.
+    let text = prediction_text(&predict(&scene, path).unwrap());
+    assert!(
+        text.contains("the scan starts at 4.4721e-2 rad/s")
+            && text.contains("the regime table follows the criterion below it"),
+        "{text}"
+    );
+}

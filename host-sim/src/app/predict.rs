@@ -523,6 +523,11 @@ pub struct StabilityOut {
     /// D = 0 (absent: nowhere).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drift_treated_as_neutral: Option<crate::engine::vibration::floquet::Unresolved>,
+    /// The scan starts above a quarter of the lowest resonance because a revolution below
+    /// would take too many integration steps; below `speed` the regime table follows the
+    /// criterion (absent: the scan starts where it would).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub criterion_below: Option<crate::app::regimes::CriterionBelow>,
 }
 
 /// One segment of the regime table.
@@ -1066,6 +1071,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             criterion: e.comparison.clone(),
             evaluations: e.map.evaluations,
             drift_treated_as_neutral: e.map.unresolved,
+            criterion_below: e.criterion_below.clone(),
         });
         let segment = |from: f64, r: drive_monitor::balancer::Regime| SegmentOut {
             from,

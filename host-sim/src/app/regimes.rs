@@ -21,6 +21,13 @@
 //! past every characteristic speed and capture window, and is extended until the balancing
 //! position is stable at its top).
 //!
+//! The scan starts at a quarter of the lowest resonance, or higher where a revolution there
+//! would last more than [`crate::engine::vibration::floquet::REVOLUTION_RATIO`] periods of the machine's fastest motion
+//! ([`crate::engine::vibration::floquet::lowest_speed`]: a machine hung only on its couplings, its rigid-body resonance
+//! near 1e-4 rad/s and its couplings' at 45 rad/s, took over a million integration steps for
+//! one revolution there). Below that speed the table follows the criterion's zones
+//! ([`Exact::criterion_below`], said by `predict`), as the criterion's own table does.
+//!
 //! Where the multiplier of the loads' slow drift along what is a family of balancing
 //! positions at `D = 0` cannot be told from 1 (a tiny `D`: it is `1 − O(D²)`), it is treated as
 //! neutral, as at `D = 0`, and the map says where ([`StabilityMap::unresolved`], shown by
@@ -79,6 +86,20 @@ pub struct Exact {
     /// Where each of those members is stable (Floquet, the fan's scan settings).
     #[serde(skip)]
     pub family: Vec<StabilityMap>,
+    /// Where the scan starts above a quarter of the lowest resonance because a revolution
+    /// below would take too many integration steps; the table follows the criterion below.
+    pub criterion_below: Option<CriterionBelow>,
+}
+
+/// The speed below which the exact analysis cannot integrate a revolution, and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct CriterionBelow {
+    /// The lowest speed analysed exactly, rad/s ([`crate::engine::vibration::floquet::lowest_speed`]).
+    pub speed: f64,
+    /// The bound on the machine's fastest motion it comes from, rad/s.
+    pub fastest_rate: f64,
+    /// What sets that motion (scene keys).
+    pub set_by: String,
 }
 
 /// A boundary of the seed criterion's zones and the exact boundary of the same kind nearest
@@ -221,16 +242,36 @@ pub fn scan_options(machine: &Machine) -> ScanOptions {
 }
 
 /// The stability map of `floquet` over [`scan_options`], its top extended (doubled, up to
-/// four times) while the balancing position is still unstable there.
+/// four times) while the balancing position is still unstable there, and its bottom raised to
+/// [`crate::engine::vibration::floquet::lowest_speed`] where that is higher (returned: the
+/// table follows the criterion below it), its top then at least four times that.
 pub fn stability_map(
     floquet: &Floquet,
     machine: &Machine,
     file: &Path,
-) -> Result<StabilityMap, SceneError> {
+) -> Result<(StabilityMap, Option<CriterionBelow>), SceneError> {
     let err = |e: crate::engine::vibration::floquet::StabilityError| {
         SceneError::value(file, "autobalancer", e.to_string())
     };
     let mut opts = scan_options(machine);
+    let lowest = floquet.lowest_speed();
+    let mut below = None;
+    if opts.from < lowest {
+        let fast = floquet.fastest_motion();
+        let set_by = fast.source.to_string();
+        // Nothing of the criterion's range can be integrated (a single platform hung on
+        // nothing, loads relaxing a million times faster than the rotor turns): two octaves
+        // above the lowest speed are, and their class holds beyond.
+        if lowest >= opts.to {
+            opts.to = 4.0 * lowest;
+        }
+        opts.from = lowest;
+        below = Some(CriterionBelow {
+            speed: lowest,
+            fastest_rate: fast.rate,
+            set_by,
+        });
+    }
     let mut map = floquet.map(&opts).map_err(err)?;
     for _ in 0..4 {
         if map.stable_at(opts.to) {
@@ -239,16 +280,29 @@ pub fn stability_map(
         opts.to *= 2.0;
         map = floquet.map(&opts).map_err(err)?;
     }
-    Ok(map)
+    Ok((map, below))
 }
 
 /// The regime table from the exact stability map and the machine's criterion and capture
 /// windows (module docs), as `(from rad/s, regime)` ascending from 0, neighbours different.
-pub fn table(map: &StabilityMap, family: &[StabilityMap], machine: &Machine) -> Vec<(f64, Regime)> {
+/// Below `criterion_below` rad/s (where the scan could not reach) the criterion's zone decides
+/// in place of the map: `Gathering` in its gathering zones, else as a stable balancing position.
+pub fn table(
+    map: &StabilityMap,
+    family: &[StabilityMap],
+    machine: &Machine,
+    criterion_below: Option<f64>,
+) -> Vec<(f64, Regime)> {
     let bands = capture_bands(machine);
     let captured = |w: f64| bands.iter().any(|c| c.from <= w && w < c.until);
     let regime = |w: f64| {
-        if !map.stable_at(w) {
+        let stable = match criterion_below {
+            Some(c) if w < c => machine.zone_kind_at(w) == ZoneKind::Balancing,
+            _ => map.stable_at(w),
+        };
+        if !stable && criterion_below.is_some_and(|c| w < c) {
+            Regime::Gathering
+        } else if !stable {
             // Three or more loads can balance at another member of their family.
             if family.iter().any(|f| f.stable_at(w)) {
                 Regime::Bistable(BistableReason::Family)
@@ -274,6 +328,7 @@ pub fn table(map: &StabilityMap, family: &[StabilityMap], machine: &Machine) -> 
         cuts.push(c.from);
         cuts.push(c.until);
     }
+    cuts.extend(criterion_below);
     cuts.retain(|c| c.is_finite() && *c > 0.0);
     cuts.sort_by(f64::total_cmp);
     cuts.dedup();
@@ -364,17 +419,24 @@ pub fn family_members(fan: &[f64]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Each criterion boundary with the nearest exact boundary of its kind.
-pub fn compare(map: &StabilityMap, machine: &Machine) -> Vec<Comparison> {
+/// Each criterion boundary with the nearest exact boundary of its kind (none below
+/// `criterion_below`, where the scan does not reach).
+pub fn compare(
+    map: &StabilityMap,
+    machine: &Machine,
+    criterion_below: Option<f64>,
+) -> Vec<Comparison> {
     machine
         .zones()
         .iter()
         .skip(1)
         .map(|z| {
             let resonance = z.kind == ZoneKind::Balancing;
+            let reached = criterion_below.is_none_or(|c| z.from >= c);
             let exact = map
                 .boundaries
                 .iter()
+                .filter(|_| reached)
                 .filter(|b| b.stable_above == resonance)
                 .map(|b| b.speed)
                 .min_by(|a, b| (a / z.from).ln().abs().total_cmp(&(b / z.from).ln().abs()));
@@ -395,7 +457,7 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
     };
     let exact = match Floquet::new(&vm) {
         Ok(f) => {
-            let map = stability_map(&f, machine, file)?;
+            let (map, criterion_below) = stability_map(&f, machine, file)?;
             let err = |e: crate::engine::vibration::floquet::StabilityError| {
                 SceneError::value(file, "autobalancer", e.to_string())
             };
@@ -404,14 +466,16 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
                 .map(|a| Floquet::with_angles(&vm, a).and_then(|m| m.map(&map.options)))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(err)?;
-            let segments = table(&map, &family, machine);
-            let comparison = compare(&map, machine);
+            let below = criterion_below.as_ref().map(|c| c.speed);
+            let segments = table(&map, &family, machine, below);
+            let comparison = compare(&map, machine, below);
             Some(Exact {
                 map,
                 segments,
                 comparison,
                 family_members: family.len(),
                 family,
+                criterion_below,
             })
         }
         Err(_) => None,
@@ -559,7 +623,7 @@ mod tests {
         let until = capture_bands(&m).iter().fold(0.0f64, |u, c| u.max(c.until));
         let capture = Regime::Bistable(BistableReason::Capture);
         // Stable from 72, as the Floquet analysis finds for this machine.
-        let t = table(&map_with(false, &[72.0]), &[], &m);
+        let t = table(&map_with(false, &[72.0]), &[], &m, None);
         assert_eq!(
             t,
             vec![
@@ -569,7 +633,7 @@ mod tests {
             ]
         );
         // Stable already below the criterion's boundary: coexisting with gathered loads there.
-        let t = table(&map_with(false, &[55.0]), &[], &m);
+        let t = table(&map_with(false, &[55.0]), &[], &m, None);
         assert_eq!(
             t,
             vec![
@@ -580,7 +644,12 @@ mod tests {
             ]
         );
         // An unstable band inside the capture window and another above it.
-        let t = table(&map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]), &[], &m);
+        let t = table(
+            &map_with(false, &[65.0, 70.0, 80.0, 120.0, 130.0]),
+            &[],
+            &m,
+            None,
+        );
         assert_eq!(
             t,
             vec![
@@ -595,7 +664,7 @@ mod tests {
         );
         // Never stable: gathering everywhere.
         assert_eq!(
-            table(&map_with(false, &[]), &[], &m),
+            table(&map_with(false, &[]), &[], &m, None),
             vec![(0.0, Regime::Gathering)]
         );
     }
@@ -775,6 +844,88 @@ mod tests {
         let (c, margin, exact) = classifier(&small, &path, &m, Some(&d)).unwrap();
         assert!(!exact && margin == DEFAULT_MARGIN);
         assert_eq!(c.classify(110.0), Regime::Balancing);
+    }
+
+    #[test]
+    fn platforms_hung_only_on_their_coupling_are_scanned_from_the_lowest_integrable_speed() {
+        // The two-mass scene with both platforms at 1e-6 N/m to the ground: a rigid-body
+        // resonance near 1e-4 rad/s, where one revolution took over a million integration
+        // steps, and the coupling's near 44 rad/s. The scan starts at the coupling's motion
+        // over 1000 (its Gershgorin bound √(2·1e5/100) = 44.72 rad/s), the table follows the
+        // criterion below it, and the exact boundaries above it are found.
+        let (mut scene, path) = resolve("two-mass").unwrap();
+        for p in &mut scene.platform {
+            p.stiffness = 1e-6;
+        }
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        let below = e.criterion_below.as_ref().unwrap();
+        let bound = (2.0e5f64 / 100.0).sqrt();
+        assert!(
+            (below.speed / (bound / 1000.0) - 1.0).abs() < 1e-9,
+            "{below:?}"
+        );
+        assert!(below.set_by.contains("platform[1].stiffness"), "{below:?}");
+        assert_eq!(e.map.options.from, below.speed);
+        // The criterion's rigid-body resonance lies below the scan: its zones decide there,
+        // and its comparison has no exact boundary.
+        let rigid = m.zones()[1].from;
+        assert!(
+            rigid < 1e-3 && m.zones()[1].kind == ZoneKind::Balancing,
+            "{rigid}"
+        );
+        assert_eq!(e.segments[0], (0.0, Regime::Gathering));
+        assert!(e.segments.iter().any(|s| s.0 == rigid), "{:?}", e.segments);
+        assert!(e.comparison[0].exact.is_none());
+        let at = |w: f64| {
+            e.segments
+                .iter()
+                .rev()
+                .find(|s| s.0 <= w)
+                .map(|s| s.1)
+                .unwrap()
+        };
+        assert_eq!(at(0.5 * rigid), Regime::Gathering);
+        assert_eq!(at(0.01), Regime::Balancing);
+        assert_eq!(at(0.5 * below.speed + 0.5 * 31.0), Regime::Balancing);
+        // Above it the exact boundaries of the coupling's resonance, within the scan's budget.
+        let speeds: Vec<f64> = e.map.boundaries.iter().map(|b| b.speed).collect();
+        assert!(
+            speeds.len() == 2
+                && (31.6..31.8).contains(&speeds[0])
+                && (45.4..45.6).contains(&speeds[1]),
+            "{speeds:?}"
+        );
+        assert!(e.map.steps < 1_000_000, "{}", e.map.steps);
+        // One platform hung on nothing: the criterion's whole range (its resonance near 1e-4
+        // rad/s) lies below the lowest speed (the loads' relaxation 10/(1.4·0.5) = 14.3 1/s
+        // over 1000). Two octaves above it are scanned; the criterion decides below.
+        let (mut scene, path) = resolve("one-mass").unwrap();
+        scene.platform[0].stiffness = 1e-6;
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        let below = e.criterion_below.as_ref().unwrap();
+        assert!(
+            (below.speed / (10.0 / 1.4 / 0.5 / 1000.0) - 1.0).abs() < 1e-9,
+            "{below:?}"
+        );
+        assert!(below.set_by.contains("autobalancer.load_mass"), "{below:?}");
+        assert!(e.map.options.to >= 4.0 * below.speed && e.map.boundaries.is_empty());
+        assert_eq!(e.segments[0], (0.0, Regime::Gathering));
+        assert_eq!(e.segments.last().unwrap().1, Regime::Balancing);
+        assert!(e.segments[1].0 < 1e-3, "{:?}", e.segments);
+        // The bundled scenes' scans start where they always did.
+        for name in ["one-mass", "two-mass", "three-mass", "one-mass-runup"] {
+            let (scene, path) = resolve(name).unwrap();
+            let m = predict::machine(&scene, &path).unwrap().unwrap();
+            let d = design(&scene, &path, &m).unwrap().unwrap();
+            let e = d.exact.unwrap();
+            assert!(e.criterion_below.is_none(), "{name}");
+            let first = m.resonant_speeds()[0];
+            assert_eq!(e.map.options.from, 0.25 * first, "{name}");
+        }
     }
 
     #[test]

@@ -705,12 +705,9 @@ pub fn prediction_text(p: &Prediction) -> String {
     }
     if let Some(a) = &p.autobalancer {
         let _ = writeln!(s, "Auto-balancer regimes (seed 001)");
-        let list = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{x:.3}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        // Three decimals, more where a speed needs them to show at all (a platform hung only
+        // on its couplings resonates near 1e-4 rad/s).
+        let list = |v: &[f64]| fmt_speeds(v).join(", ");
         let _ = writeln!(
             s,
             "  resonant speeds (undamped): {} rad/s",
@@ -799,6 +796,19 @@ pub fn prediction_text(p: &Prediction) -> String {
                 scanned[1],
                 if st.stable_at_start { "stable" } else { "unstable" }
             );
+            if let Some(c) = &st.criterion_below {
+                let _ = writeln!(
+                    s,
+                    "  the scan starts at {:.4e} rad/s, not a quarter of the lowest resonance: \
+                     below it a revolution lasts more than {} periods of the machine's fastest \
+                     motion ({:.4e} rad/s, set by {}) and takes too many integration steps; the \
+                     regime table follows the criterion below it",
+                    c.speed,
+                    crate::engine::vibration::floquet::REVOLUTION_RATIO,
+                    c.fastest_rate,
+                    c.set_by
+                );
+            }
             if let Some(u) = &st.drift_treated_as_neutral {
                 let speeds = fmt_speeds_from(&u.speeds, 2);
                 let _ = writeln!(
@@ -826,11 +836,15 @@ pub fn prediction_text(p: &Prediction) -> String {
                 );
             }
             for c in &st.criterion {
+                let below = st
+                    .criterion_below
+                    .as_ref()
+                    .filter(|b| c.criterion < b.speed);
                 let _ = writeln!(
                     s,
-                    "  criterion boundary {:.3} rad/s ({}): nearest exact boundary where the \
+                    "  criterion boundary {} rad/s ({}): nearest exact boundary where the \
                      balancing position becomes {} {}",
-                    c.criterion,
+                    fmt_speeds(&[c.criterion])[0],
                     c.kind,
                     // A resonance is where the criterion's balancing begins, an additional
                     // speed where it ends: each is set beside the exact boundary of its kind.
@@ -839,8 +853,14 @@ pub fn prediction_text(p: &Prediction) -> String {
                     } else {
                         "unstable"
                     },
-                    match (c.exact, c.difference) {
-                        (Some(e), Some(d)) => format!("{e:.3} rad/s ({:+.2} %)", 100.0 * d),
+                    match (c.exact, c.difference, below) {
+                        (_, _, Some(b)) => format!(
+                            "none: below the exact scan's {} rad/s",
+                            fmt_speeds(&[b.speed])[0]
+                        ),
+                        (Some(e), Some(d), None) => {
+                            format!("{} rad/s ({:+.2} %)", fmt_speeds(&[e])[0], 100.0 * d)
+                        }
                         _ => "none".to_string(),
                     }
                 );

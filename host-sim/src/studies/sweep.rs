@@ -8,6 +8,7 @@ use crate::app::progress::progress_bar;
 use crate::app::regimes::{balanced_start, growth_rate, settle_time, tracked};
 use crate::app::run::{run, Overrides};
 use crate::app::scene::{Scene, SceneError};
+use crate::engine::vibration::floquet;
 use crate::studies::criterion::ramp_outcome;
 use drive_monitor::balancer::{Regime, RegimeSegment, DEFAULT_MARGIN};
 use rayon::prelude::*;
@@ -389,6 +390,28 @@ pub fn sweep(
     let mut quiet = scene.clone();
     quiet.encoder = None;
     let exact_design = design.as_ref().and_then(|d| d.exact.as_ref());
+    // Each speed's settling time comes from a monodromy over its revolution: refused up front
+    // where that cannot be integrated, not after the first runs.
+    if exact_design.is_some() {
+        if let Some(vm) = crate::app::regimes::vibration_machine(scene, file)? {
+            let lowest = floquet::lowest_speed(&vm);
+            if from < lowest {
+                let fast = floquet::fastest_motion(&vm);
+                return Err(bad(
+                    "--from",
+                    format!(
+                        "{from:e} rad/s is below {lowest:.4e} rad/s, the lowest speed at which \
+                         the stability analysis integrates a revolution of this machine: a \
+                         revolution there lasts more than {} periods of its fastest motion \
+                         ({:.4e} rad/s, set by {}); sweep from {lowest:.4e} rad/s or above",
+                        floquet::REVOLUTION_RATIO,
+                        fast.rate,
+                        fast.source
+                    ),
+                ));
+            }
+        }
+    }
     let segments: Vec<RegimeSegment> = classifier.segments().collect();
     let bar = progress_bar(steps, "speeds", progress);
     let points: Result<Vec<SweepPoint>, SceneError> = (0..steps)

@@ -360,6 +360,105 @@ fn eigenvector_alignment(m: &DMatrix<f64>, lambda: f64, target: &DVector<f64>) -
 /// ran for minutes with nothing said.
 const SCAN_STEPS: u64 = 1_000_000;
 
+/// What sets a machine's fastest motion ([`Floquet::fastest_motion`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum FastestSource {
+    /// Platform `i`'s stiffness (its own and its couplings') over its mass (0-based).
+    Stiffness(usize),
+    /// Platform `i`'s damping (its own, its couplings' and, at the exciter, the loads' drag)
+    /// over its mass (0-based).
+    Damping(usize),
+    /// The loads' viscous drag over their mass (their relaxation, `b_w/(κ·m)`).
+    Loads,
+}
+
+impl std::fmt::Display for FastestSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            FastestSource::Stiffness(i) => write!(
+                f,
+                "`platform[{}].stiffness` and its couplings' against `platform[{}].mass`",
+                i + 1,
+                i + 1
+            ),
+            FastestSource::Damping(i) => write!(
+                f,
+                "`platform[{}].damping` and its couplings' against `platform[{}].mass`",
+                i + 1,
+                i + 1
+            ),
+            FastestSource::Loads => f.write_str(
+                "the loads' relaxation, `autobalancer.viscosity` against `autobalancer.load_mass`",
+            ),
+        }
+    }
+}
+
+/// A bound on the fastest motion of a machine's linearised equations, in rad/s (1/s for a
+/// damping or relaxation rate), and what sets it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FastestMotion {
+    /// The rate, rad/s.
+    pub rate: f64,
+    /// What sets it.
+    pub source: FastestSource,
+}
+
+/// How many times faster than the rotor turns the machine's fastest motion may be for one
+/// revolution to be integrated ([`lowest_speed`]). Measured at the scan's tolerance (1e-10)
+/// on five machines (the seed's, two two-platform ones, one of them hung only on its
+/// couplings at 1e-6 N/m, and the seed's with loads relaxing 1e4 times faster): one
+/// monodromy with `rate/ω` = 1000 took 1 143 to 3 273 DOP853 steps (22 to 24 at a ratio of
+/// 1), so a scan down to the lowest speed stays well inside [`SCAN_STEPS`]; at a quarter of
+/// the machine hung on its couplings' rigid-body resonance (`rate/ω` ≈ 1.8e6) one revolution
+/// took over a million.
+pub const REVOLUTION_RATIO: f64 = 1000.0;
+
+/// A bound on the fastest motion of `m`'s linearised equations, whatever the speed: the
+/// platforms' stiffness and damping by Gershgorin rows over their masses (the exciter's mass
+/// at its smallest, `M_e + M_c + N·m·(κ − 1)/κ`, with the loads' drag on it), and the loads'
+/// relaxation `b_w/(κ·m)`. A revolution at `ω` spans about `rate/ω` of its periods, and the
+/// monodromy integration's steps grow with that ratio.
+pub fn fastest_motion(m: &VibrationMachine) -> FastestMotion {
+    let n = m.loads as f64;
+    let mut best = FastestMotion {
+        rate: m.load_viscosity / (m.kappa * m.load_mass),
+        source: FastestSource::Loads,
+    };
+    for i in 0..m.platforms {
+        let exciter = i == m.exciter;
+        let mass = if exciter {
+            m.exciter_base_mass + n * m.load_mass * (m.kappa - 1.0) / m.kappa
+        } else {
+            m.mass[i]
+        };
+        let (mut k, mut b) = (m.stiffness[i], m.damping[i]);
+        for l in 0..m.platforms {
+            k += 2.0 * m.coupling_stiffness[i][l].abs();
+            b += 2.0 * m.coupling_damping[i][l].abs();
+        }
+        if exciter {
+            b += n * m.load_viscosity / m.kappa;
+        }
+        for (rate, source) in [
+            ((k / mass).sqrt(), FastestSource::Stiffness(i)),
+            (b / mass, FastestSource::Damping(i)),
+        ] {
+            // NaN counts as fastest: nothing could be integrated.
+            if rate > best.rate || rate.is_nan() {
+                best = FastestMotion { rate, source };
+            }
+        }
+    }
+    best
+}
+
+/// The lowest speed whose revolution the stability analysis integrates, rad/s:
+/// [`fastest_motion`] over [`REVOLUTION_RATIO`].
+pub fn lowest_speed(m: &VibrationMachine) -> f64 {
+    fastest_motion(m).rate / REVOLUTION_RATIO
+}
+
 impl Floquet {
     /// The balanced motion with the loads at the equally spaced fan
     /// ([`super::balancing_fan`]) for a shaft at angle `ωt`.
@@ -436,6 +535,16 @@ impl Floquet {
         })
     }
 
+    /// [`fastest_motion`] of the machine.
+    pub fn fastest_motion(&self) -> FastestMotion {
+        fastest_motion(&self.machine)
+    }
+
+    /// [`lowest_speed`] of the machine.
+    pub fn lowest_speed(&self) -> f64 {
+        lowest_speed(&self.machine)
+    }
+
     /// The load angles `α_j` of the balanced motion, rad.
     pub fn angles(&self) -> &[f64] {
         &self.alpha
@@ -502,6 +611,21 @@ impl Floquet {
             return Err(StabilityError::Input(format!(
                 "the rotor speed must be positive and finite, got {omega}"
             )));
+        }
+        let lowest = self.lowest_speed();
+        if omega < lowest {
+            let fast = self.fastest_motion();
+            return Err(StabilityError::Numerical {
+                speed: omega,
+                message: format!(
+                    "a revolution lasts {:.3e} periods of the machine's fastest motion ({:.4e} \
+                     rad/s, set by {}), more than the {REVOLUTION_RATIO} whose integration \
+                     steps the analysis affords: its lowest speed is {lowest:.4e} rad/s",
+                    fast.rate / omega,
+                    fast.rate,
+                    fast.source
+                ),
+            });
         }
         let n = self.dim();
         let mut sys = Variational {
@@ -987,6 +1111,100 @@ mod tests {
             InitialParams::default(),
         )
         .unwrap()
+    }
+
+    /// The two-platform machine of [`two_mass`] hung only on its coupling: both platforms at
+    /// 1e-6 N/m to the ground (a rigid-body resonance near 1e-4 rad/s).
+    fn hung_on_coupling() -> VibrationMachine {
+        let mut p = VibrationMachineParams {
+            platforms: vec![
+                PlatformParams {
+                    mass: 100.0,
+                    stiffness: 1e-6,
+                    damping: 200.0,
+                },
+                PlatformParams {
+                    mass: 100.0,
+                    stiffness: 1e-6,
+                    damping: 200.0,
+                },
+            ],
+            couplings: vec![CouplingParams {
+                between: [0, 1],
+                stiffness: 1e5,
+                damping: 50.0,
+            }],
+            ..seed_params()
+        };
+        p.balancer.platform = Some(1);
+        p.balancer.rotor_unbalance = 0.05;
+        VibrationMachine::new(&p).unwrap()
+    }
+
+    #[test]
+    fn the_fastest_motion_bounds_the_natural_frequencies_closely() {
+        // Reference: the undamped natural frequencies, square roots of the eigenvalues of
+        // M^-1/2·K·M^-1/2 (nalgebra's symmetric eigensolver), the exciter's mass at its
+        // smallest as the bound takes it. The bound must not fall below the highest and, for
+        // these machines (stiffness sets it), stays within twice it.
+        for (name, m) in [
+            ("seed", seed(2, 0.03)),
+            ("two-mass", two_mass()),
+            ("hung", hung_on_coupling()),
+        ] {
+            let np = m.platforms;
+            let mass = |i: usize| {
+                if i == m.exciter {
+                    m.exciter_base_mass + m.loads as f64 * m.load_mass * (m.kappa - 1.0) / m.kappa
+                } else {
+                    m.mass[i]
+                }
+            };
+            let k = DMatrix::from_fn(np, np, |i, l| {
+                let kil = if i == l {
+                    m.stiffness[i] + (0..np).map(|j| m.coupling_stiffness[i][j]).sum::<f64>()
+                } else {
+                    -m.coupling_stiffness[i][l]
+                };
+                kil / (mass(i) * mass(l)).sqrt()
+            });
+            let top = k
+                .symmetric_eigenvalues()
+                .iter()
+                .fold(0.0f64, |a, &e| a.max(e))
+                .sqrt();
+            let f = fastest_motion(&m);
+            assert!(
+                matches!(f.source, FastestSource::Stiffness(_)),
+                "{name}: {f:?}"
+            );
+            assert!(
+                f.rate >= top * (1.0 - 1e-12) && f.rate <= 2.0 * top,
+                "{name}: bound {} against {top}",
+                f.rate
+            );
+        }
+    }
+
+    #[test]
+    fn below_the_lowest_speed_a_revolution_is_refused_and_at_it_is_integrated() {
+        // One revolution of the machine hung on its coupling at a quarter of its rigid-body
+        // resonance took over a million steps before failing. Below its lowest speed the
+        // monodromy is refused without integrating, naming the keys; at it, one revolution
+        // takes a few thousand steps (2 070 measured).
+        let f = Floquet::new(&hung_on_coupling()).unwrap();
+        let low = f.lowest_speed();
+        assert!(
+            (low / ((2.0e5f64 / 100.0).sqrt() / 1000.0) - 1.0).abs() < 1e-9,
+            "{low}"
+        );
+        let e = f.multipliers(0.99 * low, 1e-10).unwrap_err().to_string();
+        assert!(
+            e.contains("platform[1].stiffness") && e.contains("lowest speed is 4.4721e-2"),
+            "{e}"
+        );
+        let (_, steps) = f.monodromy_counted(low, 1e-10).unwrap();
+        assert!(steps < 10_000, "{steps}");
     }
 
     #[test]
