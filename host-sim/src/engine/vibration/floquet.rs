@@ -1065,21 +1065,17 @@ mod tests {
         VibrationMachine::new(&p).unwrap()
     }
 
-    /// A two-platform machine with a roller balancer on platform 2 and rotor unbalance.
-    fn two_mass() -> VibrationMachine {
+    /// Two platforms coupled by 1e5 N/m and 50 N·s/m, the seed's balancer on platform 2.
+    fn coupled(platforms: [(f64, f64, f64); 2]) -> VibrationMachineParams {
         let mut p = VibrationMachineParams {
-            platforms: vec![
-                PlatformParams {
-                    mass: 100.0,
-                    stiffness: 4e5,
-                    damping: 200.0,
-                },
-                PlatformParams {
-                    mass: 80.0,
-                    stiffness: 3e5,
-                    damping: 150.0,
-                },
-            ],
+            platforms: platforms
+                .iter()
+                .map(|&(mass, stiffness, damping)| PlatformParams {
+                    mass,
+                    stiffness,
+                    damping,
+                })
+                .collect(),
             couplings: vec![CouplingParams {
                 between: [0, 1],
                 stiffness: 1e5,
@@ -1088,6 +1084,12 @@ mod tests {
             ..seed_params()
         };
         p.balancer.platform = Some(1);
+        p
+    }
+
+    /// A two-platform machine with a roller balancer on platform 2 and rotor unbalance.
+    fn two_mass() -> VibrationMachine {
+        let mut p = coupled([(100.0, 4e5, 200.0), (80.0, 3e5, 150.0)]);
         p.balancer.kind = LoadKind::Roller;
         p.balancer.rotor_unbalance = 0.06;
         p.balancer.rotor_unbalance_angle = 0.4;
@@ -1116,27 +1118,7 @@ mod tests {
     /// The two-platform machine of [`two_mass`] hung only on its coupling: both platforms at
     /// 1e-6 N/m to the ground (a rigid-body resonance near 1e-4 rad/s).
     fn hung_on_coupling() -> VibrationMachine {
-        let mut p = VibrationMachineParams {
-            platforms: vec![
-                PlatformParams {
-                    mass: 100.0,
-                    stiffness: 1e-6,
-                    damping: 200.0,
-                },
-                PlatformParams {
-                    mass: 100.0,
-                    stiffness: 1e-6,
-                    damping: 200.0,
-                },
-            ],
-            couplings: vec![CouplingParams {
-                between: [0, 1],
-                stiffness: 1e5,
-                damping: 50.0,
-            }],
-            ..seed_params()
-        };
-        p.balancer.platform = Some(1);
+        let mut p = coupled([(100.0, 1e-6, 200.0), (100.0, 1e-6, 200.0)]);
         p.balancer.rotor_unbalance = 0.05;
         VibrationMachine::new(&p).unwrap()
     }
