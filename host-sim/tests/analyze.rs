@@ -549,7 +549,8 @@ fn lines_without_framing_say_the_disc_is_taken_unframed() {
         "{note}"
     );
     assert!(
-        note.contains("`Channel 1` pulses 6 times")
+        note.contains("`Channel 1` pulses once every 24 edges of `Channel 0`")
+            && note.contains("once a revolution of 24 lines")
             && note.contains("--framing index frames each revolution")
             && !note.contains("--index-channel"),
         "{note}"
@@ -579,11 +580,63 @@ fn lines_without_framing_say_the_disc_is_taken_unframed() {
     let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
     let note = report.framing_note.unwrap();
     assert!(
-        note.contains("`Z` pulses 7 times in the 399 edges of `A`, 8.0 revolutions")
+        note.contains("`Z` pulses once every 50 edges of `A` (7 of its 7 spacings)")
             && note.contains("--framing index --index-channel 2"),
         "{note}"
     );
     assert!(!note.contains("`B`"), "{note}");
+}
+
+/// An index that pulses once every 24 edges, read with `--lines 25`: the note says the pulses
+/// come every 24, not every 25, and what that makes of the speeds (a count of pulses against
+/// edges alone read them as once a revolution of 25, and a 1000-line disc's index as once a
+/// revolution of 1024). Read the other way round, the index as the encoder: a WARNING says the
+/// channel read pulses once every 24 edges of the other (the speed read was 24 times low,
+/// without a word).
+#[test]
+fn an_index_against_the_wrong_line_count_or_read_as_the_encoder_is_named() {
+    use host_sim::app::analyze::Channel;
+    let (_scratch, file) = tmp("index-lines.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Saleae, &file);
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            lines: Some(25),
+            ..AnalyzeOptions::default()
+        },
+    );
+    let note = report.framing_note.as_deref().unwrap();
+    assert!(
+        note.contains("`Channel 1` pulses once every 24 edges of `Channel 0`")
+            && note.contains("not every 25 as an index of --lines 25 would")
+            && note.contains("the disc has 24 lines (--lines 24 --framing index)")
+            && !note.contains("once a revolution of 25"),
+        "{note}"
+    );
+    assert!(report
+        .warnings
+        .iter()
+        .all(|w| !w.contains("the channel read")));
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            lines: Some(24),
+            channel: Some(Channel::Name("Channel 1".into())),
+            ..AnalyzeOptions::default()
+        },
+    );
+    let w = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("the channel read"))
+        .unwrap();
+    assert!(
+        w.contains("`Channel 1`, the channel read, pulses once every 24 edges of `Channel 0`")
+            && w.contains("read it with --channel 0")
+            && w.contains("--framing index --index-channel 1"),
+        "{w}"
+    );
+    assert!(host_sim::app::analyze::text(&report).contains(w.as_str()));
 }
 
 /// A capture taken through the timer's input prescaler (one capture in 4 line edges): the

@@ -1278,6 +1278,11 @@ pub fn analyze<R: BufRead>(
     let mut last_event: Option<f64> = None;
     let mut end = 0.0;
     let mut changes = vec![0u64; channels.len()];
+    // Each other channel's pulses among the read channel's edges (an index's come once a
+    // revolution of lines), and the read channel's among each other's (read where the index
+    // is, it pulses once every so many of the encoder's).
+    let mut among_read = vec![Spacing::default(); channels.len()];
+    let mut read_among = vec![Spacing::default(); channels.len()];
     let mut grid = TimeGrid::default();
     let mut resolution = Resolution {
         hz: cfg.encoder.timer_hz,
@@ -1325,6 +1330,19 @@ pub fn analyze<R: BufRead>(
         let channel_edge = edge(ch) == Some(cfg.edge);
         if channel_edge {
             report.edges += 1;
+        }
+        for (k, (a, b)) in among_read.iter_mut().zip(&mut read_among).enumerate() {
+            if k == ch {
+                continue;
+            }
+            if channel_edge {
+                a.other_edge();
+                b.pulse();
+            }
+            if edge(k) == Some(cfg.edge) {
+                a.pulse();
+                b.other_edge();
+            }
         }
         // The timer's input prescaler: one capture in `prescaler` edges of the channel, the
         // first at the prescaler-th (a noise pulse's edge counts like any other).
@@ -1537,7 +1555,10 @@ pub fn analyze<R: BufRead>(
         })
         .collect();
     if cfg.framing_default {
-        report.framing_note = Some(framing_note(&report, enc.config().wheel, ch));
+        report.framing_note = Some(framing_note(&report, enc.config().wheel, ch, &among_read));
+    }
+    if let Some(w) = read_as_index(&report, ch, &read_among) {
+        report.warnings.push(w);
     }
     report.speed_trace.shrink_to_fit();
     Ok(report)
@@ -1569,32 +1590,47 @@ fn other_way(r: &AnalyzeReport) -> Option<String> {
 }
 
 /// The line saying that a disc of `--lines` without `--framing` was taken as unframed, naming
-/// each other channel whose pulses come once every revolution of the encoder channel's edges
-/// (within a revolution over the capture), as an index pulse does.
-fn framing_note(r: &AnalyzeReport, wheel: drive_monitor::encoder::Wheel, ch: usize) -> String {
+/// each other channel whose pulses come once every so many of the encoder channel's edges
+/// (`among[k]`, at least 9 in 10 of its spacings within 1 % or one edge of that count), as an
+/// index pulse does: once a revolution of `--lines`, or of another count, which `--lines`
+/// then misstates (a count of pulses against edges alone read a 1000-line disc's index as
+/// once a revolution of 1024).
+fn framing_note(
+    r: &AnalyzeReport,
+    wheel: drive_monitor::encoder::Wheel,
+    ch: usize,
+    among: &[Spacing],
+) -> String {
     let lines = u64::from(wheel.positions());
     let index_like: Vec<String> = r
         .channel_changes
         .iter()
+        .zip(among)
         .enumerate()
         .filter(|&(k, _)| k != ch)
-        .filter_map(|(k, c)| {
-            let pulses = c.changes / 2;
-            (pulses >= 2 && (pulses * lines).abs_diff(r.edges) <= lines).then(|| {
+        .filter_map(|(k, (c, sp))| {
+            let (every, n, total) = sp.regular().filter(|&(e, _, _)| e >= 2)?;
+            // The index channel's default is the second column.
+            let flag = if k == 1 {
+                String::new()
+            } else {
+                format!(" --index-channel {k}")
+            };
+            let head = format!(
+                "`{}` pulses once every {every} edges of `{}` ({n} of its {total} spacings)",
+                c.name, r.channel
+            );
+            Some(if every == lines {
                 format!(
-                    "`{}` pulses {pulses} times in the {} edges of `{}`, {:.1} revolutions of \
-                     {lines} lines: once a revolution, as an index does; --framing index{} \
-                     frames each revolution by it",
-                    c.name,
-                    r.edges,
-                    r.channel,
-                    r.edges as f64 / lines as f64,
-                    // The index channel's default is the second column.
-                    if k == 1 {
-                        String::new()
-                    } else {
-                        format!(" --index-channel {k}")
-                    }
+                    "{head}: once a revolution of {lines} lines, as an index does; --framing \
+                     index{flag} frames each revolution by it"
+                )
+            } else {
+                format!(
+                    "{head}, not every {lines} as an index of --lines {lines} would: if it is \
+                     the index, the disc has {every} lines (--lines {every} --framing \
+                     index{flag}), and speeds read with --lines {lines} are off by \
+                     {every}/{lines}"
                 )
             })
         })
@@ -1608,6 +1644,79 @@ fn framing_note(r: &AnalyzeReport, wheel: drive_monitor::encoder::Wheel, ch: usi
         s.push_str(&c);
     }
     s
+}
+
+/// A WARNING when the channel read pulses once every so many (4 or more) edges of another
+/// channel (`among[k]`, regular as [`Spacing::regular`] says), as an index pulses among an
+/// encoder's lines: the channels are likely the other way round (an index read as a disc of
+/// lines reads a speed some lines-fold low, without another word).
+fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<String> {
+    let (k, (every, n, total)) = among
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != ch)
+        .filter_map(|(k, sp)| sp.regular().filter(|&(e, _, _)| e >= 4).map(|x| (k, x)))
+        .max_by_key(|&(_, (e, _, _))| e)?;
+    let other = &r.channel_changes.get(k)?.name;
+    Some(format!(
+        "WARNING: `{read}`, the channel read, pulses once every {every} edges of `{other}` ({n} of \
+         its {total} spacings), as an index pulses once a revolution of a disc's lines: if \
+         `{other}` is the encoder, read it with --channel {k} (and frame by `{read}` with \
+         --framing index --index-channel {ch}); read as it is, the speeds are about {every} times \
+         too low",
+        read = r.channel,
+    ))
+}
+
+/// How one channel's pulses (edges of the analysed polarity) fall among another channel's:
+/// the other's edges counted between consecutive pulses, the distinct counts tallied (up to
+/// [`SPACINGS`] of them; the rest only counted). The first pulse starts the count.
+#[derive(Debug, Clone, Default)]
+pub struct Spacing {
+    since: u64,
+    started: bool,
+    tally: Vec<(u64, u64)>,
+    untallied: u64,
+}
+
+/// Distinct spacings a [`Spacing`] tallies.
+const SPACINGS: usize = 16;
+
+impl Spacing {
+    /// An edge of the other channel.
+    pub fn other_edge(&mut self) {
+        self.since += 1;
+    }
+
+    /// A pulse of this channel.
+    pub fn pulse(&mut self) {
+        if self.started {
+            let s = self.since;
+            let room = self.tally.len() < SPACINGS;
+            match self.tally.iter_mut().find(|v| v.0 == s) {
+                Some(v) => v.1 += 1,
+                None if room => self.tally.push((s, 1)),
+                None => self.untallied += 1,
+            }
+        }
+        self.started = true;
+        self.since = 0;
+    }
+
+    /// The count most spacings share, when at least 2 spacings and 9 in 10 of them lie within
+    /// 1 % or one edge of it (a noise pulse adds an edge now and then): `(count, spacings
+    /// near it, spacings)`.
+    pub fn regular(&self) -> Option<(u64, u64, u64)> {
+        let total = self.tally.iter().map(|v| v.1).sum::<u64>() + self.untallied;
+        let &(every, _) = self.tally.iter().max_by_key(|v| (v.1, v.0))?;
+        let near = self
+            .tally
+            .iter()
+            .filter(|v| v.0.abs_diff(every) <= (every / 100).max(1))
+            .map(|v| v.1)
+            .sum::<u64>();
+        (near >= 2 && 10 * near >= 9 * total).then_some((every, near, total))
+    }
 }
 
 /// The step every row's time lies on, from the first row's, in whole nanoseconds (the
