@@ -2637,3 +2637,49 @@ fn the_ripple_readings_readme_quotes_are_analyzes() {
         }
     }
 }
+
+/// A Saleae export's `X` (no data) on the channel read: its edges there were not seen, and the
+/// report says so with the span, where it only counted missing edges and a sync loss, as if
+/// the encoder had faulted.
+#[test]
+fn a_span_without_data_is_said_to_be_the_captures() {
+    // A 12-line disc at 1 ms a line (rising every 1 ms), `X` from 0.1005 to 0.1205 s.
+    let mut text = String::from("Time [s],Channel 0\n");
+    for k in 0..400u32 {
+        let t = f64::from(k) * 5e-4;
+        let level = if (0.1005..0.1205).contains(&t) {
+            "X".to_string()
+        } else {
+            (k % 2).to_string()
+        };
+        text.push_str(&format!("{t:.9},{level}\n"));
+    }
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(12),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "x.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let n = report.no_data.as_ref().unwrap();
+    assert_eq!(n.spans, 1);
+    assert!(
+        (n.first[0] - 0.1005).abs() < 1e-9 && (n.first[1] - 0.1205).abs() < 1e-9,
+        "{n:?}"
+    );
+    assert!((n.seconds - 0.02).abs() < 1e-9, "{n:?}");
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("WARNING: `Channel 0` had no data (unknown level) over 1 span(s)"),
+        "{said}"
+    );
+    // Without an `X`, nothing.
+    let clean: String = (0..400u32)
+        .map(|k| format!("{:.9},{}\n", f64::from(k) * 5e-4, k % 2))
+        .collect();
+    let mut reader = text_reader(format!("Time [s],Channel 0\n{clean}"), "c.csv", None).unwrap();
+    assert!(analyze(&mut reader, &cfg, &mut |_| {})
+        .unwrap()
+        .no_data
+        .is_none());
+}

@@ -489,6 +489,11 @@ pub struct AnalyzeReport {
     /// Captures at the same timer tick as the one before: the timer is too slow to resolve
     /// the edges (the report warns).
     pub captures_at_one_tick: u64,
+    /// Where the channel read had no data (a Saleae `X`, a VCD `x` or `z`): how many spans,
+    /// their time in all, s, and the first `[from, to]` (the report warns: edges there were
+    /// not seen, and the faults there are the capture's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub no_data: Option<NoData>,
     /// The emulated capture's input prescaler: one capture every this many edges.
     pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
@@ -1281,6 +1286,7 @@ pub fn analyze<R: BufRead>(
     // Each other channel's pulses among the read channel's edges (an index's come once a
     // revolution of lines), and the read channel's among each other's (read where the index
     // is, it pulses once every so many of the encoder's).
+    let (mut no_data, mut no_data_from): (Vec<(f64, f64)>, Option<f64>) = (Vec::new(), None);
     let mut among_read = vec![Spacing::default(); channels.len()];
     let mut read_among = vec![Spacing::default(); channels.len()];
     let mut grid = TimeGrid::default();
@@ -1316,6 +1322,19 @@ pub fn analyze<R: BufRead>(
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
                 *n += 1;
             }
+        }
+        // The channel read without data: from the row it went unknown to the row it came back
+        // (or the end of the capture).
+        match (prev.get(ch), levels.get(ch)) {
+            (Some(&a), Some(&Level::Unknown)) if a != Level::Unknown || report.rows == 0 => {
+                no_data_from = Some(t);
+            }
+            (Some(&Level::Unknown), Some(&b)) if b != Level::Unknown => {
+                if let Some(f) = no_data_from.take() {
+                    no_data.push((f, t));
+                }
+            }
+            _ => {}
         }
         report.rows += 1;
         end = t;
@@ -1453,6 +1472,14 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
+    no_data.extend(no_data_from.map(|f| (f, end)));
+    if let Some(&first) = no_data.first() {
+        report.no_data = Some(NoData {
+            spans: no_data.len() as u64,
+            seconds: no_data.iter().map(|(a, b)| b - a).sum(),
+            first: [first.0, first.1],
+        });
+    }
     report.time_origin = reader.time_origin();
     report.warnings.clone_from(&cfg.warnings);
     // The end of the recording: the periodic task up to it (a shaft that stopped before the
@@ -1666,6 +1693,17 @@ fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<Stri
          too low",
         read = r.channel,
     ))
+}
+
+/// Spans without data on the channel read ([`AnalyzeReport::no_data`]).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct NoData {
+    /// Spans.
+    pub spans: u64,
+    /// Their time in all, s.
+    pub seconds: f64,
+    /// The first span, s.
+    pub first: [f64; 2],
 }
 
 /// How one channel's pulses (edges of the analysed polarity) fall among another channel's:
@@ -2110,6 +2148,15 @@ pub fn text(r: &AnalyzeReport) -> String {
     );
     for w in &r.warnings {
         let _ = writeln!(s, "{w}");
+    }
+    if let Some(n) = &r.no_data {
+        let _ = writeln!(
+            s,
+            "WARNING: `{}` had no data (unknown level) over {} span(s), {:.6} s in all, the first \
+             from {:.6} to {:.6} s: its edges there were not seen, and the missing edges, sync \
+             losses and invalid windows there are the capture's, not the encoder's",
+            r.channel, n.spans, n.seconds, n.first[0], n.first[1]
+        );
     }
     if r.captures_at_one_tick > 0 {
         let _ = writeln!(
