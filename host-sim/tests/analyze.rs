@@ -2683,3 +2683,66 @@ fn a_span_without_data_is_said_to_be_the_captures() {
         .no_data
         .is_none());
 }
+
+/// A fast timer on a narrow counter against the default minimum speed: the refusal is headed
+/// by the options given, not by a `--min-speed` nobody gave; given, it is named.
+#[test]
+fn a_timer_that_does_not_fit_the_default_minimum_speed_names_the_options_given() {
+    let o = AnalyzeOptions {
+        lines: Some(1000),
+        timer_hz: Some(84e6),
+        counter_bits: Some(16),
+        ..AnalyzeOptions::default()
+    };
+    let e = configure(&o).err().unwrap();
+    assert!(
+        e.starts_with("--timer-hz and --counter-bits do not fit the default --min-speed")
+            && e.contains("`--min-speed` at least 8.06 rad/s"),
+        "{e}"
+    );
+    let e = configure(&AnalyzeOptions {
+        min_speed: Some(1.0),
+        ..o
+    })
+    .err()
+    .unwrap();
+    assert!(e.starts_with("--min-speed does not fit"), "{e}");
+}
+
+/// `--channel 1 --framing index` without `--index-channel`: the default index channel (the
+/// second column) is the encoder's, and the refusal says it was the default.
+#[test]
+fn the_default_index_channel_on_the_encoder_is_said_to_be_the_default() {
+    use host_sim::app::analyze::{Channel, FramingArg};
+    let text = "Time [s],Channel 0,Channel 1\n0.0,0,0\n0.001,1,1\n0.002,0,0\n".to_string();
+    let o = AnalyzeOptions {
+        lines: Some(12),
+        framing: Some(FramingArg::Index),
+        channel: Some(Channel::Column(1)),
+        ..AnalyzeOptions::default()
+    };
+    let cfg = configure(&o).unwrap();
+    let mut reader = text_reader(text.clone(), "two.csv", None).unwrap();
+    let e = analyze(&mut reader, &cfg, &mut |_| {})
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("no --index-channel was given, so the default applies: `Channel 1`"),
+        "{e}"
+    );
+    let cfg = configure(&AnalyzeOptions {
+        index_channel: Some(Channel::Column(1)),
+        ..o
+    })
+    .unwrap();
+    let mut reader = text_reader(text, "two.csv", None).unwrap();
+    let e = analyze(&mut reader, &cfg, &mut |_| {})
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("--index-channel is the encoder channel itself"),
+        "{e}"
+    );
+}

@@ -1222,9 +1222,15 @@ pub fn analyze<R: BufRead>(
         None => None,
     };
     if ich == Some(ch) {
-        return Err(AnalyzeError::Option(
-            "--index-channel is the encoder channel itself".into(),
-        ));
+        return Err(AnalyzeError::Option(if cfg.index_channel_default {
+            format!(
+                "no --index-channel was given, so the default applies: `{}`, the encoder channel \
+                 itself (--channel): give --index-channel",
+                channels[ch]
+            )
+        } else {
+            "--index-channel is the encoder channel itself".into()
+        }));
     }
     let dch = match &cfg.direction {
         Some((c, lead)) => {
@@ -2781,12 +2787,15 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
                 ),
             };
         }
+        // A minimum speed nobody gave is the default's: the options given are what to change.
+        let head = if e.parameter() == "min_speed" && o.min_speed.is_none() && o.scene.is_none() {
+            "--timer-hz and --counter-bits do not fit the default --min-speed".to_string()
+        } else {
+            format!("{} does not fit", option_of(e.parameter()))
+        };
         let mut m = format!(
-            "{} does not fit: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",
-            option_of(e.parameter()),
-            enc.timer_hz,
-            enc.counter_bits,
-            enc.min_speed
+            "{head}: {e} (timer {} Hz, {}-bit counter, minimum speed {} rad/s)",
+            enc.timer_hz, enc.counter_bits, enc.min_speed
         );
         let hint = crate::app::check::speed_range_hint(
             &enc,

@@ -383,17 +383,11 @@ pub fn sweep(
             format!("need at least 2 steps, got {steps}"),
         ));
     }
-    let design = crate::app::regimes::design(scene, file, &machine)?;
-    let (classifier, _, exact) =
-        crate::app::regimes::classifier(scene, file, &machine, design.as_ref())?;
-    // The sweep judges the loads, not δ: no encoder, so no edges to generate.
-    let mut quiet = scene.clone();
-    quiet.encoder = None;
-    let exact_design = design.as_ref().and_then(|d| d.exact.as_ref());
-    // Each speed's settling time comes from a monodromy over its revolution: refused up front
-    // where that cannot be integrated, not after the first runs.
-    if exact_design.is_some() {
-        if let Some(vm) = crate::app::regimes::vibration_machine(scene, file)? {
+    // Each speed's settling time comes from a monodromy over its revolution (where the loads
+    // can balance the rotor: an exact table): refused before the design's scan where that
+    // cannot be integrated.
+    if let Some(vm) = crate::app::regimes::vibration_machine(scene, file)? {
+        if floquet::Floquet::new(&vm).is_ok() {
             let lowest = floquet::lowest_speed(&vm);
             if from < lowest {
                 let fast = floquet::fastest_motion(&vm);
@@ -412,6 +406,13 @@ pub fn sweep(
             }
         }
     }
+    let design = crate::app::regimes::design(scene, file, &machine)?;
+    let (classifier, _, exact) =
+        crate::app::regimes::classifier(scene, file, &machine, design.as_ref())?;
+    // The sweep judges the loads, not δ: no encoder, so no edges to generate.
+    let mut quiet = scene.clone();
+    quiet.encoder = None;
+    let exact_design = design.as_ref().and_then(|d| d.exact.as_ref());
     let segments: Vec<RegimeSegment> = classifier.segments().collect();
     let bar = progress_bar(steps, "speeds", progress);
     let points: Result<Vec<SweepPoint>, SceneError> = (0..steps)
