@@ -574,7 +574,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             }
             if bulk {
                 // The usual case: the whole batch at the first turn. Again after a run cut at
-                // `bulk_max`, so that the capture a run stopped at is one the fast path declines.
+                // `bulk_max` or at the ring's end, so that the capture a run stopped at is one
+                // the fast path declines.
                 while let Some(r) = self.bulk(rest) {
                     rest = r;
                     if rest.is_empty() {

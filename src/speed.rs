@@ -2804,14 +2804,14 @@ impl SpeedTracker {
     /// samples are folded into `extremes` (slowest and fastest, as tick counts of samples of
     /// equal span). The first capture it stops at (outside the band, or a special tooth next)
     /// is left for the careful path (the fast path declines it), but where the run was cut at
-    /// `bulk_max` (call it again). Identical results: the band test and its refresh points
+    /// `bulk_max` or where the ring's times wrap round its end (call it again). Identical results: the band test and its refresh points
     /// are the fast path's, and the state it leaves is the one the fast path would.
     ///
     /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
     /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), one range
     /// test for the extremes. The capture times before the batch are the ring's last `K`,
-    /// read where they lie (laid out from the ring's start first if they wrap round its end),
-    /// and the ring is written once, at the end, by a copy of fixed size. The loop itself is
+    /// read where they lie (where they wrap round its end, the run stops where they do), and
+    /// the ring is written once, at the end, by a copy of fixed size. The loop itself is
     /// [`Run::batch`], out of line so that it keeps its state in registers.
     #[inline(never)]
     pub(crate) fn bulk(
@@ -2824,9 +2824,24 @@ impl SpeedTracker {
             return (0, 0);
         }
         let room = usize::from(self.stop.wrapping_sub(self.tooth));
-        let n = caps.len().min(room).min(enc.bulk_max());
-        let caps = caps.get(..n).unwrap_or(&[]);
         let k = usize::from(enc.samples_span());
+        // The ring's last K times, read in one piece where they lie. Where they wrap round
+        // its end, the run takes only the captures whose samples start before it (fewer than
+        // K): written slot by slot, they bring the last K to the ring's start, where the next
+        // call reads them in one piece. (Laying the ring out first, turned in place, was a
+        // routine of 102 bytes and its call; laying the last K out whenever they were not at
+        // the start, once a revolution, 48 bytes more.)
+        let first = self.pos.wrapping_sub(k as u32) as usize & (MAX_SPAN - 1);
+        let n = caps.len().min(room).min(enc.bulk_max());
+        let mut caps = caps.get(..n).unwrap_or(&[]);
+        let head = match self.ring.get(first..first.wrapping_add(k)) {
+            Some(head) => head,
+            None => {
+                let head = self.ring.get(first..).unwrap_or(&[]);
+                caps = caps.get(..head.len()).unwrap_or(caps);
+                head
+            }
+        };
         // The batch writes the ring back as its last `m` times laid out from its start: `m`
         // is 16 or 32 (at least K), so that is a copy of fixed size (a few block moves).
         let m = if k <= LAID_SHORT {
@@ -2834,16 +2849,6 @@ impl SpeedTracker {
         } else {
             MAX_SPAN
         };
-        // The ring's last K times, read in one piece where they lie unless they wrap round
-        // its end (then laid out from its start first). Laying them out whenever they were
-        // not at the start (once a revolution: the frame takes the careful path) moved 16
-        // times as one block there, 48 bytes more code.
-        let mut first = self.pos.wrapping_sub(k as u32) as usize & (MAX_SPAN - 1);
-        if first.wrapping_add(k) > MAX_SPAN {
-            self.linearize(m);
-            first = m.wrapping_sub(k);
-        }
-        let head = self.ring.get(first..first.wrapping_add(k)).unwrap_or(&[]);
         let last0 = self.last;
         let mut run = Run::new(last0, self.lo, self.width, *extremes);
         // Captures up to and including the next one on a refresh tooth.
@@ -2893,36 +2898,6 @@ impl SpeedTracker {
         *extremes = run.extremes();
         // At most `bulk_max` intervals within the timeout: their total fits in 32 bits.
         (i, u64::from(run.last.wrapping_sub(last0)))
-    }
-
-    /// Lays the ring's last `m` times out from its start (newest at `m − 1`), `pos` at `m`,
-    /// when its last K wrap round its end (a batch reads them where they lie otherwise).
-    #[cold]
-    #[inline(never)]
-    fn linearize(&mut self, m: usize) {
-        let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
-        // Wrapped: the whole ring turned left by `first` in place, slot `j` taking slot
-        // `j + first` (masked), one slot a turn, 32 in all: along the cycle through `c`, and
-        // where it closes the held time put back and the next cycle started (`gcd(first,
-        // 32)` cycles). No copy of the ring, whose zeroing and copying would call `memset`
-        // and `memcpy`; one flat loop, not a loop per cycle (code size).
-        let (mut c, mut j) = (0usize, 0usize);
-        let mut held = self.ring.first().copied().unwrap_or(0);
-        for _ in 0..MAX_SPAN {
-            let next = j.wrapping_add(first) & (MAX_SPAN - 1);
-            let (v, to) = if next == c {
-                c = c.wrapping_add(1);
-                let v = core::mem::replace(&mut held, self.ring.get(c).copied().unwrap_or(0));
-                (v, c)
-            } else {
-                (self.ring.get(next).copied().unwrap_or(0), next)
-            };
-            if let Some(d) = self.ring.get_mut(j) {
-                *d = v;
-            }
-            j = to;
-        }
-        self.pos = m as u32;
     }
 
     /// Sets the band around the mean of the last `K` intervals (when the ring is full; an
