@@ -399,7 +399,9 @@ impl Revolution {
 pub struct SpeedTracker {
     state: ShaftState,
     sync: SyncState,
-    /// `last` is a time reference (an accepted or starting edge).
+    /// `last` is a time reference (an accepted or starting edge): its capture time, counted on
+    /// past a counter narrower than 32 bits from the last new reference (its low bits are the
+    /// capture's, so intervals masked to the counter are the same).
     has_ref: bool,
     last: u32,
     /// Latest raw edge time while edges are pending (`last` otherwise).
@@ -426,10 +428,13 @@ pub struct SpeedTracker {
     /// Faults since the last frame.
     faults: u8,
     /// The last accepted edges, newest at `pos − 1`, then `pos − 2`, … (`pos` runs on and the
-    /// index is masked; a batch lays them out from the start again): their capture times with a 32-bit counter (a `K`-edge sample is then
-    /// one difference, exact since `K` intervals within the timeout fit in 32 bits), their
-    /// intervals with a narrower one (summed, so a sample may last longer than the counter's
-    /// period). `fill` of them (at most `K`) belong to the current run.
+    /// index is masked; a batch lays them out from the start again): their capture times,
+    /// counted on past a counter narrower than 32 bits (see `last`), so that a `K`-edge sample
+    /// is one difference, exact since `K` intervals within the timeout fit in 32 bits (and may
+    /// last longer than the counter's period). `fill` of them (at most `K`) belong to the
+    /// current run. (One kind of ring for every counter: a ring of intervals for a narrower
+    /// one was a second copy of the fast path in every entry point, 100 bytes in firmware fed
+    /// edge by edge.)
     ring: [u32; MAX_SPAN],
     pos: u32,
     fill: u8,
@@ -753,28 +758,24 @@ impl SpeedTracker {
     /// Brings the careful path's bookkeeping up to date with what the fast path did: the
     /// accepted count, and the previous interval (the ring's newest: fast teeth are ordinary
     /// teeth, so their interval is per base pitch already).
-    fn settle(&mut self, enc: &Encoder) {
+    fn settle(&mut self) {
         if self.tooth != self.anchor {
             self.accepted = self.accepted_now();
             self.anchor = self.tooth;
-            self.prev = self.newest(enc);
+            self.prev = self.newest();
         }
     }
 
     /// The newest interval in the ring (the fast path's last interval).
     #[inline(never)] // careful path: one copy for its callers (code size)
-    fn newest(&self, enc: &Encoder) -> u32 {
+    fn newest(&self) -> u32 {
         let at = |back: u32| {
             self.ring
                 .get(self.pos.wrapping_sub(back) as usize & (MAX_SPAN - 1))
                 .copied()
                 .unwrap_or(0)
         };
-        if enc.ring_times() {
-            at(1).wrapping_sub(at(2))
-        } else {
-            at(1)
-        }
+        at(1).wrapping_sub(at(2))
     }
 
     /// The latest speed sample (the last `K` accepted intervals) while running; `None` before
@@ -873,7 +874,7 @@ impl SpeedTracker {
         // counter's period: read as a stop, a poll racing a capture interrupt cut the window
         // and lost the sync, and a drive over its δ limit never raised the alarm).
         if elapsed.wrapping_sub(enc.timeout_ticks()).wrapping_sub(1) < enc.poll_interval_ticks() {
-            self.settle(enc);
+            self.settle();
             self.flush(enc, table, sink);
             self.stop_running(now & enc.mask(), sink);
             self.has_ref = false;
@@ -914,36 +915,20 @@ impl SpeedTracker {
         ticks: u32,
         uniform: bool,
     ) -> Option<Tooth> {
-        // One branch on the ring's kind per edge, each kind's path without a select.
-        if enc.ring_times() {
-            self.try_fast_in::<P, true>(enc, table, ticks, uniform)
-        } else {
-            self.try_fast_in::<P, false>(enc, table, ticks, uniform)
-        }
-    }
-
-    #[inline(always)]
-    fn try_fast_in<P: PitchTable, const TIMES: bool>(
-        &mut self,
-        enc: &Encoder,
-        table: &P,
-        ticks: u32,
-        uniform: bool,
-    ) -> Option<Tooth> {
         let mask = enc.mask();
         let t = ticks & mask;
         let dt = t.wrapping_sub(self.last) & mask;
         if self.tooth == self.stop || dt.wrapping_sub(self.lo) > self.width {
             return None;
         }
-        let sum = self.sum;
         // `stop` is at most the tooth before the frame (tooth 0 is always special), so the
         // next tooth does not wrap.
         let tooth = self.tooth.wrapping_add(1);
         self.tooth = tooth;
-        self.last = t;
-        // The ring is full on the fast path: the sample starts K edges back (a time), or the
-        // oldest of the last K intervals leaves the sum.
+        // Counted on past the counter's wraps (see `last`): with a 32-bit counter, `t`.
+        let time = self.last.wrapping_add(dt);
+        self.last = time;
+        // The ring is full on the fast path: the sample starts K edges back.
         let k = enc.samples_span();
         let pos = self.pos;
         let oldest = self
@@ -952,12 +937,10 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = if TIMES { t } else { dt };
+            *slot = time;
         }
-        let pos = pos.wrapping_add(1);
-        self.pos = pos;
-        let end = if TIMES { t } else { sum.wrapping_add(dt) };
-        let ticks = end.wrapping_sub(oldest);
+        self.pos = pos.wrapping_add(1);
+        let ticks = time.wrapping_sub(oldest);
         self.sum = ticks;
         if tooth & (BAND_REFRESH - 1) == 0 {
             self.refresh_band(enc);
@@ -1082,7 +1065,7 @@ impl SpeedTracker {
             // An unconfigured monitor ignores everything.
             return;
         }
-        self.settle(enc);
+        self.settle();
         self.arrivals = self.arrivals.wrapping_add(1);
         // With the fast path open, an ordinary edge comes here only from outside its band.
         let open = self.stop != self.tooth;
@@ -2106,7 +2089,7 @@ impl SpeedTracker {
         // The ring: the sample ends here. An interval across a fault, unexplained, or taken
         // unjudged before the sync is no sample.
         let sample = if vouched {
-            self.push(enc, table, tooth, t, dt)
+            self.push(enc, table, tooth, dt)
         } else {
             self.reset_ring();
             None
@@ -2139,7 +2122,8 @@ impl SpeedTracker {
         if had_ref {
             self.prev = per_base;
         }
-        self.last = t;
+        // Counted on past the counter's wraps (see `last`): with a 32-bit counter, `t`.
+        self.last = self.last.wrapping_add(dt);
         self.accepted = self.accepted.wrapping_add(1);
         self.anchor = tooth;
         sink.tooth(&Tooth {
@@ -2734,18 +2718,18 @@ impl SpeedTracker {
         enc: &Encoder,
         table: &P,
         tooth: u16,
-        t: u32,
         dt: u32,
     ) -> Option<Sample> {
         let k = enc.samples_span();
-        let times = enc.ring_times();
-        if times && self.fill == 0 {
+        if self.fill == 0 {
             // A run of times starts with the first interval's start.
             if let Some(slot) = self.ring.get_mut(self.pos as usize & (MAX_SPAN - 1)) {
                 *slot = self.last;
             }
             self.pos = self.pos.wrapping_add(1);
         }
+        // Counted on past the counter's wraps (see `last`).
+        let time = self.last.wrapping_add(dt);
         let pos = self.pos;
         let oldest = self
             .ring
@@ -2753,18 +2737,12 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = if times { t } else { dt };
+            *slot = time;
         }
-        let pos = pos.wrapping_add(1);
-        self.pos = pos;
+        self.pos = pos.wrapping_add(1);
         let uniform = enc.is_uniform() && P::NOMINAL;
         let refresh = tooth & (BAND_REFRESH - 1) == 0;
         if u16::from(self.fill) >= k {
-            self.sum = if times {
-                t.wrapping_sub(oldest)
-            } else {
-                self.sum.wrapping_add(dt).wrapping_sub(oldest)
-            };
             if !uniform {
                 let out = tooth_back(tooth, k, enc.edges());
                 self.span = self
@@ -2774,18 +2752,16 @@ impl SpeedTracker {
             }
         } else {
             self.fill = self.fill.saturating_add(1);
-            self.sum = self.sum.wrapping_add(dt);
             if !uniform {
                 self.span = self.span.wrapping_add(self.pitch(enc, table, tooth));
             }
             if u16::from(self.fill) < k {
                 return None;
             }
-            if times {
-                // K intervals now: the sample starts at the run's first time.
-                self.sum = t.wrapping_sub(oldest);
-            }
         }
+        // The sample starts K times back (at the run's first time when K intervals have just
+        // been reached).
+        self.sum = time.wrapping_sub(oldest);
         if refresh {
             self.refresh_band(enc);
         }
