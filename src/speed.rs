@@ -803,8 +803,9 @@ impl SpeedTracker {
         })
     }
 
-    /// Whether the teeth are numbered: synced, or confirming a frame candidate.
-    #[inline(always)]
+    /// Whether the teeth are numbered: synced, or confirming a frame candidate. Out of line,
+    /// one copy: inlined, the acceptance's paths were copied for each answer (116 bytes).
+    #[inline(never)]
     fn teeth_known(&self, enc: &Encoder) -> bool {
         self.sync == SyncState::Synced
             || (self.sync == SyncState::Confirming && enc.framing() != Framing::None)
@@ -1834,7 +1835,7 @@ impl SpeedTracker {
     }
 
     /// The waiting index timestamps as bits (`nidx` ≤ INDEXES ≤ 8: within the byte).
-    #[inline(always)]
+    #[inline(never)] // one copy: less code than inlined (8 bytes)
     fn waiting(&self) -> u8 {
         1u8.wrapping_shl(u32::from(self.nidx)).wrapping_sub(1)
     }
