@@ -652,8 +652,8 @@ impl Encoder {
     pub const fn unit_rad(&self) -> f32 {
         self.unit_rad
     }
-    /// Whether the interval ring holds capture times (a 32-bit counter: a `K`-edge sample is
-    /// one exact difference) rather than intervals.
+    /// Whether the counter is 32 bits wide: the captures of a batch are then the times the
+    /// interval ring holds (with a narrower counter it holds them counted on past its wraps).
     #[inline(always)]
     pub(crate) fn ring_times(&self) -> bool {
         self.mask == u32::MAX

@@ -260,6 +260,7 @@ impl WindowState {
         self.started
     }
 
+    #[inline(never)] // once a window: one copy for its callers (code size)
     fn restart(&mut self, edge: u32, ticks: u32) {
         self.started = true;
         self.revs = 0;

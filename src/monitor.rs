@@ -574,7 +574,8 @@ impl<const N: usize, P: PitchTable> DeltaMonitor<N, P> {
             }
             if bulk {
                 // The usual case: the whole batch at the first turn. Again after a run cut at
-                // `bulk_max`, so that the capture a run stopped at is one the fast path declines.
+                // `bulk_max` or at the ring's end, so that the capture a run stopped at is one
+                // the fast path declines.
                 while let Some(r) = self.bulk(rest) {
                     rest = r;
                     if rest.is_empty() {
@@ -3543,6 +3544,34 @@ mod tests {
             let out = run_batched_in_order(&mut m, &evs, seed);
             assert_eq!(out, expected, "seed {seed}");
             assert_eq!(m.diagnostics(), one.diagnostics());
+        }
+    }
+
+    #[test]
+    fn a_narrow_counter_measures_what_a_32_bit_one_does_over_samples_longer_than_its_period() {
+        // 32-edge samples of about 120 000 ticks on a 16-bit counter (a period of 65 536): the
+        // ring holds the capture times counted on past the counter's wraps, so every sample,
+        // window and count is the 32-bit counter's, edge by edge and in batches.
+        let w = kneader(0.01);
+        let wide = stream(&uniform(1024), Some(0.0), 10, 84e6, u32::MAX, &w);
+        let narrow = stream(&uniform(1024), Some(0.0), 10, 84e6, 0xFFFF, &w);
+        let mut a = monitor(indexed(1024, 32, 32, 84e6), 2);
+        let expected = run(&mut a, &wide);
+        assert!(expected.len() >= 3, "{expected:?}");
+        let results = |out: &[WindowOutcome]| -> Vec<_> {
+            out.iter().map(|o| (o.report.result, o.verdict)).collect()
+        };
+        for seed in 0..3u64 {
+            let mut b = monitor(indexed(1024, 32, 16, 84e6), 2);
+            let out = if seed == 0 {
+                run(&mut b, &narrow)
+            } else {
+                run_batched_in_order(&mut b, &narrow, seed)
+            };
+            assert_eq!(results(&out), results(&expected), "seed {seed}");
+            assert!(out.iter().all(|o| o.report.valid()), "{out:?}");
+            assert_eq!(a.diagnostics(), b.diagnostics(), "seed {seed}");
+            assert_eq!(a.speed().to_bits(), b.speed().to_bits(), "seed {seed}");
         }
     }
 

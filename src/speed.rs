@@ -399,7 +399,9 @@ impl Revolution {
 pub struct SpeedTracker {
     state: ShaftState,
     sync: SyncState,
-    /// `last` is a time reference (an accepted or starting edge).
+    /// `last` is a time reference (an accepted or starting edge): its capture time, counted on
+    /// past a counter narrower than 32 bits from the last new reference (its low bits are the
+    /// capture's, so intervals masked to the counter are the same).
     has_ref: bool,
     last: u32,
     /// Latest raw edge time while edges are pending (`last` otherwise).
@@ -426,10 +428,13 @@ pub struct SpeedTracker {
     /// Faults since the last frame.
     faults: u8,
     /// The last accepted edges, newest at `pos − 1`, then `pos − 2`, … (`pos` runs on and the
-    /// index is masked; a batch lays them out from the start again): their capture times with a 32-bit counter (a `K`-edge sample is then
-    /// one difference, exact since `K` intervals within the timeout fit in 32 bits), their
-    /// intervals with a narrower one (summed, so a sample may last longer than the counter's
-    /// period). `fill` of them (at most `K`) belong to the current run.
+    /// index is masked; a batch lays them out from the start again): their capture times,
+    /// counted on past a counter narrower than 32 bits (see `last`), so that a `K`-edge sample
+    /// is one difference, exact since `K` intervals within the timeout fit in 32 bits (and may
+    /// last longer than the counter's period). `fill` of them (at most `K`) belong to the
+    /// current run. (One kind of ring for every counter: a ring of intervals for a narrower
+    /// one was a second copy of the fast path in every entry point, 100 bytes in firmware fed
+    /// edge by edge.)
     ring: [u32; MAX_SPAN],
     pos: u32,
     fill: u8,
@@ -753,29 +758,24 @@ impl SpeedTracker {
     /// Brings the careful path's bookkeeping up to date with what the fast path did: the
     /// accepted count, and the previous interval (the ring's newest: fast teeth are ordinary
     /// teeth, so their interval is per base pitch already).
-    #[inline(never)] // careful path: one copy for its callers (code size)
-    fn settle(&mut self, enc: &Encoder) {
+    fn settle(&mut self) {
         if self.tooth != self.anchor {
             self.accepted = self.accepted_now();
             self.anchor = self.tooth;
-            self.prev = self.newest(enc);
+            self.prev = self.newest();
         }
     }
 
     /// The newest interval in the ring (the fast path's last interval).
     #[inline(never)] // careful path: one copy for its callers (code size)
-    fn newest(&self, enc: &Encoder) -> u32 {
+    fn newest(&self) -> u32 {
         let at = |back: u32| {
             self.ring
                 .get(self.pos.wrapping_sub(back) as usize & (MAX_SPAN - 1))
                 .copied()
                 .unwrap_or(0)
         };
-        if enc.ring_times() {
-            at(1).wrapping_sub(at(2))
-        } else {
-            at(1)
-        }
+        at(1).wrapping_sub(at(2))
     }
 
     /// The latest speed sample (the last `K` accepted intervals) while running; `None` before
@@ -803,8 +803,9 @@ impl SpeedTracker {
         })
     }
 
-    /// Whether the teeth are numbered: synced, or confirming a frame candidate.
-    #[inline(always)]
+    /// Whether the teeth are numbered: synced, or confirming a frame candidate. Out of line,
+    /// one copy: inlined, the acceptance's paths were copied for each answer (116 bytes).
+    #[inline(never)]
     fn teeth_known(&self, enc: &Encoder) -> bool {
         self.sync == SyncState::Synced
             || (self.sync == SyncState::Confirming && enc.framing() != Framing::None)
@@ -837,10 +838,9 @@ impl SpeedTracker {
         }
         let t = ticks & enc.mask();
         if usize::from(self.nidx) >= INDEXES {
-            // The oldest waiting index lost its edge: drop it (moved element by element: a
-            // `copy_within` would link the general memmove for four pairs).
-            self.index = [self.index[1], self.index[2], self.index[3], (0, 0)];
-            self.nidx = self.nidx.wrapping_sub(1);
+            // The oldest waiting index lost its edge: drop it (the others kept by the
+            // acceptance's routine: moved here element by element, 22 bytes more code).
+            self.keep_indexes(!1);
             self.counters.missing_frames = self.counters.missing_frames.wrapping_add(1);
         }
         if let Some(slot) = self.index.get_mut(usize::from(self.nidx)) {
@@ -875,7 +875,7 @@ impl SpeedTracker {
         // counter's period: read as a stop, a poll racing a capture interrupt cut the window
         // and lost the sync, and a drive over its δ limit never raised the alarm).
         if elapsed.wrapping_sub(enc.timeout_ticks()).wrapping_sub(1) < enc.poll_interval_ticks() {
-            self.settle(enc);
+            self.settle();
             self.flush(enc, table, sink);
             self.stop_running(now & enc.mask(), sink);
             self.has_ref = false;
@@ -916,36 +916,20 @@ impl SpeedTracker {
         ticks: u32,
         uniform: bool,
     ) -> Option<Tooth> {
-        // One branch on the ring's kind per edge, each kind's path without a select.
-        if enc.ring_times() {
-            self.try_fast_in::<P, true>(enc, table, ticks, uniform)
-        } else {
-            self.try_fast_in::<P, false>(enc, table, ticks, uniform)
-        }
-    }
-
-    #[inline(always)]
-    fn try_fast_in<P: PitchTable, const TIMES: bool>(
-        &mut self,
-        enc: &Encoder,
-        table: &P,
-        ticks: u32,
-        uniform: bool,
-    ) -> Option<Tooth> {
         let mask = enc.mask();
         let t = ticks & mask;
         let dt = t.wrapping_sub(self.last) & mask;
         if self.tooth == self.stop || dt.wrapping_sub(self.lo) > self.width {
             return None;
         }
-        let sum = self.sum;
         // `stop` is at most the tooth before the frame (tooth 0 is always special), so the
         // next tooth does not wrap.
         let tooth = self.tooth.wrapping_add(1);
         self.tooth = tooth;
-        self.last = t;
-        // The ring is full on the fast path: the sample starts K edges back (a time), or the
-        // oldest of the last K intervals leaves the sum.
+        // Counted on past the counter's wraps (see `last`): with a 32-bit counter, `t`.
+        let time = self.last.wrapping_add(dt);
+        self.last = time;
+        // The ring is full on the fast path: the sample starts K edges back.
         let k = enc.samples_span();
         let pos = self.pos;
         let oldest = self
@@ -954,12 +938,10 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = if TIMES { t } else { dt };
+            *slot = time;
         }
-        let pos = pos.wrapping_add(1);
-        self.pos = pos;
-        let end = if TIMES { t } else { sum.wrapping_add(dt) };
-        let ticks = end.wrapping_sub(oldest);
+        self.pos = pos.wrapping_add(1);
+        let ticks = time.wrapping_sub(oldest);
         self.sum = ticks;
         if tooth & (BAND_REFRESH - 1) == 0 {
             self.refresh_band(enc);
@@ -1084,7 +1066,7 @@ impl SpeedTracker {
             // An unconfigured monitor ignores everything.
             return;
         }
-        self.settle(enc);
+        self.settle();
         self.arrivals = self.arrivals.wrapping_add(1);
         // With the fast path open, an ordinary edge comes here only from outside its band.
         let open = self.stop != self.tooth;
@@ -1258,7 +1240,6 @@ impl SpeedTracker {
     /// `lost` teeth before it: the interval over all their pitches, as the judgement took it
     /// (over the tooth's own pitch alone, the next edge would be judged against an interval
     /// `lost + 1` pitches long, and after a wheel's gap taken for a glitch).
-    #[inline(never)] // careful path: one copy for its callers (code size)
     fn per_base_over(&self, enc: &Encoder, lost: u16) -> u32 {
         if enc.is_uniform() {
             // Every pitch the base (always so without pattern wheels: no other division).
@@ -1690,7 +1671,6 @@ impl SpeedTracker {
     }
 
     /// Whether `tooth` needs the careful judgement when it comes next.
-    #[inline(never)] // careful path: one copy for its callers (code size)
     fn is_special(&self, enc: &Encoder, tooth: u16) -> bool {
         tooth == 0
             || (enc.framing() == Framing::Pattern
@@ -1855,7 +1835,7 @@ impl SpeedTracker {
     }
 
     /// The waiting index timestamps as bits (`nidx` ≤ INDEXES ≤ 8: within the byte).
-    #[inline(always)]
+    #[inline(never)] // one copy: less code than inlined (8 bytes)
     fn waiting(&self) -> u8 {
         1u8.wrapping_shl(u32::from(self.nidx)).wrapping_sub(1)
     }
@@ -2110,7 +2090,7 @@ impl SpeedTracker {
         // The ring: the sample ends here. An interval across a fault, unexplained, or taken
         // unjudged before the sync is no sample.
         let sample = if vouched {
-            self.push(enc, table, tooth, t, dt)
+            self.push(enc, table, tooth, dt)
         } else {
             self.reset_ring();
             None
@@ -2143,7 +2123,8 @@ impl SpeedTracker {
         if had_ref {
             self.prev = per_base;
         }
-        self.last = t;
+        // Counted on past the counter's wraps (see `last`): with a 32-bit counter, `t`.
+        self.last = self.last.wrapping_add(dt);
         self.accepted = self.accepted.wrapping_add(1);
         self.anchor = tooth;
         sink.tooth(&Tooth {
@@ -2689,6 +2670,7 @@ impl SpeedTracker {
 
     /// An owed frame's index did not come by the edge after it, or no edge follows it (a stop,
     /// a reversal).
+    #[inline(never)] // careful path: one copy for its callers (code size)
     fn settle_owed<S: EdgeSink>(&mut self, t: u32, sink: &mut S) {
         if core::mem::replace(&mut self.owed, false) {
             self.missing_frame(t, sink);
@@ -2731,23 +2713,24 @@ impl SpeedTracker {
 
     /// Pushes the interval `dt` ending at `tooth` into the ring; the sample of the last `K`
     /// intervals once there are `K`.
+    #[inline(never)] // careful path: its own routine is less code than inlined (62 bytes)
     fn push<P: PitchTable>(
         &mut self,
         enc: &Encoder,
         table: &P,
         tooth: u16,
-        t: u32,
         dt: u32,
     ) -> Option<Sample> {
         let k = enc.samples_span();
-        let times = enc.ring_times();
-        if times && self.fill == 0 {
+        if self.fill == 0 {
             // A run of times starts with the first interval's start.
             if let Some(slot) = self.ring.get_mut(self.pos as usize & (MAX_SPAN - 1)) {
                 *slot = self.last;
             }
             self.pos = self.pos.wrapping_add(1);
         }
+        // Counted on past the counter's wraps (see `last`).
+        let time = self.last.wrapping_add(dt);
         let pos = self.pos;
         let oldest = self
             .ring
@@ -2755,18 +2738,12 @@ impl SpeedTracker {
             .copied()
             .unwrap_or(0);
         if let Some(slot) = self.ring.get_mut(pos as usize & (MAX_SPAN - 1)) {
-            *slot = if times { t } else { dt };
+            *slot = time;
         }
-        let pos = pos.wrapping_add(1);
-        self.pos = pos;
+        self.pos = pos.wrapping_add(1);
         let uniform = enc.is_uniform() && P::NOMINAL;
         let refresh = tooth & (BAND_REFRESH - 1) == 0;
         if u16::from(self.fill) >= k {
-            self.sum = if times {
-                t.wrapping_sub(oldest)
-            } else {
-                self.sum.wrapping_add(dt).wrapping_sub(oldest)
-            };
             if !uniform {
                 let out = tooth_back(tooth, k, enc.edges());
                 self.span = self
@@ -2776,18 +2753,16 @@ impl SpeedTracker {
             }
         } else {
             self.fill = self.fill.saturating_add(1);
-            self.sum = self.sum.wrapping_add(dt);
             if !uniform {
                 self.span = self.span.wrapping_add(self.pitch(enc, table, tooth));
             }
             if u16::from(self.fill) < k {
                 return None;
             }
-            if times {
-                // K intervals now: the sample starts at the run's first time.
-                self.sum = t.wrapping_sub(oldest);
-            }
         }
+        // The sample starts K times back (at the run's first time when K intervals have just
+        // been reached).
+        self.sum = time.wrapping_sub(oldest);
         if refresh {
             self.refresh_band(enc);
         }
@@ -2804,14 +2779,14 @@ impl SpeedTracker {
     /// samples are folded into `extremes` (slowest and fastest, as tick counts of samples of
     /// equal span). The first capture it stops at (outside the band, or a special tooth next)
     /// is left for the careful path (the fast path declines it), but where the run was cut at
-    /// `bulk_max` (call it again). Identical results: the band test and its refresh points
+    /// `bulk_max` or where the ring's times wrap round its end (call it again). Identical results: the band test and its refresh points
     /// are the fast path's, and the state it leaves is the one the fast path would.
     ///
     /// Per capture: the interval and its band test, the `K`-edge sample as the difference of
     /// two capture times (exact: `K` intervals within the timeout fit in 32 bits), one range
     /// test for the extremes. The capture times before the batch are the ring's last `K`,
-    /// read where they lie (laid out from the ring's start first if they wrap round its end),
-    /// and the ring is written once, at the end, by a copy of fixed size. The loop itself is
+    /// read where they lie (where they wrap round its end, the run stops where they do), and
+    /// the ring is written once, at the end, by a copy of fixed size. The loop itself is
     /// [`Run::batch`], out of line so that it keeps its state in registers.
     #[inline(never)]
     pub(crate) fn bulk(
@@ -2824,9 +2799,24 @@ impl SpeedTracker {
             return (0, 0);
         }
         let room = usize::from(self.stop.wrapping_sub(self.tooth));
-        let n = caps.len().min(room).min(enc.bulk_max());
-        let caps = caps.get(..n).unwrap_or(&[]);
         let k = usize::from(enc.samples_span());
+        // The ring's last K times, read in one piece where they lie. Where they wrap round
+        // its end, the run takes only the captures whose samples start before it (fewer than
+        // K): written slot by slot, they bring the last K to the ring's start, where the next
+        // call reads them in one piece. (Laying the ring out first, turned in place, was a
+        // routine of 102 bytes and its call; laying the last K out whenever they were not at
+        // the start, once a revolution, 48 bytes more.)
+        let first = self.pos.wrapping_sub(k as u32) as usize & (MAX_SPAN - 1);
+        let n = caps.len().min(room).min(enc.bulk_max());
+        let mut caps = caps.get(..n).unwrap_or(&[]);
+        let head = match self.ring.get(first..first.wrapping_add(k)) {
+            Some(head) => head,
+            None => {
+                let head = self.ring.get(first..).unwrap_or(&[]);
+                caps = caps.get(..head.len()).unwrap_or(caps);
+                head
+            }
+        };
         // The batch writes the ring back as its last `m` times laid out from its start: `m`
         // is 16 or 32 (at least K), so that is a copy of fixed size (a few block moves).
         let m = if k <= LAID_SHORT {
@@ -2834,16 +2824,6 @@ impl SpeedTracker {
         } else {
             MAX_SPAN
         };
-        // The ring's last K times, read in one piece where they lie unless they wrap round
-        // its end (then laid out from its start first). Laying them out whenever they were
-        // not at the start (once a revolution: the frame takes the careful path) moved 16
-        // times as one block there, 48 bytes more code.
-        let mut first = self.pos.wrapping_sub(k as u32) as usize & (MAX_SPAN - 1);
-        if first.wrapping_add(k) > MAX_SPAN {
-            self.linearize(m);
-            first = m.wrapping_sub(k);
-        }
-        let head = self.ring.get(first..first.wrapping_add(k)).unwrap_or(&[]);
         let last0 = self.last;
         let mut run = Run::new(last0, self.lo, self.width, *extremes);
         // Captures up to and including the next one on a refresh tooth.
@@ -2895,40 +2875,12 @@ impl SpeedTracker {
         (i, u64::from(run.last.wrapping_sub(last0)))
     }
 
-    /// Lays the ring's last `m` times out from its start (newest at `m − 1`), `pos` at `m`,
-    /// when its last K wrap round its end (a batch reads them where they lie otherwise).
-    #[cold]
-    #[inline(never)]
-    fn linearize(&mut self, m: usize) {
-        let first = self.pos.wrapping_sub(m as u32) as usize & (MAX_SPAN - 1);
-        // Wrapped: the whole ring turned left by `first` in place, slot `j` taking slot
-        // `j + first` (masked), one slot a turn, 32 in all: along the cycle through `c`, and
-        // where it closes the held time put back and the next cycle started (`gcd(first,
-        // 32)` cycles). No copy of the ring, whose zeroing and copying would call `memset`
-        // and `memcpy`; one flat loop, not a loop per cycle (code size).
-        let (mut c, mut j) = (0usize, 0usize);
-        let mut held = self.ring.first().copied().unwrap_or(0);
-        for _ in 0..MAX_SPAN {
-            let next = j.wrapping_add(first) & (MAX_SPAN - 1);
-            let (v, to) = if next == c {
-                c = c.wrapping_add(1);
-                let v = core::mem::replace(&mut held, self.ring.get(c).copied().unwrap_or(0));
-                (v, c)
-            } else {
-                (self.ring.get(next).copied().unwrap_or(0), next)
-            };
-            if let Some(d) = self.ring.get_mut(j) {
-                *d = v;
-            }
-            j = to;
-        }
-        self.pos = m as u32;
-    }
-
     /// Sets the band around the mean of the last `K` intervals (when the ring is full; an
     /// empty band otherwise, and near the minimum speed, so nothing but the careful path
     /// takes an edge).
-    #[inline]
+    // Out of line, one copy: the fast path refreshes once every 64 teeth, and inlined there
+    // its registers cost on every edge (on_edge 44.52 instructions, out of line 43.61).
+    #[inline(never)]
     pub(crate) fn refresh_band(&mut self, enc: &Encoder) {
         let (lo, width) = if u16::from(self.fill) >= enc.samples_span() {
             enc.band(self.sum)
