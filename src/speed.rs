@@ -348,6 +348,12 @@ struct Revolution {
     /// from tooth to tooth), learnt over the recent intervals: the edge jitter, as the fit sees
     /// it.
     scatter: Learnt,
+    /// The last glitch and the last missing edge found in sync: the revolution and the tooth
+    /// counted before each (see [`SpeedTracker::fault_repeats`]).
+    last_faults: [Option<(u32, u16)>; 2],
+    /// Which of them (bit 0 the glitch, bit 1 the missing edge) came at the same tooth as a
+    /// revolution before.
+    repeated: u8,
 }
 
 /// A mean learnt from the values met: a running mean over the first `FRAME_MEMORY`, then an
@@ -388,6 +394,8 @@ impl Revolution {
         frames: Learnt::NEW,
         gaps: Learnt::NEW,
         scatter: Learnt::NEW,
+        last_faults: [None; 2],
+        repeated: 0,
     };
 }
 
@@ -716,6 +724,7 @@ impl SpeedTracker {
         (*anchor, *tooth, *stop, *nidx) = (0, 0, 0, 0);
         for f in fit {
             (f.frames, f.gaps, f.scatter) = (Learnt::NEW, Learnt::NEW, Learnt::NEW);
+            (f.last_faults, f.repeated) = ([None; 2], 0);
         }
         counters.clear(z);
     }
@@ -1167,6 +1176,8 @@ impl SpeedTracker {
                 Verdict::Glitch => {
                     self.pop();
                     self.reject(e1, sink);
+                    #[cfg(feature = "pattern-wheels")]
+                    self.fault_repeats(enc, 0);
                     // Merged with the edge after it (ringing just after a tooth, or a pulse
                     // just before one): the edge kept may be either of the pair, its time off
                     // by their spacing, so no sample starts at it either. (A pulse 1 to 16 % of
@@ -1223,6 +1234,10 @@ impl SpeedTracker {
                 continue;
             }
             self.fault_in_revolution();
+            #[cfg(feature = "pattern-wheels")]
+            if lost > 0 {
+                self.fault_repeats(enc, 1);
+            }
             if lost == 0 {
                 self.tooth = tooth_back(self.tooth, 1, enc.edges());
                 self.reset_ring();
@@ -1886,6 +1901,45 @@ impl SpeedTracker {
     fn fault_in_revolution(&mut self) {
         self.faults = self.faults.saturating_add(1);
         if self.faults >= FAULTS_TO_RESYNC && self.sync == SyncState::Synced {
+            self.lose_sync(true);
+        }
+    }
+
+    /// A glitch (`kind` 0) or a missing edge (1) found in sync on a pattern wheel: where both
+    /// came at the same tooth as a revolution before, one after the other, the count is given
+    /// up. A count two teeth off explains the gap with a tooth lost just after it and takes
+    /// the real tooth just before it for a glitch, every revolution: two faults either side
+    /// of the frame, one in each revolution the frame counts, so never the three in one
+    /// revolution that give a count up (after a dip to a tenth of the speed at the gap of a
+    /// 36-1 wheel it stayed so for good, every window invalid).
+    #[cfg(feature = "pattern-wheels")]
+    #[inline(never)] // careful path: one copy for its callers (code size)
+    fn fault_repeats(&mut self, enc: &Encoder, kind: usize) {
+        if self.sync != SyncState::Synced || enc.framing() != Framing::Pattern {
+            return;
+        }
+        let (rev, here) = (self.counters.revolutions, self.tooth);
+        let mut lost = false;
+        for f in &mut self.fit {
+            let bit = 1u8 << kind;
+            let before = f.last_faults.get(kind).copied().flatten();
+            if before == Some((rev.wrapping_sub(1), here)) {
+                f.repeated |= bit;
+            } else {
+                f.repeated &= !bit;
+            }
+            if let Some(slot) = f.last_faults.get_mut(kind) {
+                *slot = Some((rev, here));
+            }
+            // The other fault repeated too, in this revolution or the one before.
+            let other = f.last_faults.get(kind ^ 1).copied().flatten();
+            let recent = other.is_some_and(|(r, _)| rev.wrapping_sub(r) <= 1);
+            if f.repeated == 3 && recent {
+                (f.last_faults, f.repeated) = ([None; 2], 0);
+                lost = true;
+            }
+        }
+        if lost {
             self.lose_sync(true);
         }
     }
