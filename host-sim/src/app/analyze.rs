@@ -1716,7 +1716,7 @@ pub struct NoData {
 /// the other's edges counted between consecutive pulses, the distinct counts tallied (up to
 /// [`SPACINGS`] of them; the rest only counted). The first pulse starts the count.
 #[derive(Debug, Clone, Default)]
-pub struct Spacing {
+struct Spacing {
     since: u64,
     started: bool,
     tally: Vec<(u64, u64)>,
@@ -1728,12 +1728,12 @@ const SPACINGS: usize = 16;
 
 impl Spacing {
     /// An edge of the other channel.
-    pub fn other_edge(&mut self) {
+    fn other_edge(&mut self) {
         self.since += 1;
     }
 
     /// A pulse of this channel.
-    pub fn pulse(&mut self) {
+    fn pulse(&mut self) {
         if self.started {
             let s = self.since;
             let room = self.tally.len() < SPACINGS;
@@ -1750,7 +1750,7 @@ impl Spacing {
     /// The count most spacings share, when at least 2 spacings and 9 in 10 of them lie within
     /// 1 % or one edge of it (a noise pulse adds an edge now and then): `(count, spacings
     /// near it, spacings)`.
-    pub fn regular(&self) -> Option<(u64, u64, u64)> {
+    fn regular(&self) -> Option<(u64, u64, u64)> {
         let total = self.tally.iter().map(|v| v.1).sum::<u64>() + self.untallied;
         let &(every, _) = self.tally.iter().max_by_key(|v| (v.1, v.0))?;
         let near = self

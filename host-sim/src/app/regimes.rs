@@ -296,11 +296,13 @@ pub fn table(
     let bands = capture_bands(machine);
     let captured = |w: f64| bands.iter().any(|c| c.from <= w && w < c.until);
     let regime = |w: f64| {
-        let stable = match criterion_below {
-            Some(c) if w < c => machine.zone_kind_at(w) == ZoneKind::Balancing,
-            _ => map.stable_at(w),
+        let below = criterion_below.is_some_and(|c| w < c);
+        let stable = if below {
+            machine.zone_kind_at(w) == ZoneKind::Balancing
+        } else {
+            map.stable_at(w)
         };
-        if !stable && criterion_below.is_some_and(|c| w < c) {
+        if !stable && below {
             Regime::Gathering
         } else if !stable {
             // Three or more loads can balance at another member of their family.
