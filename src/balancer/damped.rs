@@ -850,10 +850,14 @@ fn find_captures(scaled: &Scaled, solver: &Solver<f64>, m: &mut Machine, opt: &S
             }
             best
         };
+        let until = best.value * w_s;
+        if until <= end * (1.0 + super::MIN_CAPTURE_WIDTH) {
+            continue;
+        }
         if let Some(slot) = m.captures.get_mut(n) {
             *slot = CaptureWindow {
                 from: end,
-                until: best.value * w_s,
+                until,
                 at: if best.w >= at_hi.w { end } else { best.w * w_s },
             };
             n += 1;

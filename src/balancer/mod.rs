@@ -479,8 +479,14 @@ pub struct Zone {
     pub kind: ZoneKind,
 }
 
+/// Narrowest capture window kept, relative to its lower edge: where the maximum of `Ω + D(Ω)`
+/// sits at the zone's end with next to no lag the window is rounding wide (1.8e-13 of 2.2e6
+/// rad/s met on a random machine, printed and tabled as a band), no band a drive could hold.
+pub const MIN_CAPTURE_WIDTH: f64 = 1e-9;
+
 /// Sommerfeld capture window above one gathering zone: loads gathered in that zone can stay
-/// captured (turning at `Ω < ω`) for rotor speeds up to `until`.
+/// captured (turning at `Ω < ω`) for rotor speeds up to `until`, at least
+/// [`MIN_CAPTURE_WIDTH`] above `from` (no window otherwise).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CaptureWindow {

@@ -159,6 +159,9 @@ pub(crate) fn find_captures(sys: &System, m: &mut Machine, opt: &SearchOptions) 
                 best = (x, v);
             }
         }
+        if best.1 <= b * (1.0 + super::MIN_CAPTURE_WIDTH) {
+            continue;
+        }
         if let Some(slot) = m.captures.get_mut(n) {
             *slot = CaptureWindow {
                 from: b,

@@ -523,6 +523,12 @@ pub struct StabilityOut {
     /// D = 0 (absent: nowhere).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drift_treated_as_neutral: Option<crate::engine::vibration::floquet::Unresolved>,
+    /// Where the spectral radius lay within the integration's resolution of 1 (the motion
+    /// grows or decays by less than the resolution a revolution: an undamped one at every speed,
+    /// or a slow crossing of 1 over a band) and the balancing position was taken as stable, a
+    /// boundary there placed at the band's unstable edge (absent: nowhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub neutral_within_resolution: Option<crate::engine::vibration::floquet::Unresolved>,
     /// The scan starts above a quarter of the lowest resonance because a revolution below
     /// would take too many integration steps; below `speed` the regime table follows the
     /// criterion (absent: the scan starts where it would).
@@ -1071,6 +1077,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             criterion: e.comparison.clone(),
             evaluations: e.map.evaluations,
             drift_treated_as_neutral: e.map.unresolved,
+            neutral_within_resolution: e.map.marginal,
             criterion_below: e.criterion_below.clone(),
         });
         let segment = |from: f64, r: drive_monitor::balancer::Regime| SegmentOut {

@@ -18,14 +18,17 @@
 //! nor (3) holds, and says `Bistable(Capture)` where it is stable and (2) holds,
 //! `Bistable(Coexisting)` where it is stable and only (3) holds. Below the scanned range the
 //! class at its lowest speed is kept, above it the class at its highest (the scan reaches
-//! past every characteristic speed and capture window, and is extended until the balancing
-//! position is stable at its top).
+//! past every characteristic speed and capture window up to the fastest speed a scene turns,
+//! [`crate::app::check::MAX_SPEED`], and is extended until the balancing position is stable at
+//! its top or it reaches that speed).
 //!
 //! The scan starts at a quarter of the lowest resonance, or higher where a revolution there
 //! would last more than [`crate::engine::vibration::floquet::REVOLUTION_RATIO`] periods of the machine's fastest motion
 //! ([`crate::engine::vibration::floquet::lowest_speed`]: a machine hung only on its couplings, its rigid-body resonance
 //! near 1e-4 rad/s and its couplings' at 45 rad/s, took over a million integration steps for
-//! one revolution there). Below that speed the table follows the criterion's zones
+//! one revolution there), and higher still where the scan from there would take more than half
+//! its step budget ([`stability_map`]: a lightly damped fast motion takes some 17 steps a
+//! period). Below that speed the table follows the criterion's zones
 //! ([`Exact::criterion_below`], said by `predict`), as the criterion's own table does.
 //!
 //! Where the multiplier of the loads' slow drift along what is a family of balancing
@@ -46,12 +49,13 @@
 use crate::app::predict::value_error;
 use crate::app::run::vibration_params;
 use crate::app::scene::{Scene, SceneError};
-use crate::engine::vibration::floquet::{golden, Floquet, ScanOptions, StabilityMap};
+use crate::engine::vibration::floquet::{golden, Floquet, ScanOptions, StabilityMap, SCAN_STEPS};
 use crate::engine::vibration::VibrationMachine;
 use drive_monitor::balancer::{
     BistableReason, CaptureWindow, Classifier, Machine, Regime, RegimeSegment, RegimeStatus,
     RegimeTable, RegimeTracker, ZoneKind, DEFAULT_MARGIN, TABLE_MARGIN,
 };
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
 
@@ -83,7 +87,9 @@ pub struct Exact {
     /// Three or more loads: the members of their family of balancing positions analysed
     /// beside the equally spaced fan ([`family_members`]); 0 for two loads.
     pub family_members: usize,
-    /// Where each of those members is stable (Floquet, the fan's scan settings).
+    /// Where each of those members is stable (Floquet, the fan's scan settings), scanned over
+    /// the fan's unstable intervals only (elsewhere the table does not ask); empty where the
+    /// fan is stable throughout.
     #[serde(skip)]
     pub family: Vec<StabilityMap>,
     /// Where the scan starts above a quarter of the lowest resonance because a revolution
@@ -207,7 +213,7 @@ pub fn resonance_captures(machine: &Machine) -> Vec<CaptureWindow> {
         })
         .unwrap_or_else(|e| match e {});
         let until = top.max(values[i]);
-        if until.is_finite() && until > r {
+        if until.is_finite() && until > r * (1.0 + drive_monitor::balancer::MIN_CAPTURE_WIDTH) {
             out.push(CaptureWindow {
                 from: r.min(at),
                 until,
@@ -244,7 +250,9 @@ pub fn scan_options(machine: &Machine) -> ScanOptions {
 /// The stability map of `floquet` over [`scan_options`], its top extended (doubled, up to
 /// four times) while the balancing position is still unstable there, and its bottom raised to
 /// [`crate::engine::vibration::floquet::lowest_speed`] where that is higher (returned: the
-/// table follows the criterion below it), its top then at least four times that.
+/// table follows the criterion below it), its top then at least four times that. The top is
+/// never above [`crate::app::check::MAX_SPEED`], the fastest a scene turns, unless the bottom
+/// is within two octaves of it (then four times the bottom).
 pub fn stability_map(
     floquet: &Floquet,
     machine: &Machine,
@@ -254,31 +262,53 @@ pub fn stability_map(
         SceneError::value(file, "autobalancer", e.to_string())
     };
     let mut opts = scan_options(machine);
-    let lowest = floquet.lowest_speed();
+    let mut start = opts.from.max(floquet.lowest_speed());
+    // A scan's steps are spent in its lowest octaves, where a revolution spans the most
+    // periods of the fastest motion and a monodromy's steps fall as 1/ω: the grid's sum is
+    // about 70 times the first one's (48 speeds an octave), half as much again for the
+    // boundaries. A start whose scan would take more than half the budget is raised until it
+    // would not (a lightly damped 620 rad/s coupling took 11 800 steps a revolution at the
+    // start, 0.88 rad/s, and 946 000 for the scan, next to the budget).
+    let first = floquet.revolution_steps(start, opts.rtol).map_err(err)?;
+    let estimate = 105.0 * first as f64;
+    let afford = 0.5 * SCAN_STEPS as f64;
+    if estimate > afford {
+        start *= estimate / afford;
+    }
     let mut below = None;
-    if opts.from < lowest {
+    if opts.from < start {
         let fast = floquet.fastest_motion();
         let set_by = fast.source.to_string();
         // Nothing of the criterion's range can be integrated (a single platform hung on
         // nothing, loads relaxing a million times faster than the rotor turns): two octaves
         // above the lowest speed are, and their class holds beyond.
-        if lowest >= opts.to {
-            opts.to = 4.0 * lowest;
+        if start >= opts.to {
+            opts.to = 4.0 * start;
         }
-        opts.from = lowest;
+        opts.from = start;
         below = Some(CriterionBelow {
-            speed: lowest,
+            speed: start,
             fastest_rate: fast.rate,
             set_by,
         });
     }
+    // No scene turns faster than MAX_SPEED: the scan stops there (a machine resonating at
+    // 1e9 rad/s was scanned to 1e12 and ran out of steps), keeping two octaves above its start.
+    let top = crate::app::check::MAX_SPEED.max(4.0 * opts.from);
+    opts.to = opts.to.min(top);
     let mut map = floquet.map(&opts).map_err(err)?;
     for _ in 0..4 {
-        if map.stable_at(opts.to) {
+        if map.stable_at(opts.to) || opts.to >= top {
             break;
         }
-        opts.to *= 2.0;
-        map = floquet.map(&opts).map_err(err)?;
+        // Only the new octave is scanned; the map below is kept.
+        let upper = ScanOptions {
+            from: opts.to,
+            to: (2.0 * opts.to).min(top),
+            ..opts
+        };
+        map = map.joined(floquet.map(&upper).map_err(err)?);
+        opts.to = upper.to;
     }
     Ok((map, below))
 }
@@ -463,11 +493,34 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
             let err = |e: crate::engine::vibration::floquet::StabilityError| {
                 SceneError::value(file, "autobalancer", e.to_string())
             };
-            let family = family_members(f.angles())
-                .iter()
-                .map(|a| Floquet::with_angles(&vm, a).and_then(|m| m.map(&map.options)))
+            // A member matters only where the fan is unstable (the table asks whether some
+            // member balances there): each is scanned over the fan's unstable intervals alone,
+            // the members side by side.
+            let unstable = map.unstable_within();
+            let members = family_members(f.angles());
+            let family = members
+                .par_iter()
+                .map(|a| {
+                    let member = Floquet::with_angles(&vm, a)?;
+                    let mut joined: Option<StabilityMap> = None;
+                    for &(from, to) in &unstable {
+                        let part = member.map(&ScanOptions {
+                            from,
+                            to,
+                            ..map.options
+                        })?;
+                        joined = Some(match joined {
+                            Some(j) => j.joined(part),
+                            None => part,
+                        });
+                    }
+                    Ok(joined)
+                })
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(err)?;
+                .map_err(err)?
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>();
             let below = criterion_below.as_ref().map(|c| c.speed);
             let segments = table(&map, &family, machine, below);
             let comparison = compare(&map, machine, below);
@@ -475,7 +528,7 @@ pub fn design(scene: &Scene, file: &Path, machine: &Machine) -> Result<Option<De
                 map,
                 segments,
                 comparison,
-                family_members: family.len(),
+                family_members: members.len(),
                 family,
                 criterion_below,
             })
@@ -614,6 +667,7 @@ mod tests {
             steps: 0,
             neutral_drift: 0.0,
             unresolved: None,
+            marginal: None,
         }
     }
 
@@ -849,6 +903,96 @@ mod tests {
     }
 
     #[test]
+    fn the_scan_stops_at_the_fastest_speed_a_scene_turns() {
+        // The one-mass scene on 0.01 N·s/m has a capture window up to 5.8e5 rad/s: the scan
+        // was to run to 1.5 times that, 8.7e5, beyond the 1e5 rad/s any scene can turn (on
+        // wide-range machines to 1e12, out of steps). It ends at MAX_SPEED; the table still
+        // holds the window, and the class at the top holds above.
+        let (mut scene, path) = resolve("one-mass").unwrap();
+        scene.platform[0].damping = 0.01;
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        assert!(scan_options(&m).to > 1.5 * crate::app::check::MAX_SPEED);
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        assert_eq!(e.map.options.to, crate::app::check::MAX_SPEED);
+        assert!(e.map.stable_at(crate::app::check::MAX_SPEED));
+        assert!(
+            e.segments
+                .iter()
+                .any(|s| s.1 == Regime::Bistable(BistableReason::Capture)),
+            "{:?}",
+            e.segments
+        );
+    }
+
+    #[test]
+    fn a_scan_that_would_overrun_its_step_budget_starts_higher() {
+        // A random two-platform machine with a lightly damped 620 rad/s coupling (1e-6 N/m to
+        // the ground, 0.016 N·s/m between): at its lowest integrable speed, 0.62 rad/s, one
+        // revolution takes 16 666 steps (17 a period of the coupling's motion), and its scan
+        // from a quarter of the first resonance took 946 000 of the 1 000 000 allowed (with
+        // four loads, then each of eight family members as much). The start is raised until
+        // the scan is planned within half the budget; the resonance's boundary above it is
+        // still found, and the table follows the criterion below it.
+        let text = "[[platform]]\nmass = 468.5079505439287\nstiffness = 1e-06\n\
+            damping = 0.01699962796691155\n[[platform]]\nmass = 651.9092089485077\n\
+            stiffness = 13840.677296011232\ndamping = 3.4624985415690723\n[[coupling]]\n\
+            between = [1, 2]\nstiffness = 90647809.1705915\ndamping = 0.016411080511131614\n\
+            [autobalancer]\nkind = \"roller\"\nplatform = 1\nloads = 2\n\
+            load_mass = 0.1706145806544954\nradius = 0.11322604842487596\n\
+            housing_mass = 1.7508408049444173\nviscosity = 7.698974235709857\n\
+            rotor_unbalance = 0.00803150789304654\n";
+        let path = std::path::PathBuf::from("fast-coupling.toml");
+        let scene = Scene::parse(text, &path).unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        let d = design(&scene, &path, &m).unwrap().unwrap();
+        let e = d.exact.as_ref().unwrap();
+        let below = e.criterion_below.as_ref().unwrap();
+        let lowest = below.fastest_rate / crate::engine::vibration::floquet::REVOLUTION_RATIO;
+        assert!(
+            below.speed > 2.0 * lowest.max(scan_options(&m).from),
+            "{below:?}"
+        );
+        assert!(e.map.steps < SCAN_STEPS / 2, "{}", e.map.steps);
+        let first = m.resonant_speeds()[0];
+        assert!(below.speed < first, "{below:?} {first}");
+        let b = e.map.boundaries[0];
+        assert!(
+            b.stable_above && (b.speed / first - 1.0).abs() < 0.05,
+            "{b:?} {first}"
+        );
+    }
+
+    #[test]
+    fn a_capture_window_of_rounding_width_is_none() {
+        // A random machine (a stiff 1e-6 kg platform coupled at 1e15 N/m, five loads) had a
+        // capture window of 1.8e-13 of its 2.2e6 rad/s zone end, printed by `predict` and
+        // tabled as a bistable band: the maximum of Ω + D(Ω) at the zone's end with next to
+        // no lag. Every window kept is at least MIN_CAPTURE_WIDTH wide.
+        let text = "[[platform]]\nmass = 1e-06\nstiffness = 457064073.37010396\ndamping = 0.0\n\
+            [[platform]]\nmass = 1253.0104322346122\nstiffness = 0.17676739985650625\n\
+            damping = 291789825.95562595\n[[coupling]]\nbetween = [1, 2]\n\
+            stiffness = 1000000000000000.0\ndamping = 1.2508481097276043e-08\n\
+            [autobalancer]\nkind = \"ball\"\nplatform = 1\nloads = 5\n\
+            load_mass = 0.00041403031666508675\nradius = 1.4794367632932022e-06\n\
+            housing_mass = 243.00665177988233\nviscosity = 1000000000000.0\n";
+        let path = std::path::PathBuf::from("wide.toml");
+        let scene = Scene::parse(text, &path).unwrap();
+        let m = predict::machine(&scene, &path).unwrap().unwrap();
+        let zone_ends: Vec<f64> = m.zones().iter().skip(1).map(|z| z.from).collect();
+        assert!(
+            zone_ends.iter().any(|&z| (z / 2.2142e6 - 1.0).abs() < 1e-4),
+            "{zone_ends:?}"
+        );
+        for w in capture_bands(&m) {
+            assert!(
+                w.until > w.from * (1.0 + drive_monitor::balancer::MIN_CAPTURE_WIDTH),
+                "{w:?}"
+            );
+        }
+    }
+
+    #[test]
     fn platforms_hung_only_on_their_coupling_are_scanned_from_the_lowest_integrable_speed() {
         // The two-mass scene with both platforms at 1e-6 N/m to the ground: a rigid-body
         // resonance near 1e-4 rad/s, where one revolution took over a million integration
@@ -1069,6 +1213,31 @@ mod tests {
         assert_eq!(exact.map.boundaries.len(), 1);
         assert!((exact.map.boundaries[0].speed - 73.1).abs() < 0.05);
         assert_eq!(at(60.0), Some(Regime::Gathering));
+        // The members are scanned only where the fan is unstable: scanned over the fan's whole
+        // range instead (another grid), they give the same table, each cut within the
+        // bisection's 1e-7 bracket (1e-6 allowed).
+        let vm = vibration_machine(&scene, &path).unwrap().unwrap();
+        let fan = Floquet::new(&vm).unwrap();
+        let whole: Vec<StabilityMap> = family_members(fan.angles())
+            .iter()
+            .map(|a| {
+                Floquet::with_angles(&vm, a)
+                    .unwrap()
+                    .map(&exact.map.options)
+                    .unwrap()
+            })
+            .collect();
+        let below = exact.criterion_below.as_ref().map(|c| c.speed);
+        let t = table(&exact.map, &whole, &m, below);
+        assert_eq!(t.len(), exact.segments.len(), "{t:?}");
+        for (a, b) in t.iter().zip(&exact.segments) {
+            assert_eq!(a.1, b.1);
+            assert!(
+                (a.0 - b.0).abs() <= 1e-6 * b.0,
+                "{t:?} {:?}",
+                exact.segments
+            );
+        }
         // The fan is unstable at both speeds; from near it the loads find a stable member at
         // 70 rad/s and gather at 72.
         for (w, want) in [(70.0, "balancing"), (72.0, "gathering")] {

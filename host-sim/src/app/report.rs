@@ -800,11 +800,11 @@ pub fn prediction_text(p: &Prediction) -> String {
                 let _ = writeln!(
                     s,
                     "  the scan starts at {:.4e} rad/s, not a quarter of the lowest resonance: \
-                     below it a revolution lasts more than {} periods of the machine's fastest \
-                     motion ({:.4e} rad/s, set by {}) and takes too many integration steps; the \
-                     regime table follows the criterion below it",
+                     below it a revolution lasts more than {:.0} periods of the machine's fastest \
+                     motion ({:.4e} rad/s, set by {}) and the scan would take too many \
+                     integration steps; the regime table follows the criterion below it",
                     c.speed,
-                    crate::engine::vibration::floquet::REVOLUTION_RATIO,
+                    c.fastest_rate / c.speed,
                     c.fastest_rate,
                     c.set_by
                 );
@@ -822,6 +822,19 @@ pub fn prediction_text(p: &Prediction) -> String {
                     speeds[0],
                     speeds[1],
                     u.largest
+                );
+            }
+            if let Some(u) = &st.neutral_within_resolution {
+                let speeds = fmt_speeds_from(&u.speeds, 2);
+                let _ = writeln!(
+                    s,
+                    "  the spectral radius lies within {:.0e} of 1, the integration's resolution, \
+                     at {} of those speeds ({}–{} rad/s; |ρ − 1| at most {:.1e}): the motion \
+                     there grows or decays by less than that a revolution (an undamped one, such \
+                     as a platform's on `damping = 0`, at every speed; a boundary where ρ crosses \
+                     1 slowly, over a band) and is taken as stable, a boundary in the band placed \
+                     at its unstable edge",
+                    u.resolution, u.evaluations, speeds[0], speeds[1], u.largest
                 );
             }
             let speeds = fmt_speeds_from(

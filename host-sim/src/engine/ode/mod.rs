@@ -340,6 +340,8 @@ pub struct Solver {
     /// Nested dense-output blocks, up to 7 of n.
     nested: Vec<f64>,
     dense: DenseOutput,
+    /// Whether each accepted step forms its dense output ([`Solver::without_dense_output`]).
+    dense_wanted: bool,
     stats: SolverStats,
 }
 
@@ -385,8 +387,18 @@ impl Solver {
             fnew: vec![0.0; n],
             nested: vec![0.0; MAX_DENSE_DEGREE * n],
             dense: DenseOutput::new(n),
+            dense_wanted: true,
             stats: SolverStats::default(),
         }
+    }
+
+    /// The same solver forming no dense output: for a caller that needs only the state at the
+    /// end of its steps (a monodromy matrix), DOP853's three extra stages a step and the
+    /// polynomial's coefficients are saved; the steps and states are the same bit for bit.
+    /// [`Solver::dense`] then stays as it was built.
+    pub fn without_dense_output(mut self) -> Self {
+        self.dense_wanted = false;
+        self
     }
 
     /// Sets the initial condition (keeps the counters). `y0.len()` must equal the dimension.
@@ -478,8 +490,10 @@ impl Solver {
             return Err(OdeError::NonFinite { t });
         }
         self.eval(sys, t + h, Buf::FNew, 0);
-        self.hermite_blocks(h);
-        self.set_dense(t, h, 3);
+        if self.dense_wanted {
+            self.hermite_blocks(h);
+            self.set_dense(t, h, 3);
+        }
         self.accept(t + h);
         Ok(())
     }
@@ -618,6 +632,7 @@ impl Solver {
         self.last_rejected = false;
         // FSAL: fnew = f(t + h, ynew) was computed by the attempt.
         match tab {
+            _ if !self.dense_wanted => {}
             Tableau::Dp5 => self.dense_dp5(t, h),
             Tableau::Dp853 => self.dense_dp853(sys, t, h),
         }

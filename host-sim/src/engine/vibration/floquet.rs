@@ -45,7 +45,8 @@
 //! triangular with the identity on `V`, so the remaining multipliers are exactly the
 //! eigenvalues of `Wᵀ·Φ(T)·W`. The balancing position is **stable** when all of them lie
 //! strictly inside the unit circle, **unstable** when one lies outside (a slow drift's
-//! multiplier within the integration's resolution of 1 set aside first: next section). [`Multipliers`] reports
+//! multiplier within the integration's resolution of 1 set aside first, and a spectral radius
+//! within it taken as neutral: next sections). [`Multipliers`] reports
 //! how far `Φ(T)·V` is from `V` (integration error) as a check.
 //!
 //! # The slow drift: a multiplier within the integration's resolution of 1
@@ -74,8 +75,25 @@
 //! because `c(ω)` depends on the machine and on the speed (it crosses zero), so no one
 //! threshold on `D` separates resolved from unresolved; away from such speeds, and for
 //! ordinary unbalances, the drift multiplier is far outside the resolution and nothing is set
-//! aside. Any other multiplier comes within the resolution of 1 only at a boundary, where
-//! the sign is immaterial to the bracket; it is never set aside.
+//! aside.
+//!
+//! # An undamped motion: the spectral radius within the resolution of 1
+//!
+//! On a damped machine any other multiplier comes within the resolution of 1 only at a
+//! boundary, in a sliver of speeds (`rtol` over the slope of `ln ρ`) where the sign is
+//! immaterial to the bracket. Without damping it need not: a platform on no damping and
+//! next to no stiffness keeps a pair of multipliers on the unit circle to rounding (`|ρ| − 1`
+//! about `±1e-14` at every speed, measured on the one-mass machine at 1e-6 N/m), and an
+//! undamped platform on its springs lets `ln ρ` fall towards 0 as the speed grows (`4e-11` at
+//! 1600 rad/s on the one-mass machine at 1e5 N/m). There the sign of `ln ρ` is the
+//! integration's error: the scan found hundreds of spurious boundaries and bisected each
+//! until its step budget ran out. By the argument above, a spectral radius within the
+//! resolution of 1 grows or decays by less than `rtol` a revolution; the scan takes the
+//! balancing position there as stable (bounded: loads put at it stay there for any time a
+//! machine runs) and reports where ([`StabilityMap::marginal`], shown by `predict`). A
+//! boundary where `ρ` crosses 1 slowly has such a band too (392.48–392.51 rad/s on the one-mass
+//! machine at 0.01 N·s/m), and is placed at the band's unstable edge: within the band the
+//! integration cannot place it, and the report names the band.
 //!
 //! For `N ≥ 3` the balancing positions form a family and the analysis is of one member: the
 //! equally spaced fan the simulator starts near ([`super::balancing_fan`]), or the angles given
@@ -93,6 +111,7 @@
 use super::{balancing_fan, VibrationMachine, MAX_LOADS, MAX_PLATFORMS};
 use crate::engine::ode::{Integrator, OdeSystem, Solver};
 use nalgebra::{Complex, DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -232,10 +251,16 @@ pub struct StabilityMap {
     /// Where the slow drift's multiplier could not be told from 1 and was set aside as neutral
     /// (module docs); `None` if it never was.
     pub unresolved: Option<Unresolved>,
+    /// Where the spectral radius itself (the slow drift set aside) lay within the resolution of
+    /// 1 and the balancing position was taken as stable: a motion that neither grows nor decays
+    /// by more than the resolution a revolution, such as an undamped platform's (module docs);
+    /// `None` if it never did.
+    pub marginal: Option<Unresolved>,
 }
 
-/// The speeds of a scan at which the slow drift's multiplier lay within the integration's
-/// resolution of 1 and was treated as neutral (as at `D = 0`).
+/// The speeds of a scan at which a multiplier lay within the integration's resolution of 1 and
+/// was treated as neutral: the slow drift's ([`StabilityMap::unresolved`], as at `D = 0`) or the
+/// spectral radius ([`StabilityMap::marginal`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Unresolved {
     /// Monodromy matrices at which it was set aside (of [`StabilityMap::evaluations`]).
@@ -254,6 +279,61 @@ impl StabilityMap {
     pub fn stable_at(&self, speed: f64) -> bool {
         let crossed = self.boundaries.iter().filter(|b| b.speed <= speed).count();
         self.stable_at_from ^ (crossed % 2 == 1)
+    }
+
+    /// This map followed by `upper`, a scan of the same machine and settings from this map's
+    /// top speed up: one map of `[self.from, upper.to]` whose grid is each part's (the top
+    /// speed, evaluated by both, decides the class at the joint). Where `upper` starts higher,
+    /// the gap between is not scanned: the map changes class at `upper`'s start if the two
+    /// differ, and says nothing true inside the gap.
+    pub fn joined(mut self, upper: StabilityMap) -> StabilityMap {
+        debug_assert!(self.options.to <= upper.options.from);
+        if self.stable_at(self.options.to) != upper.stable_at_from {
+            // Joined at a shared speed, not reached: both evaluate it the same way.
+            let w = upper.options.from;
+            self.boundaries.push(Boundary {
+                speed: w,
+                bracket: [w, w],
+                stable_above: upper.stable_at_from,
+                radius: [1.0, 1.0],
+            });
+        }
+        self.boundaries.extend(upper.boundaries);
+        self.options.to = upper.options.to;
+        self.evaluations += upper.evaluations;
+        self.steps += upper.steps;
+        self.neutral_drift = self.neutral_drift.max(upper.neutral_drift);
+        let merge = |a: Option<Unresolved>, b: Option<Unresolved>| match (a, b) {
+            (Some(a), Some(b)) => Some(Unresolved {
+                evaluations: a.evaluations + b.evaluations,
+                speeds: [a.speeds[0].min(b.speeds[0]), a.speeds[1].max(b.speeds[1])],
+                resolution: a.resolution,
+                largest: a.largest.max(b.largest),
+            }),
+            (a, b) => a.or(b),
+        };
+        self.unresolved = merge(self.unresolved, upper.unresolved);
+        self.marginal = merge(self.marginal, upper.marginal);
+        self
+    }
+
+    /// The unstable intervals within the scanned range, `[from, to]` in rad/s (the last one's
+    /// class holds above the scan's top).
+    pub fn unstable_within(&self) -> Vec<(f64, f64)> {
+        let mut out = Vec::new();
+        let mut start = (!self.stable_at_from).then_some(self.options.from);
+        for b in &self.boundaries {
+            if !b.stable_above {
+                start = Some(b.speed);
+            } else if let Some(s) = start.take() {
+                out.push((s, b.speed));
+            }
+        }
+        if let Some(s) = start {
+            out.push((s, self.options.to));
+        }
+        out.retain(|(s, e)| e > s);
+        out
     }
 
     /// The stable intervals `[from, to)` in rad/s (`to = None`: up to the end of the scan and,
@@ -358,7 +438,10 @@ fn eigenvector_alignment(m: &DMatrix<f64>, lambda: f64, target: &DVector<f64>) -
 /// study's random machines takes (`docs/criterion.md` states their largest, `steps` of
 /// [`StabilityMap`]); a machine beyond it (loads that move far faster than the rotor turns)
 /// ran for minutes with nothing said.
-const SCAN_STEPS: u64 = 1_000_000;
+pub const SCAN_STEPS: u64 = 1_000_000;
+
+/// Grid speeds of a scan integrated side by side before the step budget is checked.
+const GRID_CHUNK: usize = 16;
 
 /// What sets a machine's fastest motion ([`Floquet::fastest_motion`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -645,7 +728,7 @@ impl Floquet {
         for k in 0..n {
             y0[k * n + k] = 1.0;
         }
-        let mut solver = Solver::new(&integ, n * n);
+        let mut solver = Solver::new(&integ, n * n).without_dense_output();
         solver.reset(0.0, &y0);
         while solver.t() < TAU {
             solver
@@ -664,6 +747,11 @@ impl Floquet {
         // Column k of Φ(T) is the state at T started from the k-th unit vector.
         let steps = solver.stats().accepted_steps;
         Ok((DMatrix::from_fn(n, n, |i, k| solver.y()[k * n + i]), steps))
+    }
+
+    /// The integration steps one revolution's monodromy matrix takes at `omega` rad/s.
+    pub fn revolution_steps(&self, omega: f64, rtol: f64) -> Result<u64, StabilityError> {
+        self.monodromy_counted(omega, rtol).map(|(_, n)| n)
     }
 
     /// `Wᵀ·Φ·W`: the monodromy matrix with the neutral directions removed (see the module
@@ -794,49 +882,80 @@ impl Floquet {
         let mut drift = 0.0f64;
         let mut steps = 0u64;
         let mut unresolved: Option<Unresolved> = None;
-        let mut eval = |w: f64| -> Result<f64, StabilityError> {
-            let (m, n) = self.multipliers_counted(w, rtol)?;
+        let mut marginal: Option<Unresolved> = None;
+        let res = resolution(rtol);
+        let note = |slot: &mut Option<Unresolved>, w: f64, d: f64| {
+            let u = slot.get_or_insert(Unresolved {
+                evaluations: 0,
+                speeds: [w, w],
+                resolution: res,
+                largest: 0.0,
+            });
+            u.evaluations += 1;
+            u.speeds = [u.speeds[0].min(w), u.speeds[1].max(w)];
+            u.largest = u.largest.max(d.abs());
+        };
+        // ln ρ, or exactly 0 where ρ lies within the resolution of 1 (`stable_ln`).
+        let fast = self.fastest_motion();
+        let mut record = |w: f64, (m, n): (Multipliers, u64)| -> Result<f64, StabilityError> {
             steps += n;
             if steps > SCAN_STEPS {
                 return Err(StabilityError::Numerical {
                     speed: w,
                     message: format!(
-                        "the scan has taken more than {SCAN_STEPS} integration steps (far more \
-                         than any machine of the criterion study, docs/criterion.md): the loads \
-                         move far faster than the rotor turns; check `autobalancer.load_mass` \
-                         against `autobalancer.viscosity` (their relaxation time m/b) and the \
-                         platform masses"
+                        "the scan from {from:.4e} rad/s has taken more than {SCAN_STEPS} \
+                         integration steps over {evaluations} monodromy matrices: a revolution at \
+                         its start spans {:.0} periods of the machine's fastest motion ({:.4e} \
+                         rad/s, set by {})",
+                        fast.rate / from,
+                        fast.rate,
+                        fast.source
                     ),
                 });
             }
             evaluations += 1;
             drift = drift.max(m.neutral_drift);
             if let Some(d) = m.unresolved {
-                let u = unresolved.get_or_insert(Unresolved {
-                    evaluations: 0,
-                    speeds: [w, w],
-                    resolution: resolution(rtol),
-                    largest: 0.0,
-                });
-                u.evaluations += 1;
-                u.speeds = [u.speeds[0].min(w), u.speeds[1].max(w)];
-                u.largest = u.largest.max(d.abs());
+                note(&mut unresolved, w, d);
+            }
+            // An undamped motion keeps ρ within rounding of 1 at every speed (a platform on
+            // no damping), or lets it approach 1 as the speed grows: the sign of ln ρ there is
+            // the integration's error, and deciding from it bisected hundreds of spurious
+            // boundaries until the step budget ran out.
+            if (m.radius - 1.0).abs() <= res {
+                note(&mut marginal, w, m.radius - 1.0);
+                return Ok(0.0);
             }
             Ok(m.radius.ln())
         };
         let count = ((to / from).log2() * per_octave as f64).ceil().max(2.0) as usize;
+        let grid: Vec<f64> = (0..=count)
+            .map(|i| from * (to / from).powf(i as f64 / count as f64))
+            .collect();
         let mut pts: Vec<(f64, f64)> = Vec::with_capacity(count + 1);
-        for i in 0..=count {
-            let w = from * (to / from).powf(i as f64 / count as f64);
-            pts.push((w, eval(w)?));
+        // The grid's monodromies are independent: integrated side by side, a chunk at a time
+        // so the step budget still stops a scan early, and recorded in order (the same map).
+        for chunk in grid.chunks(GRID_CHUNK) {
+            let done: Vec<_> = chunk
+                .par_iter()
+                .map(|&w| self.multipliers_counted(w, rtol))
+                .collect();
+            for (&w, r) in chunk.iter().zip(done) {
+                pts.push((w, record(w, r?)?));
+            }
         }
+        let mut eval = |w: f64| -> Result<f64, StabilityError> {
+            let r = self.multipliers_counted(w, rtol)?;
+            record(w, r)
+        };
         // Local extrema of ln ρ close to 0 between grid speeds: search them for a crossing.
         let mut extra = Vec::new();
         for k in 1..pts.len() - 1 {
             let (g0, g1, g2) = (pts[k - 1].1, pts[k].1, pts[k + 1].1);
-            let same_sign = (g0 < 0.0) == (g1 < 0.0) && (g1 < 0.0) == (g2 < 0.0);
+            let same_sign = stable_ln(g0) == stable_ln(g1) && stable_ln(g1) == stable_ln(g2);
+            // A neutral speed (g1 = 0) is neither: it has nothing nearer 1 to search for.
             let max = g1 >= g0 && g1 >= g2 && g1 < 0.0;
-            let min = g1 <= g0 && g1 <= g2 && g1 >= 0.0;
+            let min = g1 <= g0 && g1 <= g2 && g1 > 0.0;
             if same_sign && (max || min) && g1.abs() < extremum_window {
                 let sign = if max { 1.0 } else { -1.0 };
                 let (w, g) = golden(pts[k - 1].0, pts[k + 1].0, 40, |w| {
@@ -850,15 +969,15 @@ impl Floquet {
         let mut boundaries = Vec::new();
         for pair in pts.windows(2) {
             let ((mut a, ga), (mut b, gb)) = (pair[0], pair[1]);
-            let stable_a = ga < 0.0;
-            if stable_a == (gb < 0.0) {
+            let stable_a = stable_ln(ga);
+            if stable_a == stable_ln(gb) {
                 continue;
             }
             let (mut ra, mut rb) = (ga.exp(), gb.exp());
             while b - a > rel_tol * a {
                 let mid = (a * b).sqrt();
                 let g = eval(mid)?;
-                if (g < 0.0) == stable_a {
+                if stable_ln(g) == stable_a {
                     a = mid;
                     ra = g.exp();
                 } else {
@@ -875,14 +994,21 @@ impl Floquet {
         }
         Ok(StabilityMap {
             options: *opts,
-            stable_at_from: pts[0].1 < 0.0,
+            stable_at_from: stable_ln(pts[0].1),
             boundaries,
             evaluations,
             steps,
             neutral_drift: drift,
             unresolved,
+            marginal,
         })
     }
+}
+
+/// Whether a scan's `ln ρ` is stable: negative, or exactly 0 where the spectral radius lay
+/// within the resolution of 1 ([`StabilityMap::marginal`]).
+fn stable_ln(g: f64) -> bool {
+    g <= 0.0
 }
 
 /// Golden-section search for the maximum of `f` on `[a, b]` (in log-speed), `iters` steps:
@@ -1191,6 +1317,63 @@ mod tests {
                 "{name}: bound {} against {top}",
                 f.rate
             );
+        }
+    }
+
+    #[test]
+    fn an_undamped_platform_is_neutral_within_the_resolution_not_a_budget_error() {
+        // A platform on no damping and next to no stiffness keeps a pair of multipliers on the
+        // unit circle to rounding at every speed (its rigid-body swing): deciding from the
+        // sign of ln ρ there found spurious boundaries until the step budget ran out (the
+        // scene's `predict` failed after 23 s, naming the loads' keys). Taken as neutral: no
+        // boundary, stable, reported at every speed. The same machine with a little damping
+        // (0.01 N·s/m), whose limit it is, is strictly stable there with nothing set aside.
+        let machine = |damping: f64| {
+            let mut p = seed_params();
+            p.platforms[0] = PlatformParams {
+                mass: 100.0,
+                stiffness: 1e-6,
+                damping,
+            };
+            p.balancer.rotor_unbalance = 0.05;
+            VibrationMachine::new(&p).unwrap()
+        };
+        let f = Floquet::new(&machine(0.0)).unwrap();
+        let low = f.lowest_speed();
+        let opts = ScanOptions::new(low, 4.0 * low);
+        let map = f.map(&opts).unwrap();
+        let m = map.marginal.unwrap();
+        assert_eq!(m.evaluations, map.evaluations);
+        assert!(map.boundaries.is_empty() && map.stable_at_from, "{map:?}");
+        let damped = Floquet::new(&machine(0.01)).unwrap().map(&opts).unwrap();
+        assert!(damped.marginal.is_none(), "{:?}", damped.marginal);
+        assert!(damped.boundaries.is_empty() && damped.stable_at_from);
+    }
+
+    #[test]
+    fn a_map_joined_to_its_continuation_is_the_map_of_the_whole_range() {
+        // The regime table's scan is extended an octave at a time by joining; one scan of the
+        // whole range (a different grid) finds the same boundaries, to the bisection's 1e-7
+        // bracket (1e-6 allowed), and the joined map counts both parts' work.
+        let f = Floquet::new(&two_mass()).unwrap();
+        let (a, b, c) = (20.0, 60.0, 160.0);
+        let low = f.map(&ScanOptions::new(a, b)).unwrap();
+        let high = f.map(&ScanOptions::new(b, c)).unwrap();
+        let (n_low, n_high) = (low.evaluations, high.evaluations);
+        let joined = low.joined(high);
+        let whole = f.map(&ScanOptions::new(a, c)).unwrap();
+        assert_eq!(joined.options.to, c);
+        assert_eq!(joined.evaluations, n_low + n_high);
+        assert_eq!(joined.stable_at_from, whole.stable_at_from);
+        assert!(!whole.boundaries.is_empty());
+        assert_eq!(
+            joined.boundaries.len(),
+            whole.boundaries.len(),
+            "{joined:?} {whole:?}"
+        );
+        for (j, w) in joined.boundaries.iter().zip(&whole.boundaries) {
+            assert_eq!(j.stable_above, w.stable_above);
+            assert!((j.speed / w.speed - 1.0).abs() < 1e-6, "{j:?} {w:?}");
         }
     }
 
