@@ -2746,3 +2746,102 @@ fn the_default_index_channel_on_the_encoder_is_said_to_be_the_default() {
         "{e}"
     );
 }
+
+/// A Saleae Logic 1.x digital export (`Time[s], Channel 0, Channel 1`: no space before `[s]`,
+/// one after each comma, fifteen decimals) is read as Saleae's, told from its header or named
+/// with --format saleae, and gives the analysis of the same capture exported by Logic 2, row
+/// per change or row per sample alike; a tab-separated export and a header that is no Saleae
+/// time column are refused, saying what to export.
+#[test]
+fn a_saleae_logic_1_export_is_read_as_logic_2s() {
+    use host_sim::app::analyze::FramingArg;
+    // A 16-line disc with an index, 5 ms a line, 10 revolutions; sampled at 1 MHz.
+    let mut logic2 = String::from("Time [s],Channel 0,Channel 1\n");
+    let mut logic1 = String::from("Time[s], Channel 0, Channel 1\n");
+    let mut per_sample = String::from("Time[s], Channel 0, Channel 1\n");
+    let level = |us: u64| {
+        let line = (us / 2500) % 2;
+        let index = u64::from(us % 80_000 < 2500);
+        (line, index)
+    };
+    let end = 800_000u64;
+    let mut last = None;
+    for us in 0..=end {
+        let l = level(us);
+        if last != Some(l) || us == end {
+            let t = us as f64 * 1e-6;
+            logic2.push_str(&format!("{t:.9},{},{}\n", l.0, l.1));
+            logic1.push_str(&format!("{t:.15}, {}, {}\n", l.0, l.1));
+        }
+        // A row every 10 µs (the levels hold between them).
+        if us % 10 == 0 {
+            per_sample.push_str(&format!("{:.15}, {}, {}\n", us as f64 * 1e-6, l.0, l.1));
+        }
+        last = Some(l);
+    }
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(16),
+        framing: Some(FramingArg::Index),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let read = |text: &str, format: Option<CaptureFormat>| {
+        let mut r = CaptureReader::new(
+            std::io::Cursor::new(text.to_string()),
+            Path::new("l.csv"),
+            format,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(r.format(), CaptureFormat::Saleae);
+        assert_eq!(r.channels(), ["Channel 0", "Channel 1"]);
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let two = read(&logic2, None);
+    assert!(two.valid_windows >= 7, "{}", two.valid_windows);
+    for (text, format) in [
+        (&logic1, None),
+        (&logic1, Some(CaptureFormat::Saleae)),
+        (&per_sample, None),
+    ] {
+        let one = read(text, format);
+        assert_eq!(
+            (
+                one.captured,
+                one.index_pulses,
+                one.accepted,
+                one.valid_windows
+            ),
+            (
+                two.captured,
+                two.index_pulses,
+                two.accepted,
+                two.valid_windows
+            )
+        );
+        let deltas = |r: &AnalyzeReport| r.windows.iter().map(|w| w.delta).collect::<Vec<_>>();
+        assert_eq!(deltas(&one), deltas(&two));
+    }
+    // Tab-separated: the delimiter named.
+    let e = reader_error("Time[s]\tChannel 0\tChannel 1\n0.0\t0\t0\n");
+    assert!(
+        e.starts_with("cap.csv:1:") && e.contains("tab-separated") && e.contains("delimiter"),
+        "{e}"
+    );
+    // Named saleae, a header that is not: refused with both of Saleae's headers.
+    let e = CaptureReader::new(
+        std::io::Cursor::new("Sample, Channel 0\n0, 0\n".to_string()),
+        Path::new("s.csv"),
+        Some(CaptureFormat::Saleae),
+        None,
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        e.contains("`Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` (Logic 1.x)")
+            && e.contains("found `Sample, Channel 0`")
+            && e.contains("export it with time stamps"),
+        "{e}"
+    );
+}

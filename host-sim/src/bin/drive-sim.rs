@@ -49,7 +49,7 @@ enum Command {
         #[arg(long, value_enum, requires = "capture")]
         capture_format: Option<CaptureFormat>,
     },
-    /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV, or a
+    /// Run the core on a recorded capture (Saleae Logic 2 or 1.x, sigrok/PulseView or plain CSV, or a
     /// value change dump):
     /// windows, faults, sync, edges and revolutions counted.
     Analyze {
