@@ -2845,3 +2845,140 @@ fn a_saleae_logic_1_export_is_read_as_logic_2s() {
         "{e}"
     );
 }
+
+/// A file of edge times (one captured edge a row, in seconds: a capture timer's dump), with a
+/// header naming the column or none, is read as the format `times` and gives the analysis of
+/// a logic analyzer's record of the same edges; what it cannot hold is refused: an index, a
+/// direction channel, an edge polarity, a unit other than seconds, whole numbers read as
+/// seconds unless the header says so. `run` does not write it.
+#[test]
+fn a_file_of_edge_times_is_read_as_the_captured_edges() {
+    use host_sim::app::analyze::{Channel, FramingArg, Polarity};
+    // A 12-1 wheel near 52 rad/s with a first-order ripple, 12 revolutions.
+    let pitch = 1e-3;
+    let mut times = Vec::new();
+    for k in 0..12 * 12 {
+        if k % 12 == 11 {
+            continue;
+        }
+        let a = f64::from(k) * std::f64::consts::TAU / 12.0;
+        // The time at angle a: t = a/ω0 + ε sin(a)/ω0.
+        let t = (f64::from(k) + 0.5 * (a.sin() / std::f64::consts::TAU * 12.0) * 0.05) * pitch;
+        times.push((t * 1e6).round() * 1e-6);
+    }
+    let mut saleae = String::from("Time [s],Channel 0\n0.000000000,0\n");
+    for &t in &times {
+        saleae.push_str(&format!("{:.9},1\n{:.9},0\n", t + 1e-4, t + 4e-4));
+    }
+    let listed: String = times.iter().map(|t| format!("{:.6}\n", t + 1e-4)).collect();
+    let analyze_text = |text: String, o: &AnalyzeOptions| {
+        let cfg = configure(o).unwrap();
+        let mut r = text_reader(text, "t.csv", None).unwrap_or_else(|e| panic!("{e}"));
+        let format = r.format();
+        (format, analyze(&mut r, &cfg, &mut |_| {}))
+    };
+    let o = wheel("12-1");
+    let (_, from_levels) = analyze_text(saleae, &o);
+    let from_levels = from_levels.unwrap();
+    assert!(
+        from_levels.valid_windows >= 8,
+        "{}",
+        from_levels.valid_windows
+    );
+    for text in [format!("time_s\n{listed}"), listed.clone()] {
+        let (format, r) = analyze_text(text, &o);
+        let r = r.unwrap();
+        assert_eq!(format, CaptureFormat::Times);
+        assert_eq!(
+            (r.format, r.edge, r.channel.as_str()),
+            ("times", "listed", "time_s")
+        );
+        assert_eq!(
+            (
+                r.captured,
+                r.accepted,
+                r.valid_windows,
+                r.glitches,
+                r.missing
+            ),
+            (
+                from_levels.captured,
+                from_levels.accepted,
+                from_levels.valid_windows,
+                0,
+                0
+            )
+        );
+        for (a, b) in r.windows.iter().zip(&from_levels.windows) {
+            assert_eq!((a.start, a.delta), (b.start, b.delta));
+        }
+        let said = host_sim::app::analyze::text(&r);
+        assert!(
+            said.contains("channel: time_s (edge times: each row a captured edge)"),
+            "{said}"
+        );
+    }
+    // What the file cannot hold.
+    let refused = |o: AnalyzeOptions| {
+        analyze_text(listed.clone(), &o)
+            .1
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let e = refused(AnalyzeOptions {
+        lines: Some(12),
+        framing: Some(FramingArg::Index),
+        ..AnalyzeOptions::default()
+    });
+    assert!(
+        e.contains("no index channel") && e.contains("--framing none"),
+        "{e}"
+    );
+    let e = refused(AnalyzeOptions {
+        direction_channel: Some(Channel::Column(1)),
+        ..wheel("12-1")
+    });
+    assert!(
+        e.starts_with("--direction-channel: a file of edge times"),
+        "{e}"
+    );
+    let e = refused(AnalyzeOptions {
+        edge: Some(Polarity::Rising),
+        ..wheel("12-1")
+    });
+    assert!(
+        e.starts_with("--edge: a file of edge times") && e.contains("leave --edge out"),
+        "{e}"
+    );
+    // Units: named when not seconds; whole numbers only under a header saying seconds.
+    let e = reader_error("time_us\n0.5\n2084.0\n");
+    assert!(
+        e.starts_with("cap.csv:1:") && e.contains("in us") && e.contains("seconds"),
+        "{e}"
+    );
+    let e = reader_error("0\n2084\n4146\n");
+    assert!(
+        e.starts_with("cap.csv:2:") && e.contains("`2084` is a whole number"),
+        "{e}"
+    );
+    let mut r = text_reader("time_s\n0\n2\n4\n".into(), "w.csv", None).unwrap();
+    let mut read = Vec::new();
+    while let Some((t, _)) = r.next_row().unwrap() {
+        read.push(t);
+    }
+    assert_eq!(read, [0.0, 2.0, 4.0]);
+    let e = reader_error("time_s\n0.1\n0.2,1\n");
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("one column"),
+        "{e}"
+    );
+    // `run` writes levels, not edge times.
+    let e = CaptureFormat::for_file(Path::new("x.csv"), Some(CaptureFormat::Times))
+        .err()
+        .unwrap();
+    assert!(
+        e.starts_with("--capture-format times:") && e.contains("saleae, sigrok"),
+        "{e}"
+    );
+}

@@ -24,7 +24,7 @@ use drive_monitor::irregularity::{WindowConfig, WindowReport};
 use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
 use drive_monitor::speed::{Direction, EdgeSink, Fault, SyncState, Tooth};
 
-use crate::app::logic::{CaptureError, CaptureReader, Level};
+use crate::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level};
 use crate::app::run::MAX_LINES;
 
 /// Most windows and faults listed in a report (the counters count them all).
@@ -84,6 +84,8 @@ pub struct AnalyzeConfig {
     pub direction: Option<(Channel, Lead)>,
     /// The edges taken.
     pub edge: Polarity,
+    /// Whether `--edge` was given (a file of edge times has no levels to take it of).
+    pub edge_given: bool,
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
@@ -448,7 +450,8 @@ pub struct AnalyzeReport {
     /// Edges fed without a direction: B changed in the same sample as A (the capture sampled
     /// too slowly to resolve the quadrature) or was unknown (`X`).
     pub direction_unknown: u64,
-    /// The edges taken: `rising` or `falling`.
+    /// The edges taken: `rising` or `falling`; `listed` for a file of edge times (each row
+    /// one captured edge).
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
     pub wheel: String,
@@ -1206,6 +1209,33 @@ pub fn analyze<R: BufRead>(
     let mut monitor: DeltaMonitor<MAX_LINES> = DeltaMonitor::new(enc.clone(), cfg.window, None)
         .map_err(|e| AnalyzeError::Option(format!("the monitor configuration: {e}")))?;
     let channels = reader.channels().to_vec();
+    // A file of edge times: every row is a captured edge of the encoder, and it has nothing
+    // else (no level to take an edge of, no index, no B channel).
+    let times = reader.format() == CaptureFormat::Times;
+    if times {
+        let refused = if cfg.index_channel.is_some() {
+            Some(
+                "a file of edge times holds the encoder's captured edges alone, no index \
+                 channel to frame a revolution by: analyze it as a disc framed by nothing \
+                 (--lines N, --framing none) or a wheel with a gap (--wheel N-M)",
+            )
+        } else if cfg.direction.is_some() {
+            Some(
+                "--direction-channel: a file of edge times has one column, the captured edges, \
+                 and no quadrature B channel to give their direction",
+            )
+        } else if cfg.edge_given {
+            Some(
+                "--edge: a file of edge times lists the edges the capture took, one a row, and \
+                 no levels to take rising or falling edges of: leave --edge out",
+            )
+        } else {
+            None
+        };
+        if let Some(m) = refused {
+            return Err(AnalyzeError::Option(m.to_string()));
+        }
+    }
     let ch = column(&channels, &cfg.channel, "--channel").map_err(AnalyzeError::Option)?;
     let ich = match &cfg.index_channel {
         Some(c) => Some(
@@ -1252,6 +1282,7 @@ pub fn analyze<R: BufRead>(
         direction_channel: dch.map(|(d, _)| channels[d].clone()),
         forward: dch.map(|(_, lead)| lead),
         edge: match cfg.edge {
+            _ if times => "listed",
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
         },
@@ -1304,7 +1335,13 @@ pub fn analyze<R: BufRead>(
     // less than a sample period apart: the rate or the file is wrong.
     let period = reader.sample_rate().map(|r| 1.0 / r);
     let mut previous_time: Option<f64> = None;
-    let prescaler = u32::from(cfg.encoder.prescaler.max(1));
+    // (A file of edge times lists the captures themselves: each is fed, and spans as many
+    // lines as the prescaler says.)
+    let prescaler = if times {
+        1
+    } else {
+        u32::from(cfg.encoder.prescaler.max(1))
+    };
     let mut last_capture: Option<u32> = None;
     let mut prescaled = 0u32;
     // The quadrature count of the encoder and direction channels, and whether the capture
@@ -1352,7 +1389,7 @@ pub fn analyze<R: BufRead>(
             }
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
-        let channel_edge = edge(ch) == Some(cfg.edge);
+        let channel_edge = times || edge(ch) == Some(cfg.edge);
         if channel_edge {
             report.edges += 1;
         }
@@ -2134,9 +2171,13 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     let _ = writeln!(
         s,
-        "channel: {} ({} edges){}{}",
+        "channel: {} ({}){}{}",
         r.channel,
-        r.edge,
+        if r.edge == "listed" {
+            "edge times: each row a captured edge".to_string()
+        } else {
+            format!("{} edges", r.edge)
+        },
         r.index_channel
             .as_ref()
             .map_or(String::new(), |i| format!(", index channel {i}")),
@@ -2271,7 +2312,12 @@ pub fn text(r: &AnalyzeReport) -> String {
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
-        if r.prescaler > 1 {
+        if r.prescaler > 1 && r.edge == "listed" {
+            format!(
+                "{} captured (each {} lines: the input prescaler) and",
+                r.captured, r.prescaler
+            )
+        } else if r.prescaler > 1 {
             format!(
                 "{} on the channel, {} captured (one in {}, the input prescaler) and",
                 r.edges, r.captured, r.prescaler
@@ -2839,6 +2885,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         },
         index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
+        edge_given: o.edge.is_some(),
         warnings,
         framing_default: o.lines.is_some() && o.framing.is_none(),
     })

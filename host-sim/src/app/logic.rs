@@ -70,6 +70,10 @@ pub enum CaptureFormat {
     /// Value change dump (IEEE 1364 VCD: sigrok/PulseView, Saleae Logic 2, HDL simulators);
     /// its one-bit variables are the channels.
     Vcd,
+    /// Edge times: one captured edge of the encoder a row, its time in seconds (a capture
+    /// timer's dump, a time-interval analyser's record); a header naming the column, or none.
+    /// Read by `analyze` only.
+    Times,
 }
 
 impl CaptureFormat {
@@ -80,6 +84,7 @@ impl CaptureFormat {
             CaptureFormat::Sigrok => "sigrok",
             CaptureFormat::Plain => "plain",
             CaptureFormat::Vcd => "vcd",
+            CaptureFormat::Times => "times",
         }
     }
 
@@ -94,6 +99,13 @@ impl CaptureFormat {
             .map(str::to_ascii_lowercase);
         let (vcd, csv) = (ext.as_deref() == Some("vcd"), ext.as_deref() == Some("csv"));
         match given {
+            Some(CaptureFormat::Times) => Err(
+                "--capture-format times: a file of edge times is what a capture timer's dump \
+                 holds, which `analyze` reads; `run --capture` writes what a logic analyzer \
+                 records, the levels of the encoder (and index) channel: give saleae, sigrok, \
+                 plain or vcd"
+                    .to_string(),
+            ),
             None if vcd => Ok(CaptureFormat::Vcd),
             None => Ok(CaptureFormat::Saleae),
             Some(g) if vcd && g != CaptureFormat::Vcd => Err(format!(
@@ -125,6 +137,7 @@ impl CaptureFormat {
                 .iter()
                 .map(|s| s.to_string())
                 .collect(),
+            CaptureFormat::Times => vec!["time_s".to_string()],
         }
     }
 }
@@ -254,6 +267,8 @@ pub struct CaptureReader<R> {
     unterminated: bool,
     /// A value change dump's identifiers, time unit and pending tokens.
     vcd: vcd::Vcd,
+    /// A file of edge times whose header says seconds (a whole number is then a time).
+    times_in_seconds: bool,
 }
 
 /// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
@@ -363,6 +378,7 @@ impl<R: BufRead> CaptureReader<R> {
             origin: None,
             unterminated: false,
             vcd: vcd::Vcd::default(),
+            times_in_seconds: false,
         };
         let first = loop {
             match r.read_line()? {
@@ -387,6 +403,9 @@ impl<R: BufRead> CaptureReader<R> {
             Some(CaptureFormat::Sigrok)
         } else if SALEAE_TIME.contains(&head) {
             Some(CaptureFormat::Saleae)
+        } else if !first.contains(',') {
+            // One column: edge times (a header naming it, or none).
+            Some(CaptureFormat::Times)
         } else if first.starts_with("time_s") {
             Some(CaptureFormat::Plain)
         } else {
@@ -401,8 +420,8 @@ impl<R: BufRead> CaptureReader<R> {
                     "cannot tell the capture format: expected a Saleae export (a header \
                      `Time [s],Channel 0,...` from Logic 2, `Time[s], Channel 0, ...` from Logic \
                      1.x), a sigrok/PulseView export (`;` comment lines, then a header row), a \
-                     value change dump (`$` sections) or a plain `time_s,level` file; name it \
-                     with --format",
+                     value change dump (`$` sections), a plain `time_s,level` file or a file of \
+                     edge times (one column); name it with --format",
                 ))
             }
         };
@@ -421,6 +440,7 @@ impl<R: BufRead> CaptureReader<R> {
             )?,
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
             CaptureFormat::Vcd => r.header_vcd(first)?,
+            CaptureFormat::Times => r.header_times(first)?,
         }
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
@@ -527,6 +547,49 @@ impl<R: BufRead> CaptureReader<R> {
             return Err(self.err_here(&format!("expected {expected}, found `{}`", clip(first))));
         }
         self.channels = f.map(|c| c.trim().to_string()).collect();
+        Ok(())
+    }
+
+    /// A file of edge times: the first line is a time (no header) or names the column. A
+    /// header naming a unit other than seconds is refused, naming the unit; one naming
+    /// seconds lets a row be a whole number.
+    fn header_times(&mut self, first: String) -> Result<(), CaptureError> {
+        let head = first.trim();
+        if head.contains(',') {
+            return Err(self.err_here(&format!(
+                "expected one column of edge times in seconds (a header such as `time_s`, or \
+                 none), found `{}`",
+                clip(head)
+            )));
+        }
+        if decimal_attoseconds(head).is_some() {
+            self.channels = vec!["time_s".to_string()];
+            self.held = Some(first);
+            return Ok(());
+        }
+        let words: Vec<String> = head
+            .split(|c: char| !c.is_alphanumeric())
+            .filter(|w| !w.is_empty())
+            .map(str::to_lowercase)
+            .collect();
+        let other = words.iter().find(|w| {
+            [
+                "ms", "us", "µs", "μs", "ns", "ps", "msec", "usec", "nsec", "millis", "micros",
+                "tick", "ticks", "cycle", "cycles", "count", "counts", "sample", "samples", "min",
+            ]
+            .contains(&w.as_str())
+        });
+        if let Some(unit) = other {
+            return Err(self.err_here(&format!(
+                "one column headed `{}`, in {unit}: a file of edge times is read in seconds; \
+                 convert the times to seconds (headed `time_s`)",
+                clip(head)
+            )));
+        }
+        self.times_in_seconds = words
+            .iter()
+            .any(|w| ["s", "sec", "secs", "second", "seconds"].contains(&w.as_str()));
+        self.channels = vec![head.to_string()];
         Ok(())
     }
 
@@ -646,6 +709,9 @@ impl<R: BufRead> CaptureReader<R> {
                 }
             },
         };
+        if self.format == CaptureFormat::Times {
+            return self.times_row(&line);
+        }
         let n = self.channels.len();
         let timed = !(self.format == CaptureFormat::Sigrok && self.sigrok_time == SigrokTime::None);
         let expected = n + usize::from(timed);
@@ -702,6 +768,42 @@ impl<R: BufRead> CaptureReader<R> {
         }
         self.last_time = time;
         self.rows += 1;
+        Ok(Some((time, &self.levels)))
+    }
+
+    /// A row of a file of edge times: one time, s, of a captured edge (its channel's level
+    /// reads high: every row is an edge).
+    fn times_row(&mut self, line: &str) -> Result<Option<(f64, &[Level])>, CaptureError> {
+        let f = line.trim();
+        if f.contains(',') {
+            return Err(self.err_here(&format!(
+                "expected one field (an edge time in seconds), found {}: a file of edge times \
+                 has one column",
+                f.split(',').count()
+            )));
+        }
+        // A whole number is no time of an edge in seconds but a count: timer ticks, or
+        // microseconds, read a million-fold slow.
+        let whole =
+            !f.contains(['.', 'e', 'E']) && !f.trim_start_matches(['+', '-', '0']).is_empty();
+        if whole && !self.times_in_seconds && decimal_attoseconds(f).is_some() {
+            return Err(self.err_here(&format!(
+                "`{}` is a whole number: an edge time in seconds has decimals (`0.002084`); \
+                 convert timer ticks or microseconds to seconds, or head the column `time_s` \
+                 if these are whole seconds",
+                clip(f)
+            )));
+        }
+        let time = self.time_of(f)?;
+        if time < self.last_time {
+            return Err(self.err_here(&format!(
+                "time {time} s is before the previous row's {} s: rows must be in time order",
+                self.last_time
+            )));
+        }
+        self.last_time = time;
+        self.rows += 1;
+        self.levels[0] = Level::High;
         Ok(Some((time, &self.levels)))
     }
 
@@ -937,6 +1039,13 @@ impl<W: Write> CaptureWriter<W> {
         let names = s.format.channel_names(s.index);
         let mut head = String::new();
         match s.format {
+            // A record of levels is written; edge times are only read (`for_file` refuses them).
+            CaptureFormat::Times => {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "a capture is written as saleae, sigrok, plain or vcd, not as edge times",
+                ))
+            }
             CaptureFormat::Saleae => {
                 head.push_str("Time [s]");
                 for c in &names {
@@ -1105,7 +1214,7 @@ impl<W: Write> CaptureWriter<W> {
             CaptureFormat::Saleae => {
                 let _ = write!(self.line, "{:.9}", n as f64 / rate);
             }
-            CaptureFormat::Plain => {
+            CaptureFormat::Plain | CaptureFormat::Times => {
                 let _ = write!(self.line, "{}", n as f64 / rate);
             }
             CaptureFormat::Sigrok => {
