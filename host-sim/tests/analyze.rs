@@ -377,6 +377,8 @@ fn noise_pulses_are_counted_as_glitches() {
         assert!((f - g).abs() < 3e-6, "{f} {g}");
     }
     assert_eq!((report.missing, report.extra), (0, 0), "{report:?}");
+    // Noise between teeth is no ringing.
+    assert_eq!(report.ringing, None);
     for w in report.windows.iter().filter(|w| w.valid) {
         assert!(
             !glitches.iter().any(|&g| g > w.start && g < w.end),
@@ -2981,4 +2983,77 @@ fn a_file_of_edge_times_is_read_as_the_captured_edges() {
         e.starts_with("--capture-format times:") && e.contains("saleae, sigrok"),
         "{e}"
     );
+}
+
+/// A transition that rings (the level crosses back and again within microseconds of each
+/// rising edge) gives an edge just after every tooth: the core rejects each as a glitch and
+/// every window is invalid. The report says what it is, how long the ringing lasts and what
+/// cures it, where it had only counted the glitches; noise pulses between teeth are not called
+/// ringing.
+#[test]
+fn ringing_at_each_edge_is_said_with_its_length() {
+    // A 60-line disc at 2 ms a line, 8 revolutions, times to 0.1 µs; after a tooth's rise the
+    // level falls after 1 µs to 3 µs and rises again 4 µs to 8 µs after it (by tooth).
+    let capture = |ring_every: u32, noise_every: u32| {
+        let mut rows: Vec<(f64, u8)> = Vec::new();
+        for k in 0..480u32 {
+            let t = f64::from(k) * 2e-3;
+            rows.push((t, 1));
+            // (From the ninth tooth: the core's sync is found on clean teeth.)
+            if ring_every > 0 && k >= 8 && k % ring_every == 0 {
+                let j = f64::from(k % 5);
+                rows.push((t + (1.0 + 0.5 * j) * 1e-6, 0));
+                rows.push((t + (4.0 + j) * 1e-6, 1));
+            }
+            rows.push((t + 1e-3, 0));
+            if noise_every > 0 && k % noise_every == 3 {
+                // A 2 µs noise pulse at 75 % of the tooth's interval.
+                rows.push((t + 1.5e-3, 1));
+                rows.push((t + 1.502e-3, 0));
+            }
+        }
+        let mut text = String::from("Time [s],Channel 0\n0.0000000,0\n");
+        for (t, l) in rows {
+            text.push_str(&format!("{:.7},{l}\n", t + 1e-4));
+        }
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(60),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text, "r.csv", None).unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let every = capture(1, 0);
+    assert_eq!(every.valid_windows, 0);
+    assert!(every.glitches >= 460, "{}", every.glitches);
+    let g = every.ringing.clone().unwrap();
+    assert!(g.edges >= 460 && g.of == every.captured, "{g:?}");
+    // The longest: 8 µs, to the 0.1 µs of the times.
+    assert!((g.longest - 8e-6).abs() < 2e-7, "{g:?}");
+    let said = host_sim::app::analyze::text(&every);
+    assert!(
+        said.contains(&format!(
+            "WARNING: `Channel 0` rings: {} of its {} captured edges came within 8.000e-6 s of \
+             the edge before",
+            g.edges, g.of
+        )) && said.contains("input filter")
+            && said.contains("here more than 8.000e-6 s"),
+        "{said}"
+    );
+    // One tooth in ten rings: said as well.
+    let some = capture(10, 0);
+    assert!(
+        some.ringing
+            .as_ref()
+            .is_some_and(|g| (46..=47).contains(&g.edges)),
+        "{:?}",
+        some.ringing
+    );
+    // Noise pulses between teeth, one tooth in ten: glitches, no ringing.
+    let noise = capture(0, 10);
+    assert!(noise.glitches >= 40, "{}", noise.glitches);
+    assert_eq!(noise.ringing, None);
+    // A clean disc: nothing.
+    assert_eq!(capture(0, 0).ringing, None);
 }

@@ -497,6 +497,11 @@ pub struct AnalyzeReport {
     /// not seen, and the faults there are the capture's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_data: Option<NoData>,
+    /// Edges of the channel read that came just after the edge before, as a transition that
+    /// rings or bounces gives them (the report warns: each is a glitch to the core, and a
+    /// window holding one is invalid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ringing: Option<Ringing>,
     /// The emulated capture's input prescaler: one capture every this many edges.
     pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
@@ -665,7 +670,19 @@ struct Intervals {
     short_middle: bool,
     /// Intervals short against both neighbours and next to no long one: a noise pulse's.
     irregular: u64,
+    /// Intervals short against both neighbours ([`SHORT_RATIO`]), and of them those that
+    /// are a small part of them ([`RING_RATIO`]: an edge just after another, as a ringing
+    /// transition gives), with the longest of those, s.
+    short: u64,
+    ringing: u64,
+    longest_ring: f64,
 }
+
+/// An interval less than this many times the geometric mean of its two neighbours is an edge
+/// just after the one before: a transition that rang or bounced, crossing the threshold again
+/// (a noise pulse between teeth splits an interval at 30–70 %, 0.43 times its neighbours and
+/// more).
+pub const RING_RATIO: f64 = 0.1;
 
 /// An interval less than this many times the geometric mean of its two neighbours, and next
 /// to no long one, is a noise pulse's (a tooth's next to a 3-pitch gap is 0.58 times).
@@ -717,6 +734,13 @@ impl Intervals {
                     self.irregular += 1;
                 }
                 self.short_middle = ratio < SHORT_RATIO && !self.long_before;
+                if ratio < SHORT_RATIO {
+                    self.short += 1;
+                }
+                if ratio < RING_RATIO {
+                    self.ringing += 1;
+                    self.longest_ring = self.longest_ring.max(b);
+                }
                 self.long_before = long;
                 if long {
                     pitches = ratio.round().clamp(1.0, longest);
@@ -1348,6 +1372,7 @@ pub fn analyze<R: BufRead>(
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
+
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
         drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
@@ -1390,6 +1415,7 @@ pub fn analyze<R: BufRead>(
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
         let channel_edge = times || edge(ch) == Some(cfg.edge);
+
         if channel_edge {
             report.edges += 1;
         }
@@ -1564,6 +1590,18 @@ pub fn analyze<R: BufRead>(
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
     intervals.finish();
+    // Ringing: most short intervals are an edge just after another, and they are a
+    // hundredth of the captures or more.
+    if intervals.ringing >= 3
+        && intervals.ringing * 2 >= intervals.short
+        && intervals.ringing * 100 >= report.captured
+    {
+        report.ringing = Some(Ringing {
+            edges: intervals.ringing,
+            of: report.captured,
+            longest: intervals.longest_ring,
+        });
+    }
     // Never synced, or lost again and again and not synced at the end: why, from the capture.
     if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
     {
@@ -1736,6 +1774,20 @@ fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<Stri
          too low",
         read = r.channel,
     ))
+}
+
+/// Edges that came just after the edge before ([`AnalyzeReport::ringing`]): most of the
+/// intervals short against their neighbours are [`RING_RATIO`] of them or less, so the
+/// signal crosses the threshold again at a transition, not a noise pulse between teeth.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Ringing {
+    /// Captures less than [`RING_RATIO`] times their neighbours' geometric mean after the
+    /// capture before.
+    pub edges: u64,
+    /// Captures of the channel read.
+    pub of: u64,
+    /// The longest of those intervals, s: an input filter must hold a level longer.
+    pub longest: f64,
 }
 
 /// Spans without data on the channel read ([`AnalyzeReport::no_data`]).
@@ -2203,6 +2255,22 @@ pub fn text(r: &AnalyzeReport) -> String {
              from {:.6} to {:.6} s: its edges there were not seen, and the missing edges, sync \
              losses and invalid windows there are the capture's, not the encoder's",
             r.channel, n.spans, n.seconds, n.first[0], n.first[1]
+        );
+    }
+    if let Some(g) = &r.ringing {
+        let _ = writeln!(
+            s,
+            "WARNING: `{}` rings: {} of its {} captured edges came within {:.3e} s of the edge \
+             before (a tenth of the intervals beside them or less): the signal crosses the \
+             threshold again at a transition (ringing, or a contact's bounce), and each crossing \
+             is an edge; the core rejects them as glitches, but a window holding a glitch is \
+             invalid. The edges of the other polarity are no cure: a crossing back is one of \
+             them. Filter the crossings out before the edges are timed (analyze takes the edges \
+             as recorded): a Schmitt-trigger input or the sensor's own hysteresis on the line, \
+             or the capture timer's input filter, which takes a level only once it has held \
+             longer than its setting (the example firmware's TIM2 filter, for 47 ns): here more \
+             than {:.3e} s, and the edge it takes is then the ringing's last crossing",
+            r.channel, g.edges, g.of, g.longest, g.longest
         );
     }
     if r.captures_at_one_tick > 0 {
