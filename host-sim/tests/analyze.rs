@@ -3057,3 +3057,86 @@ fn ringing_at_each_edge_is_said_with_its_length() {
     // A clean disc: nothing.
     assert_eq!(capture(0, 0).ringing, None);
 }
+
+/// A channel that pulses once a revolution read as the encoder (a cam or index channel first
+/// in the export, or the two swapped): the core does not sync, and the hint names the busier
+/// channel as the encoder with the options that read it, where it said the capture was too
+/// short (and, with a long revolution, that the shaft had stopped). A capture that is too
+/// short is still said to be.
+#[test]
+fn a_channel_pulsing_once_a_revolution_read_as_the_encoder_names_the_encoder() {
+    use host_sim::app::analyze::{Channel, FramingArg};
+    // A 60-2 wheel on `Channel 1`, 1 ms a pitch, 30 revolutions; `Channel 0` pulses once a
+    // revolution, at the fifth tooth.
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for rev in 0..30u32 {
+        for pos in 0..58u32 {
+            let t = f64::from(rev * 60 + pos) * 1e-3 + 1e-4;
+            let cam = u8::from(pos == 4);
+            text.push_str(&format!("{t:.6},{cam},1\n{:.6},0,0\n", t + 5e-4));
+        }
+    }
+    let causes = |text: &str, o: AnalyzeOptions| {
+        let cfg = configure(&o).unwrap();
+        let mut r = text_reader(text.to_string(), "cam.csv", None).unwrap();
+        let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.sync_acquired, None);
+        report.sync_hint.unwrap().causes
+    };
+    let said = causes(&text, wheel("60-2"));
+    assert!(
+        said[0].contains("`Channel 0`, the channel read, has 30 edges")
+            && said[0].contains("where `Channel 1` has 1740 (30.0 revolutions)")
+            && said[0].contains("pulses once every 58 edges of `Channel 1`")
+            && said[0].ends_with("the encoder is likely `Channel 1`: read it with --channel 1"),
+        "{said:?}"
+    );
+    assert!(
+        said.iter()
+            .all(|c| !c.contains("too short") && !c.contains("stopped")),
+        "{said:?}"
+    );
+    // A 1000-line index disc at 2 µs a line with its channels swapped, framed by the index:
+    // the index channel is the encoder.
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) * 2e-6 + 1e-6;
+        let index = u8::from(k % 1000 == 7);
+        text.push_str(&format!("{t:.7},{index},1\n{:.7},0,0\n", t + 1e-6));
+    }
+    let indexed = AnalyzeOptions {
+        lines: Some(1000),
+        framing: Some(FramingArg::Index),
+        timer_hz: Some(100e6),
+        ..AnalyzeOptions::default()
+    };
+    let said = causes(&text, indexed.clone());
+    assert!(
+        said[0].ends_with(
+            "the encoder is likely `Channel 1`: read it with --channel 1 --index-channel 0"
+        ) && said
+            .iter()
+            .all(|c| !c.contains("too short") && !c.contains("stopped")),
+        "{said:?}"
+    );
+    // Read so, it syncs.
+    let cfg = configure(&AnalyzeOptions {
+        channel: Some(Channel::Column(1)),
+        index_channel: Some(Channel::Column(0)),
+        ..indexed
+    })
+    .unwrap();
+    let mut r = text_reader(text, "swap.csv", None).unwrap();
+    assert!(analyze(&mut r, &cfg, &mut |_| {}).unwrap().valid_windows >= 8);
+    // One revolution of a 60-2 wheel and nothing else: too short.
+    let mut text = String::from("Time [s],Channel 0\n0.000000,0\n");
+    for pos in 0..58u32 {
+        let t = f64::from(pos) * 1e-3 + 1e-4;
+        text.push_str(&format!("{t:.6},1\n{:.6},0\n", t + 5e-4));
+    }
+    let said = causes(&text, wheel("60-2"));
+    assert!(
+        said.iter().any(|c| c.contains("the capture is too short")),
+        "{said:?}"
+    );
+}

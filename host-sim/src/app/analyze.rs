@@ -889,6 +889,7 @@ fn sync_hint(
     runs: &[(u64, u64)],
     intervals: &Intervals,
     timeout: f64,
+    busier: Option<&Busier>,
 ) -> SyncHint {
     use drive_monitor::encoder::{Pattern, Wheel};
     let cfg = enc.config();
@@ -916,7 +917,36 @@ fn sync_hint(
         let recurring: u64 = g.spacings.iter().map(|s| s.times).sum();
         !noisy || recurring * 3 >= g.of * 2
     });
-    if short {
+    // Another channel has the edges the one read lacks: the capture is long enough, and the
+    // long intervals of a channel pulsing among its edges are no stop.
+    if let Some(b) = busier {
+        causes.push(format!(
+            "no sync: `{}`, the channel read, has {} edges ({:.1} revolutions of the configured \
+             wheel, {} edges a revolution), where `{}` has {} ({:.1} revolutions){}: the encoder \
+             is likely `{}`: read it with --channel {}{}",
+            r.channel,
+            r.edges,
+            revolutions_of_edges,
+            per_rev,
+            b.name,
+            b.edges,
+            b.revolutions,
+            match b.pulses_every {
+                Some(e) => format!(
+                    ", and it pulses once every {e} edges of `{}`, as an index or a cam signal \
+                     does (its long intervals are no stop of the shaft)",
+                    b.name
+                ),
+                None => String::new(),
+            },
+            b.name,
+            b.column,
+            match b.index_of {
+                Some(c) => format!(" --index-channel {c}"),
+                None => String::new(),
+            }
+        ));
+    } else if short {
         causes.push(format!(
             "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
              the configured wheel ({} edges a revolution), and acquiring sync takes about 2–3",
@@ -973,7 +1003,8 @@ fn sync_hint(
             None => {}
         }
     }
-    if intervals.beyond > 0 || r.timeouts > 1 {
+    let pulses_among = busier.is_some_and(|b| b.pulses_every.is_some());
+    if (intervals.beyond > 0 || r.timeouts > 1) && !pulses_among {
         causes.push(format!(
             "no sync: the shaft stopped or ran below --min-speed {} rad/s: {} interval(s) \
              between edges longer than the {:.3} s timeout it implies, {} timeout(s); the \
@@ -1602,11 +1633,6 @@ pub fn analyze<R: BufRead>(
             longest: intervals.longest_ring,
         });
     }
-    // Never synced, or lost again and again and not synced at the end: why, from the capture.
-    if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
-    {
-        report.sync_hint = Some(sync_hint(&report, &enc, &runs, &intervals, polls.timeout));
-    }
     // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
     // or time references after a standstill or a reversal.
     report.unjudged_at_end = report
@@ -1667,6 +1693,20 @@ pub fn analyze<R: BufRead>(
     }
     if let Some(w) = read_as_index(&report, ch, &read_among) {
         report.warnings.push(w);
+    }
+    // Never synced, or lost again and again and not synced at the end: why, from the capture
+    // (and from the other channels: the encoder may be another).
+    if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
+    {
+        let busier = busier_channel(&report, &enc, ch, &read_among, dch.map(|(d, _)| d), ich);
+        report.sync_hint = Some(sync_hint(
+            &report,
+            &enc,
+            &runs,
+            &intervals,
+            polls.timeout,
+            busier.as_ref(),
+        ));
     }
     report.speed_trace.shrink_to_fit();
     Ok(report)
@@ -1752,6 +1792,56 @@ fn framing_note(
         s.push_str(&c);
     }
     s
+}
+
+/// Another channel with edges enough for 3 revolutions of the configured wheel and four times
+/// as many as the channel read, which did not sync (`direction`: the B channel, which is not
+/// it; the index channel `index` may be, the two swapped): its column, name and edges (half
+/// its level changes), how many of its edges the channel read pulses once every, when it does
+/// so regularly (as an index, or a cam signal), and whether it is the index channel. The channel read is likely not the encoder then: "too short" and
+/// "stopped" would misname why it did not sync.
+fn busier_channel(
+    r: &AnalyzeReport,
+    enc: &Encoder,
+    ch: usize,
+    among: &[Spacing],
+    direction: Option<usize>,
+    index: Option<usize>,
+) -> Option<Busier> {
+    let per_rev = u64::from(enc.edges().max(1)) * u64::from(enc.config().prescaler.max(1));
+    let (k, c) = r
+        .channel_changes
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != ch && Some(k) != direction)
+        .max_by_key(|&(_, c)| c.changes)?;
+    let edges = c.changes / 2;
+    if edges < 3 * per_rev || edges < 4 * r.edges.max(1) {
+        return None;
+    }
+    Some(Busier {
+        column: k,
+        name: c.name.clone(),
+        edges,
+        revolutions: edges as f64 / per_rev as f64,
+        pulses_every: among
+            .get(k)
+            .and_then(Spacing::regular)
+            .map(|(e, _, _)| e)
+            .filter(|&e| e >= 4),
+        index_of: (Some(k) == index).then_some(ch),
+    })
+}
+
+/// A channel busier than the one read ([`busier_channel`]).
+struct Busier {
+    column: usize,
+    name: String,
+    edges: u64,
+    revolutions: f64,
+    pulses_every: Option<u64>,
+    /// It is the index channel: the channel read (this column) is then the index.
+    index_of: Option<usize>,
 }
 
 /// A WARNING when the channel read pulses once every so many (4 or more) edges of another
