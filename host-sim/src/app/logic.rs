@@ -390,7 +390,8 @@ impl<R: BufRead> CaptureReader<R> {
         let head = first.split(',').next().unwrap_or("").trim();
         // Logic 1.x (and Kingst's software) export tab-separated on request: said, not read as
         // one column.
-        if first.contains('\t') && !first.contains(',') && !first.trim_start().starts_with('$') {
+        let tabbed = first.contains('\t') && !first.contains(',');
+        if tabbed && !first.trim_start().starts_with(['$', ';']) {
             return Err(r.err_here(&format!(
                 "the header `{}` is tab-separated: analyze reads comma-separated files; export \
                  with commas as the delimiter (Saleae Logic 1.x: the export's delimiter option)",
