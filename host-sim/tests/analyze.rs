@@ -2920,6 +2920,22 @@ fn a_file_of_edge_times_is_read_as_the_captured_edges() {
             "{said}"
         );
     }
+    // A uniform disc's times read as a wheel with a gap: the hint names no option the file
+    // refuses.
+    let uniform: String = (0..200)
+        .map(|k| format!("{:.6}\n", f64::from(k) * 1e-3 + 1e-4))
+        .collect();
+    let (_, r) = analyze_text(uniform, &wheel("12-1"));
+    let causes = r.unwrap().sync_hint.unwrap().causes;
+    assert!(
+        causes
+            .iter()
+            .any(|c| c.contains("no gap recurs") && c.contains("a uniform disc (use --lines N)"))
+            && causes
+                .iter()
+                .all(|c| !c.contains("--edge") && !c.contains("--framing")),
+        "{causes:?}"
+    );
     // What the file cannot hold.
     let refused = |o: AnalyzeOptions| {
         analyze_text(listed.clone(), &o)

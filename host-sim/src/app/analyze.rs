@@ -996,9 +996,15 @@ fn sync_hint(
             None if !short && !noisy => causes.push(format!(
                 "no sync: the configured {name} {expected}, but no gap recurs in the capture \
                  ({} interval(s) more than {LONG_RATIO} times their neighbours, at no regular \
-                 count of edges): the wrong channel or edge polarity (--channel, --edge), or a \
-                 uniform disc (use --lines N --framing index|none)",
-                intervals.longs
+                 count of edges): {}",
+                intervals.longs,
+                // A file of edge times has no other channel or polarity to read.
+                if r.edge == "listed" {
+                    "a uniform disc (use --lines N), or times of another wheel's edges"
+                } else {
+                    "the wrong channel or edge polarity (--channel, --edge), or a uniform disc \
+                     (use --lines N --framing index|none)"
+                }
             )),
             None => {}
         }
@@ -2508,7 +2514,9 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         )
     };
-    if r.edges == 0 {
+    if r.edges == 0 && r.edge == "listed" {
+        let _ = writeln!(s, "no edge: the file of edge times lists none");
+    } else if r.edges == 0 {
         let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
     }
     if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
