@@ -377,6 +377,8 @@ fn noise_pulses_are_counted_as_glitches() {
         assert!((f - g).abs() < 3e-6, "{f} {g}");
     }
     assert_eq!((report.missing, report.extra), (0, 0), "{report:?}");
+    // Noise between teeth is no ringing.
+    assert_eq!(report.ringing, None);
     for w in report.windows.iter().filter(|w| w.valid) {
         assert!(
             !glitches.iter().any(|&g| g > w.start && g < w.end),
@@ -2744,5 +2746,413 @@ fn the_default_index_channel_on_the_encoder_is_said_to_be_the_default() {
     assert!(
         e.contains("--index-channel is the encoder channel itself"),
         "{e}"
+    );
+}
+
+/// A Saleae Logic 1.x digital export (`Time[s], Channel 0, Channel 1`: no space before `[s]`,
+/// one after each comma, fifteen decimals) is read as Saleae's, told from its header or named
+/// with --format saleae, and gives the analysis of the same capture exported by Logic 2, row
+/// per change or row per sample alike; a tab-separated export and a header that is no Saleae
+/// time column are refused, saying what to export.
+#[test]
+fn a_saleae_logic_1_export_is_read_as_logic_2s() {
+    use host_sim::app::analyze::FramingArg;
+    // A 16-line disc with an index, 5 ms a line, 10 revolutions; sampled at 1 MHz.
+    let mut logic2 = String::from("Time [s],Channel 0,Channel 1\n");
+    let mut logic1 = String::from("Time[s], Channel 0, Channel 1\n");
+    let mut per_sample = String::from("Time[s], Channel 0, Channel 1\n");
+    let level = |us: u64| {
+        let line = (us / 2500) % 2;
+        let index = u64::from(us % 80_000 < 2500);
+        (line, index)
+    };
+    let end = 800_000u64;
+    let mut last = None;
+    for us in 0..=end {
+        let l = level(us);
+        if last != Some(l) || us == end {
+            let t = us as f64 * 1e-6;
+            logic2.push_str(&format!("{t:.9},{},{}\n", l.0, l.1));
+            logic1.push_str(&format!("{t:.15}, {}, {}\n", l.0, l.1));
+        }
+        // A row every 10 µs (the levels hold between them).
+        if us % 10 == 0 {
+            per_sample.push_str(&format!("{:.15}, {}, {}\n", us as f64 * 1e-6, l.0, l.1));
+        }
+        last = Some(l);
+    }
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(16),
+        framing: Some(FramingArg::Index),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let read = |text: &str, format: Option<CaptureFormat>| {
+        let mut r = CaptureReader::new(
+            std::io::Cursor::new(text.to_string()),
+            Path::new("l.csv"),
+            format,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(r.format(), CaptureFormat::Saleae);
+        assert_eq!(r.channels(), ["Channel 0", "Channel 1"]);
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let two = read(&logic2, None);
+    assert!(two.valid_windows >= 7, "{}", two.valid_windows);
+    for (text, format) in [
+        (&logic1, None),
+        (&logic1, Some(CaptureFormat::Saleae)),
+        (&per_sample, None),
+    ] {
+        let one = read(text, format);
+        assert_eq!(
+            (
+                one.captured,
+                one.index_pulses,
+                one.accepted,
+                one.valid_windows
+            ),
+            (
+                two.captured,
+                two.index_pulses,
+                two.accepted,
+                two.valid_windows
+            )
+        );
+        let deltas = |r: &AnalyzeReport| r.windows.iter().map(|w| w.delta).collect::<Vec<_>>();
+        assert_eq!(deltas(&one), deltas(&two));
+    }
+    // Tab-separated: the delimiter named.
+    let e = reader_error("Time[s]\tChannel 0\tChannel 1\n0.0\t0\t0\n");
+    assert!(
+        e.starts_with("cap.csv:1:") && e.contains("tab-separated") && e.contains("delimiter"),
+        "{e}"
+    );
+    // Named saleae, a header that is not: refused with both of Saleae's headers.
+    let e = CaptureReader::new(
+        std::io::Cursor::new("Sample, Channel 0\n0, 0\n".to_string()),
+        Path::new("s.csv"),
+        Some(CaptureFormat::Saleae),
+        None,
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        e.contains("`Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` (Logic 1.x)")
+            && e.contains("found `Sample, Channel 0`")
+            && e.contains("export it with time stamps"),
+        "{e}"
+    );
+}
+
+/// A file of edge times (one captured edge a row, in seconds: a capture timer's dump), with a
+/// header naming the column or none, is read as the format `times` and gives the analysis of
+/// a logic analyzer's record of the same edges; what it cannot hold is refused: an index, a
+/// direction channel, an edge polarity, a unit other than seconds, whole numbers read as
+/// seconds unless the header says so. `run` does not write it.
+#[test]
+fn a_file_of_edge_times_is_read_as_the_captured_edges() {
+    use host_sim::app::analyze::{Channel, FramingArg, Polarity};
+    // A 12-1 wheel near 52 rad/s with a first-order ripple, 12 revolutions.
+    let pitch = 1e-3;
+    let mut times = Vec::new();
+    for k in 0..12 * 12 {
+        if k % 12 == 11 {
+            continue;
+        }
+        let a = f64::from(k) * std::f64::consts::TAU / 12.0;
+        // The time at angle a: t = a/ω0 + ε sin(a)/ω0.
+        let t = (f64::from(k) + 0.5 * (a.sin() / std::f64::consts::TAU * 12.0) * 0.05) * pitch;
+        times.push((t * 1e6).round() * 1e-6);
+    }
+    let mut saleae = String::from("Time [s],Channel 0\n0.000000000,0\n");
+    for &t in &times {
+        saleae.push_str(&format!("{:.9},1\n{:.9},0\n", t + 1e-4, t + 4e-4));
+    }
+    let listed: String = times.iter().map(|t| format!("{:.6}\n", t + 1e-4)).collect();
+    let analyze_text = |text: String, o: &AnalyzeOptions| {
+        let cfg = configure(o).unwrap();
+        let mut r = text_reader(text, "t.csv", None).unwrap_or_else(|e| panic!("{e}"));
+        let format = r.format();
+        (format, analyze(&mut r, &cfg, &mut |_| {}))
+    };
+    let o = wheel("12-1");
+    let (_, from_levels) = analyze_text(saleae, &o);
+    let from_levels = from_levels.unwrap();
+    assert!(
+        from_levels.valid_windows >= 8,
+        "{}",
+        from_levels.valid_windows
+    );
+    for text in [format!("time_s\n{listed}"), listed.clone()] {
+        let (format, r) = analyze_text(text, &o);
+        let r = r.unwrap();
+        assert_eq!(format, CaptureFormat::Times);
+        assert_eq!(
+            (r.format, r.edge, r.channel.as_str()),
+            ("times", "listed", "time_s")
+        );
+        assert_eq!(
+            (
+                r.captured,
+                r.accepted,
+                r.valid_windows,
+                r.glitches,
+                r.missing
+            ),
+            (
+                from_levels.captured,
+                from_levels.accepted,
+                from_levels.valid_windows,
+                0,
+                0
+            )
+        );
+        for (a, b) in r.windows.iter().zip(&from_levels.windows) {
+            assert_eq!((a.start, a.delta), (b.start, b.delta));
+        }
+        let said = host_sim::app::analyze::text(&r);
+        assert!(
+            said.contains("channel: time_s (edge times: each row a captured edge)"),
+            "{said}"
+        );
+    }
+    // A uniform disc's times read as a wheel with a gap: the hint names no option the file
+    // refuses.
+    let uniform: String = (0..200)
+        .map(|k| format!("{:.6}\n", f64::from(k) * 1e-3 + 1e-4))
+        .collect();
+    let (_, r) = analyze_text(uniform, &wheel("12-1"));
+    let causes = r.unwrap().sync_hint.unwrap().causes;
+    assert!(
+        causes
+            .iter()
+            .any(|c| c.contains("no gap recurs") && c.contains("a uniform disc (use --lines N)"))
+            && causes
+                .iter()
+                .all(|c| !c.contains("--edge") && !c.contains("--framing")),
+        "{causes:?}"
+    );
+    // What the file cannot hold.
+    let refused = |o: AnalyzeOptions| {
+        analyze_text(listed.clone(), &o)
+            .1
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let e = refused(AnalyzeOptions {
+        lines: Some(12),
+        framing: Some(FramingArg::Index),
+        ..AnalyzeOptions::default()
+    });
+    assert!(
+        e.contains("no index channel") && e.contains("--framing none"),
+        "{e}"
+    );
+    let e = refused(AnalyzeOptions {
+        direction_channel: Some(Channel::Column(1)),
+        ..wheel("12-1")
+    });
+    assert!(
+        e.starts_with("--direction-channel: a file of edge times"),
+        "{e}"
+    );
+    let e = refused(AnalyzeOptions {
+        edge: Some(Polarity::Rising),
+        ..wheel("12-1")
+    });
+    assert!(
+        e.starts_with("--edge: a file of edge times") && e.contains("leave --edge out"),
+        "{e}"
+    );
+    // Units: named when not seconds; whole numbers only under a header saying seconds.
+    let e = reader_error("time_us\n0.5\n2084.0\n");
+    assert!(
+        e.starts_with("cap.csv:1:") && e.contains("in us") && e.contains("seconds"),
+        "{e}"
+    );
+    let e = reader_error("0\n2084\n4146\n");
+    assert!(
+        e.starts_with("cap.csv:2:") && e.contains("`2084` is a whole number"),
+        "{e}"
+    );
+    let mut r = text_reader("time_s\n0\n2\n4\n".into(), "w.csv", None).unwrap();
+    let mut read = Vec::new();
+    while let Some((t, _)) = r.next_row().unwrap() {
+        read.push(t);
+    }
+    assert_eq!(read, [0.0, 2.0, 4.0]);
+    let e = reader_error("time_s\n0.1\n0.2,1\n");
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("one column"),
+        "{e}"
+    );
+    // `run` writes levels, not edge times.
+    let e = CaptureFormat::for_file(Path::new("x.csv"), Some(CaptureFormat::Times))
+        .err()
+        .unwrap();
+    assert!(
+        e.starts_with("--capture-format times:") && e.contains("saleae, sigrok"),
+        "{e}"
+    );
+}
+
+/// A transition that rings (the level crosses back and again within microseconds of each
+/// rising edge) gives an edge just after every tooth: the core rejects each as a glitch and
+/// every window is invalid. The report says what it is, how long the ringing lasts and what
+/// cures it, where it had only counted the glitches; noise pulses between teeth are not called
+/// ringing.
+#[test]
+fn ringing_at_each_edge_is_said_with_its_length() {
+    // A 60-line disc at 2 ms a line, 8 revolutions, times to 0.1 µs; after a tooth's rise the
+    // level falls after 1 µs to 3 µs and rises again 4 µs to 8 µs after it (by tooth).
+    let capture = |ring_every: u32, noise_every: u32| {
+        let mut rows: Vec<(f64, u8)> = Vec::new();
+        for k in 0..480u32 {
+            let t = f64::from(k) * 2e-3;
+            rows.push((t, 1));
+            // (From the ninth tooth: the core's sync is found on clean teeth.)
+            if ring_every > 0 && k >= 8 && k % ring_every == 0 {
+                let j = f64::from(k % 5);
+                rows.push((t + (1.0 + 0.5 * j) * 1e-6, 0));
+                rows.push((t + (4.0 + j) * 1e-6, 1));
+            }
+            rows.push((t + 1e-3, 0));
+            if noise_every > 0 && k % noise_every == 3 {
+                // A 2 µs noise pulse at 75 % of the tooth's interval.
+                rows.push((t + 1.5e-3, 1));
+                rows.push((t + 1.502e-3, 0));
+            }
+        }
+        let mut text = String::from("Time [s],Channel 0\n0.0000000,0\n");
+        for (t, l) in rows {
+            text.push_str(&format!("{:.7},{l}\n", t + 1e-4));
+        }
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(60),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text, "r.csv", None).unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let every = capture(1, 0);
+    assert_eq!(every.valid_windows, 0);
+    assert!(every.glitches >= 460, "{}", every.glitches);
+    let g = every.ringing.clone().unwrap();
+    assert!(g.edges >= 460 && g.of == every.captured, "{g:?}");
+    // The longest: 8 µs, to the 0.1 µs of the times.
+    assert!((g.longest - 8e-6).abs() < 2e-7, "{g:?}");
+    let said = host_sim::app::analyze::text(&every);
+    assert!(
+        said.contains(&format!(
+            "WARNING: `Channel 0` rings: {} of its {} captured edges came within 8.000e-6 s of \
+             the edge before",
+            g.edges, g.of
+        )) && said.contains("input filter")
+            && said.contains("here more than 8.000e-6 s"),
+        "{said}"
+    );
+    // One tooth in ten rings: said as well.
+    let some = capture(10, 0);
+    assert!(
+        some.ringing
+            .as_ref()
+            .is_some_and(|g| (46..=47).contains(&g.edges)),
+        "{:?}",
+        some.ringing
+    );
+    // Noise pulses between teeth, one tooth in ten: glitches, no ringing.
+    let noise = capture(0, 10);
+    assert!(noise.glitches >= 40, "{}", noise.glitches);
+    assert_eq!(noise.ringing, None);
+    // A clean disc: nothing.
+    assert_eq!(capture(0, 0).ringing, None);
+}
+
+/// A channel that pulses once a revolution read as the encoder (a cam or index channel first
+/// in the export, or the two swapped): the core does not sync, and the hint names the busier
+/// channel as the encoder with the options that read it, where it said the capture was too
+/// short (and, with a long revolution, that the shaft had stopped). A capture that is too
+/// short is still said to be.
+#[test]
+fn a_channel_pulsing_once_a_revolution_read_as_the_encoder_names_the_encoder() {
+    use host_sim::app::analyze::{Channel, FramingArg};
+    // A 60-2 wheel on `Channel 1`, 1 ms a pitch, 30 revolutions; `Channel 0` pulses once a
+    // revolution, at the fifth tooth.
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for rev in 0..30u32 {
+        for pos in 0..58u32 {
+            let t = f64::from(rev * 60 + pos) * 1e-3 + 1e-4;
+            let cam = u8::from(pos == 4);
+            text.push_str(&format!("{t:.6},{cam},1\n{:.6},0,0\n", t + 5e-4));
+        }
+    }
+    let causes = |text: &str, o: AnalyzeOptions| {
+        let cfg = configure(&o).unwrap();
+        let mut r = text_reader(text.to_string(), "cam.csv", None).unwrap();
+        let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.sync_acquired, None);
+        report.sync_hint.unwrap().causes
+    };
+    let said = causes(&text, wheel("60-2"));
+    assert!(
+        said[0].contains("`Channel 0`, the channel read, has 30 edges")
+            && said[0].contains("where `Channel 1` has 1740 (30.0 revolutions)")
+            && said[0].contains("pulses once every 58 edges of `Channel 1`")
+            && said[0].ends_with("the encoder is likely `Channel 1`: read it with --channel 1"),
+        "{said:?}"
+    );
+    assert!(
+        said.iter()
+            .all(|c| !c.contains("too short") && !c.contains("stopped")),
+        "{said:?}"
+    );
+    // A 1000-line index disc at 2 µs a line with its channels swapped, framed by the index:
+    // the index channel is the encoder.
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) * 2e-6 + 1e-6;
+        let index = u8::from(k % 1000 == 7);
+        text.push_str(&format!("{t:.7},{index},1\n{:.7},0,0\n", t + 1e-6));
+    }
+    let indexed = AnalyzeOptions {
+        lines: Some(1000),
+        framing: Some(FramingArg::Index),
+        timer_hz: Some(100e6),
+        ..AnalyzeOptions::default()
+    };
+    let said = causes(&text, indexed.clone());
+    assert!(
+        said[0].ends_with(
+            "the encoder is likely `Channel 1`: read it with --channel 1 --index-channel 0"
+        ) && said
+            .iter()
+            .all(|c| !c.contains("too short") && !c.contains("stopped")),
+        "{said:?}"
+    );
+    // Read so, it syncs.
+    let cfg = configure(&AnalyzeOptions {
+        channel: Some(Channel::Column(1)),
+        index_channel: Some(Channel::Column(0)),
+        ..indexed
+    })
+    .unwrap();
+    let mut r = text_reader(text, "swap.csv", None).unwrap();
+    assert!(analyze(&mut r, &cfg, &mut |_| {}).unwrap().valid_windows >= 8);
+    // One revolution of a 60-2 wheel and nothing else: too short.
+    let mut text = String::from("Time [s],Channel 0\n0.000000,0\n");
+    for pos in 0..58u32 {
+        let t = f64::from(pos) * 1e-3 + 1e-4;
+        text.push_str(&format!("{t:.6},1\n{:.6},0\n", t + 5e-4));
+    }
+    let said = causes(&text, wheel("60-2"));
+    assert!(
+        said.iter().any(|c| c.contains("the capture is too short")),
+        "{said:?}"
     );
 }

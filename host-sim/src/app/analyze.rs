@@ -24,7 +24,7 @@ use drive_monitor::irregularity::{WindowConfig, WindowReport};
 use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
 use drive_monitor::speed::{Direction, EdgeSink, Fault, SyncState, Tooth};
 
-use crate::app::logic::{CaptureError, CaptureReader, Level};
+use crate::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level};
 use crate::app::run::MAX_LINES;
 
 /// Most windows and faults listed in a report (the counters count them all).
@@ -84,6 +84,8 @@ pub struct AnalyzeConfig {
     pub direction: Option<(Channel, Lead)>,
     /// The edges taken.
     pub edge: Polarity,
+    /// Whether `--edge` was given (a file of edge times has no levels to take it of).
+    pub edge_given: bool,
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
@@ -448,7 +450,8 @@ pub struct AnalyzeReport {
     /// Edges fed without a direction: B changed in the same sample as A (the capture sampled
     /// too slowly to resolve the quadrature) or was unknown (`X`).
     pub direction_unknown: u64,
-    /// The edges taken: `rising` or `falling`.
+    /// The edges taken: `rising` or `falling`; `listed` for a file of edge times (each row
+    /// one captured edge).
     pub edge: &'static str,
     /// The wheel, as the core frames it (e.g. `pattern 36 positions, 34 teeth`).
     pub wheel: String,
@@ -494,6 +497,11 @@ pub struct AnalyzeReport {
     /// not seen, and the faults there are the capture's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub no_data: Option<NoData>,
+    /// Edges of the channel read that came just after the edge before, as a transition that
+    /// rings or bounces gives them (the report warns: each is a glitch to the core, and a
+    /// window holding one is invalid).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ringing: Option<Ringing>,
     /// The emulated capture's input prescaler: one capture every this many edges.
     pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
@@ -662,7 +670,19 @@ struct Intervals {
     short_middle: bool,
     /// Intervals short against both neighbours and next to no long one: a noise pulse's.
     irregular: u64,
+    /// Intervals short against both neighbours ([`SHORT_RATIO`]), and of them those that
+    /// are a small part of them ([`RING_RATIO`]: an edge just after another, as a ringing
+    /// transition gives), with the longest of those, s.
+    short: u64,
+    ringing: u64,
+    longest_ring: f64,
 }
+
+/// An interval less than this many times the geometric mean of its two neighbours is an edge
+/// just after the one before: a transition that rang or bounced, crossing the threshold again
+/// (a noise pulse between teeth splits an interval at 30–70 %, 0.43 times its neighbours and
+/// more).
+pub const RING_RATIO: f64 = 0.1;
 
 /// An interval less than this many times the geometric mean of its two neighbours, and next
 /// to no long one, is a noise pulse's (a tooth's next to a 3-pitch gap is 0.58 times).
@@ -714,6 +734,13 @@ impl Intervals {
                     self.irregular += 1;
                 }
                 self.short_middle = ratio < SHORT_RATIO && !self.long_before;
+                if ratio < SHORT_RATIO {
+                    self.short += 1;
+                }
+                if ratio < RING_RATIO {
+                    self.ringing += 1;
+                    self.longest_ring = self.longest_ring.max(b);
+                }
                 self.long_before = long;
                 if long {
                     pitches = ratio.round().clamp(1.0, longest);
@@ -862,6 +889,7 @@ fn sync_hint(
     runs: &[(u64, u64)],
     intervals: &Intervals,
     timeout: f64,
+    busier: Option<&Busier>,
 ) -> SyncHint {
     use drive_monitor::encoder::{Pattern, Wheel};
     let cfg = enc.config();
@@ -889,7 +917,36 @@ fn sync_hint(
         let recurring: u64 = g.spacings.iter().map(|s| s.times).sum();
         !noisy || recurring * 3 >= g.of * 2
     });
-    if short {
+    // Another channel has the edges the one read lacks: the capture is long enough, and the
+    // long intervals of a channel pulsing among its edges are no stop.
+    if let Some(b) = busier {
+        causes.push(format!(
+            "no sync: `{}`, the channel read, has {} edges ({:.1} revolutions of the configured \
+             wheel, {} edges a revolution), where `{}` has {} ({:.1} revolutions){}: the encoder \
+             is likely `{}`: read it with --channel {}{}",
+            r.channel,
+            r.edges,
+            revolutions_of_edges,
+            per_rev,
+            b.name,
+            b.edges,
+            b.revolutions,
+            match b.pulses_every {
+                Some(e) => format!(
+                    ", and it pulses once every {e} edges of `{}`, as an index or a cam signal \
+                     does (its long intervals are no stop of the shaft)",
+                    b.name
+                ),
+                None => String::new(),
+            },
+            b.name,
+            b.column,
+            match b.index_of {
+                Some(c) => format!(" --index-channel {c}"),
+                None => String::new(),
+            }
+        ));
+    } else if short {
         causes.push(format!(
             "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
              the configured wheel ({} edges a revolution), and acquiring sync takes about 2–3",
@@ -939,14 +996,21 @@ fn sync_hint(
             None if !short && !noisy => causes.push(format!(
                 "no sync: the configured {name} {expected}, but no gap recurs in the capture \
                  ({} interval(s) more than {LONG_RATIO} times their neighbours, at no regular \
-                 count of edges): the wrong channel or edge polarity (--channel, --edge), or a \
-                 uniform disc (use --lines N --framing index|none)",
-                intervals.longs
+                 count of edges): {}",
+                intervals.longs,
+                // A file of edge times has no other channel or polarity to read.
+                if r.edge == "listed" {
+                    "a uniform disc (use --lines N), or times of another wheel's edges"
+                } else {
+                    "the wrong channel or edge polarity (--channel, --edge), or a uniform disc \
+                     (use --lines N --framing index|none)"
+                }
             )),
             None => {}
         }
     }
-    if intervals.beyond > 0 || r.timeouts > 1 {
+    let pulses_among = busier.is_some_and(|b| b.pulses_every.is_some());
+    if (intervals.beyond > 0 || r.timeouts > 1) && !pulses_among {
         causes.push(format!(
             "no sync: the shaft stopped or ran below --min-speed {} rad/s: {} interval(s) \
              between edges longer than the {:.3} s timeout it implies, {} timeout(s); the \
@@ -1206,6 +1270,33 @@ pub fn analyze<R: BufRead>(
     let mut monitor: DeltaMonitor<MAX_LINES> = DeltaMonitor::new(enc.clone(), cfg.window, None)
         .map_err(|e| AnalyzeError::Option(format!("the monitor configuration: {e}")))?;
     let channels = reader.channels().to_vec();
+    // A file of edge times: every row is a captured edge of the encoder, and it has nothing
+    // else (no level to take an edge of, no index, no B channel).
+    let times = reader.format() == CaptureFormat::Times;
+    if times {
+        let refused = if cfg.index_channel.is_some() {
+            Some(
+                "a file of edge times holds the encoder's captured edges alone, no index \
+                 channel to frame a revolution by: analyze it as a disc framed by nothing \
+                 (--lines N, --framing none) or a wheel with a gap (--wheel N-M)",
+            )
+        } else if cfg.direction.is_some() {
+            Some(
+                "--direction-channel: a file of edge times has one column, the captured edges, \
+                 and no quadrature B channel to give their direction",
+            )
+        } else if cfg.edge_given {
+            Some(
+                "--edge: a file of edge times lists the edges the capture took, one a row, and \
+                 no levels to take rising or falling edges of: leave --edge out",
+            )
+        } else {
+            None
+        };
+        if let Some(m) = refused {
+            return Err(AnalyzeError::Option(m.to_string()));
+        }
+    }
     let ch = column(&channels, &cfg.channel, "--channel").map_err(AnalyzeError::Option)?;
     let ich = match &cfg.index_channel {
         Some(c) => Some(
@@ -1252,6 +1343,7 @@ pub fn analyze<R: BufRead>(
         direction_channel: dch.map(|(d, _)| channels[d].clone()),
         forward: dch.map(|(_, lead)| lead),
         edge: match cfg.edge {
+            _ if times => "listed",
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
         },
@@ -1304,13 +1396,20 @@ pub fn analyze<R: BufRead>(
     // less than a sample period apart: the rate or the file is wrong.
     let period = reader.sample_rate().map(|r| 1.0 / r);
     let mut previous_time: Option<f64> = None;
-    let prescaler = u32::from(cfg.encoder.prescaler.max(1));
+    // (A file of edge times lists the captures themselves: each is fed, and spans as many
+    // lines as the prescaler says.)
+    let prescaler = if times {
+        1
+    } else {
+        u32::from(cfg.encoder.prescaler.max(1))
+    };
     let mut last_capture: Option<u32> = None;
     let mut prescaled = 0u32;
     // The quadrature count of the encoder and direction channels, and whether the capture
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
+
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
         drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
@@ -1352,7 +1451,8 @@ pub fn analyze<R: BufRead>(
             }
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
-        let channel_edge = edge(ch) == Some(cfg.edge);
+        let channel_edge = times || edge(ch) == Some(cfg.edge);
+
         if channel_edge {
             report.edges += 1;
         }
@@ -1527,10 +1627,17 @@ pub fn analyze<R: BufRead>(
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
     intervals.finish();
-    // Never synced, or lost again and again and not synced at the end: why, from the capture.
-    if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
+    // Ringing: most short intervals are an edge just after another, and they are a
+    // hundredth of the captures or more.
+    if intervals.ringing >= 3
+        && intervals.ringing * 2 >= intervals.short
+        && intervals.ringing * 100 >= report.captured
     {
-        report.sync_hint = Some(sync_hint(&report, &enc, &runs, &intervals, polls.timeout));
+        report.ringing = Some(Ringing {
+            edges: intervals.ringing,
+            of: report.captured,
+            longest: intervals.longest_ring,
+        });
     }
     // Forward edges fed but neither accepted nor rejected: still waiting for their lookahead,
     // or time references after a standstill or a reversal.
@@ -1592,6 +1699,20 @@ pub fn analyze<R: BufRead>(
     }
     if let Some(w) = read_as_index(&report, ch, &read_among) {
         report.warnings.push(w);
+    }
+    // Never synced, or lost again and again and not synced at the end: why, from the capture
+    // (and from the other channels: the encoder may be another).
+    if report.sync_acquired.is_none() || (report.sync_losses >= 2 && report.sync_state != "synced")
+    {
+        let busier = busier_channel(&report, &enc, ch, &read_among, dch.map(|(d, _)| d), ich);
+        report.sync_hint = Some(sync_hint(
+            &report,
+            &enc,
+            &runs,
+            &intervals,
+            polls.timeout,
+            busier.as_ref(),
+        ));
     }
     report.speed_trace.shrink_to_fit();
     Ok(report)
@@ -1679,6 +1800,56 @@ fn framing_note(
     s
 }
 
+/// Another channel with edges enough for 3 revolutions of the configured wheel and four times
+/// as many as the channel read, which did not sync (`direction`: the B channel, which is not
+/// it; the index channel `index` may be, the two swapped): its column, name and edges (half
+/// its level changes), how many of its edges the channel read pulses once every, when it does
+/// so regularly (as an index, or a cam signal), and whether it is the index channel. The channel read is likely not the encoder then: "too short" and
+/// "stopped" would misname why it did not sync.
+fn busier_channel(
+    r: &AnalyzeReport,
+    enc: &Encoder,
+    ch: usize,
+    among: &[Spacing],
+    direction: Option<usize>,
+    index: Option<usize>,
+) -> Option<Busier> {
+    let per_rev = u64::from(enc.edges().max(1)) * u64::from(enc.config().prescaler.max(1));
+    let (k, c) = r
+        .channel_changes
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != ch && Some(k) != direction)
+        .max_by_key(|&(_, c)| c.changes)?;
+    let edges = c.changes / 2;
+    if edges < 3 * per_rev || edges < 4 * r.edges.max(1) {
+        return None;
+    }
+    Some(Busier {
+        column: k,
+        name: c.name.clone(),
+        edges,
+        revolutions: edges as f64 / per_rev as f64,
+        pulses_every: among
+            .get(k)
+            .and_then(Spacing::regular)
+            .map(|(e, _, _)| e)
+            .filter(|&e| e >= 4),
+        index_of: (Some(k) == index).then_some(ch),
+    })
+}
+
+/// A channel busier than the one read ([`busier_channel`]).
+struct Busier {
+    column: usize,
+    name: String,
+    edges: u64,
+    revolutions: f64,
+    pulses_every: Option<u64>,
+    /// It is the index channel: the channel read (this column) is then the index.
+    index_of: Option<usize>,
+}
+
 /// A WARNING when the channel read pulses once every so many (4 or more) edges of another
 /// channel (`among[k]`, regular as [`Spacing::regular`] says), as an index pulses among an
 /// encoder's lines: the channels are likely the other way round (an index read as a disc of
@@ -1699,6 +1870,20 @@ fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<Stri
          too low",
         read = r.channel,
     ))
+}
+
+/// Edges that came just after the edge before ([`AnalyzeReport::ringing`]): most of the
+/// intervals short against their neighbours are [`RING_RATIO`] of them or less, so the
+/// signal crosses the threshold again at a transition, not a noise pulse between teeth.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Ringing {
+    /// Captures less than [`RING_RATIO`] times their neighbours' geometric mean after the
+    /// capture before.
+    pub edges: u64,
+    /// Captures of the channel read.
+    pub of: u64,
+    /// The longest of those intervals, s: an input filter must hold a level longer.
+    pub longest: f64,
 }
 
 /// Spans without data on the channel read ([`AnalyzeReport::no_data`]).
@@ -2134,9 +2319,13 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     let _ = writeln!(
         s,
-        "channel: {} ({} edges){}{}",
+        "channel: {} ({}){}{}",
         r.channel,
-        r.edge,
+        if r.edge == "listed" {
+            "edge times: each row a captured edge".to_string()
+        } else {
+            format!("{} edges", r.edge)
+        },
         r.index_channel
             .as_ref()
             .map_or(String::new(), |i| format!(", index channel {i}")),
@@ -2162,6 +2351,22 @@ pub fn text(r: &AnalyzeReport) -> String {
              from {:.6} to {:.6} s: its edges there were not seen, and the missing edges, sync \
              losses and invalid windows there are the capture's, not the encoder's",
             r.channel, n.spans, n.seconds, n.first[0], n.first[1]
+        );
+    }
+    if let Some(g) = &r.ringing {
+        let _ = writeln!(
+            s,
+            "WARNING: `{}` rings: {} of its {} captured edges came within {:.3e} s of the edge \
+             before (a tenth of the intervals beside them or less): the signal crosses the \
+             threshold again at a transition (ringing, or a contact's bounce), and each crossing \
+             is an edge; the core rejects them as glitches, but a window holding a glitch is \
+             invalid. The edges of the other polarity are no cure: a crossing back is one of \
+             them. Filter the crossings out before the edges are timed (analyze takes the edges \
+             as recorded): a Schmitt-trigger input or the sensor's own hysteresis on the line, \
+             or the capture timer's input filter, which takes a level only once it has held \
+             longer than its setting (the example firmware's TIM2 filter, for 47 ns): here more \
+             than {:.3e} s, and the edge it takes is then the ringing's last crossing",
+            r.channel, g.edges, g.of, g.longest, g.longest
         );
     }
     if r.captures_at_one_tick > 0 {
@@ -2271,7 +2476,12 @@ pub fn text(r: &AnalyzeReport) -> String {
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
-        if r.prescaler > 1 {
+        if r.prescaler > 1 && r.edge == "listed" {
+            format!(
+                "{} captured (each {} lines: the input prescaler) and",
+                r.captured, r.prescaler
+            )
+        } else if r.prescaler > 1 {
             format!(
                 "{} on the channel, {} captured (one in {}, the input prescaler) and",
                 r.edges, r.captured, r.prescaler
@@ -2304,7 +2514,9 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         )
     };
-    if r.edges == 0 {
+    if r.edges == 0 && r.edge == "listed" {
+        let _ = writeln!(s, "no edge: the file of edge times lists none");
+    } else if r.edges == 0 {
         let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
     }
     if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
@@ -2839,6 +3051,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         },
         index_channel_default: index && o.index_channel.is_none(),
         edge: o.edge.unwrap_or(Polarity::Rising),
+        edge_given: o.edge.is_some(),
         warnings,
         framing_default: o.lines.is_some() && o.framing.is_none(),
     })

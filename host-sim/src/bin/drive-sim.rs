@@ -49,8 +49,8 @@ enum Command {
         #[arg(long, value_enum, requires = "capture")]
         capture_format: Option<CaptureFormat>,
     },
-    /// Run the core on a recorded capture (Saleae Logic 2, sigrok/PulseView or plain CSV, or a
-    /// value change dump):
+    /// Run the core on a recorded capture (Saleae Logic 2 or 1.x, sigrok/PulseView or plain CSV, a
+    /// value change dump, or a file of edge times):
     /// windows, faults, sync, edges and revolutions counted.
     Analyze {
         /// The capture file.
@@ -170,9 +170,10 @@ struct AnalyzeArgs {
     /// to, with the --forward that reads it as forward.
     #[arg(long, value_enum)]
     forward: Option<Lead>,
-    /// The edges the capture unit takes.
-    #[arg(long, value_enum, default_value = "rising")]
-    edge: Polarity,
+    /// The edges the capture unit takes (default rising; not with a file of edge times, whose
+    /// rows are the edges taken).
+    #[arg(long, value_enum)]
+    edge: Option<Polarity>,
     /// A missing-tooth wheel, "N-M" (e.g. 36-2, 60-2, 8-1).
     #[arg(long)]
     wheel: Option<String>,
@@ -233,7 +234,7 @@ impl AnalyzeArgs {
             index_channel: self.index_channel,
             direction_channel: self.direction_channel,
             forward: self.forward,
-            edge: Some(self.edge),
+            edge: self.edge,
         })
     }
 }
