@@ -183,27 +183,34 @@ fn every_numeric_key_of_every_bundled_scene_mutated() {
     // Nine scenes of 8 to 40 numeric keys each, nine mutations per key.
     assert!(all.len() > 700, "{} cases", all.len());
     println!("{} mutated scenes", all.len());
-    let failures: Vec<String> = all
-        .into_par_iter()
-        .filter_map(|case| {
-            let label = format!("{} `{}` = {}", case.scene, case.key, case.mutation);
-            let (tx, rx) = std::sync::mpsc::channel();
-            std::thread::spawn(move || {
-                let r = one(&case);
-                let _ = tx.send(r);
-            });
-            match rx.recv_timeout(HANG) {
-                Ok(Ok(())) => None,
-                Ok(Err(why)) => Some(format!("{label}: {why}")),
-                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
-                    Some(format!("{label}: still running after {HANG:?}"))
+    // The cases wait on their threads from a pool of their own: blocked in the global pool's
+    // workers, they would leave none to the stability scan's own parallel work (a deadlock).
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(std::thread::available_parallelism().map_or(2, |n| n.get()))
+        .build()
+        .unwrap();
+    let failures: Vec<String> = pool.install(|| {
+        all.into_par_iter()
+            .filter_map(|case| {
+                let label = format!("{} `{}` = {}", case.scene, case.key, case.mutation);
+                let (tx, rx) = std::sync::mpsc::channel();
+                std::thread::spawn(move || {
+                    let r = one(&case);
+                    let _ = tx.send(r);
+                });
+                match rx.recv_timeout(HANG) {
+                    Ok(Ok(())) => None,
+                    Ok(Err(why)) => Some(format!("{label}: {why}")),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                        Some(format!("{label}: still running after {HANG:?}"))
+                    }
+                    Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                        Some(format!("{label}: panicked"))
+                    }
                 }
-                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                    Some(format!("{label}: panicked"))
-                }
-            }
-        })
-        .collect();
+            })
+            .collect()
+    });
     assert!(
         failures.is_empty(),
         "{} failures:\n{}",
