@@ -292,8 +292,9 @@ pub fn stability_map(
             set_by,
         });
     }
-    // No scene turns faster than MAX_SPEED: the scan stops there (a machine resonating at
-    // 1e9 rad/s was scanned to 1e12 and ran out of steps), keeping two octaves above its start.
+    // No scene turns faster than MAX_SPEED: the scan stops there (random machines whose
+    // capture windows reach far above it were scanned to 8.5e8 rad/s), keeping two octaves
+    // above its start.
     let top = crate::app::check::MAX_SPEED.max(4.0 * opts.from);
     opts.to = opts.to.min(top);
     let mut map = floquet.map(&opts).map_err(err)?;
@@ -905,8 +906,8 @@ mod tests {
     #[test]
     fn the_scan_stops_at_the_fastest_speed_a_scene_turns() {
         // The one-mass scene on 0.01 N·s/m has a capture window up to 5.8e5 rad/s: the scan
-        // was to run to 1.5 times that, 8.7e5, beyond the 1e5 rad/s any scene can turn (on
-        // wide-range machines to 1e12, out of steps). It ends at MAX_SPEED; the table still
+        // was to run to 1.5 times that, 8.7e5, beyond the 1e5 rad/s any scene can turn (random
+        // machines were scanned to 8.5e8). It ends at MAX_SPEED; the table still
         // holds the window, and the class at the top holds above.
         let (mut scene, path) = resolve("one-mass").unwrap();
         scene.platform[0].damping = 0.01;
