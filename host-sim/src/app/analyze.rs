@@ -576,6 +576,13 @@ pub struct AnalyzeReport {
     pub speed_trace: Vec<(f64, f64)>,
 }
 
+impl AnalyzeReport {
+    /// The capture is a file of edge times: each row a captured edge (`edge` is `listed`).
+    pub fn edges_listed(&self) -> bool {
+        self.edge == "listed"
+    }
+}
+
 /// Why the core did not sync, from the capture: each cause the evidence shows, in words, and
 /// the evidence.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -999,7 +1006,7 @@ fn sync_hint(
                  count of edges): {}",
                 intervals.longs,
                 // A file of edge times has no other channel or polarity to read.
-                if r.edge == "listed" {
+                if r.edges_listed() {
                     "a uniform disc (use --lines N), or times of another wheel's edges"
                 } else {
                     "the wrong channel or edge polarity (--channel, --edge), or a uniform disc \
@@ -1409,7 +1416,6 @@ pub fn analyze<R: BufRead>(
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
-
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
         drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
@@ -1452,7 +1458,6 @@ pub fn analyze<R: BufRead>(
         };
         let index_edge = ich.and_then(edge) == Some(cfg.edge);
         let channel_edge = times || edge(ch) == Some(cfg.edge);
-
         if channel_edge {
             report.edges += 1;
         }
@@ -2321,7 +2326,7 @@ pub fn text(r: &AnalyzeReport) -> String {
         s,
         "channel: {} ({}){}{}",
         r.channel,
-        if r.edge == "listed" {
+        if r.edges_listed() {
             "edge times: each row a captured edge".to_string()
         } else {
             format!("{} edges", r.edge)
@@ -2476,7 +2481,7 @@ pub fn text(r: &AnalyzeReport) -> String {
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
-        if r.prescaler > 1 && r.edge == "listed" {
+        if r.prescaler > 1 && r.edges_listed() {
             format!(
                 "{} captured (each {} lines: the input prescaler) and",
                 r.captured, r.prescaler
@@ -2514,7 +2519,7 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         )
     };
-    if r.edges == 0 && r.edge == "listed" {
+    if r.edges == 0 && r.edges_listed() {
         let _ = writeln!(s, "no edge: the file of edge times lists none");
     } else if r.edges == 0 {
         let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));

@@ -761,14 +761,7 @@ impl<R: BufRead> CaptureReader<R> {
                 expected + extra
             )));
         }
-        if time < self.last_time {
-            return Err(self.err_here(&format!(
-                "time {time} s is before the previous row's {} s: rows must be in time order",
-                self.last_time
-            )));
-        }
-        self.last_time = time;
-        self.rows += 1;
+        self.advance(time)?;
         Ok(Some((time, &self.levels)))
     }
 
@@ -796,6 +789,13 @@ impl<R: BufRead> CaptureReader<R> {
             )));
         }
         let time = self.time_of(f)?;
+        self.advance(time)?;
+        self.levels[0] = Level::High;
+        Ok(Some((time, &self.levels)))
+    }
+
+    /// Takes `time` as the next row's, s: rows in time order.
+    fn advance(&mut self, time: f64) -> Result<(), CaptureError> {
         if time < self.last_time {
             return Err(self.err_here(&format!(
                 "time {time} s is before the previous row's {} s: rows must be in time order",
@@ -804,8 +804,7 @@ impl<R: BufRead> CaptureReader<R> {
         }
         self.last_time = time;
         self.rows += 1;
-        self.levels[0] = Level::High;
-        Ok(Some((time, &self.levels)))
+        Ok(())
     }
 
     /// The time of a row's first field, s.

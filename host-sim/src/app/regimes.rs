@@ -267,8 +267,8 @@ pub fn stability_map(
     // periods of the fastest motion and a monodromy's steps fall as 1/ω: the grid's sum is
     // about 70 times the first one's (48 speeds an octave), half as much again for the
     // boundaries. A start whose scan would take more than half the budget is raised until it
-    // would not (a lightly damped 620 rad/s coupling took 11 800 steps a revolution at the
-    // start, 0.88 rad/s, and 946 000 for the scan, next to the budget).
+    // would not (a lightly damped 620 rad/s coupling took 16 666 steps a revolution at 0.62
+    // rad/s, and its scan from 0.88 rad/s 946 000, next to the budget).
     let first = floquet.revolution_steps(start, opts.rtol).map_err(err)?;
     let estimate = 105.0 * first as f64;
     let afford = 0.5 * SCAN_STEPS as f64;

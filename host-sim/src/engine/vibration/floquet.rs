@@ -273,6 +273,35 @@ pub struct Unresolved {
     pub largest: f64,
 }
 
+impl Unresolved {
+    /// `slot` with one more evaluation at `w` rad/s where the multiplier lay `d` from 1, the
+    /// resolution being `resolution`.
+    fn note(slot: &mut Option<Unresolved>, w: f64, d: f64, resolution: f64) {
+        let u = slot.get_or_insert(Unresolved {
+            evaluations: 0,
+            speeds: [w, w],
+            resolution,
+            largest: 0.0,
+        });
+        u.evaluations += 1;
+        u.speeds = [u.speeds[0].min(w), u.speeds[1].max(w)];
+        u.largest = u.largest.max(d.abs());
+    }
+
+    /// Both parts' evaluations as one (of scans at the same resolution).
+    fn merged(a: Option<Unresolved>, b: Option<Unresolved>) -> Option<Unresolved> {
+        match (a, b) {
+            (Some(a), Some(b)) => Some(Unresolved {
+                evaluations: a.evaluations + b.evaluations,
+                speeds: [a.speeds[0].min(b.speeds[0]), a.speeds[1].max(b.speeds[1])],
+                resolution: a.resolution,
+                largest: a.largest.max(b.largest),
+            }),
+            (a, b) => a.or(b),
+        }
+    }
+}
+
 impl StabilityMap {
     /// Whether the balancing position is stable at `speed` rad/s according to the map
     /// (outside the scanned range, the class at the nearer end).
@@ -289,7 +318,7 @@ impl StabilityMap {
     pub fn joined(mut self, upper: StabilityMap) -> StabilityMap {
         debug_assert!(self.options.to <= upper.options.from);
         if self.stable_at(self.options.to) != upper.stable_at_from {
-            // Joined at a shared speed, not reached: both evaluate it the same way.
+            // Across a gap (never at a shared speed: both parts evaluate it the same way).
             let w = upper.options.from;
             self.boundaries.push(Boundary {
                 speed: w,
@@ -303,17 +332,8 @@ impl StabilityMap {
         self.evaluations += upper.evaluations;
         self.steps += upper.steps;
         self.neutral_drift = self.neutral_drift.max(upper.neutral_drift);
-        let merge = |a: Option<Unresolved>, b: Option<Unresolved>| match (a, b) {
-            (Some(a), Some(b)) => Some(Unresolved {
-                evaluations: a.evaluations + b.evaluations,
-                speeds: [a.speeds[0].min(b.speeds[0]), a.speeds[1].max(b.speeds[1])],
-                resolution: a.resolution,
-                largest: a.largest.max(b.largest),
-            }),
-            (a, b) => a.or(b),
-        };
-        self.unresolved = merge(self.unresolved, upper.unresolved);
-        self.marginal = merge(self.marginal, upper.marginal);
+        self.unresolved = Unresolved::merged(self.unresolved, upper.unresolved);
+        self.marginal = Unresolved::merged(self.marginal, upper.marginal);
         self
     }
 
@@ -884,17 +904,6 @@ impl Floquet {
         let mut unresolved: Option<Unresolved> = None;
         let mut marginal: Option<Unresolved> = None;
         let res = resolution(rtol);
-        let note = |slot: &mut Option<Unresolved>, w: f64, d: f64| {
-            let u = slot.get_or_insert(Unresolved {
-                evaluations: 0,
-                speeds: [w, w],
-                resolution: res,
-                largest: 0.0,
-            });
-            u.evaluations += 1;
-            u.speeds = [u.speeds[0].min(w), u.speeds[1].max(w)];
-            u.largest = u.largest.max(d.abs());
-        };
         // ln ρ, or exactly 0 where ρ lies within the resolution of 1 (`stable_ln`).
         let fast = self.fastest_motion();
         let mut record = |w: f64, (m, n): (Multipliers, u64)| -> Result<f64, StabilityError> {
@@ -916,14 +925,14 @@ impl Floquet {
             evaluations += 1;
             drift = drift.max(m.neutral_drift);
             if let Some(d) = m.unresolved {
-                note(&mut unresolved, w, d);
+                Unresolved::note(&mut unresolved, w, d, res);
             }
             // An undamped motion keeps ρ within rounding of 1 at every speed (a platform on
             // no damping), or lets it approach 1 as the speed grows: the sign of ln ρ there is
             // the integration's error, and deciding from it bisected hundreds of spurious
             // boundaries until the step budget ran out.
             if (m.radius - 1.0).abs() <= res {
-                note(&mut marginal, w, m.radius - 1.0);
+                Unresolved::note(&mut marginal, w, m.radius - 1.0, res);
                 return Ok(0.0);
             }
             Ok(m.radius.ln())
