@@ -356,6 +356,15 @@ struct Revolution {
     repeated: u8,
 }
 
+/// The two faults whose repetition at one tooth [`SpeedTracker::fault_repeats`] watches: their
+/// slots in `last_faults` and their bits in `repeated`.
+#[cfg(feature = "pattern-wheels")]
+#[derive(Clone, Copy)]
+enum Repeat {
+    Glitch = 0,
+    Missing = 1,
+}
+
 /// A mean learnt from the values met: a running mean over the first `FRAME_MEMORY`, then an
 /// exponential one with that memory.
 #[derive(Debug, Clone, Copy)]
@@ -1177,7 +1186,7 @@ impl SpeedTracker {
                     self.pop();
                     self.reject(e1, sink);
                     #[cfg(feature = "pattern-wheels")]
-                    self.fault_repeats(enc, 0);
+                    self.fault_repeats(enc, Repeat::Glitch);
                     // Merged with the edge after it (ringing just after a tooth, or a pulse
                     // just before one): the edge kept may be either of the pair, its time off
                     // by their spacing, so no sample starts at it either. (A pulse 1 to 16 % of
@@ -1236,7 +1245,7 @@ impl SpeedTracker {
             self.fault_in_revolution();
             #[cfg(feature = "pattern-wheels")]
             if lost > 0 {
-                self.fault_repeats(enc, 1);
+                self.fault_repeats(enc, Repeat::Missing);
             }
             if lost == 0 {
                 self.tooth = tooth_back(self.tooth, 1, enc.edges());
@@ -1905,7 +1914,7 @@ impl SpeedTracker {
         }
     }
 
-    /// A glitch (`kind` 0) or a missing edge (1) found in sync on a pattern wheel: where both
+    /// A glitch or a missing edge (`kind`) found in sync on a pattern wheel: where both
     /// came at the same tooth as a revolution before, one after the other, the count is given
     /// up. A count two teeth off explains the gap with a tooth lost just after it and takes
     /// the real tooth just before it for a glitch, every revolution: two faults either side
@@ -1914,10 +1923,11 @@ impl SpeedTracker {
     /// 36-1 wheel it stayed so for good, every window invalid).
     #[cfg(feature = "pattern-wheels")]
     #[inline(never)] // careful path: one copy for its callers (code size)
-    fn fault_repeats(&mut self, enc: &Encoder, kind: usize) {
+    fn fault_repeats(&mut self, enc: &Encoder, kind: Repeat) {
         if self.sync != SyncState::Synced || enc.framing() != Framing::Pattern {
             return;
         }
+        let kind = kind as usize;
         let (rev, here) = (self.counters.revolutions, self.tooth);
         let mut lost = false;
         for f in &mut self.fit {

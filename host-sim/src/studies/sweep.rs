@@ -396,11 +396,9 @@ pub fn sweep(
                     format!(
                         "{from:e} rad/s is below {lowest:.4e} rad/s, the lowest speed at which \
                          the stability analysis integrates a revolution of this machine: a \
-                         revolution there lasts more than {} periods of its fastest motion \
-                         ({:.4e} rad/s, set by {}); sweep from {lowest:.4e} rad/s or above",
-                        floquet::REVOLUTION_RATIO,
-                        fast.rate,
-                        fast.source
+                         revolution there lasts more than {} periods of {fast}; sweep from \
+                         {lowest:.4e} rad/s or above",
+                        floquet::REVOLUTION_RATIO
                     ),
                 ));
             }

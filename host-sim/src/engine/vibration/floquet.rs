@@ -507,6 +507,17 @@ pub struct FastestMotion {
     pub source: FastestSource,
 }
 
+/// "the machine's fastest motion (R rad/s, set by S)", as every message that names it says it.
+impl std::fmt::Display for FastestMotion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the machine's fastest motion ({:.4e} rad/s, set by {})",
+            self.rate, self.source
+        )
+    }
+}
+
 /// How many times faster than the rotor turns the machine's fastest motion may be for one
 /// revolution to be integrated ([`lowest_speed`]). Measured at the scan's tolerance (1e-10)
 /// on five machines (the seed's, two two-platform ones, one of them hung only on its
@@ -721,12 +732,10 @@ impl Floquet {
             return Err(StabilityError::Numerical {
                 speed: omega,
                 message: format!(
-                    "a revolution lasts {:.3e} periods of the machine's fastest motion ({:.4e} \
-                     rad/s, set by {}), more than the {REVOLUTION_RATIO} whose integration \
-                     steps the analysis affords: its lowest speed is {lowest:.4e} rad/s",
-                    fast.rate / omega,
-                    fast.rate,
-                    fast.source
+                    "a revolution lasts {:.3e} periods of {fast}, more than the \
+                     {REVOLUTION_RATIO} whose integration steps the analysis affords: its \
+                     lowest speed is {lowest:.4e} rad/s",
+                    fast.rate / omega
                 ),
             });
         }
@@ -914,11 +923,8 @@ impl Floquet {
                     message: format!(
                         "the scan from {from:.4e} rad/s has taken more than {SCAN_STEPS} \
                          integration steps over {evaluations} monodromy matrices: a revolution at \
-                         its start spans {:.0} periods of the machine's fastest motion ({:.4e} \
-                         rad/s, set by {})",
-                        fast.rate / from,
-                        fast.rate,
-                        fast.source
+                         its start spans {:.0} periods of {fast}",
+                        fast.rate / from
                     ),
                 });
             }
