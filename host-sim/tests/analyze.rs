@@ -2275,6 +2275,51 @@ fn a_noisy_signal_that_never_syncs_says_so() {
     );
 }
 
+/// A clean 12-1 wheel at a steady 200 rpm on average but swinging ±45 % four times a
+/// revolution (a V8 cranking) does not sync: its long intervals come every 3 edges, or after
+/// 3 and 8 in turn, as the ripple's phase against the gap has it. The report says the speed
+/// swings, from the long intervals coming at the same places every 11 edges (the wheel's
+/// teeth), and names no other wheel and no noise; a wheel of the wrong count (a_wrong_wheel_*)
+/// and a noisy signal (a_noisy_signal_*) are still named so.
+#[test]
+fn a_wheel_swinging_too_much_to_sync_is_not_called_another_wheel_or_noisy() {
+    for phase in [0.0, std::f64::consts::PI] {
+        let (_scratch, file) = tmp("swinging-12-1.csv");
+        let text = format!(
+            "[simulation]\nduration = 4.5\nseed = 3\n\
+             [motor]\nmodel = \"profile\"\npoints = [[0.0, 20.944], [4.5, 20.944]]\n\
+             [cranking]\nripple = 0.45\nstrokes = 4.0\nphase = {phase}\n\
+             [encoder]\nwheel = \"12-1\"\ntimer_hz = 1e6\nestimator_edges = 1\n\
+             [monitor]\nwindow_revolutions = 1\n\
+             [capture]\nsample_rate = 50e6\n"
+        );
+        let run = simulate(&text, CaptureFormat::Saleae, &file);
+        let (report, _) = run_analyze(&file, wheel("12-1"));
+        let lines = hint_lines(&report);
+        println!("phase {phase}:\n{}", lines.join("\n"));
+        assert!(report.sync_acquired.is_none(), "phase {phase}: {lines:?}");
+        // No edge lost or added: every edge the simulation recorded is a tooth.
+        assert_eq!(
+            report.captured,
+            teeth(&run.edge_list).len() as u64,
+            "phase {phase}"
+        );
+        assert_eq!(lines.len(), 1, "phase {phase}: {lines:?}");
+        assert!(
+            lines[0].starts_with(
+                "no sync: the configured 12-1 wheel has 11 teeth a revolution and a gap of 2 \
+                 pitches; in the capture "
+            ) && lines[0].contains(
+                "the long intervals come at the same places every 11 edges, as many as the \
+                 wheel has teeth (none added or lost): unless its teeth are placed otherwise, \
+                 the speed swings within a revolution"
+            ) && !lines[0].contains("wheel?")
+                && !lines[0].contains("positions with"),
+            "phase {phase}: {lines:?}"
+        );
+    }
+}
+
 /// The rising edges of a wheel of `n` positions carrying a tooth where `present` says, turning
 /// steadily at `omega` from t = 0 to `stop`.
 fn pattern_teeth(n: u32, present: impl Fn(u32) -> bool, omega: f64, stop: f64) -> Vec<f64> {

@@ -822,6 +822,27 @@ impl Intervals {
             spacings,
         })
     }
+
+    /// Whether the long intervals (of the first [`MAX_ORDER`]) come at the same places every
+    /// `edges` edges: over three turns of `edges` or more, nine in ten of them at a place
+    /// (their count from the first, modulo `edges`) met three times or more, and at most
+    /// `edges / 2` places. Edges added or lost between them (noise pulses, lost teeth, a
+    /// wheel of another count) move the places on, and they spread.
+    fn recur_every(&self, edges: u64) -> bool {
+        if edges < 4 || self.order.len() < 8 {
+            return false;
+        }
+        let mut places = std::collections::BTreeMap::new();
+        let mut at = 0u64;
+        *places.entry(0).or_insert(0u64) += 1;
+        for &s in &self.order {
+            at += s;
+            *places.entry(at % edges).or_insert(0) += 1;
+        }
+        let longs = self.order.len() as u64 + 1;
+        let recurring: u64 = places.values().filter(|&&c| c >= 3).sum();
+        at >= 3 * edges && places.len() as u64 * 2 <= edges && recurring * 10 >= longs * 9
+    }
 }
 
 /// A pattern's runs of teeth, in order round the wheel: (teeth in the run, pitches of the gap
@@ -853,11 +874,23 @@ fn in_words(items: &[String]) -> String {
     }
 }
 
-/// The recurring gaps of a capture in words, with the wheel they suggest.
-fn seen_gaps(g: &GapsSeen) -> String {
+/// What long intervals at the same places every `teeth` edges say of a capture that did not
+/// sync ([`Intervals::recur_every`]).
+fn swinging(teeth: u32) -> String {
+    format!(
+        "and the long intervals come at the same places every {teeth} edges, as many as the wheel \
+         has teeth \
+         (none added or lost): unless its teeth are placed otherwise, the speed swings within a \
+         revolution (a cranking engine's compression strokes) so much that its gap cannot be \
+         told from its teeth; a steadier or faster stretch of the shaft's running syncs"
+    )
+}
+
+/// The recurring gaps of a capture in words, with the wheel they suggest (`guess`).
+fn seen_gaps(g: &GapsSeen, guess: bool) -> String {
     if let [s] = g.spacings.as_slice() {
         let missing = s.pitches().saturating_sub(1);
-        let guess = if missing >= 1 && s.every + missing <= 255 {
+        let guess = if guess && missing >= 1 && s.every + missing <= 255 {
             format!(" (a {}-{missing} wheel?)", s.every + missing)
         } else {
             String::new()
@@ -879,12 +912,19 @@ fn seen_gaps(g: &GapsSeen) -> String {
     let gaps = g.spacings.len();
     format!(
         "intervals about {} times their neighbours come after {} edges in turn ({} of {} \
-         times) (a wheel of {positions} positions with {gaps} gaps? describe it in a scene's \
-         [encoder] by lines and gaps, and analyze with --scene)",
+         times){}",
         words(&|s| format!("{:.1}", s.ratio)),
         words(&|s| s.every.to_string()),
         words(&|s| s.times.to_string()),
-        g.of
+        g.of,
+        if guess {
+            format!(
+                " (a wheel of {positions} positions with {gaps} gaps? describe it in a scene's \
+                 [encoder] by lines and gaps, and analyze with --scene)"
+            )
+        } else {
+            String::new()
+        }
     )
 }
 
@@ -917,6 +957,16 @@ fn sync_hint(
     let noisy = [counted, intervals.irregular]
         .iter()
         .any(|&n| n >= 3 && n * 50 >= r.captured);
+    // The long intervals come at the same places every as many edges as the configured wheel
+    // has teeth: no edge was added or lost between them, so the wheel's teeth are all there
+    // and no noise pulse is. Where such a capture does not sync, its speed swings within a
+    // revolution (a cranking engine's compression strokes), so that the gap reads at another
+    // ratio and ordinary teeth look long or short against their neighbours: a clean 12-1
+    // wheel at 200 rpm with a 45 % swing four times a revolution was told it was a 14-3 or a
+    // 4-1 wheel and its signal noisy.
+    let teeth_counted = pattern.is_some_and(|p| intervals.recur_every(u64::from(p.teeth())));
+    let swung = teeth_counted && counted == 0 && noisy;
+    let noisy = noisy && !swung;
     // In a noisy signal the half of a tooth's interval a pulse leaves is long against the
     // other: such "gaps" recur too (every other edge under a pulse a tooth), so there the
     // recurring spacings must account for two thirds of all to name a wheel by them.
@@ -993,13 +1043,25 @@ fn sync_hint(
                     .spacings
                     .iter()
                     .all(|s| runs.contains(&(s.every, s.pitches())));
-                if !agree {
+                if teeth_counted && (!agree || swung) {
+                    causes.push(format!(
+                        "no sync: the configured {name} {expected}; in the capture {}, {}",
+                        seen_gaps(g, false),
+                        swinging(p.teeth())
+                    ));
+                } else if !agree {
                     causes.push(format!(
                         "no sync: the configured {name} {expected}; in the capture {}",
-                        seen_gaps(g)
+                        seen_gaps(g, true)
                     ));
                 }
             }
+            None if swung => causes.push(format!(
+                "no sync: the configured {name} {expected}; in the capture {} interval(s) are \
+                 more than {LONG_RATIO} times their neighbours, {}",
+                intervals.longs,
+                swinging(p.teeth())
+            )),
             None if !short && !noisy => causes.push(format!(
                 "no sync: the configured {name} {expected}, but no gap recurs in the capture \
                  ({} interval(s) more than {LONG_RATIO} times their neighbours, at no regular \
