@@ -1777,6 +1777,56 @@ fn the_time_grid_of_a_capture_without_a_rate_widens_the_floor() {
         .all(|w| w.floor_with_sampling.is_none()));
 }
 
+/// An analyser at 12 MS/s (an FX2-based one) samples every 83.33 ns, and a Saleae export
+/// writes its times to the nanosecond: they share no whole-nanosecond step, but every one lies
+/// within a nanosecond of the 12 MHz grid, which is taken as the sample period: the floor is
+/// the one a stated --sample-rate 12e6 gives. Times at 1 GS/s (any nanosecond) lie on none.
+#[test]
+fn a_grid_of_a_rate_whose_period_is_not_whole_nanoseconds_is_found() {
+    let rising = wheel_teeth(36, 2, 40.0, 2.0);
+    let cfg = configure(&AnalyzeOptions {
+        timer_hz: Some(84e6),
+        ..wheel("36-2")
+    })
+    .unwrap();
+    let text = saleae_of_rising(&rising, 12e6, 2.0);
+    let mut reader = text_reader(text.clone(), "fx2.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.sample_rate, None);
+    assert!(
+        report
+            .time_grid
+            .is_some_and(|g| (g * 12e6 - 1.0).abs() < 1e-12),
+        "{:?}",
+        report.time_grid
+    );
+    let mut reader = text_reader(text, "fx2.csv", Some(12e6)).unwrap();
+    let stated = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let valid = report.windows.iter().filter(|w| w.valid).count();
+    assert!(valid >= 5, "{valid}");
+    assert_eq!(report.windows.len(), stated.windows.len());
+    for (w, s) in report.windows.iter().zip(&stated.windows) {
+        assert_eq!((w.valid, w.resolved), (s.valid, s.resolved), "{}", w.start);
+        if let (Some(a), Some(b)) = (w.floor_with_sampling, s.floor_with_sampling) {
+            assert!((a / b - 1.0).abs() < 1e-9, "{}: {a} against {b}", w.start);
+        } else {
+            assert!(!w.valid && !s.valid, "{}: {w:?}", w.start);
+        }
+    }
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains(
+            "every time lies on a 8.333e-8 s grid, to the nanosecond its times are written to \
+             (a 12000000 Hz analyser's)"
+        ),
+        "{said}"
+    );
+    let fine = saleae_of_rising(&rising, 1e9, 2.0);
+    let mut reader = text_reader(fine, "fine.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.time_grid, None);
+}
+
 /// A steady shaft (true δ 0): what a window measures is the timer's quantization, within the
 /// noise floor. Such a window is valid but its δ is not resolved, and the report says so
 /// (`resolved` false) instead of printing it like a measured ripple.

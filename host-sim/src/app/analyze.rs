@@ -1457,6 +1457,7 @@ pub fn analyze<R: BufRead>(
     let mut among_read = vec![Spacing::default(); channels.len()];
     let mut read_among = vec![Spacing::default(); channels.len()];
     let mut grid = TimeGrid::default();
+    let mut odd_grid = OddGrid::default();
     let mut resolution = Resolution {
         hz: cfg.encoder.timer_hz,
         ..Resolution::default()
@@ -1490,6 +1491,7 @@ pub fn analyze<R: BufRead>(
             prev = levels.to_vec();
         }
         grid.row(t);
+        odd_grid.row(t);
         resolution.row(t);
         for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
@@ -1712,7 +1714,11 @@ pub fn analyze<R: BufRead>(
         .captured
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
     if report.sample_rate.is_none() {
-        report.time_grid = grid.step();
+        // Times to the nanosecond that share no coarser whole-nanosecond step: an analyser's
+        // rate whose period is not whole nanoseconds, if one fits.
+        report.time_grid = grid
+            .step()
+            .or_else(|| (grid.gcd == Some(1)).then(|| odd_grid.step()).flatten());
     }
     // Each window's floor takes the file's sampling, or the resolution of its own rows where
     // that is coarser (a time is known to no better than either).
@@ -2057,6 +2063,61 @@ impl TimeGrid {
     /// The step, s, when it is at least 2 ns.
     fn step(&self) -> Option<f64> {
         self.gcd.filter(|&g| g >= 2).map(|g| g as f64 * 1e-9)
+    }
+}
+
+/// Sample rates of logic analysers whose period is not a whole number of nanoseconds (the
+/// FX2-based analysers' 48, 24, 16, 12, 6 and 3 MHz), Hz: a file that writes their times to
+/// the nanosecond lies on no whole-nanosecond grid ([`TimeGrid`]), and is tested against
+/// each ([`OddGrid`]).
+pub const ODD_RATES: [f64; 6] = [48e6, 24e6, 16e6, 12e6, 6e6, 3e6];
+
+/// Rows [`OddGrid`] needs before it names a rate: a time written to the nanosecond lies
+/// within a nanosecond of a 48 MHz grid (20.8 ns) by chance about one time in seven, of 64
+/// such times practically never.
+const ODD_GRID_ROWS: u64 = 64;
+
+/// Which of [`ODD_RATES`] every row's time lies on from the first row's, to the nanosecond
+/// each was written to (a 12 MS/s capture's times in a Saleae export: 83.333 ns apart,
+/// rounded; their whole-nanosecond steps share no divisor but 1, and the windows' floor was
+/// the timer's alone, a third of δ's error).
+#[derive(Default)]
+struct OddGrid {
+    first: Option<f64>,
+    /// Bit `i`: every time so far lies on the grid of `ODD_RATES[i]`.
+    alive: u8,
+    rows: u64,
+}
+
+impl OddGrid {
+    fn row(&mut self, t: f64) {
+        let Some(first) = self.first else {
+            self.first = Some(t);
+            self.alive = (1 << ODD_RATES.len()) - 1;
+            return;
+        };
+        self.rows += 1;
+        let ns = (t - first) * 1e9;
+        for (i, rate) in ODD_RATES.iter().enumerate() {
+            let period = 1e9 / rate;
+            // Both times rounded to the nanosecond: within 1 ns of a multiple of the period.
+            if (ns - (ns / period).round() * period).abs() > 1.0 + 1e-9 * ns.abs() {
+                self.alive &= !(1 << i);
+            }
+        }
+    }
+
+    /// The period, s, of the slowest rate every time lies on, after [`ODD_GRID_ROWS`] rows.
+    fn step(&self) -> Option<f64> {
+        if self.rows < ODD_GRID_ROWS {
+            return None;
+        }
+        ODD_RATES
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.alive >> i & 1 == 1)
+            .map(|(_, r)| 1.0 / r)
+            .reduce(f64::max)
     }
 }
 
@@ -2483,9 +2544,17 @@ pub fn text(r: &AnalyzeReport) -> String {
             Some(g) => {
                 let _ = writeln!(
                     s,
-                    "sampling: rate not stated; every time lies on a {g:.3e} s grid ({:.3} timer \
-                     ticks), taken as the sample period: the floor below includes it, {:.3} \
-                     times the timer's alone (give --sample-rate to state the rate)",
+                    "sampling: rate not stated; every time lies on a {g:.3e} s grid{} ({:.3} \
+                     timer ticks), taken as the sample period: the floor below includes it, \
+                     {:.3} times the timer's alone (give --sample-rate to state the rate)",
+                    if ((g * 1e9).round() - g * 1e9).abs() > 1e-6 {
+                        format!(
+                            ", to the nanosecond its times are written to (a {:.0} Hz analyser's)",
+                            1.0 / g
+                        )
+                    } else {
+                        String::new()
+                    },
                     r.timer_hz * g,
                     1.0 + r.timer_hz * g
                 );
