@@ -2830,9 +2830,9 @@ fn a_saleae_logic_1_export_is_read_as_logic_2s() {
         e.starts_with("cap.csv:1:") && e.contains("tab-separated") && e.contains("delimiter"),
         "{e}"
     );
-    // Named saleae, a header that is not: refused with both of Saleae's headers.
+    // Named saleae, a header that is not: refused with Saleae's headers.
     let e = CaptureReader::new(
-        std::io::Cursor::new("Sample, Channel 0\n0, 0\n".to_string()),
+        std::io::Cursor::new("Index, Channel 0\n0, 0\n".to_string()),
         Path::new("s.csv"),
         Some(CaptureFormat::Saleae),
         None,
@@ -2842,10 +2842,135 @@ fn a_saleae_logic_1_export_is_read_as_logic_2s() {
     .to_string();
     assert!(
         e.contains("`Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` (Logic 1.x)")
-            && e.contains("found `Sample, Channel 0`")
-            && e.contains("export it with time stamps"),
+            && e.contains("`Sample Number, Channel 0, ...`")
+            && e.contains("found `Index, Channel 0`"),
         "{e}"
     );
+}
+
+/// A Saleae Logic 1.x export with sample numbers for times is read at the rate --sample-rate
+/// gives and analyzes as the same rows exported with time stamps, δ for δ (at a rate whose
+/// period is a whole number of nanoseconds, and at 24 MHz, whose is not); without the rate it
+/// is refused naming the column and the option, and a sample number that is not a whole
+/// number, or a rate that is no rate, is named.
+#[test]
+fn a_saleae_logic_1_export_with_sample_numbers_reads_as_its_time_stamps() {
+    for (rate, rate_key) in [(50e6, "sample_rate = 50e6"), (24e6, "sample_rate = 24e6")] {
+        let (_scratch, file) = tmp("crank.csv");
+        simulate(
+            &cranking("36-2", rate_key, 2.0, ""),
+            CaptureFormat::Saleae,
+            &file,
+        );
+        let written = std::fs::read_to_string(&file).unwrap();
+        // The same rows as Logic 1.x writes them: with time stamps (fifteen decimals), and
+        // with sample numbers.
+        let mut stamped = String::from("Time[s], Channel 0\n");
+        let mut numbered = String::from("Sample Number, Channel 0\n");
+        for row in written.lines().skip(1) {
+            let (t, level) = row.split_once(',').unwrap();
+            let n = (t.parse::<f64>().unwrap() * rate).round() as i64;
+            stamped.push_str(&format!("{:.15}, {level}\n", n as f64 / rate));
+            numbered.push_str(&format!("{n}, {level}\n"));
+        }
+        let cfg = configure(&wheel("36-2")).unwrap();
+        let read = |text: &str, rate: Option<f64>| {
+            let mut r =
+                text_reader(text.to_string(), "l.csv", rate).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(r.format(), CaptureFormat::Saleae);
+            assert_eq!(r.channels(), ["Channel 0"]);
+            analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+        };
+        let by_time = read(&stamped, Some(rate));
+        let by_number = read(&numbered, Some(rate));
+        assert!(by_time.valid_windows >= 2, "{}", by_time.valid_windows);
+        assert_eq!(by_number.sample_numbers.as_deref(), Some("Sample Number"));
+        assert_eq!(by_time.sample_numbers, None);
+        let windows = |r: &AnalyzeReport| {
+            r.windows
+                .iter()
+                .map(|w| {
+                    (
+                        w.valid,
+                        w.delta,
+                        w.floor_with_sampling,
+                        w.start_edge,
+                        w.end_edge,
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(windows(&by_number), windows(&by_time), "{rate}");
+        assert_eq!(
+            (
+                by_number.captured,
+                by_number.accepted,
+                by_number.glitches,
+                by_number.missing
+            ),
+            (
+                by_time.captured,
+                by_time.accepted,
+                by_time.glitches,
+                by_time.missing
+            )
+        );
+        // The time stamps without the rate: the same δ (the floor then takes the time grid).
+        let unstated = read(&stamped, None);
+        let deltas = |r: &AnalyzeReport| r.windows.iter().map(|w| w.delta).collect::<Vec<_>>();
+        assert_eq!(deltas(&by_number), deltas(&unstated));
+        let text = host_sim::app::analyze::text(&by_number);
+        assert!(
+            text.contains(&format!(
+                "sample numbers of `Sample Number` over --sample-rate {rate} Hz"
+            )),
+            "{text}"
+        );
+        // A rate other than the capture's is another capture: every speed scaled by it.
+        let doubled = read(&numbered, Some(2.0 * rate));
+        let speed = |r: &AnalyzeReport| r.windows.iter().find_map(|w| w.omega_mean).unwrap();
+        assert!((speed(&doubled) / speed(&by_number) - 2.0).abs() < 1e-3);
+    }
+    // Without the rate: refused, naming the column and the option.
+    for head in ["Sample Number", "Sample", "Sample [#]", "sample number"] {
+        let e = reader_error(&format!("{head}, Channel 0, Channel 1\n0, 0, 0\n5, 1, 0\n"));
+        assert!(
+            e.starts_with("cap.csv:1:")
+                && e.contains(&format!("`{head}`"))
+                && e.contains("--sample-rate"),
+            "{e}"
+        );
+    }
+    // A sample number with decimals, and rates that are none.
+    let mut r = text_reader(
+        "Sample Number, Channel 0\n0, 0\n12.5, 1\n".to_string(),
+        "cap.csv",
+        Some(1e6),
+    )
+    .unwrap();
+    assert!(r.next_row().is_ok());
+    let e = r.next_row().unwrap_err().to_string();
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("`12.5`") && e.contains("`Sample Number`"),
+        "{e}"
+    );
+    for bad in [0.0, -1e6, f64::NAN, f64::INFINITY] {
+        let e = text_reader(
+            "Sample Number, Channel 0\n0, 0\n".to_string(),
+            "cap.csv",
+            Some(bad),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            e.contains("--sample-rate") && e.contains("above 0"),
+            "{bad}: {e}"
+        );
+    }
+    // libsigrok's `samples` unit is still sigrok's.
+    let r = text_reader("samples,logic\n1,0\n".to_string(), "cap.csv", Some(1.0)).unwrap();
+    assert_eq!(r.format(), CaptureFormat::Sigrok);
 }
 
 /// A file of edge times (one captured edge a row, in seconds: a capture timer's dump), with a

@@ -465,6 +465,10 @@ pub struct AnalyzeReport {
     pub counter_bits: u8,
     /// The capture's sample rate, Hz, when known (a sigrok file's, or `--sample-rate`).
     pub sample_rate: Option<f64>,
+    /// A Saleae Logic 1.x export with sample numbers for times: the column's heading (every
+    /// time is its sample number over `sample_rate`, the rate `--sample-rate` gave).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_numbers: Option<String>,
     /// Without a known sample rate: the step, s, that every row's time lies on from the first
     /// row's (in whole nanoseconds, when 2 ns or more: the analyzer's sample period, as a
     /// Saleae export's nine decimals show it), taken as the sampling for the floor.
@@ -1359,6 +1363,7 @@ pub fn analyze<R: BufRead>(
         counter_bits: cfg.encoder.counter_bits,
         prescaler: cfg.encoder.prescaler,
         sample_rate: reader.sample_rate(),
+        sample_numbers: reader.sample_column().map(str::to_string),
         sync_state: "searching",
         ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
@@ -2315,6 +2320,13 @@ pub fn text(r: &AnalyzeReport) -> String {
         "capture: {} ({} format, {} rows, {:.6} s to {:.6} s)",
         r.file, r.format, r.rows, r.span[0], r.span[1]
     );
+    if let (Some(column), Some(rate)) = (&r.sample_numbers, r.sample_rate) {
+        let _ = writeln!(
+            s,
+            "times: the sample numbers of `{column}` over --sample-rate {rate} Hz (a rate other \
+             than the capture's scales every time and speed by its error)"
+        );
+    }
     if r.time_origin != 0 {
         let _ = writeln!(
             s,
