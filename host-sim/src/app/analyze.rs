@@ -82,16 +82,23 @@ pub struct AnalyzeConfig {
     /// The quadrature B channel that gives each edge its direction, and which of A and B
     /// leads when running forward.
     pub direction: Option<(Channel, Lead)>,
-    /// The edges taken.
-    pub edge: Polarity,
-    /// Whether `--edge` was given (a file of edge times has no levels to take it of).
-    pub edge_given: bool,
+    /// The edges taken, as `--edge` gave them; `None`: not given, rising edges taken (a file
+    /// of edge times, which has no levels to take an edge of, refuses one given). See
+    /// [`AnalyzeConfig::polarity`].
+    pub edge: Option<Polarity>,
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
     /// The disc of `--lines` is unframed because `--framing` was not given (the report says
     /// so, and names a channel that pulses once a revolution).
     pub framing_default: bool,
+}
+
+impl AnalyzeConfig {
+    /// The edges taken: `--edge`'s, rising by default.
+    pub fn polarity(&self) -> Polarity {
+        self.edge.unwrap_or(Polarity::Rising)
+    }
 }
 
 /// Which channel of a quadrature pair leads when the shaft runs forward.
@@ -1296,7 +1303,7 @@ pub fn analyze<R: BufRead>(
                 "--direction-channel: a file of edge times has one column, the captured edges, \
                  and no quadrature B channel to give their direction",
             )
-        } else if cfg.edge_given {
+        } else if cfg.edge.is_some() {
             Some(
                 "--edge: a file of edge times lists the edges the capture took, one a row, and \
                  no levels to take rising or falling edges of: leave --edge out",
@@ -1353,7 +1360,7 @@ pub fn analyze<R: BufRead>(
         index_channel: ich.map(|i| channels[i].clone()),
         direction_channel: dch.map(|(d, _)| channels[d].clone()),
         forward: dch.map(|(_, lead)| lead),
-        edge: match cfg.edge {
+        edge: match cfg.polarity() {
             _ if times => "listed",
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
@@ -1421,6 +1428,7 @@ pub fn analyze<R: BufRead>(
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
+    let polarity = cfg.polarity();
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
         drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
@@ -1461,8 +1469,8 @@ pub fn analyze<R: BufRead>(
                 _ => None,
             }
         };
-        let index_edge = ich.and_then(edge) == Some(cfg.edge);
-        let channel_edge = times || edge(ch) == Some(cfg.edge);
+        let index_edge = ich.and_then(edge) == Some(polarity);
+        let channel_edge = times || edge(ch) == Some(polarity);
         if channel_edge {
             report.edges += 1;
         }
@@ -1474,7 +1482,7 @@ pub fn analyze<R: BufRead>(
                 a.other_edge();
                 b.pulse();
             }
-            if edge(k) == Some(cfg.edge) {
+            if edge(k) == Some(polarity) {
                 a.pulse();
                 b.other_edge();
             }
@@ -3067,8 +3075,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
             None
         },
         index_channel_default: index && o.index_channel.is_none(),
-        edge: o.edge.unwrap_or(Polarity::Rising),
-        edge_given: o.edge.is_some(),
+        edge: o.edge,
         warnings,
         framing_default: o.lines.is_some() && o.framing.is_none(),
     })
