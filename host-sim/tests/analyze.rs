@@ -3199,6 +3199,76 @@ fn ringing_at_each_edge_is_said_with_its_length() {
     assert_eq!(capture(0, 0).ringing, None);
 }
 
+/// The busier-channel hint under an input prescaler: both channels' edges are counted on the
+/// lines, before the prescaler, and each count's revolutions are it over the lines a
+/// revolution the hint states (the channel read's revolutions were its captured edges', a
+/// prescaler-fold fewer, beside the busier channel's lines), and the prescaler is said.
+#[test]
+fn the_busier_channel_hint_counts_edges_in_one_unit_under_a_prescaler() {
+    use host_sim::app::analyze::FramingArg;
+    // A 1000-line index disc at 2 µs a line, 10 revolutions, its channels swapped; the
+    // channel read pulses every 10 lines (a 100-line disc's signal on the wrong probe).
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) * 2e-6 + 1e-6;
+        let read = u8::from(k % 10 == 7);
+        text.push_str(&format!("{t:.7},{read},1\n{:.7},0,0\n", t + 1e-6));
+    }
+    // The number after `key` in `text`, up to the first character no number has.
+    let number = |text: &str, key: &str| -> f64 {
+        let at = text
+            .find(key)
+            .unwrap_or_else(|| panic!("no `{key}` in {text}"))
+            + key.len();
+        let digits: String = text[at..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || *c == '.')
+            .collect();
+        digits
+            .parse()
+            .unwrap_or_else(|_| panic!("`{key}` in {text}"))
+    };
+    for prescaler in [1u8, 4] {
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(1000),
+            framing: Some(FramingArg::Index),
+            timer_hz: Some(100e6),
+            prescaler: Some(prescaler),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text.clone(), "swap.csv", None).unwrap();
+        let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.sync_acquired, None);
+        let said = report.sync_hint.unwrap().causes;
+        let hint = said
+            .iter()
+            .find(|c| c.contains("the channel read, has"))
+            .unwrap_or_else(|| panic!("{said:?}"));
+        let read = number(hint, "the channel read, has ");
+        let read_revs = number(hint, "edges (");
+        let per_rev = number(hint, "revolutions of the configured wheel, ");
+        let busier = number(hint, "`Channel 1` has ");
+        let busier_revs = number(hint, &format!("`Channel 1` has {busier} ("));
+        assert_eq!(
+            (read, busier, per_rev),
+            (1000.0, 10_000.0, 1000.0),
+            "{hint}"
+        );
+        assert!((read / per_rev - read_revs).abs() <= 0.05, "{hint}");
+        assert!((busier / per_rev - busier_revs).abs() <= 0.05, "{hint}");
+        assert_eq!(
+            hint.contains("before the input prescaler of 4, which captures 250 a revolution"),
+            prescaler == 4,
+            "{hint}"
+        );
+        assert!(
+            hint.ends_with("read it with --channel 1 --index-channel 0"),
+            "{hint}"
+        );
+    }
+}
+
 /// A channel that pulses once a revolution read as the encoder (a cam or index channel first
 /// in the export, or the two swapped): the core does not sync, and the hint names the busier
 /// channel as the encoder with the options that read it, where it said the capture was too

@@ -938,14 +938,27 @@ fn sync_hint(
     // Another channel has the edges the one read lacks: the capture is long enough, and the
     // long intervals of a channel pulsing among its edges are no stop.
     if let Some(b) = busier {
+        // Both channels' edges as the lines give them, before the input prescaler (the
+        // busier channel's are counted so): a revolution is the wheel's lines then.
+        let prescaler = u64::from(cfg.prescaler.max(1));
+        let lines_per_rev = u64::from(enc.edges().max(1)) * prescaler;
         causes.push(format!(
             "no sync: `{}`, the channel read, has {} edges ({:.1} revolutions of the configured \
-             wheel, {} edges a revolution), where `{}` has {} ({:.1} revolutions){}: the encoder \
-             is likely `{}`: read it with --channel {}{}",
+             wheel, {} edges a revolution{}), where `{}` has {} ({:.1} revolutions){}: the \
+             encoder is likely `{}`: read it with --channel {}{}",
             r.channel,
             r.edges,
-            revolutions_of_edges,
-            per_rev,
+            r.edges as f64 / lines_per_rev as f64,
+            lines_per_rev,
+            if prescaler > 1 {
+                format!(
+                    "; edges on the channel, before the input prescaler of {prescaler}, which \
+                     captures {} a revolution",
+                    enc.edges()
+                )
+            } else {
+                String::new()
+            },
             b.name,
             b.edges,
             b.revolutions,
