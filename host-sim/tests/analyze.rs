@@ -3199,6 +3199,87 @@ fn ringing_at_each_edge_is_said_with_its_length() {
     assert_eq!(capture(0, 0).ringing, None);
 }
 
+/// The other polarity of a ringing channel is no cure, and the ringing WARNING suggests none:
+/// on one channel the levels alternate, so each extra crossing of the polarity read brings
+/// one of the other, and the two polarities' edges differ by one at most. Where every tooth
+/// rings the falling edges are a regular train at twice the lines, which reads clean (no
+/// interval of a bounce's length, valid windows) at twice the true speed; where one tooth in
+/// ten rings they hold noise pulses instead (glitches, no clean run of windows).
+#[test]
+fn the_other_polarity_of_a_ringing_channel_is_no_cure() {
+    use host_sim::app::analyze::Polarity;
+    // As in `ringing_at_each_edge_is_said_with_its_length`: a 60-line disc at 2 ms a line,
+    // 8 revolutions; after a ringing tooth's rise the level falls 1 µs to 3 µs after it and
+    // rises again 4 µs to 8 µs after it.
+    let capture = |ring_every: u32, edge: Polarity| {
+        let mut text = String::from("Time [s],Channel 0\n0.0000000,0\n");
+        for k in 0..480u32 {
+            let t = f64::from(k) * 2e-3 + 1e-4;
+            text.push_str(&format!("{t:.7},1\n"));
+            if k >= 8 && k % ring_every == 0 {
+                let j = f64::from(k % 5);
+                text.push_str(&format!("{:.7},0\n", t + (1.0 + 0.5 * j) * 1e-6));
+                text.push_str(&format!("{:.7},1\n", t + (4.0 + j) * 1e-6));
+            }
+            text.push_str(&format!("{:.7},0\n", t + 1e-3));
+        }
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(60),
+            edge: Some(edge),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text, "r.csv", None).unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let truth = std::f64::consts::TAU / (60.0 * 2e-3);
+    let mean_speed = |r: &AnalyzeReport| {
+        let w: Vec<f64> = r
+            .windows
+            .iter()
+            .filter(|w| w.valid)
+            .filter_map(|w| w.omega_mean)
+            .collect();
+        w.iter().sum::<f64>() / w.len() as f64
+    };
+    for ring_every in [1u32, 10] {
+        let rising = capture(ring_every, Polarity::Rising);
+        let falling = capture(ring_every, Polarity::Falling);
+        let ringing = rising.ringing.clone().unwrap();
+        // One falling edge for each rising one, the bounces' included.
+        assert!(
+            rising.edges.abs_diff(falling.edges) <= 1,
+            "{} {}",
+            rising.edges,
+            falling.edges
+        );
+        assert!(
+            falling.edges >= 480 + ringing.edges - 1,
+            "{}",
+            falling.edges
+        );
+        let said = host_sim::app::analyze::text(&rising);
+        assert!(
+            said.contains("The edges of the other polarity are no cure")
+                && !said.contains("--edge falling"),
+            "{said}"
+        );
+        if ring_every == 1 {
+            // Clean to every check on the intervals, and twice as fast as the shaft.
+            assert_eq!(falling.ringing, None);
+            assert!(falling.valid_windows >= 8, "{}", falling.valid_windows);
+            let ratio = mean_speed(&falling) / truth;
+            assert!((ratio - 2.0).abs() < 0.01, "{ratio}");
+        } else {
+            assert!(falling.glitches >= 20, "{}", falling.glitches);
+            assert!(
+                falling.invalid_windows > falling.valid_windows,
+                "{falling:?}"
+            );
+        }
+    }
+}
+
 /// The busier-channel hint under an input prescaler: both channels' edges are counted on the
 /// lines, before the prescaler, and each count's revolutions are it over the lines a
 /// revolution the hint states (the channel read's revolutions were its captured edges', a
