@@ -2925,9 +2925,9 @@ fn a_saleae_logic_1_export_is_read_as_logic_2s() {
         e.starts_with("cap.csv:1:") && e.contains("tab-separated") && e.contains("delimiter"),
         "{e}"
     );
-    // Named saleae, a header that is not: refused with both of Saleae's headers.
+    // Named saleae, a header that is not: refused with Saleae's headers.
     let e = CaptureReader::new(
-        std::io::Cursor::new("Sample, Channel 0\n0, 0\n".to_string()),
+        std::io::Cursor::new("Index, Channel 0\n0, 0\n".to_string()),
         Path::new("s.csv"),
         Some(CaptureFormat::Saleae),
         None,
@@ -2937,10 +2937,135 @@ fn a_saleae_logic_1_export_is_read_as_logic_2s() {
     .to_string();
     assert!(
         e.contains("`Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` (Logic 1.x)")
-            && e.contains("found `Sample, Channel 0`")
-            && e.contains("export it with time stamps"),
+            && e.contains("`Sample Number, Channel 0, ...`")
+            && e.contains("found `Index, Channel 0`"),
         "{e}"
     );
+}
+
+/// A Saleae Logic 1.x export with sample numbers for times is read at the rate --sample-rate
+/// gives and analyzes as the same rows exported with time stamps, δ for δ (at a rate whose
+/// period is a whole number of nanoseconds, and at 24 MHz, whose is not); without the rate it
+/// is refused naming the column and the option, and a sample number that is not a whole
+/// number, or a rate that is no rate, is named.
+#[test]
+fn a_saleae_logic_1_export_with_sample_numbers_reads_as_its_time_stamps() {
+    for (rate, rate_key) in [(50e6, "sample_rate = 50e6"), (24e6, "sample_rate = 24e6")] {
+        let (_scratch, file) = tmp("crank.csv");
+        simulate(
+            &cranking("36-2", rate_key, 2.0, ""),
+            CaptureFormat::Saleae,
+            &file,
+        );
+        let written = std::fs::read_to_string(&file).unwrap();
+        // The same rows as Logic 1.x writes them: with time stamps (fifteen decimals), and
+        // with sample numbers.
+        let mut stamped = String::from("Time[s], Channel 0\n");
+        let mut numbered = String::from("Sample Number, Channel 0\n");
+        for row in written.lines().skip(1) {
+            let (t, level) = row.split_once(',').unwrap();
+            let n = (t.parse::<f64>().unwrap() * rate).round() as i64;
+            stamped.push_str(&format!("{:.15}, {level}\n", n as f64 / rate));
+            numbered.push_str(&format!("{n}, {level}\n"));
+        }
+        let cfg = configure(&wheel("36-2")).unwrap();
+        let read = |text: &str, rate: Option<f64>| {
+            let mut r =
+                text_reader(text.to_string(), "l.csv", rate).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(r.format(), CaptureFormat::Saleae);
+            assert_eq!(r.channels(), ["Channel 0"]);
+            analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+        };
+        let by_time = read(&stamped, Some(rate));
+        let by_number = read(&numbered, Some(rate));
+        assert!(by_time.valid_windows >= 2, "{}", by_time.valid_windows);
+        assert_eq!(by_number.sample_numbers.as_deref(), Some("Sample Number"));
+        assert_eq!(by_time.sample_numbers, None);
+        let windows = |r: &AnalyzeReport| {
+            r.windows
+                .iter()
+                .map(|w| {
+                    (
+                        w.valid,
+                        w.delta,
+                        w.floor_with_sampling,
+                        w.start_edge,
+                        w.end_edge,
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(windows(&by_number), windows(&by_time), "{rate}");
+        assert_eq!(
+            (
+                by_number.captured,
+                by_number.accepted,
+                by_number.glitches,
+                by_number.missing
+            ),
+            (
+                by_time.captured,
+                by_time.accepted,
+                by_time.glitches,
+                by_time.missing
+            )
+        );
+        // The time stamps without the rate: the same δ (the floor then takes the time grid).
+        let unstated = read(&stamped, None);
+        let deltas = |r: &AnalyzeReport| r.windows.iter().map(|w| w.delta).collect::<Vec<_>>();
+        assert_eq!(deltas(&by_number), deltas(&unstated));
+        let text = host_sim::app::analyze::text(&by_number);
+        assert!(
+            text.contains(&format!(
+                "sample numbers of `Sample Number` over --sample-rate {rate} Hz"
+            )),
+            "{text}"
+        );
+        // A rate other than the capture's is another capture: every speed scaled by it.
+        let doubled = read(&numbered, Some(2.0 * rate));
+        let speed = |r: &AnalyzeReport| r.windows.iter().find_map(|w| w.omega_mean).unwrap();
+        assert!((speed(&doubled) / speed(&by_number) - 2.0).abs() < 1e-3);
+    }
+    // Without the rate: refused, naming the column and the option.
+    for head in ["Sample Number", "Sample", "Sample [#]", "sample number"] {
+        let e = reader_error(&format!("{head}, Channel 0, Channel 1\n0, 0, 0\n5, 1, 0\n"));
+        assert!(
+            e.starts_with("cap.csv:1:")
+                && e.contains(&format!("`{head}`"))
+                && e.contains("--sample-rate"),
+            "{e}"
+        );
+    }
+    // A sample number with decimals, and rates that are none.
+    let mut r = text_reader(
+        "Sample Number, Channel 0\n0, 0\n12.5, 1\n".to_string(),
+        "cap.csv",
+        Some(1e6),
+    )
+    .unwrap();
+    assert!(r.next_row().is_ok());
+    let e = r.next_row().unwrap_err().to_string();
+    assert!(
+        e.starts_with("cap.csv:3:") && e.contains("`12.5`") && e.contains("`Sample Number`"),
+        "{e}"
+    );
+    for bad in [0.0, -1e6, f64::NAN, f64::INFINITY] {
+        let e = text_reader(
+            "Sample Number, Channel 0\n0, 0\n".to_string(),
+            "cap.csv",
+            Some(bad),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            e.contains("--sample-rate") && e.contains("above 0"),
+            "{bad}: {e}"
+        );
+    }
+    // libsigrok's `samples` unit is still sigrok's.
+    let r = text_reader("samples,logic\n1,0\n".to_string(), "cap.csv", Some(1.0)).unwrap();
+    assert_eq!(r.format(), CaptureFormat::Sigrok);
 }
 
 /// A file of edge times (one captured edge a row, in seconds: a capture timer's dump), with a
@@ -3167,6 +3292,157 @@ fn ringing_at_each_edge_is_said_with_its_length() {
     assert_eq!(noise.ringing, None);
     // A clean disc: nothing.
     assert_eq!(capture(0, 0).ringing, None);
+}
+
+/// The other polarity of a ringing channel is no cure, and the ringing WARNING suggests none:
+/// on one channel the levels alternate, so each extra crossing of the polarity read brings
+/// one of the other, and the two polarities' edges differ by one at most. Where every tooth
+/// rings the falling edges are a regular train at twice the lines, which reads clean (no
+/// interval of a bounce's length, valid windows) at twice the true speed; where one tooth in
+/// ten rings they hold noise pulses instead (glitches, no clean run of windows).
+#[test]
+fn the_other_polarity_of_a_ringing_channel_is_no_cure() {
+    use host_sim::app::analyze::Polarity;
+    // As in `ringing_at_each_edge_is_said_with_its_length`: a 60-line disc at 2 ms a line,
+    // 8 revolutions; after a ringing tooth's rise the level falls 1 µs to 3 µs after it and
+    // rises again 4 µs to 8 µs after it.
+    let capture = |ring_every: u32, edge: Polarity| {
+        let mut text = String::from("Time [s],Channel 0\n0.0000000,0\n");
+        for k in 0..480u32 {
+            let t = f64::from(k) * 2e-3 + 1e-4;
+            text.push_str(&format!("{t:.7},1\n"));
+            if k >= 8 && k % ring_every == 0 {
+                let j = f64::from(k % 5);
+                text.push_str(&format!("{:.7},0\n", t + (1.0 + 0.5 * j) * 1e-6));
+                text.push_str(&format!("{:.7},1\n", t + (4.0 + j) * 1e-6));
+            }
+            text.push_str(&format!("{:.7},0\n", t + 1e-3));
+        }
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(60),
+            edge: Some(edge),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text, "r.csv", None).unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let truth = std::f64::consts::TAU / (60.0 * 2e-3);
+    let mean_speed = |r: &AnalyzeReport| {
+        let w: Vec<f64> = r
+            .windows
+            .iter()
+            .filter(|w| w.valid)
+            .filter_map(|w| w.omega_mean)
+            .collect();
+        w.iter().sum::<f64>() / w.len() as f64
+    };
+    for ring_every in [1u32, 10] {
+        let rising = capture(ring_every, Polarity::Rising);
+        let falling = capture(ring_every, Polarity::Falling);
+        let ringing = rising.ringing.clone().unwrap();
+        // One falling edge for each rising one, the bounces' included.
+        assert!(
+            rising.edges.abs_diff(falling.edges) <= 1,
+            "{} {}",
+            rising.edges,
+            falling.edges
+        );
+        assert!(
+            falling.edges >= 480 + ringing.edges - 1,
+            "{}",
+            falling.edges
+        );
+        let said = host_sim::app::analyze::text(&rising);
+        assert!(
+            said.contains("The edges of the other polarity are no cure")
+                && !said.contains("--edge falling"),
+            "{said}"
+        );
+        if ring_every == 1 {
+            // Clean to every check on the intervals, and twice as fast as the shaft.
+            assert_eq!(falling.ringing, None);
+            assert!(falling.valid_windows >= 8, "{}", falling.valid_windows);
+            let ratio = mean_speed(&falling) / truth;
+            assert!((ratio - 2.0).abs() < 0.01, "{ratio}");
+        } else {
+            assert!(falling.glitches >= 20, "{}", falling.glitches);
+            assert!(
+                falling.invalid_windows > falling.valid_windows,
+                "{falling:?}"
+            );
+        }
+    }
+}
+
+/// The busier-channel hint under an input prescaler: both channels' edges are counted on the
+/// lines, before the prescaler, and each count's revolutions are it over the lines a
+/// revolution the hint states (the channel read's revolutions were its captured edges', a
+/// prescaler-fold fewer, beside the busier channel's lines), and the prescaler is said.
+#[test]
+fn the_busier_channel_hint_counts_edges_in_one_unit_under_a_prescaler() {
+    use host_sim::app::analyze::FramingArg;
+    // A 1000-line index disc at 2 µs a line, 10 revolutions, its channels swapped; the
+    // channel read pulses every 10 lines (a 100-line disc's signal on the wrong probe).
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000,0,0\n");
+    for k in 0..10_000u32 {
+        let t = f64::from(k) * 2e-6 + 1e-6;
+        let read = u8::from(k % 10 == 7);
+        text.push_str(&format!("{t:.7},{read},1\n{:.7},0,0\n", t + 1e-6));
+    }
+    // The number after `key` in `text`, up to the first character no number has.
+    let number = |text: &str, key: &str| -> f64 {
+        let at = text
+            .find(key)
+            .unwrap_or_else(|| panic!("no `{key}` in {text}"))
+            + key.len();
+        let digits: String = text[at..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || *c == '.')
+            .collect();
+        digits
+            .parse()
+            .unwrap_or_else(|_| panic!("`{key}` in {text}"))
+    };
+    for prescaler in [1u8, 4] {
+        let cfg = configure(&AnalyzeOptions {
+            lines: Some(1000),
+            framing: Some(FramingArg::Index),
+            timer_hz: Some(100e6),
+            prescaler: Some(prescaler),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut r = text_reader(text.clone(), "swap.csv", None).unwrap();
+        let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap();
+        assert_eq!(report.sync_acquired, None);
+        let said = report.sync_hint.unwrap().causes;
+        let hint = said
+            .iter()
+            .find(|c| c.contains("the channel read, has"))
+            .unwrap_or_else(|| panic!("{said:?}"));
+        let read = number(hint, "the channel read, has ");
+        let read_revs = number(hint, "edges (");
+        let per_rev = number(hint, "revolutions of the configured wheel, ");
+        let busier = number(hint, "`Channel 1` has ");
+        let busier_revs = number(hint, &format!("`Channel 1` has {busier} ("));
+        assert_eq!(
+            (read, busier, per_rev),
+            (1000.0, 10_000.0, 1000.0),
+            "{hint}"
+        );
+        assert!((read / per_rev - read_revs).abs() <= 0.05, "{hint}");
+        assert!((busier / per_rev - busier_revs).abs() <= 0.05, "{hint}");
+        assert_eq!(
+            hint.contains("before the input prescaler of 4, which captures 250 a revolution"),
+            prescaler == 4,
+            "{hint}"
+        );
+        assert!(
+            hint.ends_with("read it with --channel 1 --index-channel 0"),
+            "{hint}"
+        );
+    }
 }
 
 /// A channel that pulses once a revolution read as the encoder (a cam or index channel first

@@ -82,16 +82,23 @@ pub struct AnalyzeConfig {
     /// The quadrature B channel that gives each edge its direction, and which of A and B
     /// leads when running forward.
     pub direction: Option<(Channel, Lead)>,
-    /// The edges taken.
-    pub edge: Polarity,
-    /// Whether `--edge` was given (a file of edge times has no levels to take it of).
-    pub edge_given: bool,
+    /// The edges taken, as `--edge` gave them; `None`: not given, rising edges taken (a file
+    /// of edge times, which has no levels to take an edge of, refuses one given). See
+    /// [`AnalyzeConfig::polarity`].
+    pub edge: Option<Polarity>,
     /// What the configuration leaves out, each a WARNING (a window that does not hold the
     /// scene's load cycle).
     pub warnings: Vec<String>,
     /// The disc of `--lines` is unframed because `--framing` was not given (the report says
     /// so, and names a channel that pulses once a revolution).
     pub framing_default: bool,
+}
+
+impl AnalyzeConfig {
+    /// The edges taken: `--edge`'s, rising by default.
+    pub fn polarity(&self) -> Polarity {
+        self.edge.unwrap_or(Polarity::Rising)
+    }
 }
 
 /// Which channel of a quadrature pair leads when the shaft runs forward.
@@ -465,6 +472,10 @@ pub struct AnalyzeReport {
     pub counter_bits: u8,
     /// The capture's sample rate, Hz, when known (a sigrok file's, or `--sample-rate`).
     pub sample_rate: Option<f64>,
+    /// A Saleae Logic 1.x export with sample numbers for times: the column's heading (every
+    /// time is its sample number over `sample_rate`, the rate `--sample-rate` gave).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_numbers: Option<String>,
     /// Without a known sample rate: the step, s, that every row's time lies on from the first
     /// row's (in whole nanoseconds, when 2 ns or more: the analyzer's sample period, as a
     /// Saleae export's nine decimals show it), taken as the sampling for the floor.
@@ -977,14 +988,27 @@ fn sync_hint(
     // Another channel has the edges the one read lacks: the capture is long enough, and the
     // long intervals of a channel pulsing among its edges are no stop.
     if let Some(b) = busier {
+        // Both channels' edges as the lines give them, before the input prescaler (the
+        // busier channel's are counted so): a revolution is the wheel's lines then.
+        let prescaler = u64::from(cfg.prescaler.max(1));
+        let lines_per_rev = u64::from(enc.edges().max(1)) * prescaler;
         causes.push(format!(
             "no sync: `{}`, the channel read, has {} edges ({:.1} revolutions of the configured \
-             wheel, {} edges a revolution), where `{}` has {} ({:.1} revolutions){}: the encoder \
-             is likely `{}`: read it with --channel {}{}",
+             wheel, {} edges a revolution{}), where `{}` has {} ({:.1} revolutions){}: the \
+             encoder is likely `{}`: read it with --channel {}{}",
             r.channel,
             r.edges,
-            revolutions_of_edges,
-            per_rev,
+            r.edges as f64 / lines_per_rev as f64,
+            lines_per_rev,
+            if prescaler > 1 {
+                format!(
+                    "; edges on the channel, before the input prescaler of {prescaler}, which \
+                     captures {} a revolution",
+                    enc.edges()
+                )
+            } else {
+                String::new()
+            },
             b.name,
             b.edges,
             b.revolutions,
@@ -1354,7 +1378,7 @@ pub fn analyze<R: BufRead>(
                 "--direction-channel: a file of edge times has one column, the captured edges, \
                  and no quadrature B channel to give their direction",
             )
-        } else if cfg.edge_given {
+        } else if cfg.edge.is_some() {
             Some(
                 "--edge: a file of edge times lists the edges the capture took, one a row, and \
                  no levels to take rising or falling edges of: leave --edge out",
@@ -1411,7 +1435,7 @@ pub fn analyze<R: BufRead>(
         index_channel: ich.map(|i| channels[i].clone()),
         direction_channel: dch.map(|(d, _)| channels[d].clone()),
         forward: dch.map(|(_, lead)| lead),
-        edge: match cfg.edge {
+        edge: match cfg.polarity() {
             _ if times => "listed",
             Polarity::Rising => "rising",
             Polarity::Falling => "falling",
@@ -1421,6 +1445,7 @@ pub fn analyze<R: BufRead>(
         counter_bits: cfg.encoder.counter_bits,
         prescaler: cfg.encoder.prescaler,
         sample_rate: reader.sample_rate(),
+        sample_numbers: reader.sample_column().map(str::to_string),
         sync_state: "searching",
         ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
@@ -1479,6 +1504,7 @@ pub fn analyze<R: BufRead>(
     // before the last moved it forward (the first counts as moved).
     let (mut quadrature, mut moved_before) = (Quadrature::default(), true);
     let mut intervals = Intervals::default();
+    let polarity = cfg.polarity();
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
         drive_monitor::encoder::Wheel::Pattern(p) => pattern_runs(&p),
@@ -1520,8 +1546,8 @@ pub fn analyze<R: BufRead>(
                 _ => None,
             }
         };
-        let index_edge = ich.and_then(edge) == Some(cfg.edge);
-        let channel_edge = times || edge(ch) == Some(cfg.edge);
+        let index_edge = ich.and_then(edge) == Some(polarity);
+        let channel_edge = times || edge(ch) == Some(polarity);
         if channel_edge {
             report.edges += 1;
         }
@@ -1533,7 +1559,7 @@ pub fn analyze<R: BufRead>(
                 a.other_edge();
                 b.pulse();
             }
-            if edge(k) == Some(cfg.edge) {
+            if edge(k) == Some(polarity) {
                 a.pulse();
                 b.other_edge();
             }
@@ -2438,6 +2464,13 @@ pub fn text(r: &AnalyzeReport) -> String {
         "capture: {} ({} format, {} rows, {:.6} s to {:.6} s)",
         r.file, r.format, r.rows, r.span[0], r.span[1]
     );
+    if let (Some(column), Some(rate)) = (&r.sample_numbers, r.sample_rate) {
+        let _ = writeln!(
+            s,
+            "times: the sample numbers of `{column}` over --sample-rate {rate} Hz (a rate other \
+             than the capture's scales every time and speed by its error)"
+        );
+    }
     if r.time_origin != 0 {
         let _ = writeln!(
             s,
@@ -3186,8 +3219,7 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
             None
         },
         index_channel_default: index && o.index_channel.is_none(),
-        edge: o.edge.unwrap_or(Polarity::Rising),
-        edge_given: o.edge.is_some(),
+        edge: o.edge,
         warnings,
         framing_default: o.lines.is_some() && o.framing.is_none(),
     })

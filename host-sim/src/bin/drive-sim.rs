@@ -62,8 +62,9 @@ enum Command {
         options: AnalyzeArgs,
         /// The logic analyzer's samples per second, Hz. A sigrok file states it, and so does a
         /// value change dump from sigrok (needed for a sigrok CSV that does not: its time
-        /// column alone is not exact; it must agree with the file when it states one); for any
-        /// format it widens the windows' noise floor by the sampling's
+        /// column alone is not exact; it must agree with the file when it states one); a
+        /// Saleae Logic 1.x export with sample numbers for times needs it (sample n is at
+        /// n / rate s); for any format it widens the windows' noise floor by the sampling's
         /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long)]
         sample_rate: Option<f64>,
