@@ -3527,3 +3527,75 @@ fn a_channel_pulsing_once_a_revolution_read_as_the_encoder_names_the_encoder() {
         "{said:?}"
     );
 }
+
+/// A 360-line disc whose index pulse rises at a line's rising edge, 0.05 pitch to either side
+/// of it (a quadrature encoder's index gated with the lines' levels rises at one of their
+/// edges): read on the rising edges, the index frames the count a line early or late, shown
+/// as faults on clean lines, and the report says why and what cures it; read on the falling
+/// edges the index lies mid-pitch, and every revolution is framed without a fault.
+#[test]
+fn an_index_at_a_line_edge_is_named_as_such() {
+    use host_sim::app::analyze::Polarity;
+    let (lines, omega, revolutions) = (360u32, 60.0, 24u32);
+    let pitch = std::f64::consts::TAU / f64::from(lines) / omega;
+    let mut changes: Vec<(f64, usize, u8)> = Vec::new();
+    for k in 0..lines * revolutions {
+        let t = 1e-3 + f64::from(k) * pitch;
+        changes.push((t, 0, 1));
+        changes.push((t + 0.5 * pitch, 0, 0));
+        if k % lines == 0 {
+            // To either side of the edge in turn, as jitter would have it at random.
+            let r = k / lines;
+            let side = if (r * 7 + r / 3) % 2 == 0 {
+                0.05
+            } else {
+                -0.05
+            };
+            changes.push((t + side * pitch, 1, 1));
+            changes.push((t + (side + 1.0) * pitch, 1, 0));
+        }
+    }
+    changes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut text = String::from("Time [s],Channel 0,Channel 1\n0.000000000,0,0\n");
+    let mut levels = [0u8; 2];
+    for (t, ch, level) in changes {
+        levels[ch] = level;
+        text.push_str(&format!(
+            "{:.9},{},{}\n",
+            sampled(t, 50e6),
+            levels[0],
+            levels[1]
+        ));
+    }
+    let said_of = |edge: Option<Polarity>| {
+        let cfg = configure(&AnalyzeOptions {
+            edge,
+            ..index_lines(360)
+        })
+        .unwrap();
+        let mut reader = text_reader(text.clone(), "index-at-edge.csv", None).unwrap();
+        let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        (host_sim::app::analyze::text(&report), report)
+    };
+    let (said, report) = said_of(None);
+    let p = report.index_period.unwrap();
+    assert!(p.early_late.0 >= 2 && p.early_late.1 >= 2, "{p:?}");
+    // Not told that the line count is wrong, where the count a capture short is the commonest.
+    assert!(!said.contains("check the number of lines"), "{said}");
+    assert!(
+        said.lines().any(|l| l.starts_with("index: ")
+            && l.contains("the index pulse comes at a line edge and falls to either side of it")
+            && l.contains("capture the lines' other edge (--edge)")),
+        "{said}"
+    );
+    let (said, report) = said_of(Some(Polarity::Falling));
+    assert!(!said.contains("index pulse comes at a line edge"), "{said}");
+    assert_eq!(report.index_period.unwrap().early_late, (0, 0));
+    assert_eq!(
+        (report.extra, report.missing, report.missing_frames),
+        (0, 0, 0),
+        "{said}"
+    );
+    assert_eq!(report.invalid_windows, 0, "{said}");
+    assert!(report.valid_windows >= 20, "{said}");
+}

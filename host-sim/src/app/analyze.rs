@@ -269,6 +269,22 @@ pub struct IndexPeriod {
     pub of: u64,
     /// Captures per revolution of the configured wheel.
     pub expected: u16,
+    /// How many intervals between index pulses had one capture fewer and one more than
+    /// `expected`: both in numbers, an index pulse at a line edge, jittering to either side.
+    pub early_late: (u64, u64),
+}
+
+/// Whether the index pulses fall to either side of a line edge: intervals between them a
+/// capture short and a capture long of a revolution, twice each or more, a tenth of them or
+/// more, and about as many of each (an index jittering across a line edge makes them in
+/// turn, so their numbers differ by one at most; a lost or extra line edge makes one of the
+/// two alone).
+fn index_at_a_line_edge(p: &IndexPeriod) -> bool {
+    let (early, late) = p.early_late;
+    early >= 2
+        && late >= 2
+        && (early + late) * 10 >= p.of
+        && early.abs_diff(late) <= 1 + (early + late) / 5
 }
 
 /// How much of a speed ripple's δ the windows read: a ripple of `order` cycles a revolution,
@@ -421,11 +437,14 @@ impl IndexPeriods {
                 best = Some((captures, times));
             }
         }
+        let times_of = |n: u64| self.counts.get(&n).copied().unwrap_or(0);
+        let n = u64::from(expected);
         best.map(|(captures, times)| IndexPeriod {
             captures,
             times,
             of: self.of,
             expected,
+            early_late: (times_of(n.saturating_sub(1)), times_of(n + 1)),
         })
     }
 }
@@ -2713,7 +2732,7 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     if let Some(p) = r
         .index_period
-        .filter(|p| p.captures != u64::from(p.expected))
+        .filter(|p| p.captures != u64::from(p.expected) && !index_at_a_line_edge(p))
     {
         let _ = writeln!(
             s,
@@ -2721,6 +2740,18 @@ pub fn text(r: &AnalyzeReport) -> String {
              revolution of the configured wheel is {}: check the number of lines, the edge \
              polarity and --index-channel",
             p.captures, p.times, p.of, p.expected
+        );
+    }
+    if let Some(p) = r.index_period.filter(index_at_a_line_edge) {
+        let _ = writeln!(
+            s,
+            "index: {} of {} intervals between index pulses are a capture short of the \
+             revolution's {} and {} a capture long: the index pulse comes at a line edge and \
+             falls to either side of it, so the count is framed a line early or late (extra or \
+             missing edges, missing frames, where the lines may be clean); capture the lines' \
+             other edge (--edge), where the index lies mid-pitch, or place the index against \
+             the lines so",
+            p.early_late.0, p.of, p.expected, p.early_late.1
         );
     }
     for e in r.sync.iter().take(20) {
