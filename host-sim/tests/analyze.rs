@@ -2498,6 +2498,26 @@ fn sync_lost_again_and_again_says_why() {
     let once = read(noisy(&[(1.0, 1.5)]));
     assert!(once.sync_losses >= 1 && once.sync_state == "synced");
     assert!(once.sync_hint.is_none() && hint_lines(&once).is_empty());
+    // The edges the core did not judge while it searched again are counted and said: some,
+    // at most the burst's (each tooth and its pulse) and three revolutions to sync again.
+    let burst = 2 * clean.iter().filter(|&&t| (1.0..1.5).contains(&t)).count() as u64;
+    assert!(
+        once.edges_unsynced > 0 && once.edges_unsynced <= burst + 3 * 34,
+        "{} of {}, the burst {burst}",
+        once.edges_unsynced,
+        once.captured
+    );
+    let said = host_sim::app::analyze::text(&once);
+    assert!(
+        said.contains(&format!(
+            "sync lost: {} of the {} captured edges came while the count was searched for again",
+            once.edges_unsynced, once.captured
+        )),
+        "{said}"
+    );
+    let clean = read(noisy(&[]));
+    assert_eq!((clean.sync_losses, clean.edges_unsynced), (0, 0));
+    assert!(!host_sim::app::analyze::text(&clean).contains("sync lost:"));
 }
 
 /// `t` as C's `%g` writes it: six significant digits, trailing zeros dropped.

@@ -562,6 +562,9 @@ pub struct AnalyzeReport {
     pub syncs: u32,
     /// Times sync was lost.
     pub sync_losses: u32,
+    /// Edges captured after sync was first acquired while it was not held (the count searched
+    /// or confirmed again after a sync loss): the core judges no fault among them.
+    pub edges_unsynced: u64,
     /// When sync was first acquired, s.
     pub sync_acquired: Option<f64>,
     /// The sync state at the end.
@@ -1687,6 +1690,9 @@ pub fn analyze<R: BufRead>(
                 }
             }
             periods.capture();
+            if report.sync_acquired.is_some() && st.sync != SyncState::Synced {
+                report.edges_unsynced += 1;
+            }
             let o = monitor.on_edge_observed(ticks, direction, &mut st.seen);
             st.after(&mut monitor, &clock, o, &mut report, on_decision);
         }
@@ -2726,6 +2732,15 @@ pub fn text(r: &AnalyzeReport) -> String {
         None => {
             let _ = writeln!(s, "sync: never acquired ({} at the end)", r.sync_state);
         }
+    }
+    if r.edges_unsynced > 0 {
+        let _ = writeln!(
+            s,
+            "sync lost: {} of the {} captured edges came while the count was searched for \
+             again: the core judges no fault among them, so the fault counts above leave them \
+             out (a signal losing teeth or carrying noise there shows only as the sync losses)",
+            r.edges_unsynced, r.captured
+        );
     }
     for c in r.sync_hint.iter().flat_map(|h| &h.causes) {
         let _ = writeln!(s, "{c}");
