@@ -565,6 +565,11 @@ pub struct AnalyzeReport {
     /// stepped back by 4 or more): the disc turning the other way, or a `--forward` the wrong
     /// way round for the wiring when it is most of the capture.
     pub backward_pitches: u64,
+    /// Edges of A at which B read reverse but pulsed: B changed just before the edge and back
+    /// just after, both within an eighth of a pitch (at the speed of the capture before), with
+    /// the quadrature count forward since the capture before: a noise pulse on the direction
+    /// channel, fed as forward (not counted in `reverse_edges`).
+    pub direction_glitches: u64,
     /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
     /// the last edges of the capture, waiting for the two that would confirm them, and the
     /// first edge after a standstill or a reversal (a time reference only).
@@ -1422,7 +1427,26 @@ pub fn analyze<R: BufRead>(
         _ => Vec::new(),
     };
     let longest_gap = runs.iter().map(|&(_, g)| g as f64).fold(1.0, f64::max);
-    while let Some((t, levels)) = reader.next_row()? {
+    // A row read ahead (to see whether B comes back just after an edge of A), and the time
+    // of B's last change and of the capture before.
+    let (mut ahead, mut row): (Option<(f64, Vec<Level>)>, Vec<Level>) = (None, Vec::new());
+    let (mut b_changed_at, mut captured_at) = (f64::NEG_INFINITY, None::<f64>);
+    loop {
+        let t = match ahead.take() {
+            Some((t, l)) => {
+                row = l;
+                t
+            }
+            None => match reader.next_row()? {
+                Some((t, l)) => {
+                    row.clear();
+                    row.extend_from_slice(l);
+                    t
+                }
+                None => break,
+            },
+        };
+        let levels = &row[..];
         if report.rows == 0 {
             report.span[0] = t;
             prev = levels.to_vec();
@@ -1521,8 +1545,25 @@ pub fn analyze<R: BufRead>(
         if encoder_edge && dch.is_some() && direction.is_none() {
             report.direction_unknown += 1;
         }
-        if direction == Some(Direction::Reverse) {
-            report.reverse_edges += 1;
+        // Whether B's level at this edge of A is half of a pulse, B then to come back.
+        let b_pulse = match dch {
+            Some((d, _)) if prev[d] != levels[d] => {
+                b_changed_at = t;
+                None
+            }
+            // (`moved_before` is now this capture's: a step forward since the one before.)
+            Some((d, _))
+                if encoder_edge && moved_before && direction == Some(Direction::Reverse) =>
+            {
+                let pitch = captured_at.map(|c| (t - c) / f64::from(prescaler));
+                pitch
+                    .filter(|&p| t - b_changed_at <= p / 8.0)
+                    .map(|p| (d, b_changed_at + p / 8.0))
+            }
+            _ => None,
+        };
+        if encoder_edge {
+            captured_at = Some(t);
         }
         prev.copy_from_slice(levels);
         if let (Some(p), Some(t0)) = (period, previous_time) {
@@ -1544,6 +1585,22 @@ pub fn analyze<R: BufRead>(
             }
         }
         previous_time = Some(t);
+        if let Some((d, until)) = b_pulse {
+            // B back to its level before the pulse within an eighth of a pitch of leaving it,
+            // A unchanged: the shaft stepped forward (the pulse's three steps back would be
+            // three quarters of a pitch in that time), and B's level at A's edge was noise.
+            if let Some((t2, l)) = reader.next_row()? {
+                if t2 <= until && l[d] != levels[d] && l[d] != Level::Unknown && l[ch] == levels[ch]
+                {
+                    direction = Some(Direction::Forward);
+                    report.direction_glitches += 1;
+                }
+                ahead = Some((t2, l.to_vec()));
+            }
+        }
+        if direction == Some(Direction::Reverse) {
+            report.reverse_edges += 1;
+        }
         if !index_edge && !encoder_edge {
             continue;
         }
@@ -2589,6 +2646,17 @@ pub fn text(r: &AnalyzeReport) -> String {
              before, itself so, and less than a pitch back: no pitch (a shaft at rest rocking \
              across a line edge, or turning back across one), fed as reverse",
             r.no_pitch
+        );
+    }
+    if r.direction_glitches > 0 {
+        let _ = writeln!(
+            s,
+            "direction channel: {} glitch(es) on {} at edges of {}, read as forward (it changed \
+             and came back within an eighth of a pitch across the edge, the quadrature count \
+             going on forward: a noise pulse, not a reversal)",
+            r.direction_glitches,
+            r.direction_channel.as_deref().unwrap_or("B"),
+            r.channel
         );
     }
     if r.unjudged_at_end > 0 {
