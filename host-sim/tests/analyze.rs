@@ -1759,6 +1759,65 @@ fn saleae_of_rising(rising: &[f64], rate: f64, end: f64) -> String {
     s
 }
 
+/// A capture of more windows than are listed (20 500 revolutions of a 4-line disc, a window
+/// each): the counts and the text count every window, --json says how many it lists of how
+/// many, the text says where the others are (in no list), and the δ plot covers the whole
+/// capture, decimated (it stopped at the last listed window, and the text counted "more
+/// windows" from the listed ones).
+#[test]
+fn windows_past_the_listed_are_counted_and_plotted() {
+    use host_sim::app::analyze::MAX_LISTED;
+    let omega = 100.0;
+    let pitch = std::f64::consts::TAU / 4.0 / omega;
+    let rising: Vec<f64> = (0..4 * 20_500).map(|k| 1e-3 + k as f64 * pitch).collect();
+    let end = rising.last().unwrap() + pitch;
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(4),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(saleae_of_rising(&rising, 1e8, end), "long.csv", None).unwrap();
+    let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let total = u64::from(r.valid_windows + r.invalid_windows);
+    assert!(total > 20_000, "{total}");
+    assert_eq!(r.windows_total, total);
+    assert_eq!(r.windows.len(), MAX_LISTED);
+    assert_eq!(r.windows_listed, MAX_LISTED as u64);
+    assert_eq!(r.faults_total, r.faults_listed);
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["windows_total"], total);
+    assert_eq!(json["windows_listed"], MAX_LISTED as u64);
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains(&format!(
+            "  ... {} more windows: --json lists the first {MAX_LISTED} of the {total} windows \
+             (the counts above count them all); the other {} are in no list, and the δ plot \
+             (--plot) shows them all",
+            total - 40,
+            total - MAX_LISTED as u64
+        )),
+        "{said}"
+    );
+    // The δ plot: to the end of the capture, one window in 2, and it says so.
+    assert_eq!(r.delta_every, 2);
+    let last = r.delta_trace.last().unwrap().0;
+    assert!(last > end - 3.0 * 4.0 * pitch, "{last} of {end}");
+    assert!(
+        r.delta_trace.len() as u64 >= total / 2 - 1,
+        "{}",
+        r.delta_trace.len()
+    );
+    let (_dir, file) = tmp("plots");
+    std::fs::create_dir_all(&file).unwrap();
+    host_sim::app::analyze::plots(&r, "long", &file).unwrap();
+    let svg = std::fs::read_to_string(file.join("long-delta.svg")).unwrap();
+    assert!(
+        svg.contains(&format!("one window in 2 of {total}: decimated")),
+        "{}",
+        &svg[..svg.len().min(2000)]
+    );
+}
+
 /// Lines faster than the timer ticks (an edge every 0.77 ticks of a 1 MHz timer: 8192 lines at
 /// 1000 rad/s) come two to a tick, which the core cannot tell apart (glitches and missing
 /// edges on a clean disc): the report says so and how to fix it, and says nothing at 2 MHz

@@ -551,10 +551,23 @@ pub struct AnalyzeReport {
     pub valid_windows: u32,
     /// Invalid windows.
     pub invalid_windows: u32,
-    /// The windows (at most [`MAX_LISTED`]).
+    /// The windows (at most [`MAX_LISTED`], the first).
     pub windows: Vec<WindowOut>,
-    /// The faults (at most [`MAX_LISTED`]).
+    /// The faults (at most [`MAX_LISTED`], the first).
     pub faults: Vec<FaultOut>,
+    /// How many windows the capture gave in all, and how many of them `windows` lists.
+    pub windows_total: u64,
+    /// How many windows `windows` lists (the first; fewer than `windows_total` past the cap).
+    pub windows_listed: u64,
+    /// How many faults the capture gave in all (each counter above's), and how many `faults`
+    /// lists.
+    pub faults_total: u64,
+    /// How many faults `faults` lists (the first).
+    pub faults_listed: u64,
+    /// How many changes of the sync state there were in all.
+    pub sync_changes_total: u64,
+    /// How many changes `sync` lists (the first).
+    pub sync_changes_listed: u64,
     /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
     pub reverse_edges: u64,
     /// Of them, captures with no step forward of the quadrature count (the encoder and
@@ -579,6 +592,13 @@ pub struct AnalyzeReport {
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
+    /// δ against each window's end, of every `delta_every`-th window of the capture (for the
+    /// plot: every window, not only those listed, decimated to at most [`MAX_TRACE`] points).
+    #[serde(skip)]
+    pub delta_trace: Vec<(f64, f64)>,
+    /// The decimation of `delta_trace` (1: every window).
+    #[serde(skip)]
+    pub delta_every: u64,
 }
 
 impl AnalyzeReport {
@@ -1685,6 +1705,10 @@ pub fn analyze<R: BufRead>(
     report.syncs = e.syncs;
     report.sync_losses = e.sync_losses;
     report.valid_windows = d.valid_windows;
+    report.windows_listed = report.windows.len() as u64;
+    report.faults_listed = report.faults.len() as u64;
+    report.sync_changes_listed = report.sync.len() as u64;
+    report.delta_every = report.delta_every.max(1);
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
@@ -2270,6 +2294,7 @@ impl State {
                     if f == Fault::MissingFrame {
                         self.frames_listed += 1;
                     }
+                    report.faults_total += 1;
                     if report.faults.len() < MAX_LISTED {
                         report.faults.push(FaultOut {
                             time,
@@ -2289,6 +2314,7 @@ impl State {
         while self.frames_listed < counted {
             self.frames_listed += 1;
             let time = clock.latest.1;
+            report.faults_total += 1;
             if report.faults.len() < MAX_LISTED {
                 report.faults.push(FaultOut {
                     time,
@@ -2313,6 +2339,7 @@ impl State {
             if s == SyncState::Synced && report.sync_acquired.is_none() {
                 report.sync_acquired = Some(time);
             }
+            report.sync_changes_total += 1;
             if report.sync.len() < MAX_LISTED {
                 report.sync.push(SyncOut {
                     time,
@@ -2326,9 +2353,6 @@ impl State {
     }
 
     fn window(&self, r: &WindowReport, clock: &Clock, report: &mut AnalyzeReport) {
-        if report.windows.len() >= MAX_LISTED {
-            return;
-        }
         let at = |edge: u32, ticks: u32| {
             self.frames
                 .iter()
@@ -2337,14 +2361,29 @@ impl State {
                 .map_or_else(|| clock.time(ticks), |&(_, t)| t)
         };
         let m = r.measurement();
+        let end = if r.valid() {
+            at(r.end_edge, r.end_ticks)
+        } else {
+            clock.time(r.end_ticks)
+        };
+        // Every window to the δ plot, every `delta_every`-th past MAX_TRACE of them.
+        let every = report.delta_every.max(1);
+        if let (Some(m), 0) = (m, report.windows_total % every) {
+            report.delta_trace.push((end, f64::from(m.delta)));
+            if report.delta_trace.len() >= MAX_TRACE {
+                let kept = report.delta_trace.iter().step_by(2).copied().collect();
+                report.delta_trace = kept;
+                report.delta_every = every * 2;
+            }
+        }
+        report.windows_total += 1;
+        if report.windows.len() >= MAX_LISTED {
+            return;
+        }
         let f = |x: f32| Some(f64::from(x));
         report.windows.push(WindowOut {
             start: at(r.start_edge, r.start_ticks),
-            end: if r.valid() {
-                at(r.end_edge, r.end_ticks)
-            } else {
-                clock.time(r.end_ticks)
-            },
+            end,
             start_edge: r.start_edge,
             end_edge: r.end_edge,
             revolutions: r.revolutions,
@@ -2619,8 +2658,13 @@ pub fn text(r: &AnalyzeReport) -> String {
     for e in r.sync.iter().take(20) {
         let _ = writeln!(s, "  {:>12.6} s  {}", e.time, e.state);
     }
-    if r.sync.len() > 20 {
-        let _ = writeln!(s, "  ... {} more changes (see --json)", r.sync.len() - 20);
+    if r.sync_changes_total > 20 {
+        let _ = writeln!(
+            s,
+            "  ... {} more changes{}",
+            r.sync_changes_total - 20,
+            where_listed(r.sync_changes_total, r.sync_changes_listed, "changes", "")
+        );
     }
     if r.reverse_edges > 0 {
         let _ = writeln!(
@@ -2728,11 +2772,17 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         }
     }
-    if r.windows.len() > 40 {
+    if r.windows_total > 40 {
         let _ = writeln!(
             s,
-            "  ... {} more windows (see --json)",
-            r.windows.len() - 40
+            "  ... {} more windows{}",
+            r.windows_total - 40,
+            where_listed(
+                r.windows_total,
+                r.windows_listed,
+                "windows",
+                ", and the δ plot (--plot) shows them all"
+            )
         );
     }
     if !r.faults.is_empty() {
@@ -2740,11 +2790,29 @@ pub fn text(r: &AnalyzeReport) -> String {
         for f in r.faults.iter().take(40) {
             let _ = writeln!(s, "  {:>12.6} s  {}", f.time, f.fault);
         }
-        if r.faults.len() > 40 {
-            let _ = writeln!(s, "  ... {} more faults (see --json)", r.faults.len() - 40);
+        if r.faults_total > 40 {
+            let _ = writeln!(
+                s,
+                "  ... {} more faults{}",
+                r.faults_total - 40,
+                where_listed(r.faults_total, r.faults_listed, "faults", "")
+            );
         }
     }
     s
+}
+
+/// Where the items of a list past the text's first are: `--json`, which lists them all or the
+/// first [`MAX_LISTED`] (`total` of them, `listed` in `--json`; `also`: what else shows them).
+fn where_listed(total: u64, listed: u64, what: &str, also: &str) -> String {
+    if listed >= total {
+        return " (see --json)".into();
+    }
+    format!(
+        ": --json lists the first {listed} of the {total} {what} (the counts above count them \
+         all); the other {} are in no list{also}",
+        total - listed
+    )
 }
 
 /// The speed plot (and δ per window) into `dir`: returns the files written.
@@ -2768,7 +2836,14 @@ pub fn plots(
     }];
     if !r.faults.is_empty() {
         series.push(Series {
-            label: "fault".into(),
+            label: if r.faults_listed < r.faults_total {
+                format!(
+                    "fault (the first {} of {})",
+                    r.faults_listed, r.faults_total
+                )
+            } else {
+                "fault".into()
+            },
             points: r
                 .faults
                 .iter()
@@ -2789,11 +2864,8 @@ pub fn plots(
         },
     )?;
     files.push(path);
-    let deltas: Vec<(f64, f64)> = r
-        .windows
-        .iter()
-        .filter_map(|w| w.delta.map(|d| (w.end, d)))
-        .collect();
+    // Every window of the capture (not only those listed), decimated past MAX_TRACE.
+    let deltas = r.delta_trace.clone();
     let path = dir.join(format!("{stem}-delta.svg"));
     write_svg(
         &path,
@@ -2802,7 +2874,10 @@ pub fn plots(
             x_label: "capture time at the window's end, s",
             y_label: "δ",
             series: vec![Series {
-                label: "δ".into(),
+                label: match r.delta_every {
+                    0 | 1 => "δ".into(),
+                    k => format!("δ (one window in {k} of {}: decimated)", r.windows_total),
+                },
                 points: deltas,
                 markers: true,
             }],
