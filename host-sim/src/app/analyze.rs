@@ -2982,7 +2982,7 @@ fn option_given(o: &AnalyzeOptions, enc: &EncoderConfig, parameter: &str) -> Str
 /// The allowed values of an encoder parameter with a fixed range, as the options give them.
 fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
     use drive_monitor::encoder::{MAX_PATTERN_POSITIONS, MAX_PATTERN_TEETH, MAX_SPAN};
-    use drive_monitor::ConfigError::{Capacity, OutOfRange};
+    use drive_monitor::ConfigError::{Capacity, NonFinite, NotPositive, OutOfRange};
     match e {
         OutOfRange("lines") => Some(format!(
             "a disc has 2 to {} lines",
@@ -2994,7 +2994,13 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
         )),
         OutOfRange("prescaler") => Some("the input prescaler is 1, 2, 4 or 8".into()),
         OutOfRange("counter_bits") => Some("the counter is 16 to 32 bits wide".into()),
-        OutOfRange("timer_hz") => Some("the timer clock is 1 Hz to 10 GHz".into()),
+        OutOfRange("timer_hz") | NotPositive("timer_hz") | NonFinite("timer_hz") => {
+            Some("the timer clock is 1 Hz to 10 GHz".into())
+        }
+        // (How slow a speed fits depends on the timer and the counter: said when it does not.)
+        NotPositive("min_speed") | NonFinite("min_speed") => {
+            Some("the slowest speed still running is above 0 rad/s".into())
+        }
         OutOfRange("window.revolutions") => Some(format!(
             "a window is 1 to {} revolutions",
             drive_monitor::irregularity::MAX_WINDOW_REVS
@@ -3006,6 +3012,22 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
         )),
         _ => None,
     }
+}
+
+/// The message for a whole number given to `option` (`--window-revolutions`) that the type it
+/// is held in cannot hold (beyond 65535, or negative): out of the option's range, said as
+/// [`configure`] says a value out of it; `None` for an option without a fixed range.
+pub fn out_of_range(option: &str, value: &str) -> Option<String> {
+    let parameter = match option {
+        "--lines" => "lines",
+        "--counter-bits" => "counter_bits",
+        "--prescaler" => "prescaler",
+        "--estimator-edges" => "estimator.edges",
+        "--window-revolutions" => "window.revolutions",
+        _ => return None,
+    };
+    allowed(drive_monitor::ConfigError::OutOfRange(parameter))
+        .map(|range| format!("{option} {value} is out of range: {range}"))
 }
 
 /// Checks the options and builds the analysis they describe.
