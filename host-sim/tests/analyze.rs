@@ -1556,6 +1556,109 @@ fn a_reversal_is_seen_with_the_quadrature_b_channel() {
     .contains("--forward goes with --direction-channel"));
 }
 
+/// A noise pulse on the direction channel B across a rising edge of A (B up 2 µs before it,
+/// back 2 µs after) reads B's level at the edge as reverse; the quadrature count says the
+/// shaft stepped forward (B's three steps back and one forward in 4 µs of a 3 ms pitch are
+/// no motion): the edge is fed forward and the pulse counted as a glitch of B, not a
+/// reversal. The real reversal in the same capture is still one.
+#[test]
+fn a_pulse_on_the_direction_channel_at_an_edge_is_no_reversal() {
+    use host_sim::app::analyze::{Channel, Lead};
+    let rev = std::f64::consts::TAU;
+    let off = 0.37 * rev / 50.0;
+    let stops = [8.0 * rev + off, 4.0 * rev + off, 12.0 * rev + off];
+    let (text, turns, backwards) = quadrature(50, 40.0, &stops);
+    // Rows "t,A,B,Z": a pulse on B across A's rising edges at 2 and 6 revolutions (forward,
+    // before the turn) and at 10 (forward again after it).
+    let at = [
+        2.0 * rev / 40.0,
+        6.0 * rev / 40.0,
+        turns[1] + 6.0 * rev / 40.0,
+    ];
+    // (`h`: B up `h` before A's edge and back `h` after it.)
+    let pulsed = |h: f64| {
+        let mut rows: Vec<(f64, [u8; 3])> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                let v = |i: usize| f[i].parse::<u8>().unwrap();
+                (f[0].parse().unwrap(), [v(1), v(2), v(3)])
+            })
+            .collect();
+        for &a in &at {
+            let k = (1..rows.len())
+                .find(|&k| rows[k].0 >= a && rows[k - 1].1[0] == 0 && rows[k].1[0] == 1)
+                .unwrap();
+            let (t, mut l) = rows[k];
+            let before = rows[k - 1].1;
+            l[1] ^= 1;
+            rows[k].1 = l;
+            let mut back = l;
+            back[1] ^= 1;
+            let mut early = before;
+            early[1] ^= 1;
+            rows.splice(k..k, [(t - h, early)]);
+            rows.insert(k + 2, (t + h, back));
+        }
+        let mut glitched = String::from("Time [s],A,B,Z\n");
+        for (t, l) in &rows {
+            glitched.push_str(&format!("{t:.9},{},{},{}\n", l[0], l[1], l[2]));
+        }
+        glitched
+    };
+    let run = |text: &str| {
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            index_channel: Some(Channel::Name("Z".into())),
+            direction_channel: Some(Channel::Name("B".into())),
+            forward: Some(Lead::ALeads),
+            ..index_lines(50)
+        })
+        .unwrap();
+        let mut reader = text_reader(text.to_string(), "q.csv", None).unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {}).unwrap()
+    };
+    let clean = run(&text);
+    let r = run(&pulsed(2e-6));
+    assert_eq!(clean.direction_glitches, 0);
+    assert_eq!(
+        (r.reversals, r.direction_glitches, r.reverse_edges as usize),
+        (1, 3, backwards),
+        "{:?}",
+        r.faults
+    );
+    assert!(r
+        .faults
+        .iter()
+        .all(|f| f.fault != "reversal" || (f.time > turns[0] && f.time < turns[1])));
+    // As the clean capture: the same sync, revolutions and windows.
+    assert_eq!(
+        (
+            r.sync_losses,
+            r.revolutions,
+            r.valid_windows,
+            r.invalid_windows
+        ),
+        (
+            clean.sync_losses,
+            clean.revolutions,
+            clean.valid_windows,
+            clean.invalid_windows
+        )
+    );
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains("direction channel: 3 glitch(es) on B at edges of A, read as forward"),
+        "{said}"
+    );
+    // A pulse wider than an eighth of a pitch (3.1 ms here) is not taken for noise: B's
+    // level at the edge is read as it is, a reverse edge.
+    let r = run(&pulsed(0.25e-3));
+    assert_eq!(r.direction_glitches, 0);
+    assert!(r.reversals > 1, "{:?}", r.faults);
+}
+
 /// A file cut off in the middle of its last row (a recording or a copy interrupted) is an
 /// error that says so and what to do; the same row with its line end is an ordinary bad row,
 /// and a complete last row without a line end is read.
@@ -1654,6 +1757,65 @@ fn saleae_of_rising(rising: &[f64], rate: f64, end: f64) -> String {
     }
     s.push_str(&format!("{end:.9},0\n"));
     s
+}
+
+/// A capture of more windows than are listed (20 500 revolutions of a 4-line disc, a window
+/// each): the counts and the text count every window, --json says how many it lists of how
+/// many, the text says where the others are (in no list), and the δ plot covers the whole
+/// capture, decimated (it stopped at the last listed window, and the text counted "more
+/// windows" from the listed ones).
+#[test]
+fn windows_past_the_listed_are_counted_and_plotted() {
+    use host_sim::app::analyze::MAX_LISTED;
+    let omega = 100.0;
+    let pitch = std::f64::consts::TAU / 4.0 / omega;
+    let rising: Vec<f64> = (0..4 * 20_500).map(|k| 1e-3 + k as f64 * pitch).collect();
+    let end = rising.last().unwrap() + pitch;
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(4),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(saleae_of_rising(&rising, 1e8, end), "long.csv", None).unwrap();
+    let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let total = u64::from(r.valid_windows + r.invalid_windows);
+    assert!(total > 20_000, "{total}");
+    assert_eq!(r.windows_total, total);
+    assert_eq!(r.windows.len(), MAX_LISTED);
+    assert_eq!(r.windows_listed, MAX_LISTED as u64);
+    assert_eq!(r.faults_total, r.faults_listed);
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["windows_total"], total);
+    assert_eq!(json["windows_listed"], MAX_LISTED as u64);
+    let said = host_sim::app::analyze::text(&r);
+    assert!(
+        said.contains(&format!(
+            "  ... {} more windows: --json lists the first {MAX_LISTED} of the {total} windows \
+             (the counts above count them all); the other {} are in no list, and the δ plot \
+             (--plot) shows them all",
+            total - 40,
+            total - MAX_LISTED as u64
+        )),
+        "{said}"
+    );
+    // The δ plot: to the end of the capture, one window in 2, and it says so.
+    assert_eq!(r.delta_every, 2);
+    let last = r.delta_trace.last().unwrap().0;
+    assert!(last > end - 3.0 * 4.0 * pitch, "{last} of {end}");
+    assert!(
+        r.delta_trace.len() as u64 >= total / 2 - 1,
+        "{}",
+        r.delta_trace.len()
+    );
+    let (_dir, file) = tmp("plots");
+    std::fs::create_dir_all(&file).unwrap();
+    host_sim::app::analyze::plots(&r, "long", &file).unwrap();
+    let svg = std::fs::read_to_string(file.join("long-delta.svg")).unwrap();
+    assert!(
+        svg.contains(&format!("one window in 2 of {total}: decimated")),
+        "{}",
+        &svg[..svg.len().min(2000)]
+    );
 }
 
 /// Lines faster than the timer ticks (an edge every 0.77 ticks of a 1 MHz timer: 8192 lines at

@@ -586,6 +586,93 @@ fn sweep_steps_and_criterion_machines_are_bounded() {
         assert!(err.contains("allowed"), "{args:?}: {err}");
     }
 }
+/// A number out of an option's range is refused with the project's message naming the value
+/// and the range, also when it is beyond the type the option is held in (clap said
+/// "70000 is not in 0..=65535") or negative (clap took `-1` for an unknown argument).
+#[test]
+fn numbers_out_of_range_name_the_value_and_the_range() {
+    let dir = scratch("range");
+    let file = dir.path().join("c.csv");
+    std::fs::write(&file, "Time [s],Channel 0\n0.0,0\n0.001,1\n").unwrap();
+    let f = file.to_str().unwrap();
+    let cases: [(&[&str], &str); 12] = [
+        (
+            &["--lines", "500", "--window-revolutions", "70000"],
+            "--window-revolutions 70000 is out of range: a window is 1 to 1024 revolutions",
+        ),
+        (
+            &["--lines", "500", "--window-revolutions", "-1"],
+            "--window-revolutions -1 is out of range: a window is 1 to 1024 revolutions",
+        ),
+        (
+            &["--lines", "500", "--window-revolutions", "2000"],
+            "--window-revolutions 2000 is out of range: a window is 1 to 1024 revolutions",
+        ),
+        (
+            &["--lines", "500", "--min-speed", "-1"],
+            "--min-speed -1 is out of range: the slowest speed still running is above 0 rad/s",
+        ),
+        (
+            &["--lines", "70000"],
+            "--lines 70000 is out of range: a disc has 2 to 8192 lines",
+        ),
+        (
+            &["--lines", "-5"],
+            "--lines -5 is out of range: a disc has 2 to 8192 lines",
+        ),
+        (
+            &["--lines", "500", "--counter-bits", "300"],
+            "--counter-bits 300 is out of range: the counter is 16 to 32 bits wide",
+        ),
+        (
+            &["--lines", "500", "--prescaler", "-4"],
+            "--prescaler -4 is out of range: the input prescaler is 1, 2, 4 or 8",
+        ),
+        (
+            &["--lines", "500", "--estimator-edges", "70000"],
+            "--estimator-edges 70000 is out of range: a speed sample spans 1 to",
+        ),
+        (
+            &["--lines", "500", "--timer-hz", "-1e6"],
+            "--timer-hz -1000000 is out of range: the timer clock is 1 Hz to 10 GHz",
+        ),
+        (
+            &["--lines", "500", "--sample-rate", "-1"],
+            "--sample-rate -1: allowed 1 to 1e12 Hz",
+        ),
+        (
+            &["--lines", "500", "--timer-hz", "1e11"],
+            "--timer-hz 100000000000 is out of range: the timer clock is 1 Hz to 10 GHz",
+        ),
+    ];
+    for (options, said) in cases {
+        let mut args = vec!["analyze", f];
+        args.extend_from_slice(options);
+        let (ok, _, err) = drive_sim(&args);
+        assert!(!ok, "{args:?}");
+        assert!(err.contains(said), "{args:?}: {err}");
+    }
+    // sweep and criterion: a negative count or seed is a value out of range, not an argument.
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &[
+                "sweep", "one-mass", "--from", "40", "--to", "110", "--steps", "-1",
+            ],
+            "allowed 2 to 1000",
+        ),
+        (&["criterion", "--machines", "-3"], "allowed 1 to 1000"),
+        (
+            &["criterion", "--seed", "-1"],
+            "allowed 0 to 18446744073709551615",
+        ),
+    ];
+    for (args, said) in cases {
+        let (ok, _, err) = drive_sim(args);
+        assert!(!ok, "{args:?}");
+        assert!(err.contains(said), "{args:?}: {err}");
+    }
+}
+
 #[test]
 fn undersized_balancer_is_a_design_result() {
     // Two loads of 0.5 kg on 0.1 m (N·m·R = 0.1 kg·m) against a rotor unbalance of 0.12 kg·m:

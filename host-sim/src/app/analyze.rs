@@ -584,10 +584,23 @@ pub struct AnalyzeReport {
     pub valid_windows: u32,
     /// Invalid windows.
     pub invalid_windows: u32,
-    /// The windows (at most [`MAX_LISTED`]).
+    /// The windows (at most [`MAX_LISTED`], the first).
     pub windows: Vec<WindowOut>,
-    /// The faults (at most [`MAX_LISTED`]).
+    /// The faults (at most [`MAX_LISTED`], the first).
     pub faults: Vec<FaultOut>,
+    /// How many windows the capture gave in all, and how many of them `windows` lists.
+    pub windows_total: u64,
+    /// How many windows `windows` lists (the first; fewer than `windows_total` past the cap).
+    pub windows_listed: u64,
+    /// How many faults the capture gave in all (each counter above's), and how many `faults`
+    /// lists.
+    pub faults_total: u64,
+    /// How many faults `faults` lists (the first).
+    pub faults_listed: u64,
+    /// How many changes of the sync state there were in all.
+    pub sync_changes_total: u64,
+    /// How many changes `sync` lists (the first).
+    pub sync_changes_listed: u64,
     /// Edges fed in reverse (with a direction channel): the core takes none as a tooth.
     pub reverse_edges: u64,
     /// Of them, captures with no step forward of the quadrature count (the encoder and
@@ -598,6 +611,11 @@ pub struct AnalyzeReport {
     /// stepped back by 4 or more): the disc turning the other way, or a `--forward` the wrong
     /// way round for the wiring when it is most of the capture.
     pub backward_pitches: u64,
+    /// Edges of A at which B read reverse but pulsed: B changed just before the edge and back
+    /// just after, both within an eighth of a pitch (at the speed of the capture before), with
+    /// the quadrature count forward since the capture before: a noise pulse on the direction
+    /// channel, fed as forward (not counted in `reverse_edges`).
+    pub direction_glitches: u64,
     /// Edges fed running forward that were neither taken as teeth nor rejected as glitches:
     /// the last edges of the capture, waiting for the two that would confirm them, and the
     /// first edge after a standstill or a reversal (a time reference only).
@@ -607,6 +625,13 @@ pub struct AnalyzeReport {
     /// The speed samples against time, decimated (for the plot).
     #[serde(skip)]
     pub speed_trace: Vec<(f64, f64)>,
+    /// δ against each window's end, of every `delta_every`-th window of the capture (for the
+    /// plot: every window, not only those listed, decimated to at most [`MAX_TRACE`] points).
+    #[serde(skip)]
+    pub delta_trace: Vec<(f64, f64)>,
+    /// The decimation of `delta_trace` (1: every window).
+    #[serde(skip)]
+    pub delta_every: u64,
 }
 
 impl AnalyzeReport {
@@ -1533,7 +1558,26 @@ pub fn analyze<R: BufRead>(
         _ => Vec::new(),
     };
     let longest_gap = runs.iter().map(|&(_, g)| g as f64).fold(1.0, f64::max);
-    while let Some((t, levels)) = reader.next_row()? {
+    // A row read ahead (to see whether B comes back just after an edge of A), and the time
+    // of B's last change and of the capture before.
+    let (mut ahead, mut row): (Option<(f64, Vec<Level>)>, Vec<Level>) = (None, Vec::new());
+    let (mut b_changed_at, mut captured_at) = (f64::NEG_INFINITY, None::<f64>);
+    loop {
+        let t = match ahead.take() {
+            Some((t, l)) => {
+                row = l;
+                t
+            }
+            None => match reader.next_row()? {
+                Some((t, l)) => {
+                    row.clear();
+                    row.extend_from_slice(l);
+                    t
+                }
+                None => break,
+            },
+        };
+        let levels = &row[..];
         if report.rows == 0 {
             report.span[0] = t;
             prev = levels.to_vec();
@@ -1633,8 +1677,25 @@ pub fn analyze<R: BufRead>(
         if encoder_edge && dch.is_some() && direction.is_none() {
             report.direction_unknown += 1;
         }
-        if direction == Some(Direction::Reverse) {
-            report.reverse_edges += 1;
+        // Whether B's level at this edge of A is half of a pulse, B then to come back.
+        let b_pulse = match dch {
+            Some((d, _)) if prev[d] != levels[d] => {
+                b_changed_at = t;
+                None
+            }
+            // (`moved_before` is now this capture's: a step forward since the one before.)
+            Some((d, _))
+                if encoder_edge && moved_before && direction == Some(Direction::Reverse) =>
+            {
+                let pitch = captured_at.map(|c| (t - c) / f64::from(prescaler));
+                pitch
+                    .filter(|&p| t - b_changed_at <= p / 8.0)
+                    .map(|p| (d, b_changed_at + p / 8.0))
+            }
+            _ => None,
+        };
+        if encoder_edge {
+            captured_at = Some(t);
         }
         prev.copy_from_slice(levels);
         if let (Some(p), Some(t0)) = (period, previous_time) {
@@ -1656,6 +1717,22 @@ pub fn analyze<R: BufRead>(
             }
         }
         previous_time = Some(t);
+        if let Some((d, until)) = b_pulse {
+            // B back to its level before the pulse within an eighth of a pitch of leaving it,
+            // A unchanged: the shaft stepped forward (the pulse's three steps back would be
+            // three quarters of a pitch in that time), and B's level at A's edge was noise.
+            if let Some((t2, l)) = reader.next_row()? {
+                if t2 <= until && l[d] != levels[d] && l[d] != Level::Unknown && l[ch] == levels[ch]
+                {
+                    direction = Some(Direction::Forward);
+                    report.direction_glitches += 1;
+                }
+                ahead = Some((t2, l.to_vec()));
+            }
+        }
+        if direction == Some(Direction::Reverse) {
+            report.reverse_edges += 1;
+        }
         if !index_edge && !encoder_edge {
             continue;
         }
@@ -1743,6 +1820,10 @@ pub fn analyze<R: BufRead>(
     report.syncs = e.syncs;
     report.sync_losses = e.sync_losses;
     report.valid_windows = d.valid_windows;
+    report.windows_listed = report.windows.len() as u64;
+    report.faults_listed = report.faults.len() as u64;
+    report.sync_changes_listed = report.sync.len() as u64;
+    report.delta_every = report.delta_every.max(1);
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
@@ -2387,6 +2468,7 @@ impl State {
                     if f == Fault::MissingFrame {
                         self.frames_listed += 1;
                     }
+                    report.faults_total += 1;
                     if report.faults.len() < MAX_LISTED {
                         report.faults.push(FaultOut {
                             time,
@@ -2406,6 +2488,7 @@ impl State {
         while self.frames_listed < counted {
             self.frames_listed += 1;
             let time = clock.latest.1;
+            report.faults_total += 1;
             if report.faults.len() < MAX_LISTED {
                 report.faults.push(FaultOut {
                     time,
@@ -2430,6 +2513,7 @@ impl State {
             if s == SyncState::Synced && report.sync_acquired.is_none() {
                 report.sync_acquired = Some(time);
             }
+            report.sync_changes_total += 1;
             if report.sync.len() < MAX_LISTED {
                 report.sync.push(SyncOut {
                     time,
@@ -2443,9 +2527,6 @@ impl State {
     }
 
     fn window(&self, r: &WindowReport, clock: &Clock, report: &mut AnalyzeReport) {
-        if report.windows.len() >= MAX_LISTED {
-            return;
-        }
         let at = |edge: u32, ticks: u32| {
             self.frames
                 .iter()
@@ -2454,14 +2535,29 @@ impl State {
                 .map_or_else(|| clock.time(ticks), |&(_, t)| t)
         };
         let m = r.measurement();
+        let end = if r.valid() {
+            at(r.end_edge, r.end_ticks)
+        } else {
+            clock.time(r.end_ticks)
+        };
+        // Every window to the δ plot, every `delta_every`-th past MAX_TRACE of them.
+        let every = report.delta_every.max(1);
+        if let (Some(m), 0) = (m, report.windows_total % every) {
+            report.delta_trace.push((end, f64::from(m.delta)));
+            if report.delta_trace.len() >= MAX_TRACE {
+                let kept = report.delta_trace.iter().step_by(2).copied().collect();
+                report.delta_trace = kept;
+                report.delta_every = every * 2;
+            }
+        }
+        report.windows_total += 1;
+        if report.windows.len() >= MAX_LISTED {
+            return;
+        }
         let f = |x: f32| Some(f64::from(x));
         report.windows.push(WindowOut {
             start: at(r.start_edge, r.start_ticks),
-            end: if r.valid() {
-                at(r.end_edge, r.end_ticks)
-            } else {
-                clock.time(r.end_ticks)
-            },
+            end,
             start_edge: r.start_edge,
             end_edge: r.end_edge,
             revolutions: r.revolutions,
@@ -2772,8 +2868,13 @@ pub fn text(r: &AnalyzeReport) -> String {
     for e in r.sync.iter().take(20) {
         let _ = writeln!(s, "  {:>12.6} s  {}", e.time, e.state);
     }
-    if r.sync.len() > 20 {
-        let _ = writeln!(s, "  ... {} more changes (see --json)", r.sync.len() - 20);
+    if r.sync_changes_total > 20 {
+        let _ = writeln!(
+            s,
+            "  ... {} more changes{}",
+            r.sync_changes_total - 20,
+            where_listed(r.sync_changes_total, r.sync_changes_listed, "changes", "")
+        );
     }
     if r.reverse_edges > 0 {
         let _ = writeln!(
@@ -2799,6 +2900,17 @@ pub fn text(r: &AnalyzeReport) -> String {
              before, itself so, and less than a pitch back: no pitch (a shaft at rest rocking \
              across a line edge, or turning back across one), fed as reverse",
             r.no_pitch
+        );
+    }
+    if r.direction_glitches > 0 {
+        let _ = writeln!(
+            s,
+            "direction channel: {} glitch(es) on {} at edges of {}, read as forward (it changed \
+             and came back within an eighth of a pitch across the edge, the quadrature count \
+             going on forward: a noise pulse, not a reversal)",
+            r.direction_glitches,
+            r.direction_channel.as_deref().unwrap_or("B"),
+            r.channel
         );
     }
     if r.unjudged_at_end > 0 {
@@ -2870,11 +2982,17 @@ pub fn text(r: &AnalyzeReport) -> String {
             }
         }
     }
-    if r.windows.len() > 40 {
+    if r.windows_total > 40 {
         let _ = writeln!(
             s,
-            "  ... {} more windows (see --json)",
-            r.windows.len() - 40
+            "  ... {} more windows{}",
+            r.windows_total - 40,
+            where_listed(
+                r.windows_total,
+                r.windows_listed,
+                "windows",
+                ", and the δ plot (--plot) shows them all"
+            )
         );
     }
     if !r.faults.is_empty() {
@@ -2882,11 +3000,29 @@ pub fn text(r: &AnalyzeReport) -> String {
         for f in r.faults.iter().take(40) {
             let _ = writeln!(s, "  {:>12.6} s  {}", f.time, f.fault);
         }
-        if r.faults.len() > 40 {
-            let _ = writeln!(s, "  ... {} more faults (see --json)", r.faults.len() - 40);
+        if r.faults_total > 40 {
+            let _ = writeln!(
+                s,
+                "  ... {} more faults{}",
+                r.faults_total - 40,
+                where_listed(r.faults_total, r.faults_listed, "faults", "")
+            );
         }
     }
     s
+}
+
+/// Where the items of a list past the text's first are: `--json`, which lists them all or the
+/// first [`MAX_LISTED`] (`total` of them, `listed` in `--json`; `also`: what else shows them).
+fn where_listed(total: u64, listed: u64, what: &str, also: &str) -> String {
+    if listed >= total {
+        return " (see --json)".into();
+    }
+    format!(
+        ": --json lists the first {listed} of the {total} {what} (the counts above count them \
+         all); the other {} are in no list{also}",
+        total - listed
+    )
 }
 
 /// The speed plot (and δ per window) into `dir`: returns the files written.
@@ -2910,7 +3046,14 @@ pub fn plots(
     }];
     if !r.faults.is_empty() {
         series.push(Series {
-            label: "fault".into(),
+            label: if r.faults_listed < r.faults_total {
+                format!(
+                    "fault (the first {} of {})",
+                    r.faults_listed, r.faults_total
+                )
+            } else {
+                "fault".into()
+            },
             points: r
                 .faults
                 .iter()
@@ -2931,11 +3074,8 @@ pub fn plots(
         },
     )?;
     files.push(path);
-    let deltas: Vec<(f64, f64)> = r
-        .windows
-        .iter()
-        .filter_map(|w| w.delta.map(|d| (w.end, d)))
-        .collect();
+    // Every window of the capture (not only those listed), decimated past MAX_TRACE.
+    let deltas = r.delta_trace.clone();
     let path = dir.join(format!("{stem}-delta.svg"));
     write_svg(
         &path,
@@ -2944,7 +3084,10 @@ pub fn plots(
             x_label: "capture time at the window's end, s",
             y_label: "δ",
             series: vec![Series {
-                label: "δ".into(),
+                label: match r.delta_every {
+                    0 | 1 => "δ".into(),
+                    k => format!("δ (one window in {k} of {}: decimated)", r.windows_total),
+                },
                 points: deltas,
                 markers: true,
             }],
@@ -3049,7 +3192,7 @@ fn option_given(o: &AnalyzeOptions, enc: &EncoderConfig, parameter: &str) -> Str
 /// The allowed values of an encoder parameter with a fixed range, as the options give them.
 fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
     use drive_monitor::encoder::{MAX_PATTERN_POSITIONS, MAX_PATTERN_TEETH, MAX_SPAN};
-    use drive_monitor::ConfigError::{Capacity, OutOfRange};
+    use drive_monitor::ConfigError::{Capacity, NonFinite, NotPositive, OutOfRange};
     match e {
         OutOfRange("lines") => Some(format!(
             "a disc has 2 to {} lines",
@@ -3061,7 +3204,13 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
         )),
         OutOfRange("prescaler") => Some("the input prescaler is 1, 2, 4 or 8".into()),
         OutOfRange("counter_bits") => Some("the counter is 16 to 32 bits wide".into()),
-        OutOfRange("timer_hz") => Some("the timer clock is 1 Hz to 10 GHz".into()),
+        OutOfRange("timer_hz") | NotPositive("timer_hz") | NonFinite("timer_hz") => {
+            Some("the timer clock is 1 Hz to 10 GHz".into())
+        }
+        // (How slow a speed fits depends on the timer and the counter: said when it does not.)
+        NotPositive("min_speed") | NonFinite("min_speed") => {
+            Some("the slowest speed still running is above 0 rad/s".into())
+        }
         OutOfRange("window.revolutions") => Some(format!(
             "a window is 1 to {} revolutions",
             drive_monitor::irregularity::MAX_WINDOW_REVS
@@ -3073,6 +3222,22 @@ fn allowed(e: drive_monitor::ConfigError) -> Option<String> {
         )),
         _ => None,
     }
+}
+
+/// The message for a whole number given to `option` (`--window-revolutions`) that the type it
+/// is held in cannot hold (beyond 65535, or negative): out of the option's range, said as
+/// [`configure`] says a value out of it; `None` for an option without a fixed range.
+pub fn out_of_range(option: &str, value: &str) -> Option<String> {
+    let parameter = match option {
+        "--lines" => "lines",
+        "--counter-bits" => "counter_bits",
+        "--prescaler" => "prescaler",
+        "--estimator-edges" => "estimator.edges",
+        "--window-revolutions" => "window.revolutions",
+        _ => return None,
+    };
+    allowed(drive_monitor::ConfigError::OutOfRange(parameter))
+        .map(|range| format!("{option} {value} is out of range: {range}"))
 }
 
 /// Checks the options and builds the analysis they describe.

@@ -21,6 +21,8 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+// (Parsed once: analyze's whole numbers are held wide so that their range can be said.)
+#[allow(clippy::large_enum_variant)]
 enum Command {
     /// Simulate a scene, feed its encoder edges to the core, report.
     Run {
@@ -66,7 +68,7 @@ enum Command {
         /// Saleae Logic 1.x export with sample numbers for times needs it (sample n is at
         /// n / rate s); for any format it widens the windows' noise floor by the sampling's
         /// resolution (a time is known to one sample period besides the timer's tick).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sample_rate: Option<f64>,
         /// Print JSON.
         #[arg(long)]
@@ -108,7 +110,7 @@ enum Command {
         #[arg(long, allow_negative_numbers = true)]
         to: f64,
         /// Number of speeds (2 to 1000).
-        #[arg(long, default_value_t = 20, value_parser = sweep_steps)]
+        #[arg(long, default_value_t = 20, value_parser = sweep_steps, allow_negative_numbers = true)]
         steps: usize,
         /// Start the loads together at rest instead of near the balancing position.
         #[arg(long)]
@@ -124,10 +126,15 @@ enum Command {
     /// agreement, simulated boundary shifts and the margin band they need.
     Criterion {
         /// Number of machines (platforms cycle 1, 2, 3; 1 to 1000).
-        #[arg(long, default_value_t = 30, value_parser = criterion_machines)]
+        #[arg(
+            long,
+            default_value_t = 30,
+            value_parser = criterion_machines,
+            allow_negative_numbers = true
+        )]
         machines: usize,
         /// Seed of the draws.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = seed, allow_negative_numbers = true)]
         seed: u64,
         /// Print JSON.
         #[arg(long)]
@@ -179,8 +186,8 @@ struct AnalyzeArgs {
     #[arg(long)]
     wheel: Option<String>,
     /// A uniform disc of N lines (framed as --framing says).
-    #[arg(long)]
-    lines: Option<u16>,
+    #[arg(long, allow_negative_numbers = true)]
+    lines: Option<i128>,
     /// How the uniform disc of --lines is framed (default none: no index channel is read, as
     /// a capture need not have one, and the report says so; a scene's [encoder] lines = N is
     /// framed by its index).
@@ -191,26 +198,26 @@ struct AnalyzeArgs {
     #[arg(long)]
     scene: Option<String>,
     /// The emulated capture timer clock, Hz (default 1e6, or the scene's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     timer_hz: Option<f64>,
     /// The emulated counter width, bits (16 to 32; default 32, or the scene's).
-    #[arg(long)]
-    counter_bits: Option<u8>,
+    #[arg(long, allow_negative_numbers = true)]
+    counter_bits: Option<i128>,
     /// The emulated capture's input prescaler: one capture every 1, 2, 4 or 8 edges of the
     /// channel, as a timer's input prescaler takes them (default 1, or the scene's; a uniform
     /// disc only, whose lines it divides).
-    #[arg(long)]
-    prescaler: Option<u8>,
+    #[arg(long, allow_negative_numbers = true)]
+    prescaler: Option<i128>,
     /// Slowest speed still running, rad/s (default 1, or the scene's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     min_speed: Option<f64>,
     /// Captured edges per speed sample (with --prescaler P each capture spans P lines;
     /// default 1, or the scene's).
-    #[arg(long)]
-    estimator_edges: Option<u16>,
+    #[arg(long, allow_negative_numbers = true)]
+    estimator_edges: Option<i128>,
     /// Revolutions per δ window (default 1, or the scene's).
-    #[arg(long)]
-    window_revolutions: Option<u16>,
+    #[arg(long, allow_negative_numbers = true)]
+    window_revolutions: Option<i128>,
 }
 
 impl AnalyzeArgs {
@@ -222,15 +229,15 @@ impl AnalyzeArgs {
         };
         Ok(host_sim::app::analyze::AnalyzeOptions {
             wheel: self.wheel,
-            lines: self.lines,
+            lines: narrow("--lines", self.lines)?,
             framing: self.framing,
             scene,
             timer_hz: self.timer_hz,
-            counter_bits: self.counter_bits,
-            prescaler: self.prescaler,
+            counter_bits: narrow("--counter-bits", self.counter_bits)?,
+            prescaler: narrow("--prescaler", self.prescaler)?,
             min_speed: self.min_speed,
-            estimator_edges: self.estimator_edges,
-            window_revolutions: self.window_revolutions,
+            estimator_edges: narrow("--estimator-edges", self.estimator_edges)?,
+            window_revolutions: narrow("--window-revolutions", self.window_revolutions)?,
             channel: Some(self.channel),
             index_channel: self.index_channel,
             direction_channel: self.direction_channel,
@@ -238,6 +245,21 @@ impl AnalyzeArgs {
             edge: self.edge,
         })
     }
+}
+
+/// A whole number given to `option`, in the type the analysis holds it in. The command line
+/// reads it wider, so that one beyond that type (`--window-revolutions 70000`) or negative is
+/// refused with the option's range as `analyze` words it, not the type's (0 to 65535).
+fn narrow<T: TryFrom<i128>>(option: &str, n: Option<i128>) -> Result<Option<T>, Failure> {
+    n.map(|n| {
+        T::try_from(n).map_err(|_| {
+            Failure::Message(
+                host_sim::app::analyze::out_of_range(option, &n.to_string())
+                    .unwrap_or_else(|| format!("{option} {n} is out of range")),
+            )
+        })
+    })
+    .transpose()
 }
 
 /// Most speeds `sweep --steps` accepts (each is a whole simulation of the scene).
@@ -255,8 +277,19 @@ fn criterion_machines(text: &str) -> Result<usize, String> {
     bounded(text, 1, MAX_CRITERION_MACHINES)
 }
 
+/// `--seed`: 0 to 2^64 − 1.
+fn seed(text: &str) -> Result<u64, String> {
+    let range = || format!("allowed 0 to {}", u64::MAX);
+    let n: i128 = text
+        .trim()
+        .parse()
+        .map_err(|e| format!("not a whole number ({e}); {}", range()))?;
+    u64::try_from(n).map_err(|_| range())
+}
+
 fn bounded(text: &str, min: usize, max: usize) -> Result<usize, String> {
-    let n: u128 = text
+    // (Signed: a negative count is out of the range, not "an invalid digit".)
+    let n: i128 = text
         .trim()
         .parse()
         .map_err(|e| format!("not a whole number ({e}); allowed {min} to {max}"))?;
