@@ -1512,8 +1512,8 @@ pub fn analyze<R: BufRead>(
         seen: Seen::default(),
         frames: VecDeque::new(),
         sync: SyncState::Searching,
-        stride: 1,
-        skipped: 0,
+        speeds: Decimated::default(),
+        deltas: Decimated::default(),
         max_revs: usize::from(monitor.window_revolutions()),
         frames_listed: 0,
     };
@@ -1823,7 +1823,7 @@ pub fn analyze<R: BufRead>(
     report.windows_listed = report.windows.len() as u64;
     report.faults_listed = report.faults.len() as u64;
     report.sync_changes_listed = report.sync.len() as u64;
-    report.delta_every = report.delta_every.max(1);
+    report.delta_every = st.deltas.stride.max(1);
     report.invalid_windows = d.invalid_windows;
     report.sync_state = sync_name(monitor.sync_state());
     report.index_period = periods.period(enc.edges());
@@ -2384,15 +2384,44 @@ impl Polls {
     }
 }
 
+/// A plot's trace kept to at most [`MAX_TRACE`] points: every `stride`-th point offered,
+/// the stride doubled and the trace halved each time it fills.
+#[derive(Default)]
+struct Decimated {
+    /// Keep every `stride`-th point (0 before the first: 1); `skipped` since the last kept.
+    stride: u64,
+    skipped: u64,
+}
+
+impl Decimated {
+    fn offer(&mut self, trace: &mut Vec<(f64, f64)>, point: Option<(f64, f64)>) {
+        self.stride = self.stride.max(1);
+        self.skipped += 1;
+        if self.skipped < self.stride {
+            return;
+        }
+        self.skipped = 0;
+        if let Some(p) = point {
+            trace.push(p);
+        }
+        if trace.len() >= MAX_TRACE {
+            // Halve the trace and keep every other point from now on.
+            let kept: Vec<(f64, f64)> = trace.iter().step_by(2).copied().collect();
+            *trace = kept;
+            self.stride *= 2;
+        }
+    }
+}
+
 /// The analysis state between calls to the monitor.
 struct State {
     seen: Seen,
     /// Times of recent frame teeth by accepted-edge number (window starts).
     frames: VecDeque<(u32, f64)>,
     sync: SyncState,
-    /// Keep every `stride`-th speed sample; `skipped` since the last kept.
-    stride: u64,
-    skipped: u64,
+    /// The decimation of the speed trace and of the δ trace.
+    speeds: Decimated,
+    deltas: Decimated,
     max_revs: usize,
     /// Missing frames accounted for in the fault list (listed, or left out past its cap).
     frames_listed: u32,
@@ -2441,18 +2470,7 @@ impl State {
                         self.frames.push_back((t.index, time));
                     }
                     if let Some(w) = speed.filter(|_| t.synced) {
-                        self.skipped += 1;
-                        if self.skipped >= self.stride {
-                            self.skipped = 0;
-                            report.speed_trace.push((time, w));
-                            if report.speed_trace.len() >= MAX_TRACE {
-                                // Halve the trace and keep every other sample from now on.
-                                let kept: Vec<(f64, f64)> =
-                                    report.speed_trace.iter().step_by(2).copied().collect();
-                                report.speed_trace = kept;
-                                self.stride *= 2;
-                            }
-                        }
+                        self.speeds.offer(&mut report.speed_trace, Some((time, w)));
                     }
                     if t.synced && synced_at.is_none() {
                         synced_at = Some(time);
@@ -2526,7 +2544,7 @@ impl State {
         }
     }
 
-    fn window(&self, r: &WindowReport, clock: &Clock, report: &mut AnalyzeReport) {
+    fn window(&mut self, r: &WindowReport, clock: &Clock, report: &mut AnalyzeReport) {
         let at = |edge: u32, ticks: u32| {
             self.frames
                 .iter()
@@ -2540,16 +2558,11 @@ impl State {
         } else {
             clock.time(r.end_ticks)
         };
-        // Every window to the δ plot, every `delta_every`-th past MAX_TRACE of them.
-        let every = report.delta_every.max(1);
-        if let (Some(m), 0) = (m, report.windows_total % every) {
-            report.delta_trace.push((end, f64::from(m.delta)));
-            if report.delta_trace.len() >= MAX_TRACE {
-                let kept = report.delta_trace.iter().step_by(2).copied().collect();
-                report.delta_trace = kept;
-                report.delta_every = every * 2;
-            }
-        }
+        // Every window to the δ plot (those with a δ), every `stride`-th past MAX_TRACE.
+        self.deltas.offer(
+            &mut report.delta_trace,
+            m.map(|m| (end, f64::from(m.delta))),
+        );
         report.windows_total += 1;
         if report.windows.len() >= MAX_LISTED {
             return;

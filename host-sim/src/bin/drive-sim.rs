@@ -279,22 +279,21 @@ fn criterion_machines(text: &str) -> Result<usize, String> {
 
 /// `--seed`: 0 to 2^64 − 1.
 fn seed(text: &str) -> Result<u64, String> {
-    let range = || format!("allowed 0 to {}", u64::MAX);
-    let n: i128 = text
-        .trim()
-        .parse()
-        .map_err(|e| format!("not a whole number ({e}); {}", range()))?;
-    u64::try_from(n).map_err(|_| range())
+    bounded(text, 0, u64::MAX)
 }
 
-fn bounded(text: &str, min: usize, max: usize) -> Result<usize, String> {
+/// A whole number from `min` to `max`.
+fn bounded<T>(text: &str, min: T, max: T) -> Result<T, String>
+where
+    T: TryFrom<i128> + PartialOrd + std::fmt::Display,
+{
     // (Signed: a negative count is out of the range, not "an invalid digit".)
     let n: i128 = text
         .trim()
         .parse()
         .map_err(|e| format!("not a whole number ({e}); allowed {min} to {max}"))?;
-    match usize::try_from(n) {
-        Ok(n) if (min..=max).contains(&n) => Ok(n),
+    match T::try_from(n) {
+        Ok(n) if min <= n && n <= max => Ok(n),
         _ => Err(format!("allowed {min} to {max}")),
     }
 }
