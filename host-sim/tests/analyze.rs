@@ -3163,21 +3163,7 @@ fn a_saleae_logic_1_export_with_sample_numbers_reads_as_its_time_stamps() {
         assert!(by_time.valid_windows >= 2, "{}", by_time.valid_windows);
         assert_eq!(by_number.sample_numbers.as_deref(), Some("Sample Number"));
         assert_eq!(by_time.sample_numbers, None);
-        let windows = |r: &AnalyzeReport| {
-            r.windows
-                .iter()
-                .map(|w| {
-                    (
-                        w.valid,
-                        w.delta,
-                        w.floor_with_sampling,
-                        w.start_edge,
-                        w.end_edge,
-                    )
-                })
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(windows(&by_number), windows(&by_time), "{rate}");
+        assert_eq!(window_rows(&by_number), window_rows(&by_time), "{rate}");
         assert_eq!(
             (
                 by_number.captured,
@@ -3780,4 +3766,401 @@ fn an_index_at_a_line_edge_is_named_as_such() {
     );
     assert_eq!(report.invalid_windows, 0, "{said}");
     assert!(report.valid_windows >= 20, "{said}");
+}
+
+/// How [`session_file`] writes a sigrok session file.
+struct SessionLayout {
+    /// The metadata's `[device 1]` keys before the probes (`capturefile`, `total probes`,
+    /// `samplerate`, `unitsize`, ...), one `key=value` a line.
+    keys: &'static str,
+    /// The probe numbers (1-based) of the capture's channels, in order.
+    probes: &'static [u32],
+    /// Bytes a sample.
+    unitsize: usize,
+    /// A probe not read that toggles every 7 samples, when given.
+    extra: Option<u32>,
+    /// Bytes an entry.
+    chunk: usize,
+    deflated: bool,
+    /// The entries written last first (the archive's order is not theirs).
+    reversed: bool,
+}
+
+/// A window as [`window_rows`] gives it.
+type WindowRow = (bool, Option<f64>, Option<f64>, u32, u32);
+
+/// Each window as two analyses of one capture are compared: valid, δ, the floor with the
+/// sampling, its first and last edge.
+fn window_rows(r: &AnalyzeReport) -> Vec<WindowRow> {
+    r.windows
+        .iter()
+        .map(|w| {
+            (
+                w.valid,
+                w.delta,
+                w.floor_with_sampling,
+                w.start_edge,
+                w.end_edge,
+            )
+        })
+        .collect()
+}
+
+/// Writes `entries` as a zip archive at `path`, each stored or deflated.
+fn zip_of(path: &Path, entries: &[(String, Vec<u8>)], deflated: bool) {
+    use std::io::Write as _;
+    let method = if deflated {
+        zip::CompressionMethod::Deflated
+    } else {
+        zip::CompressionMethod::Stored
+    };
+    let options = zip::write::SimpleFileOptions::default().compression_method(method);
+    let mut z = zip::ZipWriter::new(std::fs::File::create(path).unwrap());
+    for (name, bytes) in entries {
+        z.start_file(name.as_str(), options).unwrap();
+        z.write_all(bytes).unwrap();
+    }
+    z.finish().unwrap();
+}
+
+/// The sigrok session file of the sigrok CSV capture `csv` (rows at changes, a 1 MHz time
+/// column in microseconds, `(i+1)` for sample `i`), every sample of it, as `layout` says:
+/// written independently of the reader, following libsigrok's srzip output module.
+fn session_file(csv: &str, path: &Path, layout: &SessionLayout) {
+    let mut words: Vec<u64> = Vec::new();
+    let mut rows = csv.lines().filter(|l| !l.starts_with(';')).skip(1);
+    let mut word = 0u64;
+    for row in rows.by_ref() {
+        let mut fields = row.split(',');
+        let i = fields.next().unwrap().parse::<usize>().unwrap() - 1;
+        while words.len() < i {
+            words.push(word);
+        }
+        word = 0;
+        for (&p, level) in layout.probes.iter().zip(fields) {
+            if level == "1" {
+                word |= 1 << (p - 1);
+            }
+        }
+        words.truncate(i);
+        words.push(word);
+    }
+    let mut bytes = Vec::new();
+    for (i, w) in words.iter().enumerate() {
+        let w = match layout.extra {
+            Some(p) if (i / 7) % 2 == 1 => w | 1 << (p - 1),
+            _ => *w,
+        };
+        bytes.extend_from_slice(&w.to_le_bytes()[..layout.unitsize]);
+    }
+    let mut probes: Vec<(u32, String)> = layout
+        .probes
+        .iter()
+        .enumerate()
+        .map(|(k, &p)| (p, format!("D{k}")))
+        .collect();
+    if let Some(p) = layout.extra {
+        probes.push((p, "spare".into()));
+    }
+    let mut metadata = format!(
+        "[global]\nsigrok version=0.5.2\n\n[device 1]\n{}",
+        layout.keys
+    );
+    for (p, name) in probes {
+        metadata.push_str(&format!("probe{p}={name}\n"));
+    }
+    let mut entries = vec![
+        ("version".to_string(), b"2".to_vec()),
+        ("metadata".to_string(), metadata.into_bytes()),
+    ];
+    let mut chunks: Vec<(String, Vec<u8>)> = bytes
+        .chunks(layout.chunk)
+        .enumerate()
+        .map(|(k, c)| (format!("logic-1-{}", k + 1), c.to_vec()))
+        .collect();
+    if layout.reversed {
+        chunks.reverse();
+    }
+    entries.extend(chunks);
+    zip_of(path, &entries, layout.deflated);
+}
+
+/// A sigrok session file (PulseView's .sr) reads as libsigrok's CSV export of the same samples:
+/// the same windows, δ, floors and counts, whether its entries are deflated or stored, with
+/// samples of one or two bytes, straddling two entries or not, entries in the archive out of
+/// their order, and a channel not read toggling among them.
+#[test]
+fn a_sigrok_session_file_reads_as_its_csv_export() {
+    let (_scratch, csv) = tmp("disc.csv");
+    simulate(
+        &index_disc(1.0).replace("sample_rate = 10e6", "sample_rate = 1e6\ndedup = true"),
+        CaptureFormat::Sigrok,
+        &csv,
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let cfg = configure(&index_lines(24)).unwrap();
+    let read = |file: &Path| {
+        let mut r = CaptureReader::open(file, None, None).unwrap_or_else(|e| panic!("{e}"));
+        let channels = r.channels().to_vec();
+        let format = r.format();
+        let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+        (format, channels, report)
+    };
+    let (format, channels, by_csv) = read(&csv);
+    assert_eq!(format, CaptureFormat::Sigrok);
+    assert_eq!(channels, ["D0", "D1"]);
+    assert!(by_csv.valid_windows >= 2, "{}", by_csv.valid_windows);
+    let summary = |r: &AnalyzeReport| {
+        (
+            window_rows(r),
+            (r.rows, r.captured, r.accepted, r.glitches, r.missing),
+            (r.index_pulses, r.sample_rate, r.span),
+        )
+    };
+    let one = "capturefile=logic-1\ntotal probes=8\nsamplerate=1 MHz\ntotal analog=0\nunitsize=1\n";
+    let two = "capturefile=logic-1\ntotal probes=16\nsamplerate=1 MHz\nunitsize=2\n";
+    let layouts = [
+        SessionLayout {
+            keys: one,
+            probes: &[1, 2],
+            unitsize: 1,
+            extra: None,
+            chunk: 1 << 20,
+            deflated: true,
+            reversed: false,
+        },
+        SessionLayout {
+            keys: one,
+            probes: &[1, 2],
+            unitsize: 1,
+            extra: None,
+            chunk: 40_000,
+            deflated: false,
+            reversed: true,
+        },
+        SessionLayout {
+            keys: two,
+            probes: &[3, 12],
+            unitsize: 2,
+            extra: Some(16),
+            chunk: 65_537,
+            deflated: true,
+            reversed: true,
+        },
+    ];
+    for (k, layout) in layouts.iter().enumerate() {
+        let sr = csv.with_file_name(format!("disc{k}.sr"));
+        session_file(&text, &sr, layout);
+        let (format, channels, by_sr) = read(&sr);
+        assert_eq!(format, CaptureFormat::Sr);
+        assert_eq!(by_sr.format, "sr");
+        let mut expected = vec!["D0".to_string(), "D1".to_string()];
+        if layout.extra.is_some() {
+            expected.push("spare".into());
+        }
+        assert_eq!(channels, expected, "layout {k}");
+        let (sr_windows, sr_counts, sr_rest) = summary(&by_sr);
+        let (csv_windows, csv_counts, csv_rest) = summary(&by_csv);
+        assert_eq!(sr_windows, csv_windows, "layout {k}");
+        assert_eq!(sr_rest, csv_rest, "layout {k}");
+        if layout.extra.is_none() {
+            // (A toggling channel not read adds rows, not edges.)
+            assert_eq!(sr_counts, csv_counts, "layout {k}");
+        } else {
+            assert_eq!(
+                (sr_counts.1, sr_counts.2, sr_counts.3, sr_counts.4),
+                (csv_counts.1, csv_counts.2, csv_counts.3, csv_counts.4)
+            );
+            assert!(sr_counts.0 > csv_counts.0);
+        }
+    }
+}
+
+/// What is wrong with a session file is said, naming the entry or the key: never a guess.
+#[test]
+fn a_sigrok_session_file_is_refused_naming_what_is_wrong() {
+    let (_scratch, path) = tmp("bad.sr");
+    let samples: Vec<u8> = (0..4000u32).map(|i| u8::from(i % 100 < 50)).collect();
+    let meta = |keys: &str| format!("[global]\nsigrok version=0.5.2\n[device 1]\n{keys}");
+    let good = "capturefile=logic-1\ntotal probes=8\nsamplerate=1 MHz\nunitsize=1\nprobe1=D0\n";
+    let error = |version: &str, metadata: Option<String>, chunks: &[(&str, &[u8])], rate| {
+        let mut entries = vec![("version".to_string(), version.as_bytes().to_vec())];
+        if let Some(m) = metadata {
+            entries.push(("metadata".to_string(), m.into_bytes()));
+        }
+        entries.extend(chunks.iter().map(|(n, b)| (n.to_string(), b.to_vec())));
+        zip_of(&path, &entries, true);
+        match CaptureReader::open(&path, None, rate) {
+            Err(e) => e.to_string(),
+            Ok(mut r) => loop {
+                match r.next_row() {
+                    Ok(Some(_)) => continue,
+                    Ok(None) => return String::new(),
+                    Err(e) => break e.to_string(),
+                }
+            },
+        }
+    };
+    let data: &[(&str, &[u8])] = &[("logic-1-1", &samples)];
+    // The good file reads, also as version 1 with one entry `logic-1`.
+    assert_eq!(error("2", Some(meta(good)), data, None), "");
+    assert_eq!(
+        error("1", Some(meta(good)), &[("logic-1", &samples)], None),
+        ""
+    );
+    // (version, metadata, entries of samples, --sample-rate, what the error says)
+    type Case<'a> = (
+        &'a str,
+        Option<String>,
+        &'a [(&'a str, &'a [u8])],
+        Option<f64>,
+    );
+    let cases: [(Case, &[&str]); 10] = [
+        (
+            ("2", None, data, None),
+            &["without the `version` and `metadata`"],
+        ),
+        (
+            ("3", Some(meta(good)), data, None),
+            &["version `3`", "1 and 2"],
+        ),
+        (
+            (
+                "2",
+                Some(meta(&good.replace("samplerate=1 MHz\n", ""))),
+                data,
+                None,
+            ),
+            &["states no samplerate", "--sample-rate"],
+        ),
+        (
+            ("2", Some(meta(&good.replace("1 MHz", "0 Hz"))), data, None),
+            &["states no samplerate"],
+        ),
+        (
+            ("2", Some(meta(good)), data, Some(2e6)),
+            &["samplerate = 1 MHz", "--sample-rate is 2000000 Hz"],
+        ),
+        (
+            (
+                "2",
+                Some(meta(&good.replace("unitsize=1\n", ""))),
+                data,
+                None,
+            ),
+            &["no `unitsize`"],
+        ),
+        (
+            (
+                "2",
+                Some(meta("total analog=1\nsamplerate=1 MHz\nanalog2=A0\n")),
+                &[],
+                None,
+            ),
+            &["no `capturefile`", "analog"],
+        ),
+        (
+            (
+                "2",
+                Some(meta(&good.replace("probe1=D0", "probe9=D8"))),
+                data,
+                None,
+            ),
+            &["`probe9 = D8`", "probes 1 to 8"],
+        ),
+        (
+            (
+                "2",
+                Some(meta(&good.replace("unitsize=1", "unitsize=2"))),
+                &[("logic-1-1", &samples[..3999])],
+                None,
+            ),
+            &["1 byte(s) into a sample of 2", "cut off"],
+        ),
+        (
+            ("2", Some(meta(good)), &[], None),
+            &["no `logic-1-1`", "no samples"],
+        ),
+    ];
+    for ((version, metadata, chunks, rate), says) in cases {
+        let e = error(version, metadata.clone(), chunks, rate);
+        assert!(
+            says.iter().all(|s| e.contains(s)) && e.starts_with(&path.display().to_string()),
+            "{metadata:?}: {e}"
+        );
+    }
+    // A session file given another format, and a text file given `sr`.
+    let wrong = CaptureReader::open(&path, Some(CaptureFormat::Vcd), None)
+        .err()
+        .unwrap();
+    assert!(
+        wrong
+            .to_string()
+            .contains("--format vcd: the file is a zip archive"),
+        "{wrong}"
+    );
+    let (_s, csv) = tmp("x.csv");
+    std::fs::write(&csv, "time_s,level\n0,0\n").unwrap();
+    let wrong = CaptureReader::open(&csv, Some(CaptureFormat::Sr), None)
+        .err()
+        .unwrap();
+    assert!(
+        wrong
+            .to_string()
+            .contains("--format sr: the file is not a zip archive"),
+        "{wrong}"
+    );
+    // Written by `run`: refused, naming what it writes instead.
+    for (file, given) in [("x.sr", None), ("x.csv", Some(CaptureFormat::Sr))] {
+        let e = CaptureFormat::for_file(Path::new(file), given).unwrap_err();
+        assert!(
+            e.contains("not a sigrok session file") && e.contains(".vcd"),
+            "{e}"
+        );
+    }
+}
+
+/// A session file written by libsigrok itself (`sigrok-cli -i … -I vcd -o … .sr`, see
+/// `tests/data/README.md`) reads as the value change dump it was converted from: the same
+/// rows, windows, δ and counts; its last sample, the end of the recording, one sample period
+/// before the dump's closing time.
+#[test]
+fn a_session_file_written_by_libsigrok_reads_as_the_dump_it_came_from() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let cfg = configure(&index_lines(24)).unwrap();
+    let read = |name: &str| {
+        let mut r = CaptureReader::open(&data.join(name), None, None).unwrap();
+        assert_eq!(r.channels(), ["encoder", "index"], "{name}");
+        assert_eq!(r.sample_rate(), Some(1e6), "{name}");
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let (sr, vcd) = (read("disc-100rads.sr"), read("disc-100rads.vcd"));
+    assert_eq!((sr.format, vcd.format), ("sr", "vcd"));
+    assert_eq!(sr.valid_windows, 4);
+    let windows = |r: &AnalyzeReport| {
+        r.windows
+            .iter()
+            .map(|w| {
+                (
+                    w.valid,
+                    w.delta,
+                    w.omega_mean,
+                    w.floor_with_sampling,
+                    w.start_edge,
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(windows(&sr), windows(&vcd));
+    assert_eq!(
+        (sr.rows, sr.edges, sr.accepted, sr.index_pulses, sr.span[0]),
+        (
+            vcd.rows,
+            vcd.edges,
+            vcd.accepted,
+            vcd.index_pulses,
+            vcd.span[0]
+        )
+    );
+    assert_eq!((sr.span[1], vcd.span[1]), (0.399999, 0.4));
 }

@@ -2741,8 +2741,9 @@ pub fn text(r: &AnalyzeReport) -> String {
             s,
             "sampling: the times resolve less finely in places: to {worst:.3e} s ({:.3} timer \
              ticks) from {from:.6} s on (times written to a fixed number of significant digits, \
-             or far from their origin, where an f64 resolves them so); each window's floor \
-             includes the resolution of its own rows",
+             or far from their origin, where an f64 resolves them so, or a capture resampled \
+             from a slower one, such as a value change dump imported by sigrok at its time \
+             unit); each window's floor includes the resolution of its own rows",
             worst * r.timer_hz
         );
     }

@@ -1,8 +1,8 @@
 //! Logic-analyzer capture files: what `drive-sim run --capture` writes and `drive-sim analyze`
 //! reads.
 //!
-//! Three CSV formats and value change dumps ([`vcd`]), each a level-over-time record of one or
-//! more digital channels:
+//! Three CSV formats, value change dumps ([`vcd`]) and sigrok session files ([`srzip`], read
+//! only), each a level-over-time record of one or more digital channels:
 //!
 //! - **Saleae Logic 2** digital export: a header `Time [s],Channel 0,Channel 1,...`, then one
 //!   row per instant at which at least one channel changes, the time in seconds (Logic 2 writes
@@ -51,6 +51,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::encoder::Edge;
 
+mod srzip;
 mod vcd;
 
 /// Longest line read, bytes (a row of [`MAX_CHANNELS`] channels is about 550 bytes).
@@ -76,6 +77,9 @@ pub enum CaptureFormat {
     /// timer's dump, a time-interval analyser's record); a header naming the column, or none.
     /// Read by `analyze` only.
     Times,
+    /// A sigrok session file (`.sr`, libsigrok's srzip: what PulseView saves), read by
+    /// `analyze` only.
+    Sr,
 }
 
 impl CaptureFormat {
@@ -87,6 +91,7 @@ impl CaptureFormat {
             CaptureFormat::Plain => "plain",
             CaptureFormat::Vcd => "vcd",
             CaptureFormat::Times => "times",
+            CaptureFormat::Sr => "sr",
         }
     }
 
@@ -100,6 +105,18 @@ impl CaptureFormat {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let (vcd, csv) = (ext.as_deref() == Some("vcd"), ext.as_deref() == Some("csv"));
+        if given == Some(CaptureFormat::Sr) || ext.as_deref() == Some("sr") {
+            return Err(format!(
+                "{}: `run --capture` writes CSV or a value change dump, not a sigrok session \
+                 file (.sr, which `analyze` reads): give a file ending in .vcd, which PulseView \
+                 opens (File > Import > Value Change Dump), or in .csv",
+                if given == Some(CaptureFormat::Sr) {
+                    "--capture-format sr".to_string()
+                } else {
+                    path.display().to_string()
+                }
+            ));
+        }
         match given {
             Some(CaptureFormat::Times) => Err(
                 "--capture-format times: a file of edge times is what a capture timer's dump \
@@ -130,7 +147,7 @@ impl CaptureFormat {
         let n = if index { 2 } else { 1 };
         match self {
             CaptureFormat::Saleae => (0..n).map(|i| format!("Channel {i}")).collect(),
-            CaptureFormat::Sigrok => (0..n).map(|i| format!("D{i}")).collect(),
+            CaptureFormat::Sigrok | CaptureFormat::Sr => (0..n).map(|i| format!("D{i}")).collect(),
             CaptureFormat::Vcd => ["encoder", "index"][..n]
                 .iter()
                 .map(|s| s.to_string())
@@ -273,6 +290,8 @@ pub struct CaptureReader<R> {
     times_in_seconds: bool,
     /// A Saleae Logic 1.x export with sample numbers for times: its first column's heading.
     sample_column: Option<String>,
+    /// A sigrok session file's samples (the format `Sr`; `input` is then not read).
+    session: Option<Box<srzip::Session>>,
 }
 
 /// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
@@ -423,6 +442,7 @@ impl<R: BufRead> CaptureReader<R> {
             vcd: vcd::Vcd::default(),
             times_in_seconds: false,
             sample_column: None,
+            session: None,
         };
         if let Some(rate) = sample_rate {
             if !(rate.is_finite() && rate > 0.0) {
@@ -434,6 +454,14 @@ impl<R: BufRead> CaptureReader<R> {
                     ),
                 });
             }
+        }
+        // A zip archive is a sigrok session file (its bytes are no text to read lines of).
+        let zipped = r
+            .input
+            .fill_buf()
+            .is_ok_and(|b| b.starts_with(&srzip::ZIP_MAGIC));
+        if zipped || format == Some(CaptureFormat::Sr) {
+            return r.open_session(zipped, format);
         }
         let first = loop {
             match r.read_line()? {
@@ -492,6 +520,8 @@ impl<R: BufRead> CaptureReader<R> {
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
             CaptureFormat::Vcd => r.header_vcd(first)?,
             CaptureFormat::Times => r.header_times(first)?,
+            // (Opened above, from the file's first bytes.)
+            CaptureFormat::Sr => return r.open_session(false, Some(CaptureFormat::Sr)),
         }
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
@@ -504,6 +534,44 @@ impl<R: BufRead> CaptureReader<R> {
         }
         r.levels = vec![Level::Unknown; r.channels.len()];
         Ok(r)
+    }
+
+    /// Reads a sigrok session file's metadata (`zipped`: the file is a zip archive; `format`
+    /// as given).
+    fn open_session(
+        mut self,
+        zipped: bool,
+        format: Option<CaptureFormat>,
+    ) -> Result<Self, CaptureError> {
+        self.format = CaptureFormat::Sr;
+        if let Some(f) = format.filter(|&f| f != CaptureFormat::Sr) {
+            return Err(self.err_here(&format!(
+                "--format {}: the file is a zip archive (a sigrok session file, .sr?), not a \
+                 text export: leave --format out, or give --format sr",
+                f.name()
+            )));
+        }
+        if !zipped {
+            return Err(self.err_here(
+                "--format sr: the file is not a zip archive, as a sigrok session file (.sr) is: \
+                 leave --format out to have the format told from the file",
+            ));
+        }
+        let session = srzip::Session::open(&self.file).map_err(|m| self.err_here(&m))?;
+        self.channels = session.names.clone();
+        match &session.rate {
+            Some((hz, text)) => self.stated_rate(*hz, &format!("samplerate = {text}"))?,
+            None if self.sample_rate.is_none() => {
+                return Err(self.err_here(
+                    "its `metadata` states no samplerate, so the time of a sample cannot be \
+                     told: give --sample-rate (the capture's samples per second)",
+                ))
+            }
+            None => {}
+        }
+        self.levels = vec![Level::Unknown; self.channels.len()];
+        self.session = Some(Box::new(session));
+        Ok(self)
     }
 
     /// The format read.
@@ -552,7 +620,8 @@ impl<R: BufRead> CaptureReader<R> {
         }
         CaptureError {
             file: self.file.clone(),
-            line: Some(self.line.max(1)),
+            // A session file is binary: it has no lines.
+            line: (self.format != CaptureFormat::Sr).then_some(self.line.max(1)),
             message,
         }
     }
@@ -783,6 +852,16 @@ impl<R: BufRead> CaptureReader<R> {
     pub fn next_row(&mut self) -> Result<Option<(f64, &[Level])>, CaptureError> {
         if self.format == CaptureFormat::Vcd {
             return self.next_vcd_row();
+        }
+        if let Some(session) = self.session.as_mut() {
+            let change = session.next_change(&mut self.levels);
+            let Some(i) = change.map_err(|m| self.err_here(&m))? else {
+                return Ok(None);
+            };
+            // As sample i of libsigrok's CSV export is read.
+            let time = i as f64 / self.sample_rate.unwrap_or(1.0);
+            self.advance(time)?;
+            return Ok(Some((time, &self.levels)));
         }
         let line = match self.held.take() {
             Some(l) => l,
@@ -1137,10 +1216,11 @@ impl<W: Write> CaptureWriter<W> {
         let mut head = String::new();
         match s.format {
             // A record of levels is written; edge times are only read (`for_file` refuses them).
-            CaptureFormat::Times => {
+            CaptureFormat::Times | CaptureFormat::Sr => {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidInput,
-                    "a capture is written as saleae, sigrok, plain or vcd, not as edge times",
+                    "a capture is written as saleae, sigrok, plain or vcd, not as edge times or \
+                     a sigrok session file",
                 ))
             }
             CaptureFormat::Saleae => {
@@ -1311,7 +1391,7 @@ impl<W: Write> CaptureWriter<W> {
             CaptureFormat::Saleae => {
                 let _ = write!(self.line, "{:.9}", n as f64 / rate);
             }
-            CaptureFormat::Plain | CaptureFormat::Times => {
+            CaptureFormat::Plain | CaptureFormat::Times | CaptureFormat::Sr => {
                 let _ = write!(self.line, "{}", n as f64 / rate);
             }
             CaptureFormat::Sigrok => {

@@ -47,22 +47,24 @@ enum Command {
         capture: Option<PathBuf>,
         /// Format of the capture file (default: the file's extension: .vcd a value change
         /// dump, .csv or any other Saleae's CSV). A format the extension contradicts (saleae,
-        /// sigrok or plain to a .vcd file, vcd to a .csv file) is refused.
+        /// sigrok or plain to a .vcd file, vcd to a .csv file) is refused, and so are sr and
+        /// a .sr file (a sigrok session file, which analyze reads).
         #[arg(long, value_enum, requires = "capture")]
         capture_format: Option<CaptureFormat>,
     },
     /// Run the core on a recorded capture (Saleae Logic 2 or 1.x, sigrok/PulseView or plain CSV, a
-    /// value change dump, or a file of edge times):
+    /// sigrok session file (.sr), a value change dump, or a file of edge times):
     /// windows, faults, sync, edges and revolutions counted.
     Analyze {
         /// The capture file.
         capture: PathBuf,
-        /// Its format (default: told from its first lines).
+        /// Its format (default: told from its first lines; a zip archive is a sigrok session
+        /// file, sr).
         #[arg(long, value_enum)]
         format: Option<CaptureFormat>,
         #[command(flatten)]
         options: AnalyzeArgs,
-        /// The logic analyzer's samples per second, Hz. A sigrok file states it, and so does a
+        /// The logic analyzer's samples per second, Hz. A sigrok file (CSV or .sr) states it, and so does a
         /// value change dump from sigrok (needed for a sigrok CSV that does not: its time
         /// column alone is not exact; it must agree with the file when it states one); a
         /// Saleae Logic 1.x export with sample numbers for times needs it (sample n is at
