@@ -4164,3 +4164,208 @@ fn a_session_file_written_by_libsigrok_reads_as_the_dump_it_came_from() {
     );
     assert_eq!((sr.span[1], vcd.span[1]), (0.399999, 0.4));
 }
+
+/// Writes Saleae Logic 2's binary export of the Saleae CSV capture `csv` (rows at changes,
+/// `Time [s],Channel 0,Channel 1`) into the folder `dir`, a file `digital_N.bin` a channel, as
+/// Saleae documents the format: version 0, or version 1 at `rate` Hz with the channel
+/// `gap_channel` without data over `gap` s (two chunks). Written independently of the reader.
+fn saleae_binary(csv: &str, dir: &Path, version: i32, rate: f64, gap: Option<(usize, [f64; 2])>) {
+    let rows: Vec<(f64, Vec<bool>)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut f = l.split(',');
+            let t = f.next().unwrap().parse::<f64>().unwrap();
+            (t, f.map(|v| v == "1").collect())
+        })
+        .collect();
+    let (begin, end) = (rows[0].0, rows[rows.len() - 1].0);
+    std::fs::create_dir_all(dir).unwrap();
+    for ch in 0..rows[0].1.len() {
+        let level_at = |k: usize| rows[k].1[ch];
+        let changes: Vec<f64> = (1..rows.len())
+            .filter(|&k| level_at(k) != level_at(k - 1))
+            .map(|k| rows[k].0)
+            .collect();
+        // Chunks: (initial level, begin, end, transitions).
+        let mut chunks = vec![(level_at(0), begin, end, changes.clone())];
+        if let Some((c, [from, to])) = gap.filter(|&(c, _)| c == ch) {
+            let level_after = |t: f64| rows.iter().rev().find(|r| r.0 <= t).unwrap().1[ch];
+            chunks = vec![
+                (
+                    level_at(0),
+                    begin,
+                    from,
+                    changes.iter().copied().filter(|&t| t <= from).collect(),
+                ),
+                (
+                    level_after(to),
+                    to,
+                    end,
+                    changes.iter().copied().filter(|&t| t > to).collect(),
+                ),
+            ];
+            assert_eq!(c, ch);
+        }
+        let mut b: Vec<u8> = b"<SALEAE>".to_vec();
+        b.extend(version.to_le_bytes());
+        b.extend(0i32.to_le_bytes());
+        if version == 1 {
+            b.extend((chunks.len() as u64).to_le_bytes());
+        }
+        for (initial, from, to, times) in &chunks {
+            b.extend(u32::from(*initial).to_le_bytes());
+            if version == 1 {
+                b.extend(rate.to_le_bytes());
+            }
+            b.extend(from.to_le_bytes());
+            b.extend(to.to_le_bytes());
+            b.extend((times.len() as u64).to_le_bytes());
+            for t in times {
+                b.extend(t.to_le_bytes());
+            }
+        }
+        std::fs::write(dir.join(format!("digital_{ch}.bin")), b).unwrap();
+    }
+}
+
+/// Saleae Logic 2's binary export (a file a channel) reads as its CSV export of the same
+/// capture: the same windows, δ (to the rounding of the times, which the CSV writes in decimals
+/// and the export as doubles) and counts, from the folder; one channel's file alone is that
+/// channel; a chunk gap of version 1 is a span without data, as Logic 2's CSV `X` is.
+#[test]
+fn a_saleae_binary_export_reads_as_its_csv_export() {
+    let (_scratch, csv) = tmp("disc.csv");
+    simulate(&index_disc(1.0), CaptureFormat::Saleae, &csv);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let cfg = configure(&index_lines(24)).unwrap();
+    let read = |path: &Path, cfg: &host_sim::app::analyze::AnalyzeConfig| {
+        let mut r = CaptureReader::open(path, None, None).unwrap_or_else(|e| panic!("{e}"));
+        let channels = r.channels().to_vec();
+        let report = analyze(&mut r, cfg, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+        (channels, report)
+    };
+    let (_, by_csv) = read(&csv, &cfg);
+    assert!(by_csv.valid_windows >= 4, "{}", by_csv.valid_windows);
+    let close = |a: &AnalyzeReport, b: &AnalyzeReport| {
+        assert_eq!(a.windows.len(), b.windows.len());
+        for (x, y) in a.windows.iter().zip(&b.windows) {
+            assert_eq!(
+                (x.valid, x.start_edge, x.end_edge),
+                (y.valid, y.start_edge, y.end_edge)
+            );
+            match (x.delta, y.delta) {
+                (Some(p), Some(q)) => assert!((p - q).abs() <= 1e-9 * q, "{p} {q}"),
+                (p, q) => assert_eq!(p, q),
+            }
+        }
+        assert_eq!(
+            (a.rows, a.edges, a.accepted, a.glitches, a.index_pulses),
+            (b.rows, b.edges, b.accepted, b.glitches, b.index_pulses)
+        );
+    };
+    for version in [0, 1] {
+        let dir = csv.with_file_name(format!("v{version}"));
+        saleae_binary(&text, &dir, version, 10e6, None);
+        let (channels, by_bin) = read(&dir, &cfg);
+        assert_eq!(channels, ["Channel 0", "Channel 1"]);
+        assert_eq!(by_bin.format, "saleae-binary");
+        assert_eq!(by_bin.sample_rate, (version == 1).then_some(10e6));
+        close(&by_bin, &by_csv);
+    }
+    // One channel's file: that channel alone (framed by nothing).
+    let lines = AnalyzeOptions {
+        lines: Some(24),
+        ..AnalyzeOptions::default()
+    };
+    let one = configure(&lines).unwrap();
+    let (channels, alone) = read(&csv.with_file_name("v0").join("digital_0.bin"), &one);
+    assert_eq!(channels, ["Channel 0"]);
+    let (_, from_csv) = read(&csv, &one);
+    assert_eq!(alone.edges, from_csv.edges);
+    // A gap of version 1 on the encoder channel: a span without data, where the CSV says `X`.
+    let dir = csv.with_file_name("gap");
+    saleae_binary(&text, &dir, 1, 10e6, Some((0, [0.4, 0.5])));
+    let (_, gapped) = read(&dir, &cfg);
+    let no_data = gapped.no_data.as_ref().expect("a span without data");
+    assert_eq!((no_data.spans, no_data.first), (1, [0.4, 0.5]));
+    assert!(gapped.edges < by_csv.edges);
+}
+
+/// What is wrong with a binary export is said, naming the file.
+#[test]
+fn a_saleae_binary_export_is_refused_naming_what_is_wrong() {
+    let (_scratch, dir) = tmp("export");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("digital_0.bin");
+    let header = |version: i32, kind: i32| {
+        let mut b = b"<SALEAE>".to_vec();
+        b.extend(version.to_le_bytes());
+        b.extend(kind.to_le_bytes());
+        b
+    };
+    let v0 = |times: &[f64], n: u64, end: f64| {
+        let mut b = header(0, 0);
+        b.extend(1u32.to_le_bytes());
+        b.extend(0.0f64.to_le_bytes());
+        b.extend(end.to_le_bytes());
+        b.extend(n.to_le_bytes());
+        for t in times {
+            b.extend(t.to_le_bytes());
+        }
+        b
+    };
+    let error = |bytes: Vec<u8>| {
+        std::fs::write(&file, bytes).unwrap();
+        match CaptureReader::open(&file, None, None) {
+            Err(e) => e.to_string(),
+            Ok(mut r) => loop {
+                match r.next_row() {
+                    Ok(Some(_)) => continue,
+                    Ok(None) => return String::new(),
+                    Err(e) => break e.to_string(),
+                }
+            },
+        }
+    };
+    assert_eq!(error(v0(&[0.1, 0.2], 2, 1.0)), "");
+    for (bytes, says) in [
+        (header(0, 1), "type 1 (analog)"),
+        (header(2, 0), "version 2"),
+        (v0(&[0.1, 0.2], 3, 1.0), "ends before a transition's time"),
+        (v0(&[0.2, 0.1], 2, 1.0), "before the one before it"),
+        (v0(&[0.1, 2.0], 2, 1.0), "after its chunk's end"),
+        (v0(&[0.1, f64::NAN], 2, 1.0), "a transition's time is NaN"),
+        (
+            v0(&[0.1, 0.2, 0.3], 2, 1.0),
+            "bytes after its last transition",
+        ),
+        (header(0, 0)[..12].to_vec(), "shorter than the header"),
+    ] {
+        let e = error(bytes);
+        assert!(
+            e.contains(says) && e.contains("digital_0.bin"),
+            "{says}: {e}"
+        );
+    }
+    // A folder without a digital channel's export, and a CSV given the format.
+    std::fs::remove_file(&file).unwrap();
+    std::fs::write(dir.join("notes.txt"), "x").unwrap();
+    let e = CaptureReader::open(&dir, None, None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("without a digital channel's binary export"),
+        "{e}"
+    );
+    let (_s, csv) = tmp("x.csv");
+    std::fs::write(&csv, "time_s,level\n0,0\n").unwrap();
+    let e = CaptureReader::open(&csv, Some(CaptureFormat::SaleaeBinary), None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("does not start with `<SALEAE>`"), "{e}");
+    let e = CaptureFormat::for_file(Path::new("x.bin"), None).unwrap_err();
+    assert!(e.contains("not Saleae's binary export"), "{e}");
+}

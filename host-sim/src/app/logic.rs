@@ -1,8 +1,9 @@
 //! Logic-analyzer capture files: what `drive-sim run --capture` writes and `drive-sim analyze`
 //! reads.
 //!
-//! Three CSV formats, value change dumps ([`vcd`]) and sigrok session files ([`srzip`], read
-//! only), each a level-over-time record of one or more digital channels:
+//! Three CSV formats, value change dumps ([`vcd`]), sigrok session files ([`srzip`], read
+//! only) and Saleae Logic 2's binary export ([`saleae_bin`], read only), each a level-over-time
+//! record of one or more digital channels:
 //!
 //! - **Saleae Logic 2** digital export: a header `Time [s],Channel 0,Channel 1,...`, then one
 //!   row per instant at which at least one channel changes, the time in seconds (Logic 2 writes
@@ -51,6 +52,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::encoder::Edge;
 
+mod saleae_bin;
 mod srzip;
 mod vcd;
 
@@ -80,6 +82,9 @@ pub enum CaptureFormat {
     /// A sigrok session file (`.sr`, libsigrok's srzip: what PulseView saves), read by
     /// `analyze` only.
     Sr,
+    /// Saleae Logic 2's binary export of digital channels (a file a channel, `digital_0.bin`,
+    /// ...: the folder, or one file), read by `analyze` only.
+    SaleaeBinary,
 }
 
 impl CaptureFormat {
@@ -92,6 +97,7 @@ impl CaptureFormat {
             CaptureFormat::Vcd => "vcd",
             CaptureFormat::Times => "times",
             CaptureFormat::Sr => "sr",
+            CaptureFormat::SaleaeBinary => "saleae-binary",
         }
     }
 
@@ -112,6 +118,17 @@ impl CaptureFormat {
                  opens (File > Import > Value Change Dump), or in .csv",
                 if given == Some(CaptureFormat::Sr) {
                     "--capture-format sr".to_string()
+                } else {
+                    path.display().to_string()
+                }
+            ));
+        }
+        if given == Some(CaptureFormat::SaleaeBinary) || ext.as_deref() == Some("bin") {
+            return Err(format!(
+                "{}: `run --capture` writes CSV or a value change dump, not Saleae's binary \
+                 export (which `analyze` reads): give a file ending in .csv or .vcd",
+                if given == Some(CaptureFormat::SaleaeBinary) {
+                    "--capture-format saleae-binary".to_string()
                 } else {
                     path.display().to_string()
                 }
@@ -146,7 +163,9 @@ impl CaptureFormat {
     pub fn channel_names(self, index: bool) -> Vec<String> {
         let n = if index { 2 } else { 1 };
         match self {
-            CaptureFormat::Saleae => (0..n).map(|i| format!("Channel {i}")).collect(),
+            CaptureFormat::Saleae | CaptureFormat::SaleaeBinary => {
+                (0..n).map(|i| format!("Channel {i}")).collect()
+            }
             CaptureFormat::Sigrok | CaptureFormat::Sr => (0..n).map(|i| format!("D{i}")).collect(),
             CaptureFormat::Vcd => ["encoder", "index"][..n]
                 .iter()
@@ -292,6 +311,8 @@ pub struct CaptureReader<R> {
     sample_column: Option<String>,
     /// A sigrok session file's samples (the format `Sr`; `input` is then not read).
     session: Option<Box<srzip::Session>>,
+    /// A Saleae binary export's channels (the format `SaleaeBinary`; `input` is not read).
+    binary: Option<Box<saleae_bin::Export>>,
 }
 
 /// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
@@ -407,11 +428,23 @@ impl CaptureReader<std::io::BufReader<std::fs::File>> {
         format: Option<CaptureFormat>,
         sample_rate: Option<f64>,
     ) -> Result<Self, CaptureError> {
-        let file = std::fs::File::open(path).map_err(|e| CaptureError {
+        let err = |message: String| CaptureError {
             file: path.to_path_buf(),
             line: None,
-            message: format!("cannot open: {e}"),
-        })?;
+            message,
+        };
+        // A folder is a Saleae binary export (a file a channel): a file of it stands in as the
+        // input, which is not read.
+        let input = if path.is_dir() {
+            std::fs::read_dir(path)
+                .map_err(|e| err(format!("cannot list the folder: {e}")))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .find(|p| p.is_file())
+                .ok_or_else(|| err("an empty folder: no capture in it".into()))?
+        } else {
+            path.to_path_buf()
+        };
+        let file = std::fs::File::open(&input).map_err(|e| err(format!("cannot open: {e}")))?;
         Self::new(std::io::BufReader::new(file), path, format, sample_rate)
     }
 }
@@ -443,6 +476,7 @@ impl<R: BufRead> CaptureReader<R> {
             times_in_seconds: false,
             sample_column: None,
             session: None,
+            binary: None,
         };
         if let Some(rate) = sample_rate {
             if !(rate.is_finite() && rate > 0.0) {
@@ -462,6 +496,13 @@ impl<R: BufRead> CaptureReader<R> {
             .is_ok_and(|b| b.starts_with(&srzip::ZIP_MAGIC));
         if zipped || format == Some(CaptureFormat::Sr) {
             return r.open_session(zipped, format);
+        }
+        let binary = file.is_dir()
+            || r.input
+                .fill_buf()
+                .is_ok_and(|b| b.starts_with(&saleae_bin::MAGIC));
+        if binary || format == Some(CaptureFormat::SaleaeBinary) {
+            return r.open_binary(binary, format);
         }
         let first = loop {
             match r.read_line()? {
@@ -522,6 +563,9 @@ impl<R: BufRead> CaptureReader<R> {
             CaptureFormat::Times => r.header_times(first)?,
             // (Opened above, from the file's first bytes.)
             CaptureFormat::Sr => return r.open_session(false, Some(CaptureFormat::Sr)),
+            CaptureFormat::SaleaeBinary => {
+                return r.open_binary(false, Some(CaptureFormat::SaleaeBinary))
+            }
         }
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
@@ -574,6 +618,46 @@ impl<R: BufRead> CaptureReader<R> {
         Ok(self)
     }
 
+    /// Reads the headers of a Saleae binary export (`binary`: the file starts as one, or is a
+    /// folder; `format` as given).
+    fn open_binary(
+        mut self,
+        binary: bool,
+        format: Option<CaptureFormat>,
+    ) -> Result<Self, CaptureError> {
+        self.format = CaptureFormat::SaleaeBinary;
+        if let Some(f) = format.filter(|&f| f != CaptureFormat::SaleaeBinary) {
+            return Err(self.err_here(&format!(
+                "--format {}: {}: leave --format out, or give --format saleae-binary",
+                f.name(),
+                if self.file.is_dir() {
+                    "a folder is read as Saleae Logic 2's binary export"
+                } else {
+                    "the file is Saleae Logic 2's binary export (it starts with `<SALEAE>`), not \
+                     a text export"
+                }
+            )));
+        }
+        if !binary {
+            return Err(self.err_here(
+                "--format saleae-binary: the file does not start with `<SALEAE>`, as Saleae's \
+                 binary export does: leave --format out to have the format told from the file",
+            ));
+        }
+        let export = saleae_bin::Export::open(&self.file).map_err(|m| CaptureError {
+            file: self.file.clone(),
+            line: None,
+            message: m,
+        })?;
+        self.channels = export.names.clone();
+        if let Some(rate) = export.rate() {
+            self.stated_rate(rate, &format!("sample_rate {rate}"))?;
+        }
+        self.levels = vec![Level::Unknown; self.channels.len()];
+        self.binary = Some(Box::new(export));
+        Ok(self)
+    }
+
     /// The format read.
     pub fn format(&self) -> CaptureFormat {
         self.format
@@ -621,7 +705,8 @@ impl<R: BufRead> CaptureReader<R> {
         CaptureError {
             file: self.file.clone(),
             // A session file is binary: it has no lines.
-            line: (self.format != CaptureFormat::Sr).then_some(self.line.max(1)),
+            line: (!matches!(self.format, CaptureFormat::Sr | CaptureFormat::SaleaeBinary))
+                .then_some(self.line.max(1)),
             message,
         }
     }
@@ -852,6 +937,14 @@ impl<R: BufRead> CaptureReader<R> {
     pub fn next_row(&mut self) -> Result<Option<(f64, &[Level])>, CaptureError> {
         if self.format == CaptureFormat::Vcd {
             return self.next_vcd_row();
+        }
+        if let Some(export) = self.binary.as_mut() {
+            let row = export.next_row(&mut self.levels);
+            let Some(time) = row.map_err(|m| self.err_here(&m))? else {
+                return Ok(None);
+            };
+            self.advance(time)?;
+            return Ok(Some((time, &self.levels)));
         }
         if let Some(session) = self.session.as_mut() {
             let change = session.next_change(&mut self.levels);
@@ -1216,7 +1309,7 @@ impl<W: Write> CaptureWriter<W> {
         let mut head = String::new();
         match s.format {
             // A record of levels is written; edge times are only read (`for_file` refuses them).
-            CaptureFormat::Times | CaptureFormat::Sr => {
+            CaptureFormat::Times | CaptureFormat::Sr | CaptureFormat::SaleaeBinary => {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidInput,
                     "a capture is written as saleae, sigrok, plain or vcd, not as edge times or \
@@ -1391,7 +1484,10 @@ impl<W: Write> CaptureWriter<W> {
             CaptureFormat::Saleae => {
                 let _ = write!(self.line, "{:.9}", n as f64 / rate);
             }
-            CaptureFormat::Plain | CaptureFormat::Times | CaptureFormat::Sr => {
+            CaptureFormat::Plain
+            | CaptureFormat::Times
+            | CaptureFormat::Sr
+            | CaptureFormat::SaleaeBinary => {
                 let _ = write!(self.line, "{}", n as f64 / rate);
             }
             CaptureFormat::Sigrok => {

@@ -53,13 +53,14 @@ enum Command {
         capture_format: Option<CaptureFormat>,
     },
     /// Run the core on a recorded capture (Saleae Logic 2 or 1.x, sigrok/PulseView or plain CSV, a
-    /// sigrok session file (.sr), a value change dump, or a file of edge times):
+    /// sigrok session file (.sr), Saleae Logic 2's binary export (its folder, or one channel's
+    /// file), a value change dump, or a file of edge times):
     /// windows, faults, sync, edges and revolutions counted.
     Analyze {
-        /// The capture file.
+        /// The capture file (or the folder of Saleae Logic 2's binary export).
         capture: PathBuf,
         /// Its format (default: told from its first lines; a zip archive is a sigrok session
-        /// file, sr).
+        /// file, sr; a folder, or a file starting <SALEAE>, Saleae's binary export).
         #[arg(long, value_enum)]
         format: Option<CaptureFormat>,
         #[command(flatten)]
