@@ -4369,3 +4369,111 @@ fn a_saleae_binary_export_is_refused_naming_what_is_wrong() {
     let e = CaptureFormat::for_file(Path::new("x.bin"), None).unwrap_err();
     assert!(e.contains("not Saleae's binary export"), "{e}");
 }
+
+/// An analog record (an oscilloscope's CSV of a variable-reluctance sensor before its
+/// comparator: a sine a tooth, its amplitude growing with the speed, with noise) read through
+/// `--threshold` and `--hysteresis`: every valid window's δ matches the truth (the teeth's
+/// crossing times solved from the rotor's angle) within the floor analyze states; without the
+/// hysteresis the noise at each crossing is a glitch; and without the threshold the values are
+/// refused, naming the options.
+#[test]
+fn an_analog_record_is_read_through_a_threshold() {
+    use rand::{Rng, SeedableRng};
+    // φ(t) = ω̄t + b·sin(2ω̄t): ω = ω̄(1 + 2b·cos(2ω̄t)), δ = 4b.
+    let (omega, b, lines, rate) = (40.0f64, 0.025f64, 24u32, 200e3);
+    let phi = |t: f64| omega * t + b * (2.0 * omega * t).sin();
+    // Noise of σ `noise` (a sum of 12 uniforms): 0.0005 moves a crossing by 0.5 µs (σ), a
+    // tenth of a sample; 0.02 by 20 µs, which the floor (the timing's alone) does not hold.
+    let (_scratch, dir) = tmp("vr");
+    std::fs::create_dir_all(&dir).unwrap();
+    let record = |noise: f64| {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut text = String::from("time_s,level\n");
+        for i in 0..(rate as usize) {
+            let t = i as f64 / rate;
+            let speed = 1.0 + 2.0 * b * (2.0 * omega * t).cos();
+            let n: f64 = (0..12).map(|_| rng.gen::<f64>()).sum::<f64>() - 6.0;
+            let v = speed * (f64::from(lines) * phi(t)).sin() + noise * n;
+            text.push_str(&format!("{t:.6},{v:.4}\n"));
+        }
+        let file = dir.join(format!("vr-{noise}.csv"));
+        std::fs::write(&file, &text).unwrap();
+        file
+    };
+    let (quiet, noisy) = (record(0.0005), record(0.02));
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(lines as u16),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let read = |file: &Path, hysteresis: f64| {
+        let mut r = CaptureReader::open(file, None, None).unwrap();
+        r.set_threshold(host_sim::app::logic::Threshold::new(0.0, hysteresis).unwrap())
+            .unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let report = read(&quiet, 0.4);
+    assert_eq!(report.glitches, 0);
+    assert!(report.valid_windows >= 4, "{}", report.valid_windows);
+    // A rising crossing is where the sine reaches +0.2 (half the hysteresis) on its way up:
+    // tooth k at lines·φ = 2πk + asin(0.2/speed), solved by Newton's method.
+    let crossing = |k: u32, guess: f64| {
+        let mut t = guess;
+        for _ in 0..50 {
+            let speed = 1.0 + 2.0 * b * (2.0 * omega * t).cos();
+            let target = std::f64::consts::TAU * f64::from(k) + (0.2 / speed).asin();
+            let f = f64::from(lines) * phi(t) - target;
+            let df = f64::from(lines) * omega * speed;
+            t -= f / df;
+        }
+        t
+    };
+    let pitch = std::f64::consts::TAU / f64::from(lines);
+    let teeth: Vec<f64> = (0..200)
+        .map(|k| crossing(k, f64::from(k) * pitch / omega))
+        .collect();
+    for w in report.windows.iter().filter(|w| w.valid) {
+        let speeds: Vec<f64> = teeth
+            .windows(2)
+            .filter(|p| p[1] > w.start + 3e-6 && p[1] <= w.end + 3e-6)
+            .map(|p| pitch / (p[1] - p[0]))
+            .collect();
+        let (lo, hi) = speeds
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(l, h), &s| (l.min(s), h.max(s)));
+        let truth = 2.0 * (hi - lo) / (hi + lo);
+        let (delta, floor) = (w.delta.unwrap(), w.floor_with_sampling.unwrap());
+        assert_eq!(speeds.len(), lines as usize);
+        assert!(
+            (delta - truth).abs() <= floor,
+            "δ {delta} against {truth}, floor {floor}"
+        );
+        assert!((truth - 4.0 * b).abs() < 0.01, "{truth}");
+    }
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("--threshold 0 with --hysteresis 0.4"),
+        "{said}"
+    );
+    // Noise at a crossing crosses again without the hysteresis, not with it.
+    assert!(read(&noisy, 0.0).glitches > 0);
+    assert_eq!(read(&noisy, 0.4).glitches, 0);
+    // No threshold: the values are refused, naming the options.
+    let mut r = CaptureReader::open(&quiet, None, None).unwrap();
+    let e = r.next_row().err().unwrap().to_string();
+    assert!(
+        e.contains("not a logic level")
+            && e.contains("--threshold V")
+            && e.contains("--hysteresis"),
+        "{e}"
+    );
+    // A format that records levels takes no threshold.
+    let (_s, vcd) = tmp("x.vcd");
+    simulate(&index_disc(0.2), CaptureFormat::Vcd, &vcd);
+    let mut r = CaptureReader::open(&vcd, None, None).unwrap();
+    let e = r
+        .set_threshold(host_sim::app::logic::Threshold::new(0.0, 0.1).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("a vcd file records levels"), "{e}");
+}

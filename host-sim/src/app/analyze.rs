@@ -495,6 +495,10 @@ pub struct AnalyzeReport {
     /// time is its sample number over `sample_rate`, the rate `--sample-rate` gave).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sample_numbers: Option<String>,
+    /// The threshold the values of an analog record were read through (`--threshold`,
+    /// `--hysteresis`), when they were.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<crate::app::logic::Threshold>,
     /// Without a known sample rate: the step, s, that every row's time lies on from the first
     /// row's (in whole nanoseconds, when 2 ns or more: the analyzer's sample period, as a
     /// Saleae export's nine decimals show it), taken as the sampling for the floor.
@@ -1493,6 +1497,7 @@ pub fn analyze<R: BufRead>(
         prescaler: cfg.encoder.prescaler,
         sample_rate: reader.sample_rate(),
         sample_numbers: reader.sample_column().map(str::to_string),
+        threshold: reader.threshold(),
         sync_state: "searching",
         ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
@@ -2616,10 +2621,20 @@ pub fn text(r: &AnalyzeReport) -> String {
         s,
         "channel: {} ({}){}{}",
         r.channel,
-        if r.edges_listed() {
-            "edge times: each row a captured edge".to_string()
-        } else {
-            format!("{} edges", r.edge)
+        match (r.edges_listed(), r.threshold) {
+            (true, _) => "edge times: each row a captured edge".to_string(),
+            (false, None) => format!("{} edges", r.edge),
+            (false, Some(t)) => format!(
+                "{} edges of its values read at --threshold {} with --hysteresis {}: high above \
+                 {}, low below {}; each edge at the first sample past its level, and the floors \
+                 below the timing's alone: the signal's noise moves a crossing by the noise \
+                 over the signal's slope there, which they do not hold",
+                r.edge,
+                t.volts,
+                t.hysteresis,
+                t.volts + 0.5 * t.hysteresis,
+                t.volts - 0.5 * t.hysteresis
+            ),
         },
         r.index_channel
             .as_ref()

@@ -180,6 +180,47 @@ impl CaptureFormat {
     }
 }
 
+/// How the values of an analog record (an oscilloscope's or an analog channel's export: a
+/// number a sample) are read as levels, a Schmitt trigger's: high from a value above
+/// `volts + hysteresis/2` on, low from one below `volts − hysteresis/2` on, between them the
+/// level before (no data until the first value outside the band).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Threshold {
+    /// The switching level, in the unit of the values (V).
+    pub volts: f64,
+    /// The band around it, the same unit, ≥ 0.
+    pub hysteresis: f64,
+}
+
+impl Threshold {
+    /// A threshold, refused when not finite or the hysteresis is negative.
+    pub fn new(volts: f64, hysteresis: f64) -> Result<Self, String> {
+        if !volts.is_finite() {
+            return Err(format!(
+                "--threshold {volts}: a threshold is a finite value"
+            ));
+        }
+        if !(hysteresis.is_finite() && hysteresis >= 0.0) {
+            return Err(format!(
+                "--hysteresis {hysteresis}: a hysteresis is a finite band of 0 or more"
+            ));
+        }
+        Ok(Threshold { volts, hysteresis })
+    }
+
+    /// The level of value `v` after level `before`.
+    fn level(&self, v: f64, before: Level) -> Level {
+        let half = 0.5 * self.hysteresis;
+        if v > self.volts + half {
+            Level::High
+        } else if v < self.volts - half {
+            Level::Low
+        } else {
+            before
+        }
+    }
+}
+
 /// A level read from a capture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Level {
@@ -313,6 +354,8 @@ pub struct CaptureReader<R> {
     session: Option<Box<srzip::Session>>,
     /// A Saleae binary export's channels (the format `SaleaeBinary`; `input` is not read).
     binary: Option<Box<saleae_bin::Export>>,
+    /// Values read as levels through a threshold (`--threshold`), in place of 0 and 1.
+    threshold: Option<Threshold>,
 }
 
 /// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
@@ -477,6 +520,7 @@ impl<R: BufRead> CaptureReader<R> {
             sample_column: None,
             session: None,
             binary: None,
+            threshold: None,
         };
         if let Some(rate) = sample_rate {
             if !(rate.is_finite() && rate > 0.0) {
@@ -656,6 +700,34 @@ impl<R: BufRead> CaptureReader<R> {
         self.levels = vec![Level::Unknown; self.channels.len()];
         self.binary = Some(Box::new(export));
         Ok(self)
+    }
+
+    /// Reads every channel's column as values, levels through `threshold` (an analog record:
+    /// an oscilloscope's CSV, an analog channel's export). For the CSV formats only: a value
+    /// change dump, a session file, a binary export and a file of edge times record levels or
+    /// edges. Set before the first row is read.
+    pub fn set_threshold(&mut self, threshold: Threshold) -> Result<(), CaptureError> {
+        if !matches!(
+            self.format,
+            CaptureFormat::Saleae | CaptureFormat::Sigrok | CaptureFormat::Plain
+        ) {
+            return Err(self.err_here(&format!(
+                "--threshold: a {} file records {}, not values to read through a threshold",
+                self.format.name(),
+                if self.format == CaptureFormat::Times {
+                    "edge times"
+                } else {
+                    "levels"
+                }
+            )));
+        }
+        self.threshold = Some(threshold);
+        Ok(())
+    }
+
+    /// The threshold the values are read through, if any.
+    pub fn threshold(&self) -> Option<Threshold> {
+        self.threshold
     }
 
     /// The format read.
@@ -994,21 +1066,40 @@ impl<R: BufRead> CaptureReader<R> {
                 )));
             };
             count += 1;
-            self.levels[k] = match f.trim() {
-                "0" => Level::Low,
-                "1" => Level::High,
-                "X" | "x" if self.format == CaptureFormat::Saleae => Level::Unknown,
-                other => {
+            self.levels[k] = match (f.trim(), self.threshold) {
+                ("X" | "x", _) if self.format == CaptureFormat::Saleae => Level::Unknown,
+                (value, Some(th)) => match value.parse::<f64>() {
+                    Ok(v) if v.is_finite() => th.level(v, self.levels[k]),
+                    _ => {
+                        return Err(self.err_here(&format!(
+                            "`{}` in the column of channel `{}` is not a value (a finite number, \
+                             as --threshold reads)",
+                            clip(value),
+                            self.channels[k]
+                        )))
+                    }
+                },
+                ("0", None) => Level::Low,
+                ("1", None) => Level::High,
+                (other, None) => {
+                    let analog = other.parse::<f64>().is_ok_and(f64::is_finite);
                     return Err(self.err_here(&format!(
-                        "`{}` in the column of channel `{}` is not a logic level (0 or 1{})",
+                        "`{}` in the column of channel `{}` is not a logic level (0 or 1{}){}",
                         clip(other),
                         self.channels[k],
                         if self.format == CaptureFormat::Saleae {
                             ", or X"
                         } else {
                             ""
+                        },
+                        if analog {
+                            ": a value of an analog record (an oscilloscope's export)? give \
+                             --threshold V, the level the signal switches at, and --hysteresis \
+                             V, the band its noise needs"
+                        } else {
+                            ""
                         }
-                    )))
+                    )));
                 }
             };
         }

@@ -73,6 +73,16 @@ enum Command {
         /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long, allow_negative_numbers = true)]
         sample_rate: Option<f64>,
+        /// Read the channels' columns as values (an oscilloscope's or an analog channel's CSV
+        /// export, e.g. a variable-reluctance crank sensor's voltage), levels through a Schmitt
+        /// trigger at this value: high above it plus half the hysteresis, low below it less
+        /// half, between them as before. CSV formats only.
+        #[arg(long, allow_negative_numbers = true)]
+        threshold: Option<f64>,
+        /// The band around --threshold (same unit, default 0): wider than the signal's noise,
+        /// or each noisy crossing is a glitch.
+        #[arg(long, requires = "threshold", allow_negative_numbers = true)]
+        hysteresis: Option<f64>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -347,14 +357,20 @@ fn main() -> ExitCode {
             format,
             options,
             sample_rate,
+            threshold,
+            hysteresis,
             json,
             plot,
         }) => (|| {
             let options = options.resolve()?;
+            let threshold = threshold
+                .map(|v| host_sim::app::logic::Threshold::new(v, hysteresis.unwrap_or(0.0)))
+                .transpose()?;
             analyze_cmd(
                 &capture,
                 format,
                 sample_rate,
+                threshold,
                 &options,
                 json,
                 plot.as_deref(),
@@ -438,6 +454,7 @@ fn analyze_cmd(
     capture: &Path,
     format: Option<CaptureFormat>,
     sample_rate: Option<f64>,
+    threshold: Option<host_sim::app::logic::Threshold>,
     options: &host_sim::app::analyze::AnalyzeOptions,
     json: bool,
     plot: Option<&Path>,
@@ -456,6 +473,9 @@ fn analyze_cmd(
     }
     let mut reader = host_sim::app::logic::CaptureReader::open(capture, format, sample_rate)
         .map_err(|e| e.to_string())?;
+    if let Some(t) = threshold {
+        reader.set_threshold(t).map_err(|e| e.to_string())?;
+    }
     let mut report = analyze::analyze(&mut reader, &cfg, &mut |_| {}).map_err(|e| e.to_string())?;
     report.file = capture.display().to_string();
     let mut text = String::new();
