@@ -1499,6 +1499,7 @@ pub fn run_with(
         capture_channels = written.channels;
     }
     let capture_warning = capture_loss_warning(scene, file, &capture_channels);
+    let step_warning = fixed_step_warning(scene, file, sim.fixed_step_error());
     let mut report = RunReport {
         scene: file.display().to_string(),
         effects: names,
@@ -1534,7 +1535,10 @@ pub fn run_with(
         capture_warning,
         delta_limit: scene.monitor.as_ref().and_then(|m| m.delta_limit),
         not_simulated: not_simulated(scene, over),
-        model_warnings: cranking_warning(scene).into_iter().collect(),
+        model_warnings: cranking_warning(scene)
+            .into_iter()
+            .chain(step_warning)
+            .collect(),
         window_warning: scene.encoder.as_ref().and_then(|_| window_warning(scene)),
         ..Default::default()
     };
@@ -1907,6 +1911,26 @@ fn open_capture(
     CaptureWriter::new(std::io::BufWriter::new(f), settings).map_err(fail)
 }
 
+/// The WARNING for a fixed RK4 step too long for the scene's motion: its largest local error
+/// estimate ([`crate::engine::ode::Solver::fixed_step_error`]) above its scale, `None` within
+/// it (and for the adaptive methods, which keep their own tolerance).
+fn fixed_step_warning(scene: &Scene, file: &Path, error: Option<(f64, f64)>) -> Option<String> {
+    let (ratio, t) = error.filter(|&(r, _)| r > 1.0)?;
+    let step = scene.simulation.step;
+    // The estimate is the third-order companion's error, ∝ h⁴: a step shorter by ratio^¼
+    // brings it to the scale.
+    let shorter = step / ratio.powf(0.25);
+    Some(format!(
+        "WARNING: simulation.step = {} s with integrator = \"rk4\": a step's local error, estimated from its \
+         stages, reached {ratio:.3e} times {:e} of the state (the step from t = {t:.4} s): the \
+         fixed step does not resolve the scene's motion, and the run's figures hold the \
+         integration's error; take simulation.step at most {shorter:.2e} s, or the adaptive \
+         dp5 (the default)",
+        scene.checker(file).shown("simulation.step", step),
+        crate::engine::ode::RK4_RTOL
+    ))
+}
+
 /// An integration failure, with the scene keys that set the integration up.
 fn integration_error(
     scene: &Scene,
@@ -1915,6 +1939,19 @@ fn integration_error(
 ) -> SceneError {
     let c = scene.checker(file);
     let s = &scene.simulation;
+    if s.integrator == IntegratorKind::Rk4 {
+        // A fixed step: rtol and atol play no part.
+        return SceneError::value(
+            file,
+            "simulation",
+            format!(
+                "{e}: the fixed step simulation.step = {} s with integrator = \"rk4\" does not resolve the scene's \
+                 fastest motion: take a shorter simulation.step, or the adaptive dp5 (the \
+                 default)",
+                c.shown("simulation.step", s.step)
+            ),
+        );
+    }
     SceneError::value(
         file,
         "simulation",

@@ -639,6 +639,12 @@ impl Simulation {
         &self.integrator
     }
 
+    /// The fixed-step RK4's largest estimated local error so far over its scale, and when
+    /// ([`crate::engine::ode::Solver::fixed_step_error`]); `None` for adaptive methods.
+    pub fn fixed_step_error(&self) -> Option<(f64, f64)> {
+        self.solver.fixed_step_error()
+    }
+
     /// Counters so far.
     pub fn stats(&self) -> RunStats {
         RunStats {

@@ -343,9 +343,20 @@ pub struct Solver {
     /// Whether each accepted step forms its dense output ([`Solver::without_dense_output`]).
     dense_wanted: bool,
     stats: SolverStats,
+    /// RK4: the largest local error estimated so far, over its scale, and the step's start
+    /// time ([`Solver::fixed_step_error`]).
+    worst_rk4: (f64, f64),
 }
 
 const SAFETY: f64 = 0.9;
+
+/// The scale of RK4's local error estimate ([`Solver::fixed_step_error`]): relative to each
+/// component, with a floor for components near zero. Above it a step is not resolved: on the
+/// kneader (12 s) steps of 0.01 s estimate 0.004 of it and read δ 0.03 % off, 0.1 s estimate
+/// 4.9 of it and read δ 0.46 % off, 0.5 s estimate 1.4e4 of it and read δ 655 % off.
+pub const RK4_RTOL: f64 = 1e-4;
+/// See [`RK4_RTOL`].
+pub const RK4_ATOL: f64 = 1e-7;
 
 impl Solver {
     /// A solver for an `n`-dimensional system. `integrator` must have been validated.
@@ -389,6 +400,7 @@ impl Solver {
             dense: DenseOutput::new(n),
             dense_wanted: true,
             stats: SolverStats::default(),
+            worst_rk4: (0.0, 0.0),
         }
     }
 
@@ -429,6 +441,15 @@ impl Solver {
     /// Work counters.
     pub fn stats(&self) -> SolverStats {
         self.stats
+    }
+
+    /// For the fixed-step RK4: the largest local error of a step estimated so far, over
+    /// `RK4_ATOL + RK4_RTOL·|y|` component by component, and the time that step started
+    /// (`None` for the adaptive methods, which hold their own tolerance). The estimate is free:
+    /// the third-order solution through the same stages and f(t + h, y₁), weights (1/6, 1/3,
+    /// 1/3, 0, 1/6), differs from RK4's by h/6·(k₃ − f(t + h, y₁)).
+    pub fn fixed_step_error(&self) -> Option<(f64, f64)> {
+        matches!(self.method, Method::Rk4 { .. }).then_some(self.worst_rk4)
     }
 
     fn eval<S: OdeSystem + ?Sized>(&mut self, sys: &mut S, t: f64, which: Buf, stage: usize) {
@@ -490,6 +511,15 @@ impl Solver {
             return Err(OdeError::NonFinite { t });
         }
         self.eval(sys, t + h, Buf::FNew, 0);
+        let mut worst = 0.0f64;
+        for i in 0..n {
+            let e = (h / 6.0 * (self.k[3 * n + i] - self.fnew[i])).abs();
+            let scale = RK4_ATOL + RK4_RTOL * self.y[i].abs().max(self.ynew[i].abs());
+            worst = worst.max(e / scale);
+        }
+        if worst > self.worst_rk4.0 {
+            self.worst_rk4 = (worst, t);
+        }
         if self.dense_wanted {
             self.hermite_blocks(h);
             self.set_dense(t, h, 3);
