@@ -2,7 +2,9 @@
 //! an `embedded-hal` output pin.
 //!
 //! A window counts only when it is valid, steady, and its noise floor is small against the
-//! limit (floor ≤ `floor_fraction`·limit); a window whose floor is near the limit is flagged
+//! limit (floor ≤ `floor_fraction`·limit), or, with a larger floor, when δ lies on one side of
+//! the limit by more than the floor (over: δ − floor > limit; within: δ + floor below the
+//! clearing level); any other window with a floor near the limit is flagged
 //! ([`Verdict::FloorNearLimit`]) rather than trusted. The alarm raises when at least `n` of the
 //! last `m` counted windows exceed the limit, and clears when at least `n` of the last `m` are
 //! below `limit·(1 − hysteresis)`, so a δ sitting on the limit does not chatter; each switch
@@ -89,7 +91,8 @@ pub enum Verdict {
     Invalid,
     /// Not counted: the speed was not steady.
     Unsteady,
-    /// Not counted: the quantization floor is too close to the limit to trust δ.
+    /// Not counted: the quantization floor is large against the limit, and δ lies within it
+    /// of the limit (or of the clearing level), so which side it is on is not known.
     FloorNearLimit,
 }
 
@@ -130,10 +133,22 @@ impl DeltaAlarm {
         let Some(r) = r.measurement() else {
             return Verdict::Invalid;
         };
+        let floor = r.noise_floor;
         if !r.steady {
             Verdict::Unsteady
-        } else if r.noise_floor.is_nan() || r.noise_floor > c.floor_fraction * c.limit {
+        } else if floor.is_nan() {
             Verdict::FloorNearLimit
+        } else if floor > c.floor_fraction * c.limit {
+            // A floor large against the limit: δ is judged only where the floor cannot carry it
+            // across (a drive six times over its limit, its floor half the limit, was never
+            // judged, and the pin said no alarm).
+            if r.delta - floor > c.limit {
+                Verdict::Over
+            } else if r.delta + floor < c.limit * (1.0 - c.hysteresis) {
+                Verdict::Within
+            } else {
+                Verdict::FloorNearLimit
+            }
         } else if r.delta > c.limit {
             Verdict::Over
         } else {
@@ -254,7 +269,7 @@ mod tests {
         for _ in 0..10 {
             assert_eq!(a.update(&window(0.1, false, 1e-4)).0, Verdict::Unsteady);
             assert_eq!(
-                a.update(&window(0.1, true, 0.02)).0,
+                a.update(&window(0.07, true, 0.02)).0,
                 Verdict::FloorNearLimit
             );
             assert_eq!(
@@ -266,6 +281,31 @@ mod tests {
             assert_eq!(a.update(&bad).0, Verdict::Invalid);
         }
         assert!(!a.active());
+    }
+
+    /// A floor large against the limit (0.03 on a limit of 0.06, half of it): δ is judged
+    /// where the floor cannot carry it across the limit, or the clearing level 0.054, and
+    /// only there.
+    #[test]
+    fn a_large_floor_still_judges_a_delta_clear_of_the_limit() {
+        let a = AlarmConfig::new(0.06).validate().unwrap();
+        for (delta, verdict) in [
+            (0.36, Verdict::Over),
+            (0.0901, Verdict::Over),
+            (0.0899, Verdict::FloorNearLimit),
+            (0.06, Verdict::FloorNearLimit),
+            (0.0241, Verdict::FloorNearLimit),
+            (0.0239, Verdict::Within),
+            (0.0, Verdict::Within),
+        ] {
+            assert_eq!(a.judge(&window(delta, true, 0.03)), verdict, "{delta}");
+        }
+        // Over by more than its floor every window: raised as any other.
+        let mut a = a;
+        let far = window(0.36, true, 0.03);
+        assert_eq!(a.update(&far), (Verdict::Over, None));
+        assert_eq!(a.update(&far), (Verdict::Over, None));
+        assert_eq!(a.update(&far), (Verdict::Over, Some(AlarmEvent::Raised)));
     }
 
     #[test]

@@ -260,8 +260,11 @@ fn predict_rejects_a_delta_limit_below_f64_resolution() {
 }
 
 /// An alarm that cannot judge a window for its noise floor says so: the kneader (δ 0.033)
-/// with a 4 MHz timer and one-edge samples has a floor of 0.011, above 0.2 of a 0.02 limit,
-/// so the core's alarm counts no window; "no alarm" alone would read as a drive within it.
+/// with a 4 MHz timer and one-edge samples has a floor of 0.011, above 0.2 of a 0.03 limit, and
+/// δ lies within that floor of the limit, so the core's alarm counts no window; "no alarm"
+/// alone would read as a drive within it. Against a limit of 0.015 the same windows are over it
+/// by more than their floor, and the alarm judges them and raises (it had judged none, and the
+/// pin said no alarm for a drive twice its limit).
 #[test]
 fn an_alarm_that_judged_no_window_says_why() {
     let scratch_dir = scratch("blind");
@@ -271,18 +274,32 @@ fn an_alarm_that_judged_no_window_says_why() {
     let text = text
         .replace("duration = 30.0", "duration = 15.0")
         .replace("settle = 10.0", "settle = 5.0")
-        .replace("timer_hz = 84e6", "timer_hz = 4e6\nestimator_edges = 1")
-        .replace("delta_limit = 0.06", "delta_limit = 0.02");
-    assert!(text.contains("timer_hz = 4e6") && text.contains("delta_limit = 0.02"));
+        .replace("timer_hz = 84e6", "timer_hz = 4e6\nestimator_edges = 1");
+    assert!(text.contains("timer_hz = 4e6") && text.contains("delta_limit = 0.06"));
     let path = dir.join("blind-alarm.toml");
-    std::fs::write(&path, text).unwrap();
+    let far = dir.join("far-over.toml");
+    std::fs::write(
+        &path,
+        text.replace("delta_limit = 0.06", "delta_limit = 0.03"),
+    )
+    .unwrap();
+    std::fs::write(
+        &far,
+        text.replace("delta_limit = 0.06", "delta_limit = 0.015"),
+    )
+    .unwrap();
     // predict foresees it from the predicted speed: 2·ω̄/(K·timer_hz·pitch) = 1.09e-2.
     let v = json(&["predict", path.to_str().unwrap(), "--json"]);
     let w = v["irregularity"]["alarm_floor_warning"].as_str().unwrap();
     assert!(
-        w.contains("1.09e-2") && w.contains("above 0.2 of the δ limit 0.02"),
+        w.contains("1.09e-2")
+            && w.contains("above 0.2 of the δ limit 0.03")
+            && w.contains("would judge few windows or none"),
         "{w}"
     );
+    let v = json(&["predict", far.to_str().unwrap(), "--json"]);
+    let w = v["irregularity"]["alarm_floor_warning"].as_str().unwrap();
+    assert!(w.contains("judged over"), "{w}");
     let v = json(&["predict", "kneader", "--json"]);
     assert!(v["irregularity"]["alarm_floor_warning"].is_null());
     let v = json(&["run", path.to_str().unwrap(), "--json"]);
@@ -297,6 +314,9 @@ fn an_alarm_that_judged_no_window_says_why() {
         out.contains("no alarm — the alarm judged none of the") && out.contains("timer_hz"),
         "{out}"
     );
+    let v = json(&["run", far.to_str().unwrap(), "--json"]);
+    assert_eq!(v["alarms"].as_array().unwrap().len(), 1, "{}", v["alarms"]);
+    assert!(v["alarm_judged"]["counted"].as_u64().unwrap() > 10);
 }
 
 #[test]
@@ -1095,9 +1115,8 @@ fn a_small_rotors_support_loads_keep_their_digits() {
     let (ok, out, err) = drive_sim(&["run", path]);
     assert!(ok, "{err}");
     assert!(
-        out.contains(
-            "simulated peak reactions A 0.2301 N (normal against the load limit), B 0.3602 N"
-        ),
+        out.contains("simulated peak reactions over the run A 0.2301 N at ")
+            && out.contains(" s (normal against the load limit), B 0.3602 N at "),
         "{out}"
     );
     // Large loads print as before.

@@ -1047,13 +1047,13 @@ fn predict_judges_the_supports_at_its_own_drive_speed() {
     // `run` judges the same way at its window's ω max.
     let r = run_trial(&scene);
     assert_eq!(r.supports.unwrap().load_level, ["over", "normal"]);
-    // Without a drive there is no predicted speed: the service speed alone, as before.
+    // Its prescribed 60 rad/s, the service speed: judged there, and nothing above it.
     let s = host_sim::app::scene::Scene::parse(auger, path).unwrap();
     let u = host_sim::app::predict::predict(&s, path)
         .unwrap()
         .supports
         .unwrap();
-    assert_eq!(u.predicted_speed, None);
+    assert_eq!((u.predicted_speed, u.speed_prescribed), (Some(60.0), true));
     assert_eq!(u.above_service_speed, None);
 }
 
@@ -1137,5 +1137,93 @@ fn a_static_load_over_its_limit_is_named_as_why_no_speed_is_safe() {
     assert!(
         u.max_speed.unwrap() > 0.0 && u.no_safe_speed.is_none(),
         "{u:?}"
+    );
+}
+
+/// The auger (limit 2650 N at A) held at 60 rad/s but for a 0.4 s excursion to 200 rad/s in the
+/// middle of a 5 s run: at 200 rad/s support A carries 2402.0 + 7e-3·200² = 2682 N. The
+/// supports were judged at the last window's speed and the reactions over the last second only:
+/// "60.00 rad/s ... A 2427.2 N (warning)", the overload unsaid. They are judged now at the
+/// fastest speed any valid window measured and the reactions peak over the whole run, each
+/// with its time; the same excursion at the end of the run gives the same verdict.
+#[test]
+fn an_overload_anywhere_in_the_run_is_judged() {
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    // Its rotor, unbalance and soil load, without its drive, encoder and simulation.
+    let rotor = auger[..auger.find("[motor]").unwrap()]
+        .replacen("amount = 2.0e-3", "amount = 1.0e-2", 1)
+        .replacen("[8000.0, 8000.0]", "[2650.0, 8000.0]", 1);
+    assert!(rotor.contains("amount = 1.0e-2") && rotor.contains("[2650.0, 8000.0]"));
+    let scene = |points: &str| {
+        rotor.clone()
+            + &format!(
+                "\n[motor]\nmodel = \"profile\"\npoints = {points}\n[encoder]\nlines = 256\n\
+                 timer_hz = 10e6\n[simulation]\nduration = 5.0\n"
+            )
+    };
+    for (points, at) in [
+        ("[[0.0, 60.0], [2.0, 60.0], [2.2, 200.0], [2.4, 60.0]]", 2.2),
+        ("[[0.0, 60.0], [4.6, 60.0], [4.8, 200.0], [5.0, 60.0]]", 4.8),
+    ] {
+        let text = scene(points);
+        let s = run_trial(&text)
+            .supports
+            .unwrap_or_else(|| panic!("{text}"));
+        let speed = s.speed.unwrap();
+        assert!(speed > 190.0 && speed <= 200.5, "{speed}");
+        assert!((s.speed_at.unwrap() - at).abs() < 0.1, "{:?}", s.speed_at);
+        assert_eq!(s.load_level[0], "over");
+        assert_eq!(s.simulated_reaction_level.unwrap()[0], "over");
+        assert!(
+            (s.simulated_peak_at[0] - at).abs() < 0.05,
+            "{:?}",
+            s.simulated_peak_at
+        );
+        let peak = 2402.0 + 7e-3 * 200.0f64.powi(2);
+        assert!(
+            s.simulated_peak_reaction[0] > 2650.0 && s.simulated_peak_reaction[0] <= peak * 1.005,
+            "{}",
+            s.simulated_peak_reaction[0]
+        );
+        assert!(s.above_service_speed.is_some());
+    }
+}
+
+/// `predict` judges the supports at a prescribed drive's top speed as `run` does at the speed
+/// it measures: the auger (limit 2650 N at A) prescribed at 200 rad/s carries 2402.0 +
+/// 7e-3·200² = 2682 N there, over its limit, which `predict` left unsaid (it judged the service
+/// speed alone) while `run` said "over". A cranking ripple's peak counts: 150·(1 + 0.2).
+#[test]
+fn predict_judges_the_supports_at_a_prescribed_top_speed() {
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    let rotor = auger[..auger.find("[motor]").unwrap()]
+        .replacen("amount = 2.0e-3", "amount = 1.0e-2", 1)
+        .replacen("[8000.0, 8000.0]", "[2650.0, 8000.0]", 1);
+    let path = std::path::Path::new("trial.toml");
+    let supports = |motor: &str| {
+        let scene = host_sim::app::scene::Scene::parse(&format!("{rotor}{motor}"), path).unwrap();
+        host_sim::app::predict::predict(&scene, path)
+            .unwrap()
+            .supports
+            .unwrap()
+    };
+    let s = supports("[motor]\nmodel = \"speed\"\nspeed = 200.0\n");
+    assert_eq!(s.predicted_speed, Some(200.0));
+    assert!(s.speed_prescribed);
+    let peak = s.peak_load_at_predicted_speed.unwrap();
+    assert!(
+        (peak[0] - (2402.0 + 7e-3 * 200.0f64.powi(2))).abs() < 0.1,
+        "{peak:?}"
+    );
+    assert_eq!(s.load_level_at_predicted_speed.unwrap()[0], "over");
+    assert!(s.above_service_speed.is_some());
+    let s = supports(
+        "[motor]\nmodel = \"ramp\"\nfrom = 10.0\nto = 150.0\nduration = 1.0\n\
+         [cranking]\nripple = 0.2\nstrokes = 2.0\n",
+    );
+    assert!(
+        (s.predicted_speed.unwrap() - 180.0).abs() < 1e-9,
+        "{:?}",
+        s.predicted_speed
     );
 }

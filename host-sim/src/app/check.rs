@@ -1083,6 +1083,55 @@ fn vibration(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     }
     if let Some(ab) = &scene.autobalancer {
         autobalancer(ab, n, c)?;
+        // Every platform joined to the balancer's through couplings: one the rotor cannot
+        // move is no part of the machine (three platforms without a coupling had two modes
+        // the rotor cannot excite listed as its resonances and additional speeds, with capture
+        // lines copied from the first).
+        let mut reached = vec![false; scene.platform.len()];
+        if let Some(r) = reached.get_mut(usize::from(ab.platform).wrapping_sub(1)) {
+            *r = true;
+        }
+        loop {
+            let mut grew = false;
+            for cp in &scene.coupling {
+                let [a, b] = cp.between.map(|p| usize::from(p).wrapping_sub(1));
+                if let (Some(&ra), Some(&rb)) = (reached.get(a), reached.get(b)) {
+                    if ra != rb {
+                        reached[a] = true;
+                        reached[b] = true;
+                        grew = true;
+                    }
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let apart: Vec<String> = (0..reached.len())
+            .filter(|&i| !reached[i])
+            .map(|i| format!("platform[{}]", i + 1))
+            .collect();
+        if !apart.is_empty() {
+            return Err(c.bad(
+                "autobalancer.platform",
+                ab.platform,
+                format!(
+                    "{} {} joined to the balancer's platform by no [[coupling]]: the rotor \
+                     cannot move {}, so {} no part of the machine (a forgotten coupling?); \
+                     couple {} to the machine, or leave {} out",
+                    apart.join(", "),
+                    if apart.len() == 1 { "is" } else { "are" },
+                    if apart.len() == 1 { "it" } else { "them" },
+                    if apart.len() == 1 {
+                        "it is"
+                    } else {
+                        "they are"
+                    },
+                    if apart.len() == 1 { "it" } else { "them" },
+                    if apart.len() == 1 { "it" } else { "them" },
+                ),
+            ));
+        }
     }
     Ok(())
 }

@@ -780,6 +780,10 @@ pub struct SupportsOut {
     /// at its window's ω max (absent without a predicted steady state of the drive).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub predicted_speed: Option<f64>,
+    /// `predicted_speed` is the top speed a prescribed drive (`model = "speed"`, `"ramp"`,
+    /// `"profile"`, a cranking ripple's peak included) puts the shaft at, not a prediction.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub speed_prescribed: bool,
     /// Peak support loads over one turn at `predicted_speed`, N.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_load_at_predicted_speed: Option<[f64; 2]>,
@@ -829,10 +833,11 @@ pub fn static_overload(a: &drive_monitor::supports::SupportAnalysis) -> Option<S
     (!over.is_empty()).then(|| format!("{}: no speed is safe", over.join("; ")))
 }
 
-/// The warning when the δ alarm of `scene` could judge no window at the predicted speed: the
-/// noise floor a window reports there ([`drive_monitor::encoder::Encoder::noise_floor_at`],
-/// `2·ω̄/(K·timer_hz·pitch)` for `K = encoder.estimator_edges` edges of `pitch` rad each)
-/// above the fraction of the limit (0.2) the core's alarm judges a window under.
+/// The warning when the noise floor a window of `scene` reports at the predicted speed
+/// ([`drive_monitor::encoder::Encoder::noise_floor_at`], `2·ω̄/(K·timer_hz·pitch)` for
+/// `K = encoder.estimator_edges` edges of `pitch` rad each) is above the fraction of the limit
+/// (0.2) under which the core's alarm judges every window: above it the alarm judges only a δ
+/// farther than the floor from the limit, and the warning says whether the predicted δ is.
 fn alarm_floor_warning(
     scene: &Scene,
     file: &Path,
@@ -846,14 +851,46 @@ fn alarm_floor_warning(
         return Ok(None);
     };
     let floor = f64::from(encoder.noise_floor_at(steady.omega_rms as f32));
-    let fraction = drive_monitor::alarm::AlarmConfig::new(limit as f32).floor_fraction;
+    let alarm = drive_monitor::alarm::AlarmConfig::new(limit as f32);
+    let fraction = alarm.floor_fraction;
+    let clearing = limit * (1.0 - f64::from(alarm.hysteresis));
+    let delta = steady.delta;
+    // As the core judges a window whose floor is large against the limit (`DeltaAlarm::judge`).
+    let verdict = if delta - floor > limit {
+        format!("the predicted δ {delta:.4} is over it by more than the floor: judged over")
+    } else if delta + floor < clearing {
+        format!(
+            "the predicted δ {delta:.4} is under the clearing level {clearing:.4} by more than \
+             the floor: judged within"
+        )
+    } else {
+        format!(
+            "the predicted δ {delta:.4} lies within the floor of the limit: the core's alarm \
+             would judge few windows or none"
+        )
+    };
     Ok((floor > f64::from(fraction) * limit).then(|| {
         format!(
             "WARNING: at the predicted mean speed a window's noise floor is {floor:.2e}, above \
-             {fraction} of the δ limit {limit}: the core's alarm would judge no window (a \
-             faster `encoder.timer_hz` or more `encoder.estimator_edges` lower the floor)"
+             {fraction} of the δ limit {limit}: the alarm judges such a window only where its δ \
+             lies farther than the floor from the limit, and {verdict} (a faster \
+             `encoder.timer_hz` or more `encoder.estimator_edges` lower the floor)"
         )
     }))
+}
+
+/// The fastest speed a prescribed drive puts the shaft at, rad/s (`model = "speed"`, the larger
+/// end of a `"ramp"`, the fastest point of a `"profile"`; with a cranking ripple its peak,
+/// ω̄·(1 + ripple)); `None` for a torque drive or none.
+fn prescribed_top_speed(scene: &Scene) -> Option<f64> {
+    use crate::app::scene::MotorSpec;
+    let top = match scene.motor.as_ref()? {
+        MotorSpec::Speed { speed } => speed.abs(),
+        MotorSpec::Ramp { from, to, .. } => from.abs().max(to.abs()),
+        MotorSpec::Profile { points } => points.iter().map(|p| p[1].abs()).fold(0.0, f64::max),
+        MotorSpec::Parabola { .. } | MotorSpec::Kloss { .. } => return None,
+    };
+    Some(top * (1.0 + scene.cranking.map_or(0.0, |c| c.ripple)))
 }
 
 /// "normal" up to `fraction·limit`, "warning" up to `limit`, "over" above (in f64, as the
@@ -1023,9 +1060,12 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         let a = analysis(scene, &rotor, &limits, file)?;
         let r = a.report();
         let loads = rotor.loads(limits.service_speed());
-        // The drive's own prediction puts the shaft at up to ω max: judged there too, as `run`
-        // judges at its window's ω max.
-        let predicted_speed = p.irregularity.as_ref().and_then(|i| i.omega_max);
+        // The drive's own prediction puts the shaft at up to ω max, a prescribed drive at its
+        // top speed: judged there too, as `run` judges at the fastest ω max it measures (a
+        // prescribed 200 rad/s, over the safe speed, was judged at the service speed alone).
+        let predicted = p.irregularity.as_ref().and_then(|i| i.omega_max);
+        let prescribed = prescribed_top_speed(scene).filter(|w| *w > 0.0);
+        let predicted_speed = predicted.or(prescribed);
         let at_predicted = predicted_speed.map(|w| rotor.loads(w));
         let load_level_at = |loads: [drive_monitor::supports::LoadRange; 2]| {
             limits
@@ -1047,6 +1087,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             ],
             load_level: load_level_at(loads),
             predicted_speed,
+            speed_prescribed: predicted.is_none() && prescribed.is_some(),
             peak_load_at_predicted_speed: at_predicted.map(|l| [l[0].peak, l[1].peak]),
             load_level_at_predicted_speed: at_predicted.and_then(load_level_at),
             above_service_speed: predicted_speed

@@ -292,15 +292,22 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
     // The simulated reactions, each with its level against the load limit when there is one.
     let reactions = |k: usize| match u.simulated_reaction_level {
         Some(levels) => format!(
-            "{} N ({} against the load limit)",
+            "{} N at {:.3} s ({} against the load limit)",
             fmt_force(u.simulated_peak_reaction[k]),
+            u.simulated_peak_at[k],
             levels[k]
         ),
-        None => format!("{} N", fmt_force(u.simulated_peak_reaction[k])),
+        None => format!(
+            "{} N at {:.3} s",
+            fmt_force(u.simulated_peak_reaction[k]),
+            u.simulated_peak_at[k]
+        ),
     };
     let mut text = match u.speed {
         Some(speed) => format!(
-            "Supports at {speed:.2} rad/s (the fastest speed of the last window{}): peak loads A {} N ({}), B {} N ({}); simulated peak reactions A {}, B {}; unbalance A {}, B {}\n",
+            "Supports at {speed:.2} rad/s (the fastest speed a valid window measured{}{}): peak loads A {} N ({}), B {} N ({}); simulated peak reactions over the run A {}, B {}; unbalance A {}, B {}\n",
+            u.speed_at
+                .map_or(String::new(), |t| format!(", in the window ending at {t:.3} s")),
             u.speed_mean
                 .map_or(String::new(), |m| format!(", mean {m:.2}")),
             load(u.peak_load[0]),
@@ -313,7 +320,7 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
             u.unbalance_level[1]
         ),
         None => format!(
-            "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions A {}, B {}; unbalance A {}, B {}\n",
+            "Supports NOT JUDGED by the core (it measured no speed): simulated peak reactions over the run A {}, B {}; unbalance A {}, B {}\n",
             reactions(0),
             reactions(1),
             u.unbalance_level[0],
@@ -689,7 +696,12 @@ pub fn prediction_text(p: &Prediction) -> String {
         if let (Some(w), Some(peak)) = (u.predicted_speed, u.peak_load_at_predicted_speed) {
             let _ = writeln!(
                 s,
-                "  at the predicted ω max {w:.2} rad/s: peak A {} N, B {} N{}",
+                "  at the {} {w:.2} rad/s: peak A {} N, B {} N{}",
+                if u.speed_prescribed {
+                    "prescribed top speed"
+                } else {
+                    "predicted ω max"
+                },
                 fmt_force(peak[0]),
                 fmt_force(peak[1]),
                 u.load_level_at_predicted_speed

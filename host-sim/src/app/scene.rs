@@ -687,8 +687,7 @@ pub struct PlatformSpec {
     pub mass: f64,
     /// Support stiffness to ground, N/m.
     pub stiffness: f64,
-    /// Support damping, N·s/m.
-    #[serde(default)]
+    /// Support damping, N·s/m (required: 0 for an undamped support is written, not assumed).
     pub damping: f64,
 }
 
@@ -701,8 +700,7 @@ pub struct CouplingSpec {
     pub between: [u8; 2],
     /// Stiffness, N/m.
     pub stiffness: f64,
-    /// Damping, N·s/m.
-    #[serde(default)]
+    /// Damping, N·s/m (required: 0 for an undamped coupling is written, not assumed).
     pub damping: f64,
 }
 
@@ -735,8 +733,8 @@ pub struct AutobalancerSpec {
     pub load_mass: f64,
     /// Radius of the loads' track, m.
     pub radius: f64,
-    /// Housing mass, kg.
-    #[serde(default)]
+    /// Housing mass, kg (required: 0 for a housing left out of the model is written, not
+    /// assumed).
     pub housing_mass: f64,
     /// Viscosity of load motion relative to the housing, N·s/m.
     pub viscosity: f64,
