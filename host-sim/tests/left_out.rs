@@ -154,7 +154,12 @@ fn cranking_a_vibration_machine_says_the_angular_acceleration_is_left_out() {
 
     let v = json(&["run", cranked, "--json"]);
     let w = v["model_warnings"].as_array().expect("model_warnings");
-    assert_eq!(w.len(), 1, "{v}");
+    // The WARNING, and the NOTE on the ripple's mean speed.
+    assert_eq!(w.len(), 2, "{v}");
+    assert!(w[1]
+        .as_str()
+        .unwrap()
+        .starts_with("NOTE: with [cranking] ripple = 0.3"));
     let w = w[0].as_str().unwrap();
     assert!(
         w.starts_with("WARNING: [cranking] (ripple = 0.3, strokes = 2)")

@@ -1227,3 +1227,57 @@ fn predict_judges_the_supports_at_a_prescribed_top_speed() {
         s.predicted_speed
     );
 }
+
+/// What a scene's numbers mean where the run would otherwise mislead, said: a kiln-like drive
+/// predicted at 0.46–0.54 rad/s below the default `monitor.min_speed` of 1 rad/s (`run` then
+/// measured nothing, and `predict` said no word); a cranking ripple's prescribed speed, the mean
+/// over the angle, against the run's mean over time, √(1 − 0.4²) = 0.9165 of it (100 rad/s
+/// prescribed ran at 91.652 unsaid); and `sweep`, which judges no rotor, saying so.
+#[test]
+fn scene_numbers_that_would_mislead_are_said() {
+    let path = std::path::Path::new("trial.toml");
+    let kiln = "[shaft]\ninertia = 5000.0\n[motor]\nmodel = \"parabola\"\nno_load_speed = 0.6\n\
+                breakdown_speed = 0.3\nbreakdown_torque = 2.0e5\n[load]\nmean = 8.0e4\n\
+                harmonics = [{ order = 1.0, amplitude = 3.0e4 }]\n[encoder]\nlines = 1024\n\
+                timer_hz = 84e6\n";
+    let p = |text: &str| {
+        let s = host_sim::app::scene::Scene::parse(text, path).unwrap();
+        host_sim::app::predict::predict(&s, path)
+            .unwrap()
+            .irregularity
+            .unwrap()
+    };
+    let w = p(kiln).min_speed_warning.unwrap();
+    assert!(
+        w.contains("monitor.min_speed = 1 rad/s (the default)") && w.contains("nothing at all"),
+        "{w}"
+    );
+    assert_eq!(
+        p(&format!("{kiln}[monitor]\nmin_speed = 0.1\n")).min_speed_warning,
+        None
+    );
+    let r = run_trial(
+        "[motor]\nmodel = \"speed\"\nspeed = 100.0\n[cranking]\nripple = 0.4\nstrokes = 2.0\n\
+         [encoder]\nlines = 60\ntimer_hz = 1e6\n[simulation]\nduration = 3.0\n",
+    );
+    let note = r
+        .model_warnings
+        .iter()
+        .find(|w| w.starts_with("NOTE: with [cranking]"));
+    assert!(
+        note.is_some_and(|n| n.contains("0.9165")),
+        "{:?}",
+        r.model_warnings
+    );
+    let mean = r.speed_measured.unwrap();
+    assert!(
+        (mean / (100.0 * (1.0f64 - 0.16).sqrt()) - 1.0).abs() < 2e-3,
+        "{mean}"
+    );
+    let auger = host_sim::app::scene::bundled("auger").unwrap().1;
+    let one_mass = host_sim::app::scene::bundled("one-mass").unwrap().1;
+    let rotor = &auger[auger.find("[rotor]").unwrap()..auger.find("[motor]").unwrap()];
+    let both = host_sim::app::scene::Scene::parse(&format!("{one_mass}\n{rotor}"), path).unwrap();
+    let notes = host_sim::studies::sweep::not_used(&both);
+    assert!(notes.iter().any(|n| n.starts_with("[rotor]")), "{notes:?}");
+}

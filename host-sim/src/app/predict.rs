@@ -610,6 +610,10 @@ pub struct IrregularityOut {
     /// fraction of `delta_limit` the core's alarm requires (its `floor_fraction`, 0.2).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alarm_floor_warning: Option<String>,
+    /// The predicted ω min is below the encoder's `monitor.min_speed`: the core would take
+    /// those intervals for a standstill and measure nothing there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_speed_warning: Option<String>,
     /// The scene also has a vibration machine (`[[platform]]`, `[autobalancer]`): the drive
     /// prediction leaves out the torque it puts on the shaft, which `run` simulates
     /// ([`machine_torque_warning`]).
@@ -879,6 +883,38 @@ fn alarm_floor_warning(
     }))
 }
 
+/// The warning when the predicted ω min is below the slowest speed the encoder's monitor takes
+/// for running (`monitor.min_speed`, 1 rad/s by default): a kiln-like drive at 0.46–0.54 rad/s
+/// was predicted without a word, and `run` then measured nothing.
+fn min_speed_warning(
+    scene: &Scene,
+    file: &Path,
+    prediction: &drive_monitor::drive::Prediction,
+) -> Result<Option<String>, SceneError> {
+    let Some(steady) = prediction.steady() else {
+        return Ok(None);
+    };
+    let Some(encoder) = crate::app::run::core_encoder(scene, file)? else {
+        return Ok(None);
+    };
+    let min_speed = encoder.config().min_speed;
+    let given = scene.monitor.as_ref().and_then(|m| m.min_speed).is_some();
+    Ok((steady.omega_min < min_speed).then(|| {
+        format!(
+            "WARNING: monitor.min_speed = {min_speed} rad/s{} is above the predicted ω min \
+             {:.4} rad/s: the core takes an interval slower than it for a standstill, and \
+             measures {} (set monitor.min_speed below the ω min)",
+            if given { "" } else { " (the default)" },
+            steady.omega_min,
+            if steady.omega_max < min_speed {
+                "nothing at all"
+            } else {
+                "no window across the slow part of each cycle"
+            }
+        )
+    }))
+}
+
 /// The fastest speed a prescribed drive puts the shaft at, rad/s (`model = "speed"`, the larger
 /// end of a `"ramp"`, the fastest point of a `"profile"`; with a cranking ripple its peak,
 /// ω̄·(1 + ripple)); `None` for a torque drive or none.
@@ -1025,8 +1061,10 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 )
             });
         let alarm_floor_warning = alarm_floor_warning(scene, file, limit, &prediction)?;
+        let min_speed_warning = min_speed_warning(scene, file, &prediction)?;
         p.irregularity = Some(IrregularityOut {
             alarm_floor_warning,
+            min_speed_warning,
             machine_torque_warning: None,
             stall,
             working_branch_warning,

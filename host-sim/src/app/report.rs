@@ -591,6 +591,7 @@ pub fn prediction_text(p: &Prediction) -> String {
             for w in [
                 &i.working_branch_warning,
                 &i.alarm_floor_warning,
+                &i.min_speed_warning,
                 &i.machine_torque_warning,
             ]
             .into_iter()

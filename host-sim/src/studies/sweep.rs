@@ -563,6 +563,14 @@ pub fn not_used(scene: &Scene) -> Vec<String> {
             "[shaft]: {by}, so its inertia moves nothing; {drive}"
         ));
     }
+    if scene.rotor.is_some() {
+        out.push(
+            "[rotor] (its [[unbalance]] and [process_load]): the sweep judges the balancer's \
+             regime only, not the rotor's supports; `drive-sim predict` and `drive-sim run` \
+             report them"
+                .to_string(),
+        );
+    }
     out
 }
 
