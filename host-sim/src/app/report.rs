@@ -327,9 +327,13 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
             u.unbalance_level[1]
         ),
     };
-    for w in [&u.above_service_speed, &u.balancer_warning]
-        .into_iter()
-        .flatten()
+    for w in [
+        &u.above_service_speed,
+        &u.balancer_warning,
+        &u.reactions_note,
+    ]
+    .into_iter()
+    .flatten()
     {
         text.push_str("  ");
         text.push_str(w);

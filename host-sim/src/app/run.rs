@@ -105,6 +105,9 @@ pub struct SupportsRunOut {
     pub simulated_peak_reaction: [f64; 2],
     /// When each of them was seen, s.
     pub simulated_peak_at: [f64; 2],
+    /// When the run turned the shaft less than a revolution: its reactions may miss their peak.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reactions_note: Option<String>,
     /// Level of each support load: "normal" | "warning" | "over" | "unknown".
     pub load_level: [&'static str; 2],
     /// Level of each plane's unbalance against its permissible share.
@@ -864,6 +867,8 @@ struct Collector<'a> {
     rotor: Option<RotorLoads>,
     /// The largest simulated reaction at each support, and when.
     reactions: [(f64, f64); 2],
+    /// The shaft angle the reactions were sampled over, rad.
+    reactions_turned: f64,
     /// The valid window whose ω max is the fastest, and when it ended.
     fastest_window: Option<(Measurement, f64)>,
     state: Vec<f64>,
@@ -1048,6 +1053,7 @@ impl Observer for Collector<'_> {
                 // the reactions every REACTION_ANGLE of shaft rotation, so that the peak of
                 // the rotating load is not missed between step ends.
                 let turned = (step.shaft(t1).phi - step.shaft(t0).phi).abs();
+                self.reactions_turned += turned;
                 let n = (turned / REACTION_ANGLE).ceil().clamp(1.0, 1e9) as u64;
                 for i in 0..=n {
                     let t = if i == n {
@@ -1481,6 +1487,7 @@ pub fn run_with(
         next_sample: 0.0,
         rotor,
         reactions: [(0.0, 0.0); 2],
+        reactions_turned: 0.0,
         fastest_window: None,
         state: vec![0.0; dim],
         progress: Progress::new(duration, options.progress),
@@ -1608,6 +1615,18 @@ pub fn run_with(
     )?;
     report.capture = capture_analysis(scene, file, vib_params.as_ref(), &samples)?;
     supports(scene, file, &mut report, col.reactions)?;
+    if let Some(s) = report.supports.as_mut() {
+        // Less than a revolution: the unbalance's rotating load may not have come round to
+        // the static load, where the reaction peaks (0.57 revolution of the auger read 3520 N
+        // against the 3662 N it reaches).
+        let revolutions = col.reactions_turned / std::f64::consts::TAU;
+        s.reactions_note = (revolutions < 1.0).then(|| {
+            format!(
+                "NOTE: the simulated reactions cover {revolutions:.2} revolution, less than one: \
+                 their peak may be missed (lengthen simulation.duration)"
+            )
+        });
+    }
     report.alarms = col.alarms;
     report.alarm_judged = report.delta_limit.map(|l| AlarmJudged {
         floor_fraction: AlarmConfig::new(l as f32).floor_fraction,
@@ -2402,6 +2421,7 @@ fn supports(
                 peak_load: status.peak_load.map(finite),
                 simulated_peak_reaction: reactions,
                 simulated_peak_at: reactions_at,
+                reactions_note: None,
                 load_level: status.load.map(level),
                 unbalance_level: status.unbalance.map(level),
                 max_safe_speed: status.max_safe_speed.and_then(finite),
@@ -2419,6 +2439,7 @@ fn supports(
                 peak_load: [None; 2],
                 simulated_peak_reaction: reactions,
                 simulated_peak_at: reactions_at,
+                reactions_note: None,
                 load_level: ["unknown"; 2],
                 unbalance_level: status.unbalance.map(level),
                 max_safe_speed: status.max_safe_speed.and_then(finite),
