@@ -572,3 +572,57 @@ fn a_tooth_lost_just_after_the_frame_tooth_is_one_fault() {
     assert!(wrong.is_empty(), "{} of {checked}: {wrong:#?}", wrong.len());
     assert!(later.len() <= 2, "{} of {checked}: {later:#?}", later.len());
 }
+
+/// The onset of a steep start flare at the frame tooth: the mean speed rising from 25 to
+/// 150 rad/s at a constant angular acceleration from the frame tooth of the sixth revolution
+/// on, over two revolutions on a 12-1 wheel, three on 12-1 and 8-1 wheels (the speed rising
+/// by 57 and 40 % over the 12-1 wheel's first pitch), with ripples of ±20 to ±40 % at one to three
+/// strokes, 8 phases, clean: no fault in that revolution. The frame tooth, which fits, is
+/// judged with the two intervals after it, each a fifth to a third shorter against the one
+/// before than a revolution earlier: their squared log swings passed the margin shrunk at the
+/// gap, and the frame tooth was unexplained on 72, 23 and 64 of these 72 streams each. The
+/// swings the three intervals share (the middle one of the three, where the speed's trend
+/// has changed since the recorded revolution) are now taken out where a tooth is called
+/// unexplained at a gap for costing more than that margin.
+///
+/// What is left (`start_flare_census`): the frame tooth of the revolution after the onset is
+/// still unexplained on some of these streams (19 of 72 on the 12-1 wheel over two
+/// revolutions), the swings recorded during the onset unlike those after it; on an 8-1 wheel
+/// over two revolutions the onset revolution has faults on 64 of 72 streams; and a frame
+/// tooth whose own swing changed with a flare by more than a quarter of that margin is
+/// unexplained as a frame edge displaced (every stream of a 12-1 wheel where the flare to
+/// 150 rad/s starts two thirds into a revolution).
+#[test]
+fn the_onset_of_a_start_flare_at_the_frame_is_no_fault() {
+    let (mut checked, mut wrong) = (0, Vec::new());
+    for (n, revs) in [(12, 2.0), (12, 3.0), (8, 3.0)] {
+        for a in AMPS {
+            for z in ZS {
+                for ph in 0..NPHASE {
+                    let p = Params {
+                        n,
+                        m: 1,
+                        a,
+                        z,
+                        ph,
+                        nphase: NPHASE,
+                        shape: Shape::Accel,
+                        top: 150.0,
+                        revs,
+                        off: 0.0,
+                    };
+                    let edges = generate(&p);
+                    let ticks: Vec<u32> = edges.iter().map(|e| e.0).collect();
+                    let (_, r) = run(&p, 1, &ticks);
+                    checked += 1;
+                    let end = ticks[(FLARE_AT as usize + 1) * (n - 1) as usize];
+                    if r.faults.iter().any(|f| f.1 < end) {
+                        wrong.push(format!("{}: {}", p.case_args(), describe(&edges, &r)));
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 3 * 72);
+    assert!(wrong.is_empty(), "{} of {checked}: {wrong:#?}", wrong.len());
+}
