@@ -10,7 +10,7 @@
 //!
 //! - `exp`: ln ω̄ linear in u (the same ratio from tooth to tooth);
 //! - `accel`: ω̄² linear in u, a constant angular acceleration in time (the steepest rise at
-//!   its start: from 25 to 150 rad/s over two revolutions the mean rises 1.5 times over the
+//!   its start: from 25 to 150 rad/s over two revolutions the mean rises 1.57 times over the
 //!   first pitch of a 12-1 wheel);
 //! - `smooth`: ω̄ linear in smoothstep(u) = 3u² − 2u³ (no step in the acceleration).
 //!
@@ -21,8 +21,10 @@
 //! estimators of K = 1 and 4 edges, windows of one revolution. For each wheel it prints how
 //! many clean streams get any fault (by kind), and how many streams with one tooth lost at
 //! the first, second or third tooth after the gap (tooth 0, 1, 2 of the revolution the
-//! flare starts in, or of the cranking revolution before it) count other than exactly one
-//! fault. `FLARE_CASE='12 1 0.4 2 3 8 accel 150 2 0.333 1 none'` (n m a z ph nphase shape
+//! flare starts in, or of the cranking revolution before it; only where the clean stream
+//! counts no fault) count other than exactly one fault. README gives the counts (in release
+//! about 20 s here); `FLARE_WHEEL=12-1` runs one wheel, `FLARE_VERBOSE=1` prints each stream
+//! counted, with the `FLARE_CASE` that replays it. `FLARE_CASE='12 1 0.4 2 3 8 accel 150 2 0.333 1 none'` (n m a z ph nphase shape
 //! ω₁ revs off K, then `none` or `lost REV POS`) replays one stream and lists its faults
 //! with the tooth they were found at.
 
