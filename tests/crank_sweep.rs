@@ -25,7 +25,7 @@
 //! The grid: 8-1, 12-1, 24-1, 36-1, 36-2 and 60-2 wheels; ripple a of 0, 0.2, 0.3 and 0.4 with
 //! z = 1, 2 and 3 strokes (a = 0 once); 8 phases; σ of 0, 1 % and 2 % of a pitch; estimators of
 //! K = 1, 2, 4 and 8 edges; windows of 1 and 2 revolutions. README's figures (no valid window
-//! of 1 036 485 wrong; 430 562 and 429 872 in the finer sweeps near the frame, seed offsets 1
+//! of 1 038 091 wrong; 430 668 and 430 070 in the finer sweeps near the frame, seed offsets 1
 //! and 2) are printed by
 //!
 //! ```text
