@@ -946,6 +946,84 @@ fn a_load_without_a_common_period_warns_of_its_window() {
     );
 }
 
+/// A load order below 1/1024 turns once in more revolutions than the longest δ window
+/// (1024) holds. `run` refused it with a bare "`load.harmonics`: out of range" (the default
+/// window, one cycle of that order, did not exist) while `predict` accepted it with a WARNING
+/// that named the window "(none)"; a `window_revolutions` set over it got no WARNING at all,
+/// although 8 revolutions hold 0.4 % of the cycle (δ read 98.7 % low). Now the default window
+/// is the longest, the run runs, and both windows are said.
+#[test]
+fn a_load_cycle_longer_than_the_longest_window_is_said() {
+    let scene = "[simulation]\nduration = 2.0\n[shaft]\ninertia = 0.323\n[motor]\n\
+                 model = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+                 breakdown_torque = 158.0\n[load]\nmean = 24.0\n\
+                 harmonics = [{ order = 0.0005, amplitude = 12.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84e6\n[monitor]\ndelta_limit = 0.06\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(1024)
+    );
+    let w = host_sim::app::run::window_warning(&s).unwrap_or_default();
+    assert!(
+        w.starts_with(
+            "WARNING: one cycle of the load's order 0.0005 is 2000 revolutions, more than the \
+             longest δ window (1024)"
+        ) && w.contains(
+            "the default window is the longest, 1024 revolutions, which holds 0.512 of that cycle"
+        ) && w.contains("δ may be read low")
+            && !w.contains("(none)"),
+        "{w}"
+    );
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.window_warning.as_deref(), Some(w.as_str()));
+    let r = run_trial(scene);
+    assert_eq!(r.window_warning.as_deref(), Some(w.as_str()));
+    // A window set over it: said, with how much of the cycle it holds.
+    let eight = format!("{scene}window_revolutions = 8\n");
+    let s8 = host_sim::app::scene::Scene::parse(&eight, path).unwrap();
+    let w8 = host_sim::app::run::window_warning(&s8).unwrap_or_default();
+    assert!(
+        w8.contains("`monitor.window_revolutions = 8` holds only 0.004 of that cycle")
+            && w8.contains("δ may be read low")
+            && w8.contains("the longest window, 1024 revolutions, holds 0.512 of it"),
+        "{w8}"
+    );
+    let r8 = run_trial(&eight);
+    assert_eq!(r8.window_warning.as_deref(), Some(w8.as_str()));
+    assert!(r8.delta_measured.unwrap() < 0.1 * r8.delta_predicted.unwrap());
+    // Orders with no common period and a window shorter than the lowest order's cycle (0.3:
+    // 3.33 revolutions): said the same way; one holding that cycle is not.
+    let two = scene.replace("order = 0.0005,", "order = 0.3,").replace(
+        "amplitude = 12.0 }]",
+        "amplitude = 12.0 }, { order = 1.4142135623730951, amplitude = 5.0 }]",
+    );
+    for (n, said) in [(2, true), (4, false)] {
+        let text = format!("{two}window_revolutions = {n}\n");
+        let sn = host_sim::app::scene::Scene::parse(&text, path).unwrap();
+        let wn = host_sim::app::run::window_warning(&sn);
+        assert_eq!(wn.is_some(), said, "{wn:?}");
+        if let Some(wn) = wn {
+            assert!(
+                wn.contains("have no common period")
+                    && wn.contains("`monitor.window_revolutions = 2` holds only 0.600 of one cycle of the lowest order 0.3 (3.333333 revolutions)")
+                    && wn.contains("a window of at least 4 revolutions holds it"),
+                "{wn}"
+            );
+        }
+    }
+    // A cycle of a million revolutions: the window's share of it, not "(none)".
+    let slow = scene.replace("order = 0.0005,", "order = 1e-6,");
+    let ss = host_sim::app::scene::Scene::parse(&slow, path).unwrap();
+    let ws = host_sim::app::run::window_warning(&ss).unwrap_or_default();
+    assert!(
+        ws.contains("is 1000000 revolutions") && ws.contains("holds 0.001 of that cycle"),
+        "{ws}"
+    );
+    assert!(run_trial(&slow).window_warning.is_some());
+}
+
 /// A heavily loaded Kloss drive (ω_s 157.08 rad/s, σ_m 0.2, M_m 100 N·m, mean load 90 N·m)
 /// with load orders 1 and √2, which have no common period: the prediction goes through the
 /// tangent parabola at synchronous speed, and that is no bound for the Kloss drive. `run`

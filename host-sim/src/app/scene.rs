@@ -663,8 +663,9 @@ fn default_estimator_edges() -> u16 {
 pub struct MonitorSpec {
     /// Permissible δ.
     pub delta_limit: Option<f64>,
-    /// δ window in revolutions (default: the load's period, from all its and the inertia's
-    /// orders).
+    /// δ window in revolutions, 1 to 1024 (default: the load's period, from all its and the
+    /// inertia's orders; where no window holds that period, one cycle of the lowest order or,
+    /// where that is longer, 1024, with a WARNING).
     pub window_revolutions: Option<u16>,
     /// Slowest running speed, rad/s (standstill below).
     pub min_speed: Option<f64>,
