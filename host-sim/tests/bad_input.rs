@@ -567,3 +567,61 @@ fn a_sweep_below_the_lowest_integrable_speed_is_refused_naming_from() {
         "{text}"
     );
 }
+
+/// J(φ) was checked by the sufficient condition Σ|amplitude| < inertia + flywheel, and refused
+/// with a bare "`shaft.inertia_harmonics`, `shaft.inertia = 0.323`, `shaft.flywheel = 0.0`:
+/// contradict each other": a crank-slider's series (J ≥ 0.1 everywhere, Σ|a| above its mean)
+/// or 0.323 + 0.2·(cos φ + cos 2φ) (least 0.098) could not be run. Now J(φ)'s least value
+/// decides, and the refusal of one that reaches 0 says where and quotes the amplitudes.
+#[test]
+fn a_reduced_inertia_is_refused_only_where_it_reaches_zero() {
+    let with = |harmonics: &str| {
+        bundled("kneader").replacen(
+            "flywheel = 0.0",
+            &format!("flywheel = 0.0\ninertia_harmonics = {harmonics}"),
+            1,
+        )
+    };
+    let e = Scene::parse(
+        &with("[{ order = 1.0, amplitude = 0.323, phase = 0.0 }]"),
+        Path::new("bad.toml"),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert_names(
+        &e,
+        &[
+            "`shaft.inertia_harmonics` (amplitudes 0.323)",
+            "`shaft.inertia = 0.323`",
+            "`shaft.flywheel = 0.0`",
+            "falls to 0 kg·m² at φ = 3.1416 rad",
+            "the reduced inertia must stay positive",
+        ],
+    );
+    // 0.323 + 0.2·cos φ − 0.3·cos 2φ: least −0.177 at φ = π.
+    let e = Scene::parse(
+        &with("[{ order = 1.0, amplitude = 0.2 }, { order = 2.0, amplitude = -0.3 }]"),
+        Path::new("bad.toml"),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert_names(
+        &e,
+        &[
+            "(amplitudes 0.2, -0.3)",
+            "falls to -0.1770 kg·m² at φ = 3.1416 rad",
+        ],
+    );
+    // Positive everywhere although Σ|amplitude| = 0.4 > 0.323: predicted and run.
+    let positive = with("[{ order = 1.0, amplitude = 0.2 }, { order = 2.0, amplitude = 0.2 }]");
+    let s = Scene::parse(&positive, Path::new("ok.toml")).unwrap();
+    let p = predict(&s, Path::new("ok.toml")).unwrap();
+    assert!(p.irregularity.unwrap().delta.unwrap() > 0.9);
+    let short = positive
+        .replacen("duration = 30.0", "duration = 1.0", 1)
+        .replacen("settle = 10.0", "settle = 0.5", 1);
+    let s = Scene::parse(&short, Path::new("ok.toml")).unwrap();
+    run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+}

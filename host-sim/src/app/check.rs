@@ -486,6 +486,77 @@ fn harmonics(c: &Checker, key: &str, list: &[Harmonic], amplitude: f64) -> Resul
     Ok(())
 }
 
+/// J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase) must stay positive: its least
+/// value over the period as the core finds it ([`drive_monitor::drive::least_inertia`]), the
+/// refusal saying where it reaches 0 and quoting the amplitudes.
+fn least_inertia(
+    c: &Checker,
+    inertia: f64,
+    flywheel: f64,
+    list: &[Harmonic],
+) -> Result<(), SceneError> {
+    let j = inertia + flywheel;
+    let swing: f64 = list.iter().map(|h| h.amplitude.abs()).sum();
+    if swing < j {
+        return Ok(());
+    }
+    let core: Vec<_> = list
+        .iter()
+        .filter_map(|h| {
+            drive_monitor::drive::InertiaHarmonic::new(h.order, h.amplitude, h.phase).ok()
+        })
+        .collect();
+    let why = match drive_monitor::drive::least_inertia(j, &core) {
+        Some((_, least)) if least > 0.0 => return Ok(()),
+        Some((phi, least)) => {
+            let shown = if least == 0.0 {
+                "0".to_string()
+            } else if least.abs() >= 1e-3 {
+                format!("{least:.4}")
+            } else {
+                format!("{least:.3e}")
+            };
+            format!(
+                "J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase) falls to {shown} \
+                 kg·m² at φ = {phi:.4} rad: the reduced inertia must stay positive (smaller \
+                 amplitudes, or more inertia or flywheel)"
+            )
+        }
+        None => format!(
+            "the amplitudes' magnitudes add up to {} kg·m², at least inertia + flywheel = {} \
+             kg·m², and the orders have no common period over which J(φ)'s least value could \
+             be found (each a fraction with denominator ≤ {}, the period at most {} cycles of \
+             the fastest order), so J(φ) may come as close to inertia + flywheel − Σ|amplitude| = {} kg·m² as it \
+             likes: the reduced inertia must stay positive",
+            num(swing),
+            num(j),
+            drive_monitor::drive::MAX_DENOMINATOR,
+            drive_monitor::drive::MAX_SAMPLES / drive_monitor::drive::SAMPLES_PER_CYCLE,
+            num(j - swing)
+        ),
+    };
+    let amplitudes: Vec<String> = (1..=list.len())
+        .map(|i| {
+            let k = format!("shaft.inertia_harmonics[{i}].amplitude");
+            c.written
+                .get(&k)
+                .map_or_else(|| num(list[i - 1].amplitude), str::to_string)
+        })
+        .collect();
+    let keys = format!(
+        "`shaft.inertia_harmonics` (amplitudes {}), `shaft.inertia = {}`, `shaft.flywheel = {}`",
+        amplitudes.join(", "),
+        c.shown("shaft.inertia", inertia),
+        c.shown("shaft.flywheel", flywheel)
+    );
+    Err(SceneError::Core {
+        file: c.file.to_path_buf(),
+        key: "shaft.inertia_harmonics".into(),
+        keys,
+        message: why,
+    })
+}
+
 fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
     if let Some(s) = &scene.shaft {
         c.positive("shaft.inertia", s.inertia, MAX_INERTIA, "kg·m²")?;
@@ -496,6 +567,7 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
             &s.inertia_harmonics,
             MAX_INERTIA,
         )?;
+        least_inertia(c, s.inertia, s.flywheel, &s.inertia_harmonics)?;
         if let Some(w) = s.initial_speed {
             c.magnitude("shaft.initial_speed", w, MAX_SPEED, "rad/s")?;
         }

@@ -195,7 +195,9 @@ pub struct ShaftSpec {
     /// Added flywheel, kg·m².
     #[serde(default)]
     pub flywheel: f64,
-    /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase).
+    /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase),
+    /// positive for every φ (the amplitudes may add up to more than inertia + flywheel where
+    /// J(φ)'s least value stays positive, as a crank-slider's series does).
     #[serde(default)]
     pub inertia_harmonics: Vec<Harmonic>,
     /// Initial speed, rad/s (default: the drive model's mean speed, where the motor carries
