@@ -625,3 +625,44 @@ fn a_reduced_inertia_is_refused_only_where_it_reaches_zero() {
     let s = Scene::parse(&short, Path::new("ok.toml")).unwrap();
     run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
 }
+
+/// A negative prescribed speed with `[cranking]` was refused as "`motor.points`: must not be
+/// negative", a key of `model = "profile"` the scene did not have, without the value or a
+/// reason. The key as written, its value and why are said now; without `[cranking]` the
+/// same speeds still run the shaft backwards.
+#[test]
+fn a_negative_speed_under_a_cranking_ripple_names_its_own_key() {
+    let base = "[shaft]\ninertia = 1.0\n[motor]\nMOTOR\n[encoder]\nlines = 256\ntimer_hz = 10e6\n\
+                [simulation]\nduration = 0.2\n";
+    let cranking = "[cranking]\nripple = 0.1\nstrokes = 2\n";
+    for (motor, named) in [
+        ("model = \"speed\"\nspeed = -50.0", "`motor.speed = -50.0`"),
+        (
+            "model = \"ramp\"\nfrom = -1.0\nto = 100.0\nduration = 0.1",
+            "`motor.from = -1.0`",
+        ),
+        (
+            "model = \"ramp\"\nfrom = 10.0\nto = -1e2\nduration = 0.1",
+            "`motor.to = -1e2`",
+        ),
+    ] {
+        let text = format!("{}{cranking}", base.replace("MOTOR", motor));
+        let e = Scene::parse(&text, Path::new("bad.toml"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert_names(
+            &e,
+            &[
+                named,
+                "a cranking ripple needs a forward speed",
+                "allowed [0, 1e5] rad/s",
+            ],
+        );
+        assert!(!e.contains("motor.points"), "{e}");
+        // Without the ripple: accepted.
+        let plain = base.replace("MOTOR", motor);
+        let s = Scene::parse(&plain, Path::new("ok.toml")).unwrap();
+        run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+    }
+}

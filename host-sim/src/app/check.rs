@@ -1060,6 +1060,29 @@ fn cranking_and_capture(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
                 rule: "a cranking ripple modulates a prescribed speed: [motor] model = \"speed\", \"ramp\" or \"profile\"".into(),
             });
         }
+        // The ripple scales the mean speed by (1 + ripple·sin(strokes·φ + phase)), a function
+        // of the angle: a shaft turning backwards has no such law. (Without [cranking] a
+        // negative speed runs the shaft backwards.)
+        let speeds: Vec<(String, f64)> = match &scene.motor {
+            Some(MotorSpec::Speed { speed }) => vec![("motor.speed".into(), *speed)],
+            Some(MotorSpec::Ramp { from, to, .. }) => {
+                vec![("motor.from".into(), *from), ("motor.to".into(), *to)]
+            }
+            // (A profile's speeds are [0, 1e5] rad/s with or without [cranking].)
+            _ => Vec::new(),
+        };
+        if let Some((key, w)) = speeds.into_iter().find(|(_, w)| *w < 0.0) {
+            return Err(c.bad(
+                &key,
+                w,
+                format!(
+                    "a cranking ripple needs a forward speed: allowed [0, {}] rad/s with \
+                     [cranking] (it modulates the speed by the shaft's angle; without \
+                     [cranking] a negative speed runs the shaft backwards)",
+                    num(MAX_SPEED)
+                ),
+            ));
+        }
     }
     if let Some(k) = &scene.capture {
         c.range("capture.sample_rate", k.sample_rate, 1.0, false, 1e10, "Hz")?;
