@@ -215,7 +215,7 @@ fn keys_a_scene_does_not_use_are_still_checked() {
     let e = error(
         "kneader",
         "timer_hz = 84e6",
-        "timer_hz = 84e6\nmissing = 255",
+        "timer_hz = 84e6\nframing = \"index\"\nmissing = 255",
     );
     assert_names(
         &e,
@@ -665,4 +665,54 @@ fn a_negative_speed_under_a_cranking_ripple_names_its_own_key() {
         let s = Scene::parse(&plain, Path::new("ok.toml")).unwrap();
         run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
     }
+}
+
+/// `missing = 2` without `framing` was refused as "only with framing = \"missing-tooth\" (this
+/// encoder has no gap)", although the key docs say `missing` implies the framing as `wheel`,
+/// `gaps` and `teeth` do: it implies it now. A prescaler on a wheel was refused with a bare
+/// "`encoder.prescaler = 2`, `encoder.framing = \"missing-tooth\"` (the default): contradict
+/// each other": the framing is the wheel's, not a default, and the reason is said.
+#[test]
+fn missing_teeth_imply_their_framing_and_a_prescaler_on_a_wheel_says_why() {
+    let e = error(
+        "kneader",
+        "lines = 1024",
+        "lines = 36\nmissing = 2\nprescaler = 2",
+    );
+    assert_names(
+        &e,
+        &[
+            "`encoder.prescaler = 2`",
+            "framing = \"missing-tooth\", implied by `encoder.missing = 2`",
+            "the prescaler is for uniform discs only",
+        ],
+    );
+    assert!(!e.contains("the default"), "{e}");
+    let e = error("kneader", "lines = 1024", "wheel = \"36-2\"\nprescaler = 2");
+    assert_names(
+        &e,
+        &[
+            "`encoder.prescaler = 2`",
+            "implied by `encoder.wheel = \"36-2\"`",
+            "the prescaler is for uniform discs only",
+        ],
+    );
+    // A uniform disc whose lines the prescaler does not divide: said.
+    let e = error("kneader", "lines = 1024", "lines = 30\nprescaler = 4");
+    assert_names(
+        &e,
+        &["`encoder.prescaler = 4`", "divide the disc's 30 lines"],
+    );
+    // Missing teeth alone: a 36-2 wheel, framed by its gap, that runs.
+    let text = bundled("kneader")
+        .replacen("lines = 1024", "lines = 36\nmissing = 2", 1)
+        .replacen("duration = 30.0", "duration = 3.0", 1)
+        .replacen("settle = 10.0", "settle = 1.0", 1);
+    let s = Scene::parse(&text, Path::new("ok.toml")).unwrap();
+    assert_eq!(
+        s.encoder.as_ref().unwrap().framing(),
+        host_sim::app::scene::FramingSpec::MissingTooth
+    );
+    let r = run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+    assert!(r.delta_measured.is_some());
 }

@@ -270,9 +270,10 @@ impl<'a> Checker<'a> {
             }
             let _ = match self.written.get(k) {
                 Some(v) => write!(quoted, "`{k} = {v}`"),
-                None => match default_of(scene, k) {
-                    Some(v) => write!(quoted, "`{k} = {v}` (the default)"),
-                    None => write!(quoted, "`{k}`"),
+                None => match (default_of(scene, k), implied_by(scene, k)) {
+                    (Some(v), Some(by)) => write!(quoted, "`{k} = {v}` (implied by `{by}`)"),
+                    (Some(v), None) => write!(quoted, "`{k} = {v}` (the default)"),
+                    (None, _) => write!(quoted, "`{k}`"),
                 },
             };
         }
@@ -419,6 +420,15 @@ pub fn core_keys(section: &str, parameter: &str) -> Vec<String> {
         vec![format!("{section}.{parameter}")]
     } else {
         listed.iter().map(|k| k.to_string()).collect()
+    }
+}
+
+/// The key whose value gives `key` its value where the file does not give it (the framing
+/// a wheel implies), rather than a default.
+fn implied_by(scene: &Scene, key: &str) -> Option<&'static str> {
+    match key {
+        "encoder.framing" => scene.encoder.as_ref()?.framing_implied_by(),
+        _ => None,
     }
 }
 
@@ -783,8 +793,11 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
             format!("allowed 2 to {MAX_LINES}")
         } else {
             format!(
-                "a wheel framed by its pattern has 3 to {MAX_PATTERN_LINES} grid positions (framing = \"{}\")",
-                framing.name()
+                "a wheel framed by its pattern has 3 to {MAX_PATTERN_LINES} grid positions (framing = \"{}\"{})",
+                framing.name(),
+                e.framing_implied_by()
+                    .map(|by| format!(", implied by `{by} = {}`", c.shown(by, "?")))
+                    .unwrap_or_default()
             )
         };
         return Err(c.bad(lines_key, shown, rule));
@@ -797,7 +810,11 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
                     return Err(c.bad(
                         "encoder.missing",
                         e.missing,
-                        "only with framing = \"missing-tooth\" (this encoder has no gap)",
+                        format!(
+                            "only with framing = \"missing-tooth\" (framing = {} has no gap; \
+                             without `framing` the missing teeth imply it)",
+                            c.shown("encoder.framing", format!("\"{}\"", framing.name()))
+                        ),
                     ));
                 }
                 for key in ["encoder.gaps", "encoder.teeth"] {
@@ -976,6 +993,37 @@ fn encoder(e: &EncoderSpec, c: &Checker) -> Result<(), SceneError> {
     c.count("encoder.counter_bits", e.counter_bits.into(), 16, 32)?;
     if ![1, 2, 4, 8].contains(&e.prescaler) {
         return Err(c.bad("encoder.prescaler", e.prescaler, "allowed 1, 2, 4 or 8"));
+    }
+    // The core's rules (`drive_monitor::encoder::Encoder::new`), with their reasons.
+    let framing = e.framing();
+    let framed_by_pattern = matches!(framing, FramingSpec::MissingTooth | FramingSpec::Pattern);
+    if e.prescaler != 1 && framed_by_pattern {
+        let how = match e.framing_implied_by() {
+            Some(by) => format!("implied by `{by} = {}`", c.shown(by, "?")),
+            None => "as written".to_string(),
+        };
+        return Err(c.bad(
+            "encoder.prescaler",
+            e.prescaler,
+            format!(
+                "a wheel framed by its pattern (framing = \"{}\", {how}) is captured edge by \
+                 edge, each tooth's pitch told apart: the prescaler is for uniform discs only \
+                 (prescaler = 1 here)",
+                framing.name()
+            ),
+        ));
+    }
+    let lines = w.teeth.len() as u64;
+    let p = u64::from(e.prescaler);
+    if e.prescaler != 1 && (lines % p != 0 || lines / p < 2) {
+        return Err(c.bad(
+            "encoder.prescaler",
+            e.prescaler,
+            format!(
+                "the prescaler must divide the disc's {lines} lines into whole captures, at \
+                 least 2 a revolution"
+            ),
+        ));
     }
     let edges = w.teeth.len() as u64 / u64::from(e.prescaler).max(1);
     let span = (drive_monitor::encoder::MAX_SPAN as u64).min(edges.max(1));
