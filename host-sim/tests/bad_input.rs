@@ -716,3 +716,49 @@ fn missing_teeth_imply_their_framing_and_a_prescaler_on_a_wheel_says_why() {
     let r = run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
     assert!(r.delta_measured.is_some());
 }
+
+/// A count the file gives was quoted as a default: "`unbalance = 100 tables (the default)`:
+/// at most 32 unbalances", "`motor.points = 0 points (the default)`"; a load of 9 harmonics got
+/// a bare "more than the fixed capacity holds". Counts are quoted as the file's, with the
+/// limit (README's limits table lists them).
+#[test]
+fn counts_written_in_the_file_are_not_called_defaults() {
+    let unbalance = "[[unbalance]]\nz = 1.0\namount = 1e-3\nangle = 0.0\n";
+    let mut text = bundled("auger").to_string();
+    for _ in 0..40 {
+        text.push_str(unbalance);
+    }
+    let e = Scene::parse(&text, Path::new("bad.toml"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("`unbalance = ") && e.contains(" tables`: at most 32 unbalances"),
+        "{e}"
+    );
+    assert!(!e.contains("the default"), "{e}");
+    let e = error(
+        "auger",
+        "model = \"speed\"\nspeed = 60.0              # rad/s, prescribed",
+        "model = \"profile\"\npoints = []",
+    );
+    assert_names(&e, &["`motor.points = 0 points`: 1 to 10000 points"]);
+    assert!(!e.contains("the default"), "{e}");
+    let nine = (1..=9)
+        .map(|i| format!("{{ order = {i}.0, amplitude = 1.0 }}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let e = error(
+        "kneader",
+        "harmonics = [{ order = 0.125, amplitude = 12.0, phase = 0.0 }]",
+        &format!("harmonics = [{nine}]"),
+    );
+    assert_names(
+        &e,
+        &["`load.harmonics = 9 harmonics`", "at most 8 harmonics"],
+    );
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+            .unwrap();
+    assert!(readme.contains("`[[unbalance]]` at most 32"));
+}

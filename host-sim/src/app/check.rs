@@ -189,6 +189,23 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// The error for the list `key` holding `n` `what` (tables, points) as the file gives
+    /// them: `rule` says how many are allowed. (A count is the file's own, never a default.)
+    pub fn bad_count(
+        &self,
+        key: &str,
+        n: usize,
+        what: &str,
+        rule: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Rule {
+            file: self.file.to_path_buf(),
+            key: key.to_string(),
+            value: format!("{n} {what}"),
+            rule: rule.into(),
+        }
+    }
+
     /// `x` finite and in `[lo, hi]` (`lo` excluded when `open`), in `unit`.
     pub fn range(
         &self,
@@ -487,6 +504,22 @@ fn simulation(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
 }
 
 fn harmonics(c: &Checker, key: &str, list: &[Harmonic], amplitude: f64) -> Result<(), SceneError> {
+    // The core's fixed capacities: drive::MAX_HARMONICS, and MAX_INERTIA_HARMONICS for the
+    // inertia's harmonics that are there (the core drops those of amplitude 0).
+    let (most, n) = if key == "shaft.inertia_harmonics" {
+        let there = list.iter().filter(|h| h.amplitude != 0.0).count();
+        (drive_monitor::drive::MAX_INERTIA_HARMONICS, there)
+    } else {
+        (drive_monitor::drive::MAX_HARMONICS, list.len())
+    };
+    if n > most {
+        return Err(c.bad_count(
+            key,
+            n,
+            "harmonics",
+            format!("at most {most} harmonics (the core's fixed capacity)"),
+        ));
+    }
     for (i, h) in list.iter().enumerate() {
         let k = format!("{key}[{}]", i + 1);
         c.positive(&format!("{k}.order"), h.order, MAX_ORDER, "per revolution")?;
@@ -649,9 +682,10 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         Some(MotorSpec::Profile { points }) => {
             let most = crate::engine::cranking::MAX_PROFILE_POINTS as u64;
             if points.is_empty() || points.len() as u64 > most {
-                return Err(c.bad(
+                return Err(c.bad_count(
                     "motor.points",
-                    format!("{} points", points.len()),
+                    points.len(),
+                    "points",
                     format!("1 to {most} points [t, ω]"),
                 ));
             }
@@ -1354,10 +1388,14 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         rule: why.to_string(),
     };
     if scene.platform.len() > drive_monitor::balancer::MAX_PLATFORMS {
-        return Err(c.bad(
+        return Err(c.bad_count(
             "platform",
-            format!("{} tables", scene.platform.len()),
-            "at most 3 platforms",
+            scene.platform.len(),
+            "tables",
+            format!(
+                "at most {} platforms",
+                drive_monitor::balancer::MAX_PLATFORMS
+            ),
         ));
     }
     if !scene.platform.is_empty() && scene.autobalancer.is_none() {
@@ -1376,10 +1414,14 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         ));
     }
     if scene.unbalance.len() > crate::app::predict::MAX_UNBALANCES {
-        return Err(c.bad(
+        return Err(c.bad_count(
             "unbalance",
-            format!("{} tables", scene.unbalance.len()),
-            format!("at most {} unbalances", crate::app::predict::MAX_UNBALANCES),
+            scene.unbalance.len(),
+            "tables",
+            format!(
+                "at most {} unbalances (the rotor's fixed capacity)",
+                crate::app::predict::MAX_UNBALANCES
+            ),
         ));
     }
     Ok(())
