@@ -1219,6 +1219,63 @@ fn a_load_the_motor_cannot_start_is_named() {
     );
 }
 
+/// The maximum safe speed was printed in fixed point with one decimal: 1.069e152 rad/s as a
+/// 150-digit number, 0.0941 rad/s as "0.1"; and "not limited by the support loads" where no
+/// load limit was given at all, `max_speed` null both there and where the unbalance is zero.
+/// Now a readable figure (said to be above what a scene can turn), four significant digits
+/// below 100 rad/s, and `max_speed_status` ("limited", "not_limited", "no_load_limit").
+#[test]
+fn the_maximum_safe_speed_is_readable_and_says_what_it_is() {
+    let scene = "[rotor]\nmass = 1e-6\ncentre_of_mass = 1.9\nsupport_a = 0.0\nsupport_b = 4.0\n\
+                 grade = 1e-3\nservice_speed = 1e5\nsupport_load_limit = [8000.0, 8000.0]\n\
+                 [[unbalance]]\nz = 1.2\namount = 1e-300\nangle = 30.0\n";
+    let path = std::path::Path::new("trial.toml");
+    let predicted = |text: &str| {
+        let s = host_sim::app::scene::Scene::parse(text, path).unwrap();
+        host_sim::app::predict::predict(&s, path).unwrap()
+    };
+    let p = predicted(scene);
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!(u.max_speed_status, "limited");
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(
+            "maximum safe speed 1.0690e152 rad/s, above the 1e5 rad/s any scene can turn"
+        ),
+        "{text}"
+    );
+    // A heavy unbalance: a slow safe speed keeps its digits (0.09410, not 0.1).
+    let slow = scene
+        .replace("amount = 1e-300", "amount = 1e6")
+        .replace("mass = 1e-6", "mass = 350.0");
+    let p = predicted(&slow);
+    let w = p.supports.as_ref().unwrap().max_speed.unwrap();
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        w < 1.0 && text.contains(&format!("maximum safe speed {w:.5} rad/s\n")),
+        "{w}: {text}"
+    );
+    // No load limit: not computed, and said so.
+    let p = predicted(&scene.replace("support_load_limit = [8000.0, 8000.0]\n", ""));
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!((u.max_speed, u.max_speed_status), (None, "no_load_limit"));
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("maximum safe speed: not computed (no `rotor.support_load_limit` given)")
+            && !text.contains("not limited"),
+        "{text}"
+    );
+    // Limits and no unbalance: not limited.
+    let p = predicted(&scene.replace("amount = 1e-300", "amount = 0.0"));
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!((u.max_speed, u.max_speed_status), (None, "not_limited"));
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("maximum safe speed: not limited by the support loads"),
+        "{text}"
+    );
+}
+
 /// A 1548 kg rotor whose centre of mass sits over support A: A carries its whole weight,
 /// 15 181.1 N, against a 7260.5 N limit, so `predict` printed "maximum safe speed 0.0 rad/s"
 /// and left the reader to find why. It now names the support and both figures, in the text and
