@@ -1629,12 +1629,9 @@ fn horizon(components: &[Component]) -> Horizon {
 /// [`MAX_DENOMINATOR`]) or it holds more than `MAX_SAMPLES/SAMPLES_PER_CYCLE` cycles of the
 /// fastest order. [`DriveModel::with_inertia_harmonics`] takes a J(φ) whose least value is
 /// positive.
+#[inline(never)]
 pub fn least_inertia(j: f64, harmonics: &[InertiaHarmonic]) -> Option<(f64, f64)> {
-    let at = |phi: f64| {
-        harmonics.iter().fold(j, |sum, h| {
-            sum + h.amplitude() * libm::cos(h.order() * phi + h.phase())
-        })
-    };
+    let at = |phi: f64| inertia_at(j, harmonics, phi);
     let there = harmonics.iter().filter(|h| h.amplitude() != 0.0);
     if there.clone().next().is_none() {
         return Some((0.0, j));
@@ -1680,6 +1677,15 @@ pub fn least_inertia(j: f64, harmonics: &[InertiaHarmonic]) -> Option<(f64, f64)
         best.1
     };
     Some((phi, least))
+}
+
+/// `J(φ) = j + Σ amplitude·cos(order·φ + phase)` (out of line: [`least_inertia`] calls it from
+/// its scans and its refinement, and firmware that builds a drive model links it).
+#[inline(never)]
+fn inertia_at(j: f64, harmonics: &[InertiaHarmonic], phi: f64) -> f64 {
+    harmonics.iter().fold(j, |sum, h| {
+        sum + h.amplitude() * libm::cos(h.order() * phi + h.phase())
+    })
 }
 
 /// The common period of `orders` (each a rational with denominator ≤ [`MAX_DENOMINATOR`]) and
