@@ -1841,6 +1841,40 @@ fn edges_faster_than_the_timer_are_warned_of() {
     }
 }
 
+/// A file of edge times with one row repeated (0 s apart) was warned of as "captures at the
+/// same timer tick ... raise --timer-hz" even at 1 GHz, where the pitch is 174 000 ticks. The
+/// report now names the line and says it repeats the edge before; the timer warning is left
+/// for edges that are distinct in the file.
+#[test]
+fn a_repeated_row_is_named_not_blamed_on_the_timer() {
+    let pitch = std::f64::consts::TAU / 360.0 / 100.0;
+    let mut rows: Vec<String> = (0..2000)
+        .map(|i| format!("{:.12}", f64::from(i) * pitch))
+        .collect();
+    rows.insert(100, rows[99].clone());
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(360),
+        timer_hz: Some(1e9),
+        estimator_edges: Some(1),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(rows.join("\n") + "\n", "dup.csv", None).unwrap();
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+    let repeated = report.repeated_times.clone().unwrap();
+    assert_eq!((repeated.rows, repeated.first_line), (1, 101));
+    assert_eq!(report.captures_at_one_tick, 0);
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains(&format!(
+            "WARNING: line 101 repeats the time of the edge before it, {} s (1 row repeats the \
+             one before): a duplicated row in the file",
+            rows[99].parse::<f64>().unwrap()
+        )) && !said.contains("raise --timer-hz"),
+        "{said}"
+    );
+}
+
 /// A shaft that stops before the recording does: the timeout is where the firmware's poll
 /// would see it (the core's timeout after the last tooth), not at the end of the file, and so
 /// is the end of the window it makes invalid.

@@ -215,7 +215,7 @@ fn keys_a_scene_does_not_use_are_still_checked() {
     let e = error(
         "kneader",
         "timer_hz = 84e6",
-        "timer_hz = 84e6\nmissing = 255",
+        "timer_hz = 84e6\nframing = \"index\"\nmissing = 255",
     );
     assert_names(
         &e,
@@ -621,4 +621,199 @@ fn platforms_joined_to_nothing_are_named() {
          [[coupling]]\nbetween = [3, 2]\nstiffness = 1e5\ndamping = 50.0\n{balancer}"
     );
     assert_eq!(refusal(&chained), None);
+}
+
+/// J(φ) was checked by the sufficient condition Σ|amplitude| < inertia + flywheel, and refused
+/// with a bare "`shaft.inertia_harmonics`, `shaft.inertia = 0.323`, `shaft.flywheel = 0.0`:
+/// contradict each other": a crank-slider's series (J ≥ 0.1 everywhere, Σ|a| above its mean)
+/// or 0.323 + 0.2·(cos φ + cos 2φ) (least 0.098) could not be run. Now J(φ)'s least value
+/// decides, and the refusal of one that reaches 0 says where and quotes the amplitudes.
+#[test]
+fn a_reduced_inertia_is_refused_only_where_it_reaches_zero() {
+    let with = |harmonics: &str| {
+        bundled("kneader").replacen(
+            "flywheel = 0.0",
+            &format!("flywheel = 0.0\ninertia_harmonics = {harmonics}"),
+            1,
+        )
+    };
+    let e = Scene::parse(
+        &with("[{ order = 1.0, amplitude = 0.323, phase = 0.0 }]"),
+        Path::new("bad.toml"),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert_names(
+        &e,
+        &[
+            "`shaft.inertia_harmonics` (amplitudes 0.323)",
+            "`shaft.inertia = 0.323`",
+            "`shaft.flywheel = 0.0`",
+            "falls to 0 kg·m² at φ = 3.1416 rad",
+            "the reduced inertia must stay positive",
+        ],
+    );
+    // 0.323 + 0.2·cos φ − 0.3·cos 2φ: least −0.177 at φ = π.
+    let e = Scene::parse(
+        &with("[{ order = 1.0, amplitude = 0.2 }, { order = 2.0, amplitude = -0.3 }]"),
+        Path::new("bad.toml"),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert_names(
+        &e,
+        &[
+            "(amplitudes 0.2, -0.3)",
+            "falls to -0.1770 kg·m² at φ = 3.1416 rad",
+        ],
+    );
+    // Positive everywhere although Σ|amplitude| = 0.4 > 0.323: predicted and run.
+    let positive = with("[{ order = 1.0, amplitude = 0.2 }, { order = 2.0, amplitude = 0.2 }]");
+    let s = Scene::parse(&positive, Path::new("ok.toml")).unwrap();
+    let p = predict(&s, Path::new("ok.toml")).unwrap();
+    assert!(p.irregularity.unwrap().delta.unwrap() > 0.9);
+    let short = positive
+        .replacen("duration = 30.0", "duration = 1.0", 1)
+        .replacen("settle = 10.0", "settle = 0.5", 1);
+    let s = Scene::parse(&short, Path::new("ok.toml")).unwrap();
+    run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+}
+
+/// A negative prescribed speed with `[cranking]` was refused as "`motor.points`: must not be
+/// negative", a key of `model = "profile"` the scene did not have, without the value or a
+/// reason. The key as written, its value and why are said now; without `[cranking]` the
+/// same speeds still run the shaft backwards.
+#[test]
+fn a_negative_speed_under_a_cranking_ripple_names_its_own_key() {
+    let base = "[shaft]\ninertia = 1.0\n[motor]\nMOTOR\n[encoder]\nlines = 256\ntimer_hz = 10e6\n\
+                [simulation]\nduration = 0.2\n";
+    let cranking = "[cranking]\nripple = 0.1\nstrokes = 2\n";
+    for (motor, named) in [
+        ("model = \"speed\"\nspeed = -50.0", "`motor.speed = -50.0`"),
+        (
+            "model = \"ramp\"\nfrom = -1.0\nto = 100.0\nduration = 0.1",
+            "`motor.from = -1.0`",
+        ),
+        (
+            "model = \"ramp\"\nfrom = 10.0\nto = -1e2\nduration = 0.1",
+            "`motor.to = -1e2`",
+        ),
+    ] {
+        let text = format!("{}{cranking}", base.replace("MOTOR", motor));
+        let e = Scene::parse(&text, Path::new("bad.toml"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert_names(
+            &e,
+            &[
+                named,
+                "a cranking ripple needs a forward speed",
+                "allowed [0, 1e5] rad/s",
+            ],
+        );
+        assert!(!e.contains("motor.points"), "{e}");
+        // Without the ripple: accepted.
+        let plain = base.replace("MOTOR", motor);
+        let s = Scene::parse(&plain, Path::new("ok.toml")).unwrap();
+        run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+    }
+}
+
+/// `missing = 2` without `framing` was refused as "only with framing = \"missing-tooth\" (this
+/// encoder has no gap)", although the key docs say `missing` implies the framing as `wheel`,
+/// `gaps` and `teeth` do: it implies it now. A prescaler on a wheel was refused with a bare
+/// "`encoder.prescaler = 2`, `encoder.framing = \"missing-tooth\"` (the default): contradict
+/// each other": the framing is the wheel's, not a default, and the reason is said.
+#[test]
+fn missing_teeth_imply_their_framing_and_a_prescaler_on_a_wheel_says_why() {
+    let e = error(
+        "kneader",
+        "lines = 1024",
+        "lines = 36\nmissing = 2\nprescaler = 2",
+    );
+    assert_names(
+        &e,
+        &[
+            "`encoder.prescaler = 2`",
+            "framing = \"missing-tooth\", implied by `encoder.missing = 2`",
+            "the prescaler is for uniform discs only",
+        ],
+    );
+    assert!(!e.contains("the default"), "{e}");
+    let e = error("kneader", "lines = 1024", "wheel = \"36-2\"\nprescaler = 2");
+    assert_names(
+        &e,
+        &[
+            "`encoder.prescaler = 2`",
+            "implied by `encoder.wheel = \"36-2\"`",
+            "the prescaler is for uniform discs only",
+        ],
+    );
+    // A uniform disc whose lines the prescaler does not divide: said.
+    let e = error("kneader", "lines = 1024", "lines = 30\nprescaler = 4");
+    assert_names(
+        &e,
+        &["`encoder.prescaler = 4`", "divide the disc's 30 lines"],
+    );
+    // Missing teeth alone: a 36-2 wheel, framed by its gap, that runs.
+    let text = bundled("kneader")
+        .replacen("lines = 1024", "lines = 36\nmissing = 2", 1)
+        .replacen("duration = 30.0", "duration = 3.0", 1)
+        .replacen("settle = 10.0", "settle = 1.0", 1);
+    let s = Scene::parse(&text, Path::new("ok.toml")).unwrap();
+    assert_eq!(
+        s.encoder.as_ref().unwrap().framing(),
+        host_sim::app::scene::FramingSpec::MissingTooth
+    );
+    let r = run(&s, Path::new("ok.toml"), Overrides::default()).unwrap();
+    assert!(r.delta_measured.is_some());
+}
+
+/// A count the file gives was quoted as a default: "`unbalance = 100 tables (the default)`:
+/// at most 32 unbalances", "`motor.points = 0 points (the default)`"; a load of 9 harmonics got
+/// a bare "more than the fixed capacity holds". Counts are quoted as the file's, with the
+/// limit (README's limits table lists them).
+#[test]
+fn counts_written_in_the_file_are_not_called_defaults() {
+    let unbalance = "[[unbalance]]\nz = 1.0\namount = 1e-3\nangle = 0.0\n";
+    let mut text = bundled("auger").to_string();
+    for _ in 0..40 {
+        text.push_str(unbalance);
+    }
+    let e = Scene::parse(&text, Path::new("bad.toml"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("`unbalance = ") && e.contains(" tables`: at most 32 unbalances"),
+        "{e}"
+    );
+    assert!(!e.contains("the default"), "{e}");
+    let e = error(
+        "auger",
+        "model = \"speed\"\nspeed = 60.0              # rad/s, prescribed",
+        "model = \"profile\"\npoints = []",
+    );
+    assert_names(&e, &["`motor.points = 0 points`: 1 to 10000 points"]);
+    assert!(!e.contains("the default"), "{e}");
+    let nine = (1..=9)
+        .map(|i| format!("{{ order = {i}.0, amplitude = 1.0 }}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let e = error(
+        "kneader",
+        "harmonics = [{ order = 0.125, amplitude = 12.0, phase = 0.0 }]",
+        &format!("harmonics = [{nine}]"),
+    );
+    assert_names(
+        &e,
+        &["`load.harmonics = 9 harmonics`", "at most 8 harmonics"],
+    );
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+            .unwrap();
+    assert!(readme.contains("`[[unbalance]]` at most 32"));
 }

@@ -532,6 +532,47 @@ fn a_varying_inertia_is_predicted() {
     }
 }
 
+/// A crank-slider's J(φ) (J_c = 0.1, m·r² = 1 kg·m², λ = 0.25, written as its cosine series,
+/// whose amplitudes add up to more than its mean) was refused by `predict` and `run` as
+/// "contradict each other". Now it is predicted (δ 1.093634, ω 86.788–296.229 rad/s, as an
+/// independent shooting gives) and `run` measures it from the encoder edges within 0.1 % of
+/// what the 16-edge speed samples can show (measured 1.088065 against 1.088933).
+#[test]
+fn a_crank_slider_scene_is_predicted_and_run() {
+    let scene = "[shaft]\ninertia = 0.6078125\ninertia_harmonics = [\
+                 { order = 1.0, amplitude = 0.125 }, \
+                 { order = 2.0, amplitude = 0.5, phase = 3.141592653589793 }, \
+                 { order = 3.0, amplitude = 0.125, phase = 3.141592653589793 }, \
+                 { order = 4.0, amplitude = 0.0078125, phase = 3.141592653589793 }]\n\
+                 [motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\nbreakdown_slip = 0.2\n\
+                 breakdown_torque = 100.0\n[load]\nmean = 30.0\n\
+                 harmonics = [{ order = 1.0, amplitude = 20.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84e6\n\
+                 [simulation]\nduration = 5.0\nintegrator = \"dop853\"\nrtol = 1e-10\natol = 1e-10\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.irregularity_not_predicted, None);
+    let i = p.irregularity.unwrap();
+    let (delta, lo, hi) = (i.delta.unwrap(), i.omega_min.unwrap(), i.omega_max.unwrap());
+    assert!((delta - 1.093634).abs() < 1e-6, "{delta}");
+    assert!(
+        (lo - 86.788).abs() < 1e-3 && (hi - 296.229).abs() < 1e-3,
+        "{lo} {hi}"
+    );
+    let r = run_trial(scene);
+    let measured = r.delta_measured.unwrap();
+    let sampled = r.delta_predicted_through_samples.unwrap();
+    assert!(
+        (measured / sampled - 1.0).abs() < 1e-3,
+        "{measured} against {sampled}"
+    );
+    assert!(
+        (measured / delta - 1.0).abs() < 1e-2,
+        "{measured} against {delta}"
+    );
+}
+
 /// What the core's J(φ) path does not cover is still refused, naming the key: an inertia
 /// order with no common period with the load's (√2 against 1), and a J(φ) reaching down to
 /// 1e-9 of its mean. `run` still simulates such a drive and predicts nothing.
@@ -946,6 +987,84 @@ fn a_load_without_a_common_period_warns_of_its_window() {
     );
 }
 
+/// A load order below 1/1024 turns once in more revolutions than the longest δ window
+/// (1024) holds. `run` refused it with a bare "`load.harmonics`: out of range" (the default
+/// window, one cycle of that order, did not exist) while `predict` accepted it with a WARNING
+/// that named the window "(none)"; a `window_revolutions` set over it got no WARNING at all,
+/// although 8 revolutions hold 0.4 % of the cycle (δ read 98.7 % low). Now the default window
+/// is the longest, the run runs, and both windows are said.
+#[test]
+fn a_load_cycle_longer_than_the_longest_window_is_said() {
+    let scene = "[simulation]\nduration = 2.0\n[shaft]\ninertia = 0.323\n[motor]\n\
+                 model = \"parabola\"\nno_load_speed = 145.0\nbreakdown_speed = 36.0\n\
+                 breakdown_torque = 158.0\n[load]\nmean = 24.0\n\
+                 harmonics = [{ order = 0.0005, amplitude = 12.0 }]\n\
+                 [encoder]\nlines = 1024\ntimer_hz = 84e6\n[monitor]\ndelta_limit = 0.06\n";
+    let path = std::path::Path::new("trial.toml");
+    let s = host_sim::app::scene::Scene::parse(scene, path).unwrap();
+    assert_eq!(
+        host_sim::app::run::window_config(&s).length,
+        drive_monitor::irregularity::WindowLength::Revolutions(1024)
+    );
+    let w = host_sim::app::run::window_warning(&s).unwrap_or_default();
+    assert!(
+        w.starts_with(
+            "WARNING: one cycle of the load's order 0.0005 is 2000 revolutions, more than the \
+             longest δ window (1024)"
+        ) && w.contains(
+            "the default window is the longest, 1024 revolutions, which holds 0.512 of that cycle"
+        ) && w.contains("δ may be read low")
+            && !w.contains("(none)"),
+        "{w}"
+    );
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.window_warning.as_deref(), Some(w.as_str()));
+    let r = run_trial(scene);
+    assert_eq!(r.window_warning.as_deref(), Some(w.as_str()));
+    // A window set over it: said, with how much of the cycle it holds.
+    let eight = format!("{scene}window_revolutions = 8\n");
+    let s8 = host_sim::app::scene::Scene::parse(&eight, path).unwrap();
+    let w8 = host_sim::app::run::window_warning(&s8).unwrap_or_default();
+    assert!(
+        w8.contains("`monitor.window_revolutions = 8` holds only 0.004 of that cycle")
+            && w8.contains("δ may be read low")
+            && w8.contains("the longest window, 1024 revolutions, holds 0.512 of it"),
+        "{w8}"
+    );
+    let r8 = run_trial(&eight);
+    assert_eq!(r8.window_warning.as_deref(), Some(w8.as_str()));
+    assert!(r8.delta_measured.unwrap() < 0.1 * r8.delta_predicted.unwrap());
+    // Orders with no common period and a window shorter than the lowest order's cycle (0.3:
+    // 3.33 revolutions): said the same way; one holding that cycle is not.
+    let two = scene.replace("order = 0.0005,", "order = 0.3,").replace(
+        "amplitude = 12.0 }]",
+        "amplitude = 12.0 }, { order = 1.4142135623730951, amplitude = 5.0 }]",
+    );
+    for (n, said) in [(2, true), (4, false)] {
+        let text = format!("{two}window_revolutions = {n}\n");
+        let sn = host_sim::app::scene::Scene::parse(&text, path).unwrap();
+        let wn = host_sim::app::run::window_warning(&sn);
+        assert_eq!(wn.is_some(), said, "{wn:?}");
+        if let Some(wn) = wn {
+            assert!(
+                wn.contains("have no common period")
+                    && wn.contains("`monitor.window_revolutions = 2` holds only 0.600 of one cycle of the lowest order 0.3 (3.333333 revolutions)")
+                    && wn.contains("a window of at least 4 revolutions holds it"),
+                "{wn}"
+            );
+        }
+    }
+    // A cycle of a million revolutions: the window's share of it, not "(none)".
+    let slow = scene.replace("order = 0.0005,", "order = 1e-6,");
+    let ss = host_sim::app::scene::Scene::parse(&slow, path).unwrap();
+    let ws = host_sim::app::run::window_warning(&ss).unwrap_or_default();
+    assert!(
+        ws.contains("is 1000000 revolutions") && ws.contains("holds 0.001 of that cycle"),
+        "{ws}"
+    );
+    assert!(run_trial(&slow).window_warning.is_some());
+}
+
 /// A heavily loaded Kloss drive (ω_s 157.08 rad/s, σ_m 0.2, M_m 100 N·m, mean load 90 N·m)
 /// with load orders 1 and √2, which have no common period: the prediction goes through the
 /// tangent parabola at synchronous speed, and that is no bound for the Kloss drive. `run`
@@ -1097,6 +1216,63 @@ fn a_load_the_motor_cannot_start_is_named() {
             && e.contains("the motor's torque at standstill (168.")
             && e.contains("shaft.initial_speed"),
         "{e}"
+    );
+}
+
+/// The maximum safe speed was printed in fixed point with one decimal: 1.069e152 rad/s as a
+/// 150-digit number, 0.0941 rad/s as "0.1"; and "not limited by the support loads" where no
+/// load limit was given at all, `max_speed` null both there and where the unbalance is zero.
+/// Now a readable figure (said to be above what a scene can turn), four significant digits
+/// below 100 rad/s, and `max_speed_status` ("limited", "not_limited", "no_load_limit").
+#[test]
+fn the_maximum_safe_speed_is_readable_and_says_what_it_is() {
+    let scene = "[rotor]\nmass = 1e-6\ncentre_of_mass = 1.9\nsupport_a = 0.0\nsupport_b = 4.0\n\
+                 grade = 1e-3\nservice_speed = 1e5\nsupport_load_limit = [8000.0, 8000.0]\n\
+                 [[unbalance]]\nz = 1.2\namount = 1e-300\nangle = 30.0\n";
+    let path = std::path::Path::new("trial.toml");
+    let predicted = |text: &str| {
+        let s = host_sim::app::scene::Scene::parse(text, path).unwrap();
+        host_sim::app::predict::predict(&s, path).unwrap()
+    };
+    let p = predicted(scene);
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!(u.max_speed_status, "limited");
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(
+            "maximum safe speed 1.0690e152 rad/s, above the 1e5 rad/s any scene can turn"
+        ),
+        "{text}"
+    );
+    // A heavy unbalance: a slow safe speed keeps its digits (0.09410, not 0.1).
+    let slow = scene
+        .replace("amount = 1e-300", "amount = 1e6")
+        .replace("mass = 1e-6", "mass = 350.0");
+    let p = predicted(&slow);
+    let w = p.supports.as_ref().unwrap().max_speed.unwrap();
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        w < 1.0 && text.contains(&format!("maximum safe speed {w:.5} rad/s\n")),
+        "{w}: {text}"
+    );
+    // No load limit: not computed, and said so.
+    let p = predicted(&scene.replace("support_load_limit = [8000.0, 8000.0]\n", ""));
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!((u.max_speed, u.max_speed_status), (None, "no_load_limit"));
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("maximum safe speed: not computed (no `rotor.support_load_limit` given)")
+            && !text.contains("not limited"),
+        "{text}"
+    );
+    // Limits and no unbalance: not limited.
+    let p = predicted(&scene.replace("amount = 1e-300", "amount = 0.0"));
+    let u = p.supports.as_ref().unwrap();
+    assert_eq!((u.max_speed, u.max_speed_status), (None, "not_limited"));
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains("maximum safe speed: not limited by the support loads"),
+        "{text}"
     );
 }
 

@@ -19,8 +19,8 @@ mod varying;
 
 pub use load::{Harmonic, Load, MAX_HARMONICS, MAX_ORDER};
 pub use model::{
-    period_revolutions, DesignError, DriveModel, Horizon, Irregularity, Prediction, Sensitivity,
-    Stall, SteadyCurve, SteadyState, MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET,
+    least_inertia, period_revolutions, DesignError, DriveModel, Horizon, Irregularity, Prediction,
+    Sensitivity, Stall, SteadyCurve, SteadyState, MAX_DENOMINATOR, MAX_SAMPLES, MIN_DELTA_TARGET,
     SAMPLES_PER_CYCLE,
 };
 pub use motor::{Kloss, KlossFit, Motor, Parabola};

@@ -349,9 +349,11 @@ impl DriveModel {
     /// replacing any harmonics given before. Harmonics of amplitude 0 are dropped; with none
     /// left the drive is the constant-inertia one.
     ///
-    /// Rejected: more than [`MAX_INERTIA_HARMONICS`] harmonics (`Capacity`); amplitudes whose
-    /// magnitudes add up to `inertia + flywheel` or more, so that J(φ) could reach 0
-    /// (`Inconsistent("inertia_harmonic.amplitude")`: the simulator's own condition);
+    /// Rejected: more than [`MAX_INERTIA_HARMONICS`] harmonics (`Capacity`); a J(φ) that
+    /// reaches 0 or below, its least value over the period ([`least_inertia`]) not positive
+    /// (`Inconsistent("inertia_harmonic.amplitude")`, the simulator's own condition; amplitudes
+    /// whose magnitudes add up to less than `inertia + flywheel` are accepted without the
+    /// search, and more than that with orders that have no common period are rejected);
     /// orders with no common period with each other and with the load's
     /// (`Inconsistent("inertia_harmonic.order")`: rationals with denominators up to
     /// [`MAX_DENOMINATOR`] and a period of at most [`MAX_SAMPLES`]/32 cycles of the fastest
@@ -475,8 +477,10 @@ impl DriveModel {
             kept.push(*h)
                 .map_err(|_| ConfigError::Capacity("inertia_harmonics"))?;
         }
-        // An overflowed `swing` (+∞) is rejected here too; `j` is finite.
-        if swing >= j {
+        // J(φ) > 0 for every φ: certain when the amplitudes' magnitudes add up to less than
+        // `j`, else J(φ)'s least value over the period decides (an overflowed `swing`, +∞, is
+        // rejected too; `j` is finite).
+        if swing >= j && !least_inertia(j, &kept).is_some_and(|(_, least)| least > 0.0) {
             return Err(ConfigError::Inconsistent("inertia_harmonic.amplitude"));
         }
         let mut model = Self {
@@ -1612,6 +1616,76 @@ fn horizon(components: &[Component]) -> Horizon {
         },
         _ => Horizon::Unbounded,
     }
+}
+
+/// The least value of the reduced inertia `J(φ) = j + Σ amplitude·cos(order·φ + phase)` of
+/// `harmonics` and an angle where J(φ) takes it, `(φ, least)` with φ in `[0, period)`; a least
+/// value within the rounding of the sum, `4·ε·(j + Σ|amplitude|)`, is returned as 0 (J(φ)
+/// reaches 0 there as far as f64 can tell). J(φ) is sampled [`SAMPLES_PER_CYCLE`] times a cycle
+/// of the fastest order over the orders' common period, and every sampled local minimum that
+/// can hide the least value (within `J''max·h²/8` of the least sample, `h` the spacing and
+/// `J''max = Σ|amplitude|·order²`) is refined by golden section. Without harmonics `(0, j)`.
+/// `None` where the orders have no common period (each a rational with denominator ≤
+/// [`MAX_DENOMINATOR`]) or it holds more than `MAX_SAMPLES/SAMPLES_PER_CYCLE` cycles of the
+/// fastest order. [`DriveModel::with_inertia_harmonics`] takes a J(φ) whose least value is
+/// positive.
+#[inline(never)]
+pub fn least_inertia(j: f64, harmonics: &[InertiaHarmonic]) -> Option<(f64, f64)> {
+    let at = |phi: f64| inertia_at(j, harmonics, phi);
+    let there = harmonics.iter().filter(|h| h.amplitude() != 0.0);
+    if there.clone().next().is_none() {
+        return Some((0.0, j));
+    }
+    let (radians, cycles) = common_period(there.clone().map(InertiaHarmonic::order))?;
+    let n = cycles * SAMPLES_PER_CYCLE;
+    let h = radians / n as f64;
+    let (mut curvature, mut swing) = (0.0, 0.0);
+    for k in there {
+        let a = libm::fabs(k.amplitude());
+        curvature += a * k.order() * k.order();
+        swing += a;
+    }
+    let slack = curvature * h * h / 8.0;
+    let mut least = (0.0, at(0.0));
+    for i in 1..n {
+        let phi = i as f64 * h;
+        let v = at(phi);
+        if v < least.1 {
+            least = (phi, v);
+        }
+    }
+    let bound = least.1 + slack;
+    let mut best = least;
+    let (mut before, mut here) = (at(-h), at(0.0));
+    for i in 0..n {
+        let phi = i as f64 * h;
+        let after = at(phi + h);
+        if here <= before && here <= after && here <= bound {
+            let (x, v) = golden(at, phi - h, phi + h, -1.0);
+            if v < best.1 {
+                best = (x, v);
+            }
+        }
+        before = here;
+        here = after;
+    }
+    let phi = libm::fmod(best.0, radians);
+    let phi = if phi < 0.0 { phi + radians } else { phi };
+    let least = if best.1 <= 4.0 * f64::EPSILON * (j + swing) {
+        best.1.min(0.0)
+    } else {
+        best.1
+    };
+    Some((phi, least))
+}
+
+/// `J(φ) = j + Σ amplitude·cos(order·φ + phase)` (out of line: [`least_inertia`] calls it from
+/// its scans and its refinement, and firmware that builds a drive model links it).
+#[inline(never)]
+fn inertia_at(j: f64, harmonics: &[InertiaHarmonic], phi: f64) -> f64 {
+    harmonics.iter().fold(j, |sum, h| {
+        sum + h.amplitude() * libm::cos(h.order() * phi + h.phase())
+    })
 }
 
 /// The common period of `orders` (each a rational with denominator ≤ [`MAX_DENOMINATOR`]) and

@@ -293,8 +293,14 @@ impl<'a> Shooter<'a> {
         cycles: u64,
     ) -> Result<Self, Failure> {
         let omega_ref = curve.speed_for(mean_load).ok_or(Failure::MeanLoad)?;
+        // The least J(φ): `j0 − Σ|amplitude|` bounds it from below where that is positive;
+        // else (a crank-slider's series) it is searched over the period.
         let swing: f64 = inertia.iter().map(|h| libm::fabs(h.amplitude())).sum();
-        let j_min = j0 - swing;
+        let j_min = if swing < j0 {
+            j0 - swing
+        } else {
+            super::model::least_inertia(j0, inertia).map_or(0.0, |(_, least)| least)
+        };
         let rate = curve.rate_bound(0.5 * omega_ref) / j_min;
         let by_rate = libm::ceil(period * rate / MAX_STEP_RATE);
         let by_cycles = cycles.saturating_mul(STEPS_PER_CYCLE) as f64;

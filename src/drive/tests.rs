@@ -1031,3 +1031,56 @@ pub(super) fn finite_results(m: &DriveModel, limit: f64) -> Result<(), TestCaseE
     }
     Ok(())
 }
+
+/// A crank-slider's J(φ) = J_c + m·r²·(sin φ + λ/2·sin 2φ)² (J_c = 0.1, m·r² = 1, λ = 0.25) as its
+/// cosine series: mean 0.6078125, magnitudes adding up to 0.7578125, more than the mean, yet
+/// J(φ) ≥ J_c. The check was Σ|amplitude| < J0 and refused it; the least value over the
+/// period decides now: 0.1 at φ = 0 (or π), 0.098 for 0.323 + 0.2·(cos φ + cos 2φ) at
+/// cos φ = −1/4, and 0 at φ = π for 0.323·(1 + cos φ), which is still refused.
+#[test]
+fn the_least_inertia_decides_whether_j_stays_positive() {
+    let crank = [
+        ih(1.0, 0.125, 0.0),
+        ih(2.0, 0.5, PI),
+        ih(3.0, 0.125, PI),
+        ih(4.0, 0.0078125, PI),
+    ];
+    let j0 = 0.6078125;
+    // The series is the closed form.
+    for i in 0..1000 {
+        let phi = f64::from(i) * 2.0 * PI / 1000.0;
+        let series: f64 = crank
+            .iter()
+            .map(|h| h.amplitude() * libm::cos(h.order() * phi + h.phase()))
+            .sum::<f64>()
+            + j0;
+        let s = libm::sin(phi) + 0.125 * libm::sin(2.0 * phi);
+        assert!((series - (0.1 + s * s)).abs() < 1e-14, "{phi}: {series}");
+    }
+    let (phi, least) = least_inertia(j0, &crank).unwrap();
+    assert!((least - 0.1).abs() < 1e-14, "{least}");
+    assert!(phi.abs() < 1e-6 || (phi - PI).abs() < 1e-6, "{phi}");
+    let two = [ih(1.0, 0.2, 0.0), ih(2.0, 0.2, 0.0)];
+    let (phi, least) = least_inertia(0.323, &two).unwrap();
+    assert!((least - 0.098).abs() < 1e-14, "{least}");
+    assert!((libm::cos(phi) + 0.25).abs() < 1e-7, "{phi}");
+    let (phi, least) = least_inertia(0.323, &[ih(1.0, 0.323, 0.0)]).unwrap();
+    assert_eq!(least, 0.0);
+    assert!((phi - PI).abs() < 1e-6, "{phi}");
+    // No common period: not searched.
+    assert_eq!(
+        least_inertia(
+            1.0,
+            &[ih(1.0, 0.6, 0.0), ih(core::f64::consts::SQRT_2, 0.6, 0.0)]
+        ),
+        None
+    );
+    // The drive model takes the positive ones and refuses the one that reaches 0.
+    assert!(drive(&[], j0).with_inertia_harmonics(&crank).is_ok());
+    let seed = seed();
+    assert!(seed.with_inertia_harmonics(&two).is_ok());
+    assert_eq!(
+        seed.with_inertia_harmonics(&[ih(1.0, 0.323, 0.0)]),
+        Err(ConfigError::Inconsistent("inertia_harmonic.amplitude"))
+    );
+}

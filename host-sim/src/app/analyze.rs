@@ -523,9 +523,14 @@ pub struct AnalyzeReport {
     pub edges: u64,
     /// Of them, those captured and fed to the core: one in `prescaler` (all without one).
     pub captured: u64,
-    /// Captures at the same timer tick as the one before: the timer is too slow to resolve
-    /// the edges (the report warns).
+    /// Captures at the same timer tick as the one before, at a later time: the timer is too
+    /// slow to resolve the edges (the report warns).
     pub captures_at_one_tick: u64,
+    /// Captures whose time, as the file writes it, is the one before's (0 s apart, which no
+    /// timer resolves): a duplicated row, or times written more coarsely than the edges came
+    /// (the report warns, naming the first line).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub repeated_times: Option<RepeatedTimes>,
     /// Where the channel read had no data (a Saleae `X`, a VCD `x` or `z`): how many spans,
     /// their time in all, s, and the first `[from, to]` (the report warns: edges there were
     /// not seen, and the faults there are the capture's).
@@ -1551,6 +1556,8 @@ pub fn analyze<R: BufRead>(
         u32::from(cfg.encoder.prescaler.max(1))
     };
     let mut last_capture: Option<u32> = None;
+    // The time of that capture, s, as the file writes it.
+    let mut last_capture_time: Option<f64> = None;
     let mut prescaled = 0u32;
     // The quadrature count of the encoder and direction channels, and whether the capture
     // before the last moved it forward (the first counts as moved).
@@ -1764,9 +1771,19 @@ pub fn analyze<R: BufRead>(
             } else {
                 intervals.capture(t, polls.timeout, longest_gap);
             }
+            let before = last_capture_time.replace(t);
             if let Some(p) = last_capture.replace(ticks) {
-                // Two captures at one tick: the timer cannot resolve the edges.
-                if ticks.wrapping_sub(p) & enc.mask() == 0 && direction != Some(Direction::Reverse)
+                // Two captures at one time as written: the file repeats a row (no timer
+                // resolves 0 s). Two at one tick otherwise: the timer cannot resolve the edges.
+                if before == Some(t) {
+                    let r = report.repeated_times.get_or_insert(RepeatedTimes {
+                        rows: 0,
+                        first_line: reader.line(),
+                        time: t,
+                    });
+                    r.rows += 1;
+                } else if ticks.wrapping_sub(p) & enc.mask() == 0
+                    && direction != Some(Direction::Reverse)
                 {
                     report.captures_at_one_tick += 1;
                 }
@@ -2094,6 +2111,17 @@ pub struct Ringing {
     pub of: u64,
     /// The longest of those intervals, s: an input filter must hold a level longer.
     pub longest: f64,
+}
+
+/// Captures at the time of the one before ([`AnalyzeReport::repeated_times`]).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct RepeatedTimes {
+    /// How many.
+    pub rows: u64,
+    /// The file's line of the first, 1-based.
+    pub first_line: u64,
+    /// Its time, s, counted from `time_origin`.
+    pub time: f64,
 }
 
 /// Spans without data on the channel read ([`AnalyzeReport::no_data`]).
@@ -2677,6 +2705,21 @@ pub fn text(r: &AnalyzeReport) -> String {
              longer than its setting (the example firmware's TIM2 filter, for 47 ns): here more \
              than {:.3e} s, and the edge it takes is then the ringing's last crossing",
             r.channel, g.edges, g.of, g.longest, g.longest
+        );
+    }
+    if let Some(d) = &r.repeated_times {
+        let _ = writeln!(
+            s,
+            "WARNING: line {} repeats the time of the edge before it, {} s ({}): a \
+             duplicated row in the file, or times written more coarsely than the edges came; \
+             no timer resolves two edges 0 s apart, and each repeat shows as a glitch",
+            d.first_line,
+            d.time,
+            if d.rows == 1 {
+                "1 row repeats the one before".to_string()
+            } else {
+                format!("{} rows in all repeat the one before", d.rows)
+            }
         );
     }
     if r.captures_at_one_tick > 0 {

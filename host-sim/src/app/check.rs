@@ -189,6 +189,23 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// The error for the list `key` holding `n` `what` (tables, points) as the file gives
+    /// them: `rule` says how many are allowed. (A count is the file's own, never a default.)
+    pub fn bad_count(
+        &self,
+        key: &str,
+        n: usize,
+        what: &str,
+        rule: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Rule {
+            file: self.file.to_path_buf(),
+            key: key.to_string(),
+            value: format!("{n} {what}"),
+            rule: rule.into(),
+        }
+    }
+
     /// `x` finite and in `[lo, hi]` (`lo` excluded when `open`), in `unit`.
     pub fn range(
         &self,
@@ -270,9 +287,10 @@ impl<'a> Checker<'a> {
             }
             let _ = match self.written.get(k) {
                 Some(v) => write!(quoted, "`{k} = {v}`"),
-                None => match default_of(scene, k) {
-                    Some(v) => write!(quoted, "`{k} = {v}` (the default)"),
-                    None => write!(quoted, "`{k}`"),
+                None => match (default_of(scene, k), implied_by(scene, k)) {
+                    (Some(v), Some(by)) => write!(quoted, "`{k} = {v}` (implied by `{by}`)"),
+                    (Some(v), None) => write!(quoted, "`{k} = {v}` (the default)"),
+                    (None, _) => write!(quoted, "`{k}`"),
                 },
             };
         }
@@ -422,6 +440,15 @@ pub fn core_keys(section: &str, parameter: &str) -> Vec<String> {
     }
 }
 
+/// The key whose value gives `key` its value where the file does not give it (the framing
+/// a wheel implies), rather than a default.
+fn implied_by(scene: &Scene, key: &str) -> Option<&'static str> {
+    match key {
+        "encoder.framing" => scene.encoder.as_ref()?.framing_implied_by(),
+        _ => None,
+    }
+}
+
 /// The value a key takes when the file does not give it (for the keys [`core_keys`] lists).
 fn default_of(scene: &Scene, key: &str) -> Option<String> {
     let e = scene.encoder.as_ref();
@@ -477,6 +504,22 @@ fn simulation(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
 }
 
 fn harmonics(c: &Checker, key: &str, list: &[Harmonic], amplitude: f64) -> Result<(), SceneError> {
+    // The core's fixed capacities: drive::MAX_HARMONICS, and MAX_INERTIA_HARMONICS for the
+    // inertia's harmonics that are there (the core drops those of amplitude 0).
+    let (most, n) = if key == "shaft.inertia_harmonics" {
+        let there = list.iter().filter(|h| h.amplitude != 0.0).count();
+        (drive_monitor::drive::MAX_INERTIA_HARMONICS, there)
+    } else {
+        (drive_monitor::drive::MAX_HARMONICS, list.len())
+    };
+    if n > most {
+        return Err(c.bad_count(
+            key,
+            n,
+            "harmonics",
+            format!("at most {most} harmonics (the core's fixed capacity)"),
+        ));
+    }
     for (i, h) in list.iter().enumerate() {
         let k = format!("{key}[{}]", i + 1);
         c.positive(&format!("{k}.order"), h.order, MAX_ORDER, "per revolution")?;
@@ -484,6 +527,77 @@ fn harmonics(c: &Checker, key: &str, list: &[Harmonic], amplitude: f64) -> Resul
         c.magnitude(&format!("{k}.phase"), h.phase, MAX_ANGLE, "rad")?;
     }
     Ok(())
+}
+
+/// J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase) must stay positive: its least
+/// value over the period as the core finds it ([`drive_monitor::drive::least_inertia`]), the
+/// refusal saying where it reaches 0 and quoting the amplitudes.
+fn least_inertia(
+    c: &Checker,
+    inertia: f64,
+    flywheel: f64,
+    list: &[Harmonic],
+) -> Result<(), SceneError> {
+    let j = inertia + flywheel;
+    let swing: f64 = list.iter().map(|h| h.amplitude.abs()).sum();
+    if swing < j {
+        return Ok(());
+    }
+    let core: Vec<_> = list
+        .iter()
+        .filter_map(|h| {
+            drive_monitor::drive::InertiaHarmonic::new(h.order, h.amplitude, h.phase).ok()
+        })
+        .collect();
+    let why = match drive_monitor::drive::least_inertia(j, &core) {
+        Some((_, least)) if least > 0.0 => return Ok(()),
+        Some((phi, least)) => {
+            let shown = if least == 0.0 {
+                "0".to_string()
+            } else if least.abs() >= 1e-3 {
+                format!("{least:.4}")
+            } else {
+                format!("{least:.3e}")
+            };
+            format!(
+                "J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase) falls to {shown} \
+                 kg·m² at φ = {phi:.4} rad: the reduced inertia must stay positive (smaller \
+                 amplitudes, or more inertia or flywheel)"
+            )
+        }
+        None => format!(
+            "the amplitudes' magnitudes add up to {} kg·m², at least inertia + flywheel = {} \
+             kg·m², and the orders have no common period over which J(φ)'s least value could \
+             be found (each a fraction with denominator ≤ {}, the period at most {} cycles of \
+             the fastest order), so J(φ) may come as close to inertia + flywheel − Σ|amplitude| = {} kg·m² as it \
+             likes: the reduced inertia must stay positive",
+            num(swing),
+            num(j),
+            drive_monitor::drive::MAX_DENOMINATOR,
+            drive_monitor::drive::MAX_SAMPLES / drive_monitor::drive::SAMPLES_PER_CYCLE,
+            num(j - swing)
+        ),
+    };
+    let amplitudes: Vec<String> = (1..=list.len())
+        .map(|i| {
+            let k = format!("shaft.inertia_harmonics[{i}].amplitude");
+            c.written
+                .get(&k)
+                .map_or_else(|| num(list[i - 1].amplitude), str::to_string)
+        })
+        .collect();
+    let keys = format!(
+        "`shaft.inertia_harmonics` (amplitudes {}), `shaft.inertia = {}`, `shaft.flywheel = {}`",
+        amplitudes.join(", "),
+        c.shown("shaft.inertia", inertia),
+        c.shown("shaft.flywheel", flywheel)
+    );
+    Err(SceneError::Core {
+        file: c.file.to_path_buf(),
+        key: "shaft.inertia_harmonics".into(),
+        keys,
+        message: why,
+    })
 }
 
 fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
@@ -496,6 +610,7 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
             &s.inertia_harmonics,
             MAX_INERTIA,
         )?;
+        least_inertia(c, s.inertia, s.flywheel, &s.inertia_harmonics)?;
         if let Some(w) = s.initial_speed {
             c.magnitude("shaft.initial_speed", w, MAX_SPEED, "rad/s")?;
         }
@@ -567,9 +682,10 @@ fn drive(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         Some(MotorSpec::Profile { points }) => {
             let most = crate::engine::cranking::MAX_PROFILE_POINTS as u64;
             if points.is_empty() || points.len() as u64 > most {
-                return Err(c.bad(
+                return Err(c.bad_count(
                     "motor.points",
-                    format!("{} points", points.len()),
+                    points.len(),
+                    "points",
                     format!("1 to {most} points [t, ω]"),
                 ));
             }
@@ -711,8 +827,11 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
             format!("allowed 2 to {MAX_LINES}")
         } else {
             format!(
-                "a wheel framed by its pattern has 3 to {MAX_PATTERN_LINES} grid positions (framing = \"{}\")",
-                framing.name()
+                "a wheel framed by its pattern has 3 to {MAX_PATTERN_LINES} grid positions (framing = \"{}\"{})",
+                framing.name(),
+                e.framing_implied_by()
+                    .map(|by| format!(", implied by `{by} = {}`", c.shown(by, "?")))
+                    .unwrap_or_default()
             )
         };
         return Err(c.bad(lines_key, shown, rule));
@@ -725,7 +844,11 @@ pub fn wheel(e: &EncoderSpec, c: &Checker) -> Result<WheelDesc, SceneError> {
                     return Err(c.bad(
                         "encoder.missing",
                         e.missing,
-                        "only with framing = \"missing-tooth\" (this encoder has no gap)",
+                        format!(
+                            "only with framing = \"missing-tooth\" (framing = {} has no gap; \
+                             without `framing` the missing teeth imply it)",
+                            c.shown("encoder.framing", format!("\"{}\"", framing.name()))
+                        ),
                     ));
                 }
                 for key in ["encoder.gaps", "encoder.teeth"] {
@@ -905,6 +1028,37 @@ fn encoder(e: &EncoderSpec, c: &Checker) -> Result<(), SceneError> {
     if ![1, 2, 4, 8].contains(&e.prescaler) {
         return Err(c.bad("encoder.prescaler", e.prescaler, "allowed 1, 2, 4 or 8"));
     }
+    // The core's rules (`drive_monitor::encoder::Encoder::new`), with their reasons.
+    let framing = e.framing();
+    let framed_by_pattern = matches!(framing, FramingSpec::MissingTooth | FramingSpec::Pattern);
+    if e.prescaler != 1 && framed_by_pattern {
+        let how = match e.framing_implied_by() {
+            Some(by) => format!("implied by `{by} = {}`", c.shown(by, "?")),
+            None => "as written".to_string(),
+        };
+        return Err(c.bad(
+            "encoder.prescaler",
+            e.prescaler,
+            format!(
+                "a wheel framed by its pattern (framing = \"{}\", {how}) is captured edge by \
+                 edge, each tooth's pitch told apart: the prescaler is for uniform discs only \
+                 (prescaler = 1 here)",
+                framing.name()
+            ),
+        ));
+    }
+    let lines = w.teeth.len() as u64;
+    let p = u64::from(e.prescaler);
+    if e.prescaler != 1 && (lines % p != 0 || lines / p < 2) {
+        return Err(c.bad(
+            "encoder.prescaler",
+            e.prescaler,
+            format!(
+                "the prescaler must divide the disc's {lines} lines into whole captures, at \
+                 least 2 a revolution"
+            ),
+        ));
+    }
     let edges = w.teeth.len() as u64 / u64::from(e.prescaler).max(1);
     let span = (drive_monitor::encoder::MAX_SPAN as u64).min(edges.max(1));
     c.count("encoder.estimator_edges", e.estimator_edges.into(), 1, span)?;
@@ -987,6 +1141,29 @@ fn cranking_and_capture(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
                 value: "(table)".into(),
                 rule: "a cranking ripple modulates a prescribed speed: [motor] model = \"speed\", \"ramp\" or \"profile\"".into(),
             });
+        }
+        // The ripple scales the mean speed by (1 + ripple·sin(strokes·φ + phase)), a function
+        // of the angle: a shaft turning backwards has no such law. (Without [cranking] a
+        // negative speed runs the shaft backwards.)
+        let speeds: Vec<(String, f64)> = match &scene.motor {
+            Some(MotorSpec::Speed { speed }) => vec![("motor.speed".into(), *speed)],
+            Some(MotorSpec::Ramp { from, to, .. }) => {
+                vec![("motor.from".into(), *from), ("motor.to".into(), *to)]
+            }
+            // (A profile's speeds are [0, 1e5] rad/s with or without [cranking].)
+            _ => Vec::new(),
+        };
+        if let Some((key, w)) = speeds.into_iter().find(|(_, w)| *w < 0.0) {
+            return Err(c.bad(
+                &key,
+                w,
+                format!(
+                    "a cranking ripple needs a forward speed: allowed [0, {}] rad/s with \
+                     [cranking] (it modulates the speed by the shaft's angle; without \
+                     [cranking] a negative speed runs the shaft backwards)",
+                    num(MAX_SPEED)
+                ),
+            ));
         }
     }
     if let Some(k) = &scene.capture {
@@ -1260,10 +1437,14 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         rule: why.to_string(),
     };
     if scene.platform.len() > drive_monitor::balancer::MAX_PLATFORMS {
-        return Err(c.bad(
+        return Err(c.bad_count(
             "platform",
-            format!("{} tables", scene.platform.len()),
-            "at most 3 platforms",
+            scene.platform.len(),
+            "tables",
+            format!(
+                "at most {} platforms",
+                drive_monitor::balancer::MAX_PLATFORMS
+            ),
         ));
     }
     if !scene.platform.is_empty() && scene.autobalancer.is_none() {
@@ -1282,10 +1463,14 @@ fn structure(scene: &Scene, c: &Checker) -> Result<(), SceneError> {
         ));
     }
     if scene.unbalance.len() > crate::app::predict::MAX_UNBALANCES {
-        return Err(c.bad(
+        return Err(c.bad_count(
             "unbalance",
-            format!("{} tables", scene.unbalance.len()),
-            format!("at most {} unbalances", crate::app::predict::MAX_UNBALANCES),
+            scene.unbalance.len(),
+            "tables",
+            format!(
+                "at most {} unbalances (the rotor's fixed capacity)",
+                crate::app::predict::MAX_UNBALANCES
+            ),
         ));
     }
     Ok(())

@@ -765,8 +765,14 @@ pub struct SupportsOut {
     pub permissible_a: f64,
     /// Permissible residual unbalance allocated to B, kg·m.
     pub permissible_b: f64,
-    /// Largest safe speed, rad/s (null without load limits, or when no unbalance limits it).
+    /// Largest safe speed, rad/s (null without load limits, or when no unbalance limits it:
+    /// `max_speed_status` tells the two apart).
     pub max_speed: Option<f64>,
+    /// What `max_speed` is: "limited" (the support loads reach their limits at it; it may
+    /// exceed the 1e5 rad/s any scene can turn), "not_limited" (load limits given, and no
+    /// speed brings the loads to them: no unbalance) or "no_load_limit" (no
+    /// `rotor.support_load_limit` given: not computed).
+    pub max_speed_status: &'static str,
     /// Why `max_speed` is 0: the supports whose static load alone reaches their limit, each
     /// named with both figures ([`static_overload`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -1116,6 +1122,11 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             permissible_a: r.permissible_a,
             permissible_b: r.permissible_b,
             max_speed: r.max_speed.filter(|v| v.is_finite()),
+            max_speed_status: match (limits.support_load_limit(), r.max_speed) {
+                (None, _) => "no_load_limit",
+                (Some(_), Some(v)) if v.is_finite() => "limited",
+                (Some(_), _) => "not_limited",
+            },
             no_safe_speed: static_overload(&a),
             static_load: [a.static_load[0].norm(), a.static_load[1].norm()],
             peak_load_at_service_speed: [loads[0].peak, loads[1].peak],

@@ -269,6 +269,18 @@ pub fn fmt_speed_pair(from: f64, to: f64) -> (String, String) {
     (a, v.next().unwrap_or_default())
 }
 
+/// A safe speed, rad/s: one decimal from 100 rad/s (188.2), 4 significant digits below (0.09410,
+/// 5.432), scientific from 1e6 (1.0690e152), where a fixed-point figure would run to many
+/// digits; 0 as "0.0".
+fn fmt_safe_speed(w: f64) -> String {
+    let a = w.abs();
+    if a >= 1e6 && a.is_finite() {
+        format!("{w:.4e}")
+    } else {
+        fmt_force(w)
+    }
+}
+
 /// A support load in N: one decimal from 100 N up (`2407.0`), four significant digits below
 /// (`0.1634`, `52.18`), so that a small rotor's loads keep their digits (a 50 g rotor's
 /// 0.163 N was printed `0.2`), and `1.234e-5` under a millinewton.
@@ -686,16 +698,39 @@ pub fn prediction_text(p: &Prediction) -> String {
             u.load_level
                 .map_or(String::new(), |l| format!(" ({}, {})", l[0], l[1]))
         );
-        match u.max_speed {
-            Some(w) => {
+        match (u.max_speed, u.max_speed_status) {
+            (Some(w), _) => {
                 let why = u
                     .no_safe_speed
                     .as_ref()
                     .map_or(String::new(), |why| format!(": {why}"));
-                let _ = writeln!(s, "  maximum safe speed {w:.1} rad/s{why}");
+                let above = if w > crate::app::check::MAX_SPEED {
+                    format!(
+                        ", above the {:e} rad/s any scene can turn: not limited within the \
+                         speeds a scene runs",
+                        crate::app::check::MAX_SPEED
+                    )
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    s,
+                    "  maximum safe speed {} rad/s{above}{why}",
+                    fmt_safe_speed(w)
+                );
             }
-            None => {
-                let _ = writeln!(s, "  maximum safe speed: not limited by the support loads");
+            (None, "no_load_limit") => {
+                let _ = writeln!(
+                    s,
+                    "  maximum safe speed: not computed (no `rotor.support_load_limit` given)"
+                );
+            }
+            (None, _) => {
+                let _ = writeln!(
+                    s,
+                    "  maximum safe speed: not limited by the support loads (no unbalance \
+                     loads them with the speed)"
+                );
             }
         }
         if let (Some(w), Some(peak)) = (u.predicted_speed, u.peak_load_at_predicted_speed) {

@@ -484,7 +484,8 @@ pub fn core_encoder(scene: &Scene, file: &Path) -> Result<Option<Encoder>, Scene
 /// inertia order, [`drive_monitor::drive::period_revolutions`], as the prediction finds it),
 /// else one revolution. Where the orders have no common period within
 /// [`MAX_WINDOW_REVS`](drive_monitor::irregularity::MAX_WINDOW_REVS) revolutions, one cycle
-/// of the lowest order, which [`window_warning`] says.
+/// of the lowest order, or the longest window where that cycle is longer (an order below
+/// 1/1024), which [`window_warning`] says.
 pub fn window_config(scene: &Scene) -> WindowConfig {
     let m = scene.monitor.clone().unwrap_or_default();
     WindowConfig {
@@ -495,7 +496,8 @@ pub fn window_config(scene: &Scene) -> WindowConfig {
 
 /// The WARNING for a δ window that does not hold the load's whole period (`None` where it
 /// does): the default window where no window can (the orders, the window chosen and why δ may
-/// be read low in it), or a `[monitor] window_revolutions` that is no whole number of periods.
+/// be read low in it), a `[monitor] window_revolutions` that is no whole number of periods,
+/// or one shorter than a cycle of the lowest order where no window holds the period.
 pub fn window_warning(scene: &Scene) -> Option<String> {
     default_window(scene).1
 }
@@ -535,13 +537,19 @@ pub fn window_warning_for(scene: &Scene, revolutions: u16, given: &str) -> Optio
 /// (else the default), and the WARNING where it does not hold the load's whole period.
 fn window_for(scene: &Scene, given: Option<(u16, String)>) -> (WindowLength, Option<String>) {
     use drive_monitor::irregularity::MAX_WINDOW_REVS;
+    let longest = f64::from(MAX_WINDOW_REVS);
     let orders = periodic_orders(scene);
     let period = drive_monitor::drive::period_revolutions(&orders);
-    if let Some((n, what)) = given {
-        // A window set that is no whole number of load periods sees part of the load cycle in
-        // each window, as the lowest order's did: said. (Where the orders have no common
-        // period, setting a window is how the default's warning is answered: not said.)
-        let warning = period.filter(|&p| u64::from(n) % p != 0).map(|p| {
+    let held = period.filter(|&p| p <= u64::from(MAX_WINDOW_REVS));
+    let (Some(&lowest), None) = (orders.first(), held) else {
+        // A window holds the load's whole period (or there is no load cycle).
+        let Some((n, what)) = given else {
+            let n = held.map_or(1, |p| p as u16);
+            return (WindowLength::Revolutions(n), None);
+        };
+        // A window set that is no whole number of load periods sees part of the load cycle
+        // in each window, as the lowest order's did: said.
+        let warning = held.filter(|&p| u64::from(n) % p != 0).map(|p| {
             format!(
                 "WARNING: {what} is not a whole number of the load's period ({p} revolutions), \
                  so each δ window sees part of the load cycle: δ may be read low in it and the \
@@ -549,15 +557,8 @@ fn window_for(scene: &Scene, given: Option<(u16, String)>) -> (WindowLength, Opt
             )
         });
         return (WindowLength::Revolutions(n), warning);
-    }
-    let Some(&lowest) = orders.first() else {
-        return (WindowLength::Revolutions(1), None);
     };
-    if let Some(n) = period.filter(|&n| n <= u64::from(MAX_WINDOW_REVS)) {
-        return (WindowLength::Revolutions(n as u16), None);
-    }
-    // No window holds the load's whole period: one cycle of the lowest order, said.
-    let length = WindowLength::LoadOrder(lowest);
+    // No window holds the load's whole period.
     // Six decimals, trailing zeros dropped: 0.333333, 1.414214, 0.5.
     let short = |o: f64| {
         let t = format!("{o:.6}");
@@ -568,25 +569,100 @@ fn window_for(scene: &Scene, given: Option<(u16, String)>) -> (WindowLength, Opt
         .map(|&o| short(o))
         .collect::<Vec<_>>()
         .join(", ");
+    // One cycle of the lowest order, in revolutions: 2000, 3.333333.
+    let cycle = 1.0 / lowest;
+    let cycle_text = if (cycle - cycle.round()).abs() <= 1e-9 * cycle {
+        format!("{cycle:.0}")
+    } else {
+        short(cycle)
+    };
+    let too_long = cycle > longest * (1.0 + 1e-9);
     let why = match period {
         Some(n) => format!(
-            "repeat only every {n} revolutions, more than the longest δ window ({MAX_WINDOW_REVS})"
+            "the load's orders {list} repeat only every {n} revolutions, more than the longest \
+             δ window ({MAX_WINDOW_REVS})"
+        ),
+        None if orders.len() == 1 && too_long => format!(
+            "one cycle of the load's order {list} is {cycle_text} revolutions, more than the \
+             longest δ window ({MAX_WINDOW_REVS})"
+        ),
+        None if orders.len() == 1 => format!(
+            "the load's order {list} is no fraction with denominator ≤ {}, so no whole number \
+             of revolutions holds a whole number of its cycles",
+            drive_monitor::drive::MAX_DENOMINATOR
         ),
         None => format!(
-            "have no common period (that needs each to be a fraction with denominator ≤ {})",
+            "the load's orders {list} have no common period (that needs each to be a fraction \
+             with denominator ≤ {})",
             drive_monitor::drive::MAX_DENOMINATOR
         ),
     };
-    let window = match length.revolutions() {
-        Ok(w) => format!("{w} revolution{}", if w == 1 { "" } else { "s" }),
-        Err(_) => "none".to_string(),
+    // "one cycle of the lowest order 0.3 (3.333333 revolutions)", or "that cycle" where `why`
+    // has said it.
+    let of_cycle = if orders.len() == 1 && too_long {
+        "that cycle".to_string()
+    } else {
+        format!(
+            "one cycle of the lowest order {} ({cycle_text} revolutions)",
+            short(lowest)
+        )
+    };
+    let read_low = "so δ may be read low in it and the δ alarm may stay silent";
+    if let Some((n, what)) = given {
+        // One that holds at least a cycle of the lowest order is how the default's WARNING is
+        // answered (not said again); a shorter one sees a part of even that cycle: said, with
+        // how much it holds.
+        let part = f64::from(n) * lowest;
+        let warning = (part < 1.0 - 1e-4).then(|| {
+            let way = if too_long {
+                format!(
+                    "the longest window, {MAX_WINDOW_REVS} revolutions, holds {:.3} of it",
+                    longest * lowest
+                )
+            } else {
+                format!("a window of at least {} revolutions holds it", cycle.ceil())
+            };
+            format!(
+                "WARNING: {why}, so no δ window holds the load's whole cycle, and {what} holds \
+                 only {part:.3} of {of_cycle}, {read_low}; {way}"
+            )
+        });
+        return (WindowLength::Revolutions(n), warning);
+    }
+    // The default: one cycle of the lowest order where a window holds it, else the longest
+    // window (or the nearest whole number of revolutions to that cycle); said.
+    let (length, window) = match WindowLength::LoadOrder(lowest).revolutions() {
+        Ok(w) => (
+            WindowLength::LoadOrder(lowest),
+            format!(
+                "one cycle of the lowest order {} ({w} revolution{})",
+                short(lowest),
+                if w == 1 { "" } else { "s" }
+            ),
+        ),
+        Err(_) if too_long => (
+            WindowLength::Revolutions(MAX_WINDOW_REVS),
+            format!(
+                "the longest, {MAX_WINDOW_REVS} revolutions, which holds {:.3} of {of_cycle}",
+                longest * lowest
+            ),
+        ),
+        Err(_) => {
+            let w = cycle.round().clamp(1.0, longest) as u16;
+            (
+                WindowLength::Revolutions(w),
+                format!("{w} revolutions, the nearest to {of_cycle}"),
+            )
+        }
+    };
+    let way = if too_long {
+        String::new()
+    } else {
+        "; `[monitor] window_revolutions` sets a longer window".to_string()
     };
     let warning = format!(
-        "WARNING: the load's orders {list} {why}, so no δ window holds the load's whole cycle: \
-         the default window is one cycle of the lowest order {} ({window}), which sees only \
-         part of the combinations of the harmonics' phases, so δ may be read low in it and the \
-         δ alarm may stay silent; `[monitor] window_revolutions` sets a longer window",
-        short(lowest)
+        "WARNING: {why}, so no δ window holds the load's whole cycle: the default window is \
+         {window}; it sees only part of the load cycle, {read_low}{way}"
     );
     (length, Some(warning))
 }

@@ -195,7 +195,9 @@ pub struct ShaftSpec {
     /// Added flywheel, kg·m².
     #[serde(default)]
     pub flywheel: f64,
-    /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase).
+    /// Position-dependent inertia J(φ) = inertia + flywheel + Σ amplitude·cos(order·φ + phase),
+    /// positive for every φ (the amplitudes may add up to more than inertia + flywheel where
+    /// J(φ)'s least value stays positive, as a crank-slider's series does).
     #[serde(default)]
     pub inertia_harmonics: Vec<Harmonic>,
     /// Initial speed, rad/s (default: the drive model's mean speed, where the motor carries
@@ -501,7 +503,7 @@ pub struct EncoderSpec {
     /// Framing (default: `index`, or what `wheel`, `missing`, `gaps` or `teeth` imply).
     #[serde(default)]
     pub framing: Option<FramingSpec>,
-    /// Missing positions (missing-tooth framing).
+    /// Missing positions (missing-tooth framing, which `missing` implies).
     #[serde(default)]
     pub missing: u8,
     /// Edges averaged per speed sample (16 by default; 1 to 32, and at most the edges captured
@@ -552,11 +554,28 @@ impl EncoderSpec {
 
     /// The framing the keys ask for: `framing` if given, else what the wheel keys imply.
     pub fn framing(&self) -> FramingSpec {
+        // (`framing_implied_by` names the key that implies it.)
         match self.framing {
             Some(f) => f,
-            None if self.wheel.is_some() => FramingSpec::MissingTooth,
+            None if self.wheel.is_some() || self.missing != 0 => FramingSpec::MissingTooth,
             None if self.gaps.is_some() || self.teeth.is_some() => FramingSpec::Pattern,
             None => FramingSpec::Index,
+        }
+    }
+}
+
+impl EncoderSpec {
+    /// The key that implies [`Self::framing`] where the file does not give `framing`
+    /// (`encoder.wheel`, `encoder.missing`, `encoder.gaps` or `encoder.teeth`); `None` where
+    /// it is given or is the default (`index`).
+    pub fn framing_implied_by(&self) -> Option<&'static str> {
+        match self.framing {
+            Some(_) => None,
+            None if self.wheel.is_some() => Some("encoder.wheel"),
+            None if self.missing != 0 => Some("encoder.missing"),
+            None if self.gaps.is_some() => Some("encoder.gaps"),
+            None if self.teeth.is_some() => Some("encoder.teeth"),
+            None => None,
         }
     }
 }
@@ -663,8 +682,9 @@ fn default_estimator_edges() -> u16 {
 pub struct MonitorSpec {
     /// Permissible δ.
     pub delta_limit: Option<f64>,
-    /// δ window in revolutions (default: the load's period, from all its and the inertia's
-    /// orders).
+    /// δ window in revolutions, 1 to 1024 (default: the load's period, from all its and the
+    /// inertia's orders; where no window holds that period, one cycle of the lowest order or,
+    /// where that is longer, 1024, with a WARNING).
     pub window_revolutions: Option<u16>,
     /// Slowest running speed, rad/s (standstill below).
     pub min_speed: Option<f64>,

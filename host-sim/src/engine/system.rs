@@ -231,8 +231,23 @@ impl DynamicShaft {
             positive("shaft.harmonics.order", h.order)?;
             finite("shaft.harmonics.phase", h.phase)?;
         }
+        // J(φ) > 0 for every φ: certain when the amplitudes' magnitudes add up to less than J,
+        // else the least value of J(φ) over the period decides, as the core's drive model
+        // finds it (orders with no common period: refused, as J(φ) may come as close to
+        // J − Σ|amplitude| as it likes).
         if swing >= j {
-            return Err(ConfigError::Inconsistent("shaft.harmonics"));
+            let core: Result<Vec<_>, _> = self
+                .harmonics
+                .iter()
+                .map(|h| drive_monitor::drive::InertiaHarmonic::new(h.order, h.amplitude, h.phase))
+                .collect();
+            let least = core
+                .ok()
+                .and_then(|c| drive_monitor::drive::least_inertia(j, &c))
+                .map(|(_, least)| least);
+            if !least.is_some_and(|l| l > 0.0) {
+                return Err(ConfigError::Inconsistent("shaft.harmonics"));
+            }
         }
         finite("shaft.phi0", self.phi0)?;
         finite("shaft.omega0", self.omega0)?;
