@@ -41,13 +41,12 @@
 //! `none`, `lost EDGE` or `pulse EDGE FRACTION`) replays one case edge by edge instead. The
 //! test that is not ignored runs a part of the grid (4 s here in a debug build).
 
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Pattern};
-use drive_monitor::irregularity::{WindowConfig, WindowLength};
-use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
-use drive_monitor::speed::{Direction, EdgeSink, Fault, Tooth};
+mod crank_common;
+
+use crank_common::{integrate, run_wheel, Rec, HZ};
+use drive_monitor::monitor::WindowOutcome;
 use std::f64::consts::TAU;
 
-const HZ: f64 = 1e6;
 const OMEGA: f64 = 25.0;
 const REVS: u32 = 10;
 const T0_TICKS: f64 = 12_345.0;
@@ -88,38 +87,6 @@ impl Rng {
         let u2 = self.unif();
         (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
     }
-}
-
-// The 16-point Gauss-Legendre nodes and weights (the positive half), to double precision.
-const GL_X: [f64; 8] = [
-    0.0950125098376374,
-    0.2816035507792589,
-    0.4580167776572274,
-    0.6178762444026438,
-    0.755404408355003,
-    0.8656312023878318,
-    0.9445750230732326,
-    0.9894009349916499,
-];
-const GL_W: [f64; 8] = [
-    0.1894506104550685,
-    0.1826034150449236,
-    0.1691565193950025,
-    0.1495959888165768,
-    0.1246289712555339,
-    0.0951585116824928,
-    0.0622535239386479,
-    0.0271524594117541,
-];
-
-/// ∫ f over [a, b], 16-point Gauss-Legendre.
-fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    let (c, h) = ((a + b) / 2.0, (b - a) / 2.0);
-    let mut s = 0.0;
-    for (x, w) in GL_X.iter().zip(GL_W) {
-        s += w * (f(c + h * x) + f(c - h * x));
-    }
-    s * h
 }
 
 /// The rule is exact for polynomials of degree up to 31: ∫₀¹ xᵏ dx = 1/(k + 1) (one weight
@@ -192,45 +159,8 @@ fn generate(p: &Params) -> Vec<Edge> {
     out
 }
 
-/// What the monitor tells its observer: the accepted teeth (time, number, synced, frame) and
-/// the faults.
-#[derive(Default)]
-struct Rec {
-    teeth: Vec<(u32, u16, bool, bool)>,
-    faults: Vec<(Fault, u32)>,
-}
-
-impl EdgeSink for Rec {
-    fn tooth(&mut self, t: &Tooth) {
-        self.teeth.push((t.time, t.tooth, t.synced, t.frame));
-    }
-    fn fault(&mut self, f: Fault, time: u32) {
-        self.faults.push((f, time));
-    }
-}
-
 fn run(p: &Params, k: u16, w: u16, ticks: &[u32]) -> (Vec<WindowOutcome>, Rec) {
-    let mut c = EncoderConfig::pattern(Pattern::missing_teeth(p.n as u8, p.m as u8), HZ);
-    c.estimator = Estimator::Edges(k);
-    c.min_speed = 5.0;
-    let enc = Encoder::new(c).unwrap();
-    let mut mon: DeltaMonitor<1024> = DeltaMonitor::new(
-        enc,
-        WindowConfig {
-            length: WindowLength::Revolutions(w),
-            steady_tolerance: 0.02,
-        },
-        None,
-    )
-    .unwrap();
-    let mut rec = Rec::default();
-    let mut out = Vec::new();
-    for &t in ticks {
-        if let Some(o) = mon.on_edge_observed(t, Some(Direction::Forward), &mut rec) {
-            out.push(o);
-        }
-    }
-    (out, rec)
+    run_wheel(p.n, p.m, k, w, ticks)
 }
 
 /// δ as the monitor forms it, from samples (span units, ticks): the fastest and the slowest

@@ -28,13 +28,13 @@
 //! ω₁ revs off K, then `none` or `lost REV POS`) replays one stream and lists its faults
 //! with the tooth they were found at.
 
-use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator, Pattern};
-use drive_monitor::irregularity::{WindowConfig, WindowLength};
-use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
-use drive_monitor::speed::{Direction, EdgeSink, Fault, Tooth};
+mod crank_common;
+
+use crank_common::{integrate, run_wheel, Rec, HZ};
+use drive_monitor::monitor::WindowOutcome;
+use drive_monitor::speed::Fault;
 use std::f64::consts::TAU;
 
-const HZ: f64 = 1e6;
 const OMEGA0: f64 = 25.0;
 const REVS: u32 = 14;
 /// Whole revolutions of cranking before the flare.
@@ -50,38 +50,6 @@ const TOPS: [f64; 2] = [80.0, 150.0];
 const FLARE_REVS: [f64; 3] = [2.0, 3.0, 5.0];
 const OFFS: [f64; 3] = [0.0, 1.0 / 3.0, 2.0 / 3.0];
 const KS: [u16; 2] = [1, 4];
-
-// The 16-point Gauss-Legendre nodes and weights (the positive half), to double precision.
-const GL_X: [f64; 8] = [
-    0.0950125098376374,
-    0.2816035507792589,
-    0.4580167776572274,
-    0.6178762444026438,
-    0.755404408355003,
-    0.8656312023878318,
-    0.9445750230732326,
-    0.9894009349916499,
-];
-const GL_W: [f64; 8] = [
-    0.1894506104550685,
-    0.1826034150449236,
-    0.1691565193950025,
-    0.1495959888165768,
-    0.1246289712555339,
-    0.0951585116824928,
-    0.0622535239386479,
-    0.0271524594117541,
-];
-
-/// ∫ f over [a, b], 16-point Gauss-Legendre.
-fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    let (c, h) = ((a + b) / 2.0, (b - a) / 2.0);
-    let mut s = 0.0;
-    for (x, w) in GL_X.iter().zip(GL_W) {
-        s += w * (f(c + h * x) + f(c - h * x));
-    }
-    s * h
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Shape {
@@ -195,43 +163,8 @@ fn generate(p: &Params) -> Vec<(u32, u32, u32)> {
     out
 }
 
-/// The faults counted, with their times, and the teeth accepted (time, number, synced).
-#[derive(Default)]
-struct Rec {
-    teeth: Vec<(u32, u16, bool)>,
-    faults: Vec<(Fault, u32)>,
-}
-
-impl EdgeSink for Rec {
-    fn tooth(&mut self, t: &Tooth) {
-        self.teeth.push((t.time, t.tooth, t.synced));
-    }
-    fn fault(&mut self, f: Fault, time: u32) {
-        self.faults.push((f, time));
-    }
-}
-
 fn run(p: &Params, k: u16, ticks: &[u32]) -> (Vec<WindowOutcome>, Rec) {
-    let mut c = EncoderConfig::pattern(Pattern::missing_teeth(p.n as u8, p.m as u8), HZ);
-    c.estimator = Estimator::Edges(k);
-    c.min_speed = 5.0;
-    let mut mon: DeltaMonitor<1024> = DeltaMonitor::new(
-        Encoder::new(c).unwrap(),
-        WindowConfig {
-            length: WindowLength::Revolutions(1),
-            steady_tolerance: 0.02,
-        },
-        None,
-    )
-    .unwrap();
-    let mut rec = Rec::default();
-    let mut out = Vec::new();
-    for &t in ticks {
-        if let Some(o) = mon.on_edge_observed(t, Some(Direction::Forward), &mut rec) {
-            out.push(o);
-        }
-    }
-    (out, rec)
+    run_wheel(p.n, p.m, k, 1, ticks)
 }
 
 /// The stream with the tooth at grid position `pos` of revolution `rev` lost.
