@@ -1472,3 +1472,34 @@ fn reactions_of_a_run_shorter_than_a_revolution_are_noted() {
     assert!(note.contains("0.57 revolution"), "{note}");
     assert_eq!(run_trial(auger).supports.unwrap().reactions_note, None);
 }
+
+/// A Kloss drive whose load orders have a common period too long to sample (0.333 and 12: 1000
+/// revolutions, 384 000 samples) is predicted through the tangent parabola, and its note said
+/// the orders had no common period; it names the period now. Orders with none (1 and √2) keep
+/// their reason.
+#[test]
+fn a_load_period_too_long_to_sample_is_not_called_none() {
+    let path = std::path::Path::new("trial.toml");
+    let note = |orders: (f64, f64)| {
+        let text = format!(
+            "[shaft]\ninertia = 0.5\n[motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+             breakdown_slip = 0.2\nbreakdown_torque = 100.0\n[load]\nmean = 90.0\n\
+             harmonics = [{{ order = {}, amplitude = 10.0 }}, {{ order = {}, amplitude = 5.0 }}]\n",
+            orders.0, orders.1
+        );
+        let s = host_sim::app::scene::Scene::parse(&text, path).unwrap();
+        host_sim::app::predict::predict(&s, path)
+            .unwrap()
+            .irregularity
+            .unwrap()
+            .motor_note
+            .unwrap()
+    };
+    let long = note((0.333, 12.0));
+    assert!(
+        long.contains("common period, 1000 revolutions") && !long.contains("no common period"),
+        "{long}"
+    );
+    let none = note((1.0, std::f64::consts::SQRT_2));
+    assert!(none.contains("no common period"), "{none}");
+}

@@ -717,9 +717,21 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
         _ => {}
     }
     let p = motor.model();
+    // Orders with a common period too long to sample (0.333 and 12: 1000 revolutions) were
+    // said to have none.
+    let why = match model.period_revolutions() {
+        Some(n) => format!(
+            "the load's common period, {n} revolutions, needs more than the {} samples (32 \
+             a cycle of the fastest order) the prediction integrates over, so its periodic \
+             steady state is not integrated",
+            drive_monitor::drive::MAX_SAMPLES
+        ),
+        None => "the load's orders have no common period, so no periodic steady state exists \
+                 to integrate"
+            .to_string(),
+    };
     let head = format!(
-        "the load's orders have no common period, so no periodic steady state exists to \
-         integrate: the Kloss motor is predicted through its tangent parabola at synchronous \
+        "{why}: the Kloss motor is predicted through its tangent parabola at synchronous \
          speed (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
         p.a(),
         p.b()
