@@ -1503,3 +1503,43 @@ fn a_load_period_too_long_to_sample_is_not_called_none() {
     let none = note((1.0, std::f64::consts::SQRT_2));
     assert!(none.contains("no common period"), "{none}");
 }
+
+/// A phase beyond a turn is most likely meant in degrees (the rotor's angles are degrees, the
+/// harmonics' phases radians): `phase = 90` was read as 90 rad without a word. `predict` and
+/// `run` WARN, naming the key; a phase within ±2π says nothing.
+#[test]
+fn a_phase_beyond_a_turn_is_warned_of() {
+    let kneader = host_sim::app::scene::bundled("kneader").unwrap().1;
+    let path = std::path::Path::new("trial.toml");
+    let with = |phase: &str| {
+        let text = kneader.replacen("phase = 0.0", &format!("phase = {phase}"), 1);
+        assert_ne!(text, kneader);
+        host_sim::app::scene::Scene::parse(&text, path).unwrap()
+    };
+    let s = with("90.0");
+    let w = host_sim::app::predict::predict(&s, path)
+        .unwrap()
+        .irregularity
+        .unwrap()
+        .phase_warning
+        .unwrap();
+    assert!(
+        w.contains("`load.harmonics[1].phase = 90`") && w.contains("radians"),
+        "{w}"
+    );
+    let s = with("1.0");
+    let p = host_sim::app::predict::predict(&s, path).unwrap();
+    assert_eq!(p.irregularity.unwrap().phase_warning, None);
+    let text = kneader
+        .replacen("phase = 0.0", "phase = 90.0", 1)
+        .replacen("duration = 30.0", "duration = 2.0", 1)
+        .replacen("settle = 10.0", "settle = 1.0", 1);
+    let r = run_trial(&text);
+    assert!(
+        r.model_warnings
+            .iter()
+            .any(|m| m.contains("load.harmonics[1].phase")),
+        "{:?}",
+        r.model_warnings
+    );
+}

@@ -614,6 +614,9 @@ pub struct IrregularityOut {
     /// those intervals for a standstill and measure nothing there.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min_speed_warning: Option<String>,
+    /// A harmonic's phase beyond a turn, likely meant in degrees ([`phase_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub phase_warning: Option<String>,
     /// The scene also has a vibration machine (`[[platform]]`, `[autobalancer]`): the drive
     /// prediction leaves out the torque it puts on the shaft, which `run` simulates
     /// ([`machine_torque_warning`]).
@@ -933,6 +936,51 @@ fn min_speed_warning(
     }))
 }
 
+/// The WARNING for phases (in radians) beyond a turn: `load.harmonics[k].phase`,
+/// `shaft.inertia_harmonics[k].phase` and `cranking.phase` are radians where the rotor's angles
+/// (`[[unbalance]] angle`, `[process_load] angle`) are degrees, and `phase = 90` was read as 90
+/// rad without a word (with two harmonics, δ depends on it). `None` when every phase is within
+/// ±2π.
+pub fn phase_warning(scene: &Scene) -> Option<String> {
+    let mut over: Vec<String> = Vec::new();
+    let mut note = |key: String, phase: f64| {
+        if phase.abs() > std::f64::consts::TAU {
+            over.push(format!("`{key} = {phase}`"));
+        }
+    };
+    for (k, h) in scene
+        .load
+        .iter()
+        .flat_map(|l| l.harmonics.iter())
+        .enumerate()
+    {
+        note(format!("load.harmonics[{}].phase", k + 1), h.phase);
+    }
+    for (k, h) in scene
+        .shaft
+        .iter()
+        .flat_map(|s| s.inertia_harmonics.iter())
+        .enumerate()
+    {
+        note(format!("shaft.inertia_harmonics[{}].phase", k + 1), h.phase);
+    }
+    if let Some(c) = scene.cranking {
+        note("cranking.phase".to_string(), c.phase);
+    }
+    (!over.is_empty()).then(|| {
+        format!(
+            "WARNING: {} more than a turn: phases are in radians (the rotor's angles are \
+             degrees), so a phase meant in degrees is read as that many radians (90° is \
+             1.5708 rad)",
+            if over.len() == 1 {
+                format!("{} is", over[0])
+            } else {
+                format!("{} are", over.join(", "))
+            }
+        )
+    })
+}
+
 /// The fastest speed a prescribed drive puts the shaft at, rad/s (`model = "speed"`, the larger
 /// end of a `"ramp"`, the fastest point of a `"profile"`; with a cranking ripple its peak,
 /// ω̄·(1 + ripple)); `None` for a torque drive or none.
@@ -1083,6 +1131,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         p.irregularity = Some(IrregularityOut {
             alarm_floor_warning,
             min_speed_warning,
+            phase_warning: phase_warning(scene),
             machine_torque_warning: None,
             stall,
             working_branch_warning,

@@ -608,6 +608,7 @@ pub fn prediction_text(p: &Prediction) -> String {
                 &i.working_branch_warning,
                 &i.alarm_floor_warning,
                 &i.min_speed_warning,
+                &i.phase_warning,
                 &i.machine_torque_warning,
             ]
             .into_iter()

@@ -1642,6 +1642,7 @@ pub fn run_with(
         model_warnings: cranking_warning(scene)
             .into_iter()
             .chain(cranking_mean_note(scene))
+            .chain(predict::phase_warning(scene))
             .chain(step_warning)
             .collect(),
         window_warning: scene.encoder.as_ref().and_then(|_| window_warning(scene)),
