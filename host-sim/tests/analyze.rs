@@ -3840,6 +3840,21 @@ fn window_rows(r: &AnalyzeReport) -> Vec<WindowRow> {
         .collect()
 }
 
+/// The error reading the capture file `path` (format told from it, `rate` as --sample-rate)
+/// gives, opening it or at a row; empty when it reads to its end.
+fn open_error(path: &Path, rate: Option<f64>) -> String {
+    match CaptureReader::open(path, None, rate) {
+        Err(e) => e.to_string(),
+        Ok(mut r) => loop {
+            match r.next_row() {
+                Ok(Some(_)) => continue,
+                Ok(None) => return String::new(),
+                Err(e) => break e.to_string(),
+            }
+        },
+    }
+}
+
 /// Writes `entries` as a zip archive at `path`, each stored or deflated.
 fn zip_of(path: &Path, entries: &[(String, Vec<u8>)], deflated: bool) {
     use std::io::Write as _;
@@ -4024,16 +4039,7 @@ fn a_sigrok_session_file_is_refused_naming_what_is_wrong() {
         }
         entries.extend(chunks.iter().map(|(n, b)| (n.to_string(), b.to_vec())));
         zip_of(&path, &entries, true);
-        match CaptureReader::open(&path, None, rate) {
-            Err(e) => e.to_string(),
-            Ok(mut r) => loop {
-                match r.next_row() {
-                    Ok(Some(_)) => continue,
-                    Ok(None) => return String::new(),
-                    Err(e) => break e.to_string(),
-                }
-            },
-        }
+        open_error(&path, rate)
     };
     let data: &[(&str, &[u8])] = &[("logic-1-1", &samples)];
     // The good file reads, also as version 1 with one entry `logic-1`.
@@ -4351,16 +4357,7 @@ fn a_saleae_binary_export_is_refused_naming_what_is_wrong() {
     };
     let error = |bytes: Vec<u8>| {
         std::fs::write(&file, bytes).unwrap();
-        match CaptureReader::open(&file, None, None) {
-            Err(e) => e.to_string(),
-            Ok(mut r) => loop {
-                match r.next_row() {
-                    Ok(Some(_)) => continue,
-                    Ok(None) => return String::new(),
-                    Err(e) => break e.to_string(),
-                }
-            },
-        }
+        open_error(&file, None)
     };
     assert_eq!(error(v0(&[0.1, 0.2], 2, 1.0)), "");
     for (bytes, says) in [

@@ -985,13 +985,7 @@ pub fn phase_warning(scene: &Scene) -> Option<String> {
 /// end of a `"ramp"`, the fastest point of a `"profile"`; with a cranking ripple its peak,
 /// ω̄·(1 + ripple)); `None` for a torque drive or none.
 fn prescribed_top_speed(scene: &Scene) -> Option<f64> {
-    use crate::app::scene::MotorSpec;
-    let top = match scene.motor.as_ref()? {
-        MotorSpec::Speed { speed } => speed.abs(),
-        MotorSpec::Ramp { from, to, .. } => from.abs().max(to.abs()),
-        MotorSpec::Profile { points } => points.iter().map(|p| p[1].abs()).fold(0.0, f64::max),
-        MotorSpec::Parabola { .. } | MotorSpec::Kloss { .. } => return None,
-    };
+    let top = scene.motor.as_ref()?.prescribed_top()?;
     Some(top * (1.0 + scene.cranking.map_or(0.0, |c| c.ripple)))
 }
 

@@ -1383,11 +1383,9 @@ fn speed_bound(scene: &Scene, over: Overrides) -> f64 {
         .abs();
     let motor = match &scene.motor {
         _ if over.speed.is_some() => over.speed.unwrap_or(0.0).abs(),
-        Some(MotorSpec::Speed { speed }) => speed.abs(),
-        Some(MotorSpec::Ramp { from, to, .. }) => from.abs().max(to.abs()),
-        Some(MotorSpec::Profile { points }) => {
-            points.iter().map(|p| p[1].abs()).fold(0.0, f64::max)
-        }
+        Some(
+            m @ (MotorSpec::Speed { .. } | MotorSpec::Ramp { .. } | MotorSpec::Profile { .. }),
+        ) => m.prescribed_top().unwrap_or(0.0),
         Some(MotorSpec::Parabola { no_load_speed, .. }) => 2.0 * no_load_speed,
         Some(MotorSpec::Kloss {
             synchronous_speed, ..

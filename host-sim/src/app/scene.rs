@@ -263,6 +263,21 @@ pub enum MotorSpec {
     },
 }
 
+impl MotorSpec {
+    /// The fastest |ω̄| a prescribed model gives, rad/s (`speed`, the larger end of a `ramp`,
+    /// a `profile`'s fastest point), before any cranking ripple; `None` for a torque drive.
+    pub fn prescribed_top(&self) -> Option<f64> {
+        match self {
+            MotorSpec::Speed { speed } => Some(speed.abs()),
+            MotorSpec::Ramp { from, to, .. } => Some(from.abs().max(to.abs())),
+            MotorSpec::Profile { points } => {
+                Some(points.iter().map(|p| p[1].abs()).fold(0.0, f64::max))
+            }
+            MotorSpec::Parabola { .. } | MotorSpec::Kloss { .. } => None,
+        }
+    }
+}
+
 /// An array of exactly `N` values: more are refused as fewer are (serde's arrays read the first
 /// `N` of a TOML array and drop the rest unsaid: `support_load_limit = [8000, 1, 2]` ran with
 /// B's limit 1 N).
