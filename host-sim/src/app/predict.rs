@@ -606,6 +606,10 @@ pub struct IrregularityOut {
     /// stands for (a real motor's torque falls past its breakdown point).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub working_branch_warning: Option<String>,
+    /// ω max above the motor's no-load speed (a Kloss motor's synchronous speed): there the
+    /// load drives the shaft and the motor brakes it as a generator ([`generator_note`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub generator_note: Option<String>,
     /// The δ alarm could judge no window: the noise floor at the predicted speed is above the
     /// fraction of `delta_limit` the core's alarm requires (its `floor_fraction`, 0.2).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -683,6 +687,77 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
             "s"
         },
         radians
+    ))
+}
+
+/// The note for a steady state that runs above the motor's no-load speed (the synchronous
+/// speed of a Kloss motor), where its torque is negative: the load (a negative mean, or a
+/// harmonic's swing) drives the shaft and the motor brakes it as a generator. The parabola
+/// is fitted between breakdown and no-load speed and continues past it; the Kloss curve
+/// has its generator branch. `None` when ω max is at most that speed.
+pub fn generator_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
+    let motor = model.motor();
+    let (speed, name, branch) = match motor.kloss_curve() {
+        Some(k) => (
+            k.synchronous_speed(),
+            "synchronous speed",
+            "the Kloss curve's generator branch",
+        ),
+        None => (
+            motor.model().no_load_speed(),
+            "no-load speed",
+            "the parabola continued past its no-load point (it is fitted between breakdown \
+             and no-load speed)",
+        ),
+    };
+    if omega_max.partial_cmp(&speed) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let part = if omega_min > speed {
+        "throughout the period"
+    } else {
+        "for part of the period"
+    };
+    let mean = model.load().mean();
+    let active = if mean < 0.0 {
+        format!(" (the mean load {mean} N·m is negative: an active torque that drives the shaft)")
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "NOTE: ω max {omega_max:.3} rad/s is above the motor's {name} {speed:.3} rad/s: \
+         {part} the load drives the shaft and the motor brakes it as a generator{active}; \
+         its torque there is {branch}"
+    ))
+}
+
+/// The note for a run whose shaft turned backwards under a motor and a load: the load is
+/// modelled as an active torque (it keeps its sign at any speed, as a hoist's weight does), so
+/// where it exceeds the motor's torque at standstill it turns the shaft backwards; a reactive
+/// load (friction, kneading, a fan) would stall it instead. `None` without a torque motor and
+/// a load, or when the load's peak (its mean and every amplitude) stays below that torque.
+pub fn active_load_note(scene: &Scene, file: &Path) -> Option<String> {
+    let (motor, load, ..) = drive_parts_of(scene, file).ok()??;
+    let peak = load.mean()
+        + load
+            .harmonics()
+            .iter()
+            .map(|h| h.amplitude().abs())
+            .sum::<f64>();
+    let standstill = motor.torque(0.0);
+    if peak.partial_cmp(&standstill) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let which = if load.mean() > standstill {
+        format!("the mean load {} N·m", load.mean())
+    } else {
+        format!("the load's peak {peak:.4} N·m")
+    };
+    Some(format!(
+        "NOTE: {which} exceeds the motor's torque at standstill, {standstill:.4} N·m, and the \
+         load is modelled as an active torque (its sign whatever the speed, as a hoist's \
+         weight): where it exceeds the motor's torque it turns the shaft backwards; a reactive \
+         load (friction, kneading, a fan) would stall the shaft instead"
     ))
 }
 
@@ -827,6 +902,44 @@ pub struct SupportsOut {
     /// ([`balancer_supports_warning`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub balancer_warning: Option<String>,
+    /// The unbalances imply an eccentricity longer than the rotor ([`unbalance_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unbalance_warning: Option<String>,
+}
+
+/// The WARNING when the scene's unbalances, all in one direction, would put the rotor's centre
+/// of mass farther off its axis than the rotor is long (the extent of its supports, centre of
+/// mass, unbalance planes and process load along the axis): no rotor is that eccentric, and
+/// it is the mark of a unit slip (ISO 21940 quotes unbalance in g·mm, 1e-6 of the kg·m a
+/// scene takes: 2000 g·mm entered as 2000 kg·m). Such a scene is still analysed, as given.
+/// `None` without a rotor or when the eccentricity is within that length.
+pub fn unbalance_warning(scene: &Scene) -> Option<String> {
+    let rotor = scene.rotor.as_ref()?;
+    let total: f64 = scene.unbalance.iter().map(|u| u.amount.abs()).sum();
+    let eccentricity = total / rotor.mass;
+    let axial = [rotor.support_a, rotor.support_b, rotor.centre_of_mass]
+        .into_iter()
+        .chain(scene.unbalance.iter().map(|u| u.z))
+        .chain(scene.process_load.iter().flat_map(|p| [p.from, p.to]));
+    let (lo, hi) = axial.fold((f64::MAX, f64::MIN), |(lo, hi), z| (lo.min(z), hi.max(z)));
+    let length = hi - lo;
+    if eccentricity.partial_cmp(&length) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let (k, largest) = scene
+        .unbalance
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.amount.abs().total_cmp(&b.1.amount.abs()))?;
+    Some(format!(
+        "WARNING: the unbalances add up to {total:.4e} kg·m, an eccentricity of {eccentricity:.4e} m \
+         of the {} kg rotor, more than its {length:.4} m along the axis: no rotor is that \
+         eccentric; a unit slip? `unbalance[{}].amount = {}` is in kg·m (ISO 21940 quotes \
+         g·mm: 1 g·mm = 1e-6 kg·m)",
+        rotor.mass,
+        k + 1,
+        largest.amount
+    ))
 }
 
 /// Why the supports allow no speed at all: each support whose static load (weight and
@@ -1086,7 +1199,8 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             }
             drive_monitor::drive::Prediction::Stalls(s) if s.u_mean <= 0.0 => Some(
                 "the mean load exceeds the motor's torque at standstill: no speed and no \
-                 flywheel carry it",
+                 flywheel carry it (`run` models the load as an active torque, which turns the \
+                 shaft backwards)",
             ),
             drive_monitor::drive::Prediction::Stalls(_) => Some(
                 "the motor stalls under the peak load (it carries the mean load: more \
@@ -1120,6 +1234,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                     model.motor().model().working_min_speed()
                 )
             });
+        let generator_note = prediction
+            .steady()
+            .and_then(|s| generator_note(&model, s.omega_min, s.omega_max));
         let alarm_floor_warning = alarm_floor_warning(scene, file, limit, &prediction)?;
         let min_speed_warning = min_speed_warning(scene, file, &prediction)?;
         p.irregularity = Some(IrregularityOut {
@@ -1129,6 +1246,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             machine_torque_warning: None,
             stall,
             working_branch_warning,
+            generator_note,
             delta_through_samples: sampled.map(|s| s.delta),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
@@ -1201,6 +1319,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 drive_monitor::supports::Allocation::Overhung => "overhung",
             },
             balancer_warning: balancer_supports_warning(scene),
+            unbalance_warning: unbalance_warning(scene),
         });
     }
     if let Some(m) = machine(scene, file)? {

@@ -342,6 +342,7 @@ fn supports_text(u: &crate::app::run::SupportsRunOut) -> String {
     for w in [
         &u.above_service_speed,
         &u.balancer_warning,
+        &u.unbalance_warning,
         &u.reactions_note,
     ]
     .into_iter()
@@ -606,6 +607,7 @@ pub fn prediction_text(p: &Prediction) -> String {
             );
             for w in [
                 &i.working_branch_warning,
+                &i.generator_note,
                 &i.alarm_floor_warning,
                 &i.min_speed_warning,
                 &i.phase_warning,
@@ -753,6 +755,9 @@ pub fn prediction_text(p: &Prediction) -> String {
             let _ = writeln!(s, "  {w}");
         }
         if let Some(w) = &u.balancer_warning {
+            let _ = writeln!(s, "  {w}");
+        }
+        if let Some(w) = &u.unbalance_warning {
             let _ = writeln!(s, "  {w}");
         }
     }

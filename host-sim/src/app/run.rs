@@ -125,6 +125,10 @@ pub struct SupportsRunOut {
     /// reactions leave out ([`predict::balancer_supports_warning`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub balancer_warning: Option<String>,
+    /// The unbalances imply an eccentricity longer than the rotor
+    /// ([`predict::unbalance_warning`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unbalance_warning: Option<String>,
 }
 
 /// What a run produced.
@@ -1664,6 +1668,11 @@ pub fn run_with(
         col.outcome(stats.time, o);
     }
     measurement(&mut report, &mut col);
+    if col.reverse_edges > 0 {
+        report
+            .model_warnings
+            .extend(predict::active_load_note(scene, file));
+    }
     // The vibration machine's torque is in the run (a motor-driven shaft integrates it) and
     // not in the prediction; the encoder's errors are in the measured δ and not its floor.
     let coupled = vib_machine.is_some() && over.speed.is_none();
@@ -1676,6 +1685,11 @@ pub fn run_with(
             .delta_measured
             .and(scene.encoder.as_ref())
             .and_then(encoder_errors_note),
+        report
+            .delta_measured
+            .and(model.as_ref())
+            .filter(|_| over.speed.is_none())
+            .and_then(|m| settle_note(m, settle, scene.simulation.settle.is_none())),
     ]
     .into_iter()
     .flatten()
@@ -1712,6 +1726,43 @@ pub fn run_with(
     report.edge_list = col.edge_list.take().unwrap_or_default();
     report.wall_seconds = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// The NOTE under `run`'s δ line when the windows counted after `settle` (s; `default`: a
+/// third of the duration, not the scene's) may still carry the start's transient: the drive's
+/// deviations from its steady state decay as e^(−t/τ), τ = J / (−∂M_d/∂ω) at the predicted
+/// mean speed (the load's torque does not change with the speed), and `settle` is under 3τ
+/// (5 % left). A heavy drive on a stiff-enough motor can take tens of seconds (J = 305 kg·m²
+/// on a parabola motor: τ 17 s, and δ read 0.56 % high after a default settle of 3.5 s).
+/// `None` without a steady state, or on a motor branch whose torque rises with the speed.
+pub fn settle_note(
+    model: &drive_monitor::drive::DriveModel,
+    settle: f64,
+    default: bool,
+) -> Option<String> {
+    model.predict().steady()?;
+    let omega = model.u_mean().sqrt();
+    let h = 1e-4 * omega;
+    let motor = model.motor();
+    // Central difference of the characteristic (the Kloss curve itself where it is one).
+    let stiffness = (motor.torque(omega - h) - motor.torque(omega + h)) / (2.0 * h);
+    let tau = model.total_inertia() / stiffness;
+    if !(tau > 0.0 && tau.is_finite() && settle < 3.0 * tau) {
+        return None;
+    }
+    let given = if default {
+        "the default settle, a third of the duration,"
+    } else {
+        "simulation.settle ="
+    };
+    Some(format!(
+        "NOTE: the drive's deviations from its steady state decay with a time constant of \
+         {tau:.3} s (J / −∂M_d/∂ω at the mean speed {omega:.3} rad/s): the windows after \
+         {given} {settle:.3} s still carry {:.0} % of the start's; a `simulation.settle` of 3τ = \
+         {:.3} s leaves 5 % (with a duration beyond it)",
+        100.0 * (-settle / tau).exp(),
+        3.0 * tau
+    ))
 }
 
 /// The WARNING under `run`'s δ line for a drive prediction beside a vibration machine whose
@@ -2503,6 +2554,7 @@ fn supports(
                 simulated_reaction_level: reaction_level,
                 above_service_speed: above_service_speed(speed, limits.service_speed()),
                 balancer_warning: predict::balancer_supports_warning(scene),
+                unbalance_warning: predict::unbalance_warning(scene),
             }
         }
         None => {
@@ -2521,6 +2573,7 @@ fn supports(
                 simulated_reaction_level: reaction_level,
                 above_service_speed: None,
                 balancer_warning: predict::balancer_supports_warning(scene),
+                unbalance_warning: predict::unbalance_warning(scene),
             }
         }
     };
