@@ -1195,3 +1195,58 @@ fn a_sweep_judges_no_speed_its_runs_are_too_short_for() {
     assert_eq!((s.away_from_characteristic, s.agreeing), (2, 0));
     assert!(s.markdown().contains("2 speeds did not settle"));
 }
+
+/// A symmetric chain (platforms 1 and 3 equal, each coupled to the balancer's platform 2 only):
+/// its antisymmetric mode, platform 2 at rest, is an eigenfrequency of the machine and of the
+/// machine with platform 2 held, √((k + k_c)/m), a pole and a zero of the receptance that
+/// cancel. It was listed as a resonance and twice as an additional speed, with a capture line
+/// copied from the first resonance. Now the excited resonances are the symmetric modes'
+/// (closed form: the 2×2 pencil on [x, y, x]), one additional speed is left, and the cancelled
+/// speed is listed as not excited.
+#[test]
+fn a_mode_with_a_node_at_the_balancer_is_not_listed_as_excited() {
+    let (m, k, kc): (f64, f64, f64) = (100.0, 4e5, 1e5);
+    let exciter = m + 5.0 + 2.0 * 0.5;
+    let text = format!(
+        "[[platform]]\nmass = {m}\nstiffness = {k}\ndamping = 200.0\n\
+         [[platform]]\nmass = {m}\nstiffness = {k}\ndamping = 200.0\n\
+         [[platform]]\nmass = {m}\nstiffness = {k}\ndamping = 200.0\n\
+         [[coupling]]\nbetween = [1, 2]\nstiffness = {kc}\ndamping = 50.0\n\
+         [[coupling]]\nbetween = [2, 3]\nstiffness = {kc}\ndamping = 50.0\n\
+         [autobalancer]\nkind = \"ball\"\nplatform = 2\nloads = 2\nload_mass = 0.5\n\
+         radius = 0.1\nhousing_mass = 5.0\nviscosity = 10.0\nrotor_unbalance = 0.05\n\
+         [motor]\nmodel = \"speed\"\nspeed = 100.0\n"
+    );
+    let path = std::path::Path::new("chain.toml");
+    let scene = host_sim::app::scene::Scene::parse(&text, path).unwrap();
+    let p = host_sim::app::predict::predict(&scene, path).unwrap();
+    let a = p.autobalancer.as_ref().unwrap();
+    let anti = ((k + kc) / m).sqrt();
+    // Symmetric modes: m·λ·x = (k + kc)·x − kc·y, M_e·λ·y = −2·kc·x + (k + 2·kc)·y.
+    let (p11, p12, p21, p22) = (
+        (k + kc) / m,
+        -kc / m,
+        -2.0 * kc / exciter,
+        (k + 2.0 * kc) / exciter,
+    );
+    let (tr, det) = (p11 + p22, p11 * p22 - p12 * p21);
+    let disc = (tr * tr / 4.0 - det).sqrt();
+    let symmetric = [(tr / 2.0 - disc).sqrt(), (tr / 2.0 + disc).sqrt()];
+    let rel = |a: f64, b: f64| (a - b).abs() / b;
+    assert_eq!(a.resonant_speeds.len(), 2, "{:?}", a.resonant_speeds);
+    for (r, s) in a.resonant_speeds.iter().zip(symmetric) {
+        assert!(rel(*r, s) < 1e-12, "{r} {s}");
+    }
+    assert_eq!(a.additional_speeds.len(), 1, "{:?}", a.additional_speeds);
+    assert!(rel(a.additional_speeds[0], anti) < 1e-12);
+    assert_eq!(a.unexcited_speeds.len(), 1, "{:?}", a.unexcited_speeds);
+    assert!(rel(a.unexcited_speeds[0], anti) < 1e-12);
+    // One capture line per excited resonance, none copied.
+    assert_eq!(a.resonance_capture.len(), 2, "{:?}", a.resonance_capture);
+    assert!(a.resonance_capture[1].until > a.resonance_capture[0].until * 1.1);
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(
+        text.contains(&format!("not excited by the rotor: {anti:.3} rad/s")),
+        "{text}"
+    );
+}

@@ -569,10 +569,16 @@ pub struct AutobalancerOut {
     pub regime_table: Vec<SegmentOut>,
     /// "exact" (from the stability above) or "criterion" (without a balancing position).
     pub regime_table_source: &'static str,
-    /// Undamped resonant speeds, ascending, rad/s.
+    /// Undamped resonant speeds the rotor excites, ascending, rad/s
+    /// ([`crate::app::regimes::excited_speeds`]).
     pub resonant_speeds: Vec<f64>,
-    /// Undamped additional speeds, ascending, rad/s.
+    /// Undamped additional speeds, ascending, rad/s, less those cancelled against a
+    /// resonance.
     pub additional_speeds: Vec<f64>,
+    /// Speeds where a resonance and an additional speed cancel: a mode with a node at the
+    /// balancer's platform, which the rotor does not excite (absent when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unexcited_speeds: Vec<f64>,
     /// Zones with the scene's damping.
     pub zones: Vec<ZoneOut>,
     /// Sommerfeld capture windows (balancing locally stable, capture also possible).
@@ -1357,6 +1363,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 .map(|s| segment(f64::from(s.from), s.regime))
                 .collect(),
         };
+        let excited = crate::app::regimes::excited_speeds(&m);
         p.autobalancer = Some(AutobalancerOut {
             capacity: design.capacity,
             rotor_unbalance: design.rotor_unbalance,
@@ -1372,8 +1379,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             } else {
                 "criterion"
             },
-            resonant_speeds: m.resonant_speeds().to_vec(),
-            additional_speeds: m.additional_speeds().to_vec(),
+            resonant_speeds: excited.resonant,
+            additional_speeds: excited.additional,
+            unexcited_speeds: excited.cancelled,
             zones: m
                 .zones()
                 .iter()

@@ -164,6 +164,51 @@ pub fn settle_time(sigma: f64) -> f64 {
     10.0 / sigma.abs()
 }
 
+/// Relative distance within which a resonant and an additional speed are one speed
+/// ([`excited_speeds`]). The core finds a double root to 1e-14 (a symmetric chain's
+/// antisymmetric mode); nearly equal partial frequencies (1e-6 apart) leave a narrow but real
+/// resonance, kept.
+const CANCEL_RTOL: f64 = 1e-9;
+
+/// The undamped characteristic speeds the rotor excites: the machine's resonant and additional
+/// speeds with every pair of equal ones cancelled. A mode with a node at the balancer's
+/// platform (platforms 1 and 3 of a symmetric chain swinging against each other, platform 2 at
+/// rest) is an eigenfrequency of the machine and of the machine with that platform held: a
+/// pole and a zero of the platform's receptance at once, which cancel. The rotor does not
+/// excite that mode, and `Re H` changes sign there only as often as the zeros outnumber the
+/// poles (the symmetric chain: once, where the seed's lists hold the speed three times).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ExcitedSpeeds {
+    /// Resonant speeds the rotor excites, ascending, rad/s.
+    pub resonant: Vec<f64>,
+    /// Additional speeds (zeros of the receptance) left after cancelling, ascending, rad/s.
+    pub additional: Vec<f64>,
+    /// The speeds of the cancelled pairs (a resonance and an additional speed each),
+    /// ascending, rad/s.
+    pub cancelled: Vec<f64>,
+}
+
+/// [`ExcitedSpeeds`] of `machine`: each resonant speed paired with an unpaired additional
+/// speed within [`CANCEL_RTOL`] of it, both dropped.
+pub fn excited_speeds(machine: &Machine) -> ExcitedSpeeds {
+    let mut additional: Vec<f64> = machine.additional_speeds().to_vec();
+    let mut out = ExcitedSpeeds::default();
+    for &r in machine.resonant_speeds() {
+        let pair = additional
+            .iter()
+            .position(|&a| (a - r).abs() <= CANCEL_RTOL * r.abs().max(a.abs()));
+        match pair {
+            Some(k) => {
+                additional.remove(k);
+                out.cancelled.push(r);
+            }
+            None => out.resonant.push(r),
+        }
+    }
+    out.additional = additional;
+    out
+}
+
 /// Log-spaced nodes per capture band search ([`resonance_captures`]).
 const CAPTURE_NODES: usize = 2000;
 
@@ -179,10 +224,16 @@ const CAPTURE_NODES: usize = 2000;
 /// No window where `Ω + D(Ω)` has no interior maximum (it only rises: a slip in proportion
 /// to the speed, no capture).
 pub fn resonance_captures(machine: &Machine) -> Vec<CaptureWindow> {
-    let extra = machine.additional_speeds();
+    // Only the resonances the rotor excites, bracketed by the zeros left ([`excited_speeds`]):
+    // a cancelled one, bracketed by nothing, copied the first resonance's window.
+    let ExcitedSpeeds {
+        resonant,
+        additional: extra,
+        ..
+    } = excited_speeds(machine);
     let f = |w: f64| w + machine.capture_lag(w);
     let mut out = Vec::new();
-    for &r in machine.resonant_speeds() {
+    for &r in &resonant {
         if !(r.is_finite() && r > 0.0) {
             continue;
         }

@@ -778,6 +778,15 @@ pub fn prediction_text(p: &Prediction) -> String {
                 list(&a.additional_speeds)
             );
         }
+        if !a.unexcited_speeds.is_empty() {
+            let _ = writeln!(
+                s,
+                "  not excited by the rotor: {} rad/s (a mode with a node at the balancer's \
+                 platform: a resonance and an additional speed of the seed's lists, whose pole \
+                 and zero cancel)",
+                list(&a.unexcited_speeds)
+            );
+        }
         // The zones are contiguous: each boundary printed once with the digits both its
         // zones need.
         let ends = fmt_speeds(
