@@ -1061,31 +1061,31 @@ fn min_speed_warning(
 /// rad without a word (with two harmonics, δ depends on it). `None` when every phase is within
 /// ±2π.
 pub fn phase_warning(scene: &Scene) -> Option<String> {
-    let mut over: Vec<String> = Vec::new();
-    let mut note = |key: String, phase: f64| {
-        if phase.abs() > std::f64::consts::TAU {
-            over.push(format!("`{key} = {phase}`"));
-        }
+    // Every harmonic phase of the scene, with its key (numbered from 1 within its table).
+    let numbered = |table: &'static str, phases: Vec<f64>| {
+        phases
+            .into_iter()
+            .enumerate()
+            .map(move |(k, phase)| (format!("{table}[{}].phase", k + 1), phase))
     };
-    for (k, h) in scene
+    let load = scene
         .load
         .iter()
-        .flat_map(|l| l.harmonics.iter())
-        .enumerate()
-    {
-        note(format!("load.harmonics[{}].phase", k + 1), h.phase);
-    }
-    for (k, h) in scene
+        .flat_map(|l| l.harmonics.iter().map(|h| h.phase));
+    let inertia = scene
         .shaft
         .iter()
-        .flat_map(|s| s.inertia_harmonics.iter())
-        .enumerate()
-    {
-        note(format!("shaft.inertia_harmonics[{}].phase", k + 1), h.phase);
-    }
-    if let Some(c) = scene.cranking {
-        note("cranking.phase".to_string(), c.phase);
-    }
+        .flat_map(|s| s.inertia_harmonics.iter().map(|h| h.phase));
+    let over: Vec<String> = numbered("load.harmonics", load.collect())
+        .chain(numbered("shaft.inertia_harmonics", inertia.collect()))
+        .chain(
+            scene
+                .cranking
+                .map(|c| ("cranking.phase".to_string(), c.phase)),
+        )
+        .filter(|(_, phase)| phase.abs() > std::f64::consts::TAU)
+        .map(|(key, phase)| format!("`{key} = {phase}`"))
+        .collect();
     (!over.is_empty()).then(|| {
         format!(
             "WARNING: {} more than a turn: phases are in radians (the rotor's angles are \

@@ -316,12 +316,14 @@ pub fn stability_map(
     let mut start = opts.from.max(floquet.lowest_speed());
     // A scan's steps are spent in its lowest octaves, where a revolution spans the most
     // periods of the fastest motion and a monodromy's steps fall as 1/ω: the grid's sum is
-    // about 70 times the first one's (48 speeds an octave), half as much again for the
-    // boundaries. A start whose scan would take more than half the budget is raised until it
-    // would not (a lightly damped 620 rad/s coupling took 16 666 steps a revolution at 0.62
-    // rad/s, and its scan from 0.88 rad/s 946 000, next to the budget).
+    // the first one's times Σ 2^(−k/n) = 1/(1 − 2^(−1/n)) for n speeds an octave (about 70 at
+    // 48), half as much again for the boundaries. A start whose scan would take more than half
+    // the budget is raised until it would not (a lightly damped 620 rad/s coupling took
+    // 16 666 steps a revolution at 0.62 rad/s, and its scan from 0.88 rad/s 946 000, next to
+    // the budget).
     let first = floquet.revolution_steps(start, opts.rtol).map_err(err)?;
-    let estimate = 105.0 * first as f64;
+    let grid_sum = 1.0 / (1.0 - 0.5f64.powf(1.0 / opts.per_octave.max(1) as f64));
+    let estimate = 1.5 * grid_sum * first as f64;
     let afford = 0.5 * SCAN_STEPS as f64;
     if estimate > afford {
         start *= estimate / afford;
