@@ -4508,3 +4508,81 @@ fn an_analog_record_is_read_through_a_threshold() {
         .to_string();
     assert!(e.contains("a vcd file records levels"), "{e}");
 }
+
+/// A channel that rings at the transitions of the polarity NOT read: each falling transition
+/// crosses back and again within microseconds, and the crossing back is a rising edge, half a
+/// pitch after the tooth's. The rising edges read then come twice a tooth, evenly enough for
+/// the core to take them as teeth: valid windows at twice the shaft's speed, which nothing
+/// said. Now a WARNING names the ringing polarity; noise pulses between teeth and a clean disc
+/// give none, and read on the ringing polarity the capture gets the ringing WARNING instead.
+#[test]
+fn ringing_on_the_polarity_not_read_is_said() {
+    // A 60-line disc at 2 ms a line (52.36 rad/s), 8 revolutions, times to 0.1 µs; after a
+    // tooth's fall the level rises after 3 µs and falls again at 4 µs.
+    let capture =
+        |bounce: bool, noise_every: u32, edge: Option<host_sim::app::analyze::Polarity>| {
+            let mut rows: Vec<(f64, u8)> = Vec::new();
+            for k in 0..480u32 {
+                let t = f64::from(k) * 2e-3;
+                rows.push((t, 1));
+                rows.push((t + 1e-3, 0));
+                if bounce {
+                    rows.push((t + 1.003e-3, 1));
+                    rows.push((t + 1.004e-3, 0));
+                }
+                if noise_every > 0 && k % noise_every == 3 {
+                    // A 2 µs noise pulse at 75 % of the tooth's interval.
+                    rows.push((t + 1.5e-3, 1));
+                    rows.push((t + 1.502e-3, 0));
+                }
+            }
+            let mut text = String::from("Time [s],Channel 0\n0.0000000,0\n");
+            for (t, l) in rows {
+                text.push_str(&format!("{:.7},{l}\n", t + 1e-4));
+            }
+            let cfg = configure(&AnalyzeOptions {
+                lines: Some(60),
+                edge,
+                ..AnalyzeOptions::default()
+            })
+            .unwrap();
+            let mut r = text_reader(text, "r.csv", None).unwrap();
+            analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+        };
+    let omega = std::f64::consts::TAU / 60.0 / 2e-3;
+    let bounced = capture(true, 0, None);
+    // What the WARNING is for: valid windows at twice the shaft's speed.
+    let doubled = bounced
+        .windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.omega_mean)
+        .collect::<Vec<_>>();
+    assert!(
+        !doubled.is_empty() && doubled.iter().all(|w| (w / omega - 2.0).abs() < 0.01),
+        "{doubled:?}"
+    );
+    assert_eq!(bounced.ringing, None);
+    let g = bounced.ringing_other_polarity.clone().unwrap();
+    assert!(g.edges >= 470 && g.of >= 958, "{g:?}");
+    // The longest: 4 µs, to the 0.1 µs of the times.
+    assert!((g.longest - 4e-6).abs() < 2e-7, "{g:?}");
+    let said = host_sim::app::analyze::text(&bounced);
+    assert!(
+        said.contains(&format!(
+            "WARNING: `Channel 0` rings at its falling transitions: {} of its {} falling edges \
+             came within 4.000e-6 s",
+            g.edges, g.of
+        )) && said.contains("twice the teeth's")
+            && said.contains("`--edge falling`"),
+        "{said}"
+    );
+    // Read on the falling edges: the ringing of the polarity read, said as such.
+    let falling = capture(true, 0, Some(host_sim::app::analyze::Polarity::Falling));
+    assert!(falling.ringing.is_some() && falling.ringing_other_polarity.is_none());
+    // Noise pulses between teeth (one tooth in ten), and a clean disc: nothing.
+    let noise = capture(false, 10, None);
+    assert!(noise.glitches >= 40, "{}", noise.glitches);
+    assert_eq!(noise.ringing_other_polarity, None);
+    assert_eq!(capture(false, 0, None).ringing_other_polarity, None);
+}
