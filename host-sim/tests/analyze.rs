@@ -4586,3 +4586,109 @@ fn ringing_on_the_polarity_not_read_is_said() {
     assert_eq!(noise.ringing_other_polarity, None);
     assert_eq!(capture(false, 0, None).ringing_other_polarity, None);
 }
+
+/// One tooth's edge moved 30 % of a pitch early (a noise pulse that merged with the tooth) on
+/// a 1024-line disc at a constant 150 rad/s: the core takes it (its intervals are within the
+/// accept band), and the window holding it read δ 0.60 valid and resolved where the shaft's
+/// is 0, with no word. The window is now marked with the edge and how far off it lies, and a
+/// WARNING says so; with 16-edge samples (δ 0.037 from it) as well. A shaft whose speed swings
+/// smoothly (3 % at order 2, and 40 % at order 2 on a 36-2 wheel) has no edge marked.
+#[test]
+fn a_window_whose_delta_one_displaced_edge_makes_is_marked() {
+    // Rising edges of `lines` lines at angle θ_k, the shaft at ω(φ) = ω̄·(1 + a·sin 2φ): the
+    // time of angle φ by Simpson's rule on a fine grid (exact enough: 1e-12 s).
+    let edges = |lines: u32, missing: u32, a: f64, moved: Option<(usize, f64)>| {
+        let omega = |phi: f64| 150.0 * (1.0 + a * (2.0 * phi).sin());
+        let pitch = std::f64::consts::TAU / f64::from(lines);
+        let mut times = Vec::new();
+        let (mut t, mut phi) = (1e-3, 0.0);
+        for k in 0..lines * 8 {
+            if k % lines < lines - missing {
+                times.push(t);
+            }
+            let n = 64;
+            let h = pitch / f64::from(n);
+            let mut sum = 0.0;
+            for j in 0..=n {
+                let w = if j == 0 || j == n {
+                    1.0
+                } else if j % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                sum += w / omega(phi + f64::from(j) * h);
+            }
+            t += sum * h / 3.0;
+            phi += pitch;
+        }
+        if let Some((i, f)) = moved {
+            let d = times[i] - times[i - 1];
+            times[i] -= f * d;
+        }
+        times
+    };
+    let analyzed = |times: &[f64], options: AnalyzeOptions| {
+        let text = saleae_of_rising(times, 1e9, times.last().unwrap() + 1e-3);
+        let cfg = configure(&options).unwrap();
+        let mut r = text_reader(text, "d.csv", Some(1e9)).unwrap();
+        analyze(&mut r, &cfg, &mut |_| {}).unwrap()
+    };
+    let disc = |k: u16| AnalyzeOptions {
+        lines: Some(1024),
+        estimator_edges: Some(k),
+        ..AnalyzeOptions::default()
+    };
+    let moved = edges(1024, 0, 0.0, Some((5130, 0.3)));
+    let at = moved[5130];
+    for (k, delta) in [(1u16, 0.6), (16, 0.6 / 16.0)] {
+        let r = analyzed(&moved, disc(k));
+        let marked: Vec<_> = r
+            .windows
+            .iter()
+            .filter(|w| w.displaced_edge.is_some())
+            .collect();
+        assert_eq!(marked.len(), 1, "K {k}: {:?}", r.windows);
+        let (w, e) = (marked[0], marked[0].displaced_edge.unwrap());
+        assert!(
+            (e.pitches - 0.3).abs() < 0.01 && (e.time - at).abs() < 2e-9,
+            "{e:?}"
+        );
+        // What it marks: δ made by that edge, 2·f/K.
+        assert!(
+            (w.delta.unwrap() / delta - 1.0).abs() < 0.05,
+            "K {k}: {:?}",
+            w.delta
+        );
+        let e = r.displaced_edges.unwrap();
+        // (The capture's times are on a 1 ns grid.)
+        assert!(e.windows == 1 && (e.first - at).abs() < 2e-9, "{e:?}");
+        let said = host_sim::app::analyze::text(&r);
+        assert!(
+            said.contains("WARNING: in 1 valid window(s) one edge lies off the line")
+                && said.contains(&format!(
+                    ", δ from one edge 30.0 % of a pitch off at {at:.6} s"
+                )),
+            "{said}"
+        );
+    }
+    // Smooth swings of the speed: nothing marked.
+    let r = analyzed(&edges(1024, 0, 0.03, None), disc(1));
+    assert!(
+        r.valid_windows >= 6 && r.displaced_edges.is_none(),
+        "{} {:?}",
+        r.valid_windows,
+        r.displaced_edges
+    );
+    let wheel = AnalyzeOptions {
+        wheel: Some("36-2".into()),
+        ..AnalyzeOptions::default()
+    };
+    let r = analyzed(&edges(36, 2, 0.4, None), wheel);
+    assert!(
+        r.valid_windows >= 4 && r.displaced_edges.is_none(),
+        "{} {:?}",
+        r.valid_windows,
+        r.displaced_edges
+    );
+}

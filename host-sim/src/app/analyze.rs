@@ -19,7 +19,7 @@ use std::io::BufRead;
 
 use serde::Serialize;
 
-use drive_monitor::encoder::{Encoder, EncoderConfig};
+use drive_monitor::encoder::{Encoder, EncoderConfig, Estimator};
 use drive_monitor::irregularity::{WindowConfig, WindowReport};
 use drive_monitor::monitor::{DeltaMonitor, WindowOutcome};
 use drive_monitor::speed::{Direction, EdgeSink, Fault, SyncState, Tooth};
@@ -237,6 +237,32 @@ pub struct WindowOut {
     /// `noise_floor`; valid windows): otherwise δ is not resolved from the quantization and
     /// its value is no measurement of the ripple, only a bound on it.
     pub resolved: Option<bool>,
+    /// One edge of the window (or of its first samples) lies off the line of its neighbours
+    /// by enough to make half the window's δ or more by itself (valid windows): δ is then
+    /// that edge's, not the shaft's (`DisplacedEdges` in the module's source).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub displaced_edge: Option<DisplacedEdge>,
+}
+
+/// An edge off the line of its neighbours ([`WindowOut::displaced_edge`]).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct DisplacedEdge {
+    /// Its capture time, s.
+    pub time: f64,
+    /// How far off, in pitches (0.3: a tooth's edge 30 % of a pitch early or late).
+    pub pitches: f64,
+}
+
+/// The valid windows whose δ an edge off its neighbours' line can make by itself
+/// ([`AnalyzeReport::displaced_edges`]).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct DisplacedWindows {
+    /// How many of the listed windows.
+    pub windows: u64,
+    /// The first such edge's time, s.
+    pub first: f64,
+    /// The largest displacement, pitches.
+    pub largest: f64,
 }
 
 /// A fault with its time.
@@ -548,6 +574,10 @@ pub struct AnalyzeReport {
     /// edges.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ringing_other_polarity: Option<Ringing>,
+    /// Valid windows whose δ one edge off the line of its neighbours makes by itself (half
+    /// of it or more: [`WindowOut::displaced_edge`]); the report warns.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub displaced_edges: Option<DisplacedWindows>,
     /// The emulated capture's input prescaler: one capture every this many edges.
     pub prescaler: u8,
     /// Edges on the index channel (fed to the core).
@@ -723,6 +753,122 @@ impl SpacingSeen {
 /// An interval more than this many times the geometric mean of its two neighbours is long (a
 /// gap): a 36-1 wheel's is 2, a tooth's on a cranking shaft stays well below.
 pub const LONG_RATIO: f64 = 1.5;
+
+/// Displacement, in pitches, above which an edge is kept as a candidate for
+/// [`DisplacedEdges`] (a half per cent: with 16-edge samples it alone can make δ 6e-4).
+const DISPLACED_CANDIDATE: f64 = 0.005;
+
+/// Candidates [`DisplacedEdges`] keeps (beyond, the signal is rough everywhere and no edge
+/// stands out).
+const MAX_DISPLACED: usize = 100_000;
+
+/// Edges per block of [`DisplacedEdges`]'s running scatter.
+const DISPLACED_BLOCK: u64 = 64;
+
+/// Edges that lie off the line of their neighbours: the edge one capture moved (a noise
+/// pulse that merged with a tooth, starting before it, makes its edge early), which the core
+/// takes as a tooth (its intervals, (1 − f) and (1 + f) pitches, are in its band) and which
+/// makes δ 2·f/K by itself with `K`-edge samples (0.6 for a tooth 30 % early, per edge, on a
+/// constant shaft). Each edge's time against the cubic through the two edges either side,
+/// `(−t₋₂ + 4·t₋₁ + 4·t₊₁ − t₊₂)/6`, in pitches of their mean spacing: exactly `f` for an
+/// edge moved by `f` pitches, and near 0 where the speed changes smoothly from tooth to
+/// tooth (the cubic follows it to the fourth order). Edges beside intervals more than 1.9
+/// apart (a wheel's gap) are left out. Candidates above [`DISPLACED_CANDIDATE`] are kept with
+/// their time, and the mean of every block of [`DISPLACED_BLOCK`] edges, so that each window
+/// can be judged at the end.
+#[derive(Default)]
+struct DisplacedEdges {
+    /// The last five capture times, newest last, and how many there are.
+    times: [f64; 5],
+    have: usize,
+    /// (time, displacement in pitches) of the candidates.
+    candidates: Vec<(f64, f64)>,
+    /// (first time, mean displacement) per block, and the block being summed.
+    blocks: Vec<(f64, f64)>,
+    block_start: f64,
+    block_sum: f64,
+    block_n: u64,
+}
+
+impl DisplacedEdges {
+    /// A reversal or a stop: the intervals before it are no neighbours of those after.
+    fn reset(&mut self) {
+        self.have = 0;
+    }
+
+    /// A forward capture at `t`.
+    fn capture(&mut self, t: f64) {
+        self.times.rotate_left(1);
+        self.times[4] = t;
+        self.have = (self.have + 1).min(5);
+        if self.have < 5 {
+            return;
+        }
+        let [t0, t1, t2, t3, t4] = self.times;
+        let d = [t1 - t0, t2 - t1, t3 - t2, t4 - t3];
+        let even = d.windows(2).all(|p| {
+            let ratio = p[1] / p[0];
+            ratio.is_finite() && ratio > 0.0 && (1.0 / 1.9..=1.9).contains(&ratio)
+        });
+        if !even {
+            return;
+        }
+        let pitch = (t4 - t0) / 4.0;
+        let expected = (-t0 + 4.0 * t1 + 4.0 * t3 - t4) / 6.0;
+        self.edge(t2, ((expected - t2) / pitch).abs());
+    }
+
+    fn edge(&mut self, at: f64, f: f64) {
+        if f >= DISPLACED_CANDIDATE && self.candidates.len() < MAX_DISPLACED {
+            self.candidates.push((at, f));
+        }
+        if self.block_n == 0 {
+            self.block_start = at;
+        }
+        self.block_sum += f;
+        self.block_n += 1;
+        if self.block_n == DISPLACED_BLOCK {
+            self.close_block();
+        }
+    }
+
+    fn close_block(&mut self) {
+        if self.block_n > 0 {
+            self.blocks
+                .push((self.block_start, self.block_sum / self.block_n as f64));
+        }
+        (self.block_sum, self.block_n) = (0.0, 0);
+    }
+
+    /// The edge of `[start, end]` that lies farthest off its neighbours' line, with its
+    /// displacement (pitches), when it stands out: at least ten times the mean displacement
+    /// of the blocks in the window (one of its edges excepted), so that it is one edge, not a
+    /// rough signal or a shaft whose speed swings from tooth to tooth.
+    fn standout(&self, start: f64, end: f64) -> Option<(f64, f64)> {
+        let from = self.candidates.partition_point(|c| c.0 < start);
+        let (at, f) = self.candidates[from..]
+            .iter()
+            .take_while(|c| c.0 <= end)
+            .copied()
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        let b0 = self
+            .blocks
+            .partition_point(|b| b.0 < start)
+            .saturating_sub(1);
+        let blocks: Vec<f64> = self.blocks[b0..]
+            .iter()
+            .take_while(|b| b.0 <= end)
+            .map(|b| b.1)
+            .collect();
+        if blocks.is_empty() {
+            return None;
+        }
+        // The mean over the window's blocks, less the candidate's own share of its block.
+        let n = blocks.len() as f64 * DISPLACED_BLOCK as f64;
+        let mean = (blocks.iter().sum::<f64>() * DISPLACED_BLOCK as f64 - f).max(0.0) / (n - 1.0);
+        (f >= 10.0 * mean).then_some((at, f))
+    }
+}
 
 /// The raw intervals between forward captures, as they come: the long ones and their spacing,
 /// the longest, in bounded memory.
@@ -1591,6 +1737,7 @@ pub fn analyze<R: BufRead>(
     // clean pulse train at twice the speed (valid windows, the wrong δ).
     let mut other = Intervals::default();
     let mut other_edges = 0u64;
+    let mut displaced = DisplacedEdges::default();
     let polarity = cfg.polarity();
     // A pattern's runs of teeth and gaps (for the hint on a wheel that never syncs).
     let runs = match cfg.encoder.wheel {
@@ -1800,8 +1947,10 @@ pub fn analyze<R: BufRead>(
             report.captured += 1;
             if direction == Some(Direction::Reverse) {
                 intervals.reset();
+                displaced.reset();
             } else {
                 intervals.capture(t, polls.timeout, longest_gap);
+                displaced.capture(t);
             }
             let before = last_capture_time.replace(t);
             if let Some(p) = last_capture.replace(ticks) {
@@ -1957,6 +2106,35 @@ pub fn analyze<R: BufRead>(
     for w in &mut report.windows {
         if let (Some(d), Some(f)) = (w.delta, w.floor_with_sampling.or(w.noise_floor)) {
             w.resolved = Some(d > f);
+        }
+    }
+    // Valid windows whose δ one edge off its neighbours' line can make by itself (half of it
+    // or more): that edge's 2·f/K ([`DisplacedEdges`]).
+    displaced.close_block();
+    let Estimator::Edges(k) = cfg.encoder.estimator;
+    let k = f64::from(k.max(1));
+    for w in &mut report.windows {
+        // (A δ within its floor is said to be no measurement already.)
+        let Some(d) = w.delta.filter(|_| w.valid && w.resolved != Some(false)) else {
+            continue;
+        };
+        // Its first samples start K edges before its first.
+        let edges = f64::from(w.end_edge.wrapping_sub(w.start_edge).max(1));
+        let back = (w.end - w.start) * k / edges;
+        if let Some((at, f)) = displaced.standout(w.start - back, w.end) {
+            if 2.0 * f / k >= 0.5 * d {
+                w.displaced_edge = Some(DisplacedEdge {
+                    time: at,
+                    pitches: f,
+                });
+                let e = report.displaced_edges.get_or_insert(DisplacedWindows {
+                    windows: 0,
+                    first: at,
+                    largest: 0.0,
+                });
+                e.windows += 1;
+                e.largest = e.largest.max(f);
+            }
         }
     }
     report.channel_changes = channels
@@ -2664,6 +2842,7 @@ impl State {
             time_resolution: None,
             steady: m.map(|m| m.steady),
             resolved: None,
+            displaced_edge: None,
         });
     }
 }
@@ -2751,6 +2930,21 @@ pub fn text(r: &AnalyzeReport) -> String {
              longer than its setting (the example firmware's TIM2 filter, for 47 ns): here more \
              than {:.3e} s, and the edge it takes is then the ringing's last crossing",
             r.channel, g.edges, g.of, g.longest, g.longest
+        );
+    }
+    if let Some(e) = &r.displaced_edges {
+        let _ = writeln!(
+            s,
+            "WARNING: in {} valid window(s) one edge lies off the line of its neighbours by up \
+             to {:.1} % of a pitch (the first at {:.6} s), enough to make half the window's δ or \
+             more by itself (2·f/K with K-edge samples): their δ is that edge's, not the \
+             shaft's. A noise pulse that merges with a tooth moves its edge so (the core takes \
+             it, its intervals being within the accept band); so does one tooth's pitch error, \
+             every revolution (a per-tooth correction learns that). Marked \"δ from one edge\" \
+             below",
+            e.windows,
+            100.0 * e.largest,
+            e.first
         );
     }
     if let Some(g) = &r.ringing_other_polarity {
@@ -3090,7 +3284,7 @@ pub fn text(r: &AnalyzeReport) -> String {
             (Some(d), Some(m), Some(f)) => {
                 let _ = writeln!(
                     s,
-                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid{}",
+                    "  {:>12.6} {:>12.6} {:>5}  {:>10.6} {:>10.3} {:>10.2e}  valid{}{}",
                     w.start,
                     w.end,
                     w.revolutions,
@@ -3102,7 +3296,12 @@ pub fn text(r: &AnalyzeReport) -> String {
                         (false, false) => ", not steady",
                         (true, true) => ", δ within its floor: not resolved",
                         (false, true) => ", not steady, δ within its floor: not resolved",
-                    }
+                    },
+                    w.displaced_edge.map_or(String::new(), |e| format!(
+                        ", δ from one edge {:.1} % of a pitch off at {:.6} s",
+                        100.0 * e.pitches,
+                        e.time
+                    ))
                 );
             }
             _ => {
