@@ -211,117 +211,97 @@ fn drive_parts_of(
 /// What the core's speed samples do to the predicted δ: each sample is the angle of
 /// `encoder.estimator_edges` edges over their time, the mean speed over that angle, so a load
 /// cycle not much longer than the samples' span is averaged away (entirely when the span is a
-/// whole number of load cycles: 16-edge samples on a 16-line disc see no order-1 ripple).
+/// whole number of load cycles: 16-edge samples on a 16-line disc see no order-1 ripple); and
+/// the samples start only at the teeth, so a ripple with few teeth a cycle is read between its
+/// peaks, by how much depending on the load's phase against the teeth
+/// ([`crate::app::sampled`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampledDelta {
     /// Edges per speed sample (`encoder.estimator_edges`).
     pub edges: u16,
-    /// Shaft angle one sample spans, rad.
+    /// Shaft angle one sample spans, rad (on a pattern wheel, K mean pitches).
     pub span: f64,
-    /// δ of the predicted steady state through those samples.
-    pub delta: f64,
-    /// The most edges per sample that keep 99 % of the predicted δ (`None` when even one
-    /// edge does not).
+    /// The least δ of the predicted steady state the samples read, over the load's phase
+    /// against the teeth: what the δ alarm can count on.
+    pub least: f64,
+    /// The most they read over that phase.
+    pub most: f64,
+    /// What they read with the teeth where the scene has them (the simulator's wheel, its
+    /// tooth 0 at the load's φ = 0): what `run` measures.
+    pub at_scene_phase: f64,
+    /// The most edges per sample whose least keeps 99 % of the predicted δ (`None` when even
+    /// one edge does not).
     pub edges_for_99_percent: Option<u16>,
 }
 
-/// Largest grid [`delta_through_samples`] evaluates the steady state on.
-const MAX_SAMPLED_POINTS: usize = 1 << 22;
-
-/// δ of `model`'s steady state as speed samples spanning `span` radians show it: the mean
-/// speed over each span (the angle over the time `∫dφ/ω`), at every shaft angle of one period
-/// of the load, on a grid of at least 16 points per span and 512 per period. `None` without a
-/// steady state, for loads without a common period ([`drive_monitor::drive::Horizon::Unbounded`])
-/// or when the grid would exceed 4 M points.
-pub fn delta_through_samples(model: &DriveModel, span: f64) -> Option<f64> {
-    use drive_monitor::drive::Horizon;
-    model.predict().steady()?;
-    let period = match model.horizon() {
-        Horizon::Constant => return Some(0.0),
-        Horizon::ClosedForm => {
-            let order = model
-                .load()
-                .harmonics()
-                .iter()
-                .map(|h| h.order().abs())
-                .filter(|o| *o > 0.0)
-                .reduce(f64::min)?;
-            std::f64::consts::TAU / order
-        }
-        Horizon::Period { radians, .. }
-        | Horizon::Varying { radians, .. }
-        | Horizon::Shooting { radians, .. } => radians,
-        Horizon::Unbounded => return None,
-    };
-    if !(span > 0.0 && period > 0.0) {
-        return None;
+/// The edges the core samples on a scene's wheel: a uniform disc's lines, one in `prescaler`
+/// from line 0, or a pattern wheel's teeth.
+pub fn sample_wheel(
+    e: &crate::app::scene::EncoderSpec,
+    wheel: &crate::app::check::WheelDesc,
+) -> crate::app::sampled::SampleWheel {
+    use crate::app::scene::FramingSpec;
+    match wheel.framing {
+        FramingSpec::Index | FramingSpec::None => crate::app::sampled::SampleWheel::uniform(
+            u32::from(wheel.lines),
+            u32::from(e.prescaler),
+        ),
+        FramingSpec::MissingTooth | FramingSpec::Pattern => crate::app::sampled::SampleWheel {
+            positions: u32::from(wheel.lines),
+            teeth: wheel.teeth.iter().map(|&t| u32::from(t)).collect(),
+        },
     }
-    let per_span = ((512.0 * span / period).ceil() as usize).max(16);
-    let h = span / per_span as f64;
-    let steps = (period / h).ceil();
-    if !(steps.is_finite() && steps as usize + per_span <= MAX_SAMPLED_POINTS) {
-        return None;
-    }
-    let steps = steps as usize;
-    // Time per radian on the grid from −span to the period, and its running integral.
-    let mut time = Vec::with_capacity(steps + per_span + 1);
-    let curve = model.steady_curve();
-    let mut last = 1.0 / curve.steady_omega(-span)?;
-    time.push(0.0);
-    for j in 1..=steps + per_span {
-        let f = 1.0 / curve.steady_omega(-span + j as f64 * h)?;
-        time.push(time[j - 1] + 0.5 * h * (last + f));
-        last = f;
-    }
-    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for j in per_span..time.len() {
-        let w = span / (time[j] - time[j - per_span]);
-        lo = lo.min(w);
-        hi = hi.max(w);
-    }
-    Some(2.0 * (hi - lo) / (hi + lo))
 }
 
 /// [`SampledDelta`] of a scene's drive through its encoder's speed samples (`None` without a
-/// prediction, an `[encoder]`, or when [`delta_through_samples`] gives none).
+/// prediction, an `[encoder]`, or when [`crate::app::sampled::delta_through_samples`] gives
+/// none: a load without a common period, or one too long to tabulate).
 pub fn sampled_delta(
     scene: &Scene,
     file: &Path,
     model: &DriveModel,
 ) -> Result<Option<SampledDelta>, SceneError> {
+    use crate::app::sampled::{sampled_range, SteadyTime, SCAN_BUDGET};
     let Some(e) = &scene.encoder else {
         return Ok(None);
     };
     let Some(predicted) = model.predict().steady().map(|s| s.delta) else {
         return Ok(None);
     };
-    let wheel = crate::app::check::wheel(e, &scene.checker(file))?;
+    let desc = crate::app::check::wheel(e, &scene.checker(file))?;
+    let wheel = sample_wheel(e, &desc);
     // Edges per revolution the core sees: the wheel's teeth, one in `prescaler` captured.
-    let pitch = std::f64::consts::TAU * f64::from(e.prescaler) / wheel.teeth.len().max(1) as f64;
+    let pitch = std::f64::consts::TAU / wheel.teeth.len().max(1) as f64;
     let span = |k: u16| f64::from(k) * pitch;
-    let Some(delta) = delta_through_samples(model, span(e.estimator_edges)) else {
+    let Some(time) = SteadyTime::new(model) else {
+        return Ok(None);
+    };
+    let Some(range) = sampled_range(&time, &wheel, e.estimator_edges, SCAN_BUDGET) else {
         return Ok(None);
     };
     let keeps = |d: f64| d >= 0.99 * predicted;
-    let edges_for_99_percent = if keeps(delta) {
+    let edges_for_99_percent = if keeps(range.least) {
         Some(e.estimator_edges)
     } else {
-        (1..e.estimator_edges)
-            .rev()
-            .find(|&k| delta_through_samples(model, span(k)).is_some_and(keeps))
+        // A coarser scan of the offsets for each candidate: up to 31 of them.
+        (1..e.estimator_edges).rev().find(|&k| {
+            sampled_range(&time, &wheel, k, SCAN_BUDGET / 4).is_some_and(|r| keeps(r.least))
+        })
     };
     Ok(Some(SampledDelta {
         edges: e.estimator_edges,
         span: span(e.estimator_edges),
-        delta,
+        least: range.least,
+        most: range.most,
+        at_scene_phase: range.at_zero,
         edges_for_99_percent,
     }))
 }
 
-/// The line a report adds when the speed samples average away more than 1 % of the predicted
-/// δ (`None` otherwise).
+/// The line a report adds when the speed samples can read more than 1 % less than the
+/// predicted δ, at the least over the load's phase against the teeth (`None` otherwise).
 pub fn sampled_delta_warning(predicted: f64, s: &SampledDelta) -> Option<String> {
-    if s.delta >= 0.99 * predicted {
+    if s.least >= 0.99 * predicted {
         return None;
     }
     let advice = match s.edges_for_99_percent {
@@ -330,21 +310,50 @@ pub fn sampled_delta_warning(predicted: f64, s: &SampledDelta) -> Option<String>
             "even one edge per sample loses more than 1 % (a finer encoder would not)".to_string()
         }
     };
+    let shown = |d: f64| fmt_sampled(d, predicted);
+    let pct = |d: f64| 100.0 * (d / predicted - 1.0);
+    let read = if sampled_spread(predicted, s.least, s.most) {
+        format!(
+            "they show {} to {} ({:+.1} % to {:+.1} %), the least and most over the load's \
+             phase against the teeth ({} with the teeth where this scene has them), and the \
+             δ alarm can count only on the least",
+            shown(s.least),
+            shown(s.most),
+            pct(s.least),
+            pct(s.most),
+            shown(s.at_scene_phase)
+        )
+    } else {
+        format!(
+            "they show {} ({:+.1} %), and the δ alarm sees only that",
+            shown(s.least),
+            pct(s.least)
+        )
+    };
     Some(format!(
-        "WARNING: speed samples over encoder.estimator_edges = {} edges span {:.3} revolution and \
-         average the load ripple: of the predicted δ {} they can show {} ({:+.1} %), and the δ \
-         alarm sees only that; {advice}",
+        "WARNING: speed samples over encoder.estimator_edges = {} edges span {:.3} revolution, \
+         start only at the teeth and average the load ripple: of the predicted δ {} {read}; \
+         {advice}",
         s.edges,
         s.span / std::f64::consts::TAU,
         fmt_delta(predicted),
-        // Below this the samples' δ is the rounding of a ripple averaged away exactly.
-        if s.delta < 1e-9 * predicted {
-            "none".to_string()
-        } else {
-            fmt_delta(s.delta)
-        },
-        100.0 * (s.delta / predicted - 1.0)
     ))
+}
+
+/// A δ through the speed samples as text: "none" below 1e-9 of the `predicted` δ (the
+/// rounding of a ripple averaged away exactly), else [`fmt_delta`].
+pub fn fmt_sampled(d: f64, predicted: f64) -> String {
+    if d < 1e-9 * predicted {
+        "none".to_string()
+    } else {
+        fmt_delta(d)
+    }
+}
+
+/// Whether the least and most δ through the samples differ enough (0.1 % of the `predicted`
+/// δ) for a report to give both.
+pub fn sampled_spread(predicted: f64, least: f64, most: f64) -> bool {
+    most - least > 1e-3 * predicted
 }
 
 /// A δ as text: six decimals, or four significant digits below 0.001 (where six decimals
@@ -640,10 +649,19 @@ pub struct IrregularityOut {
     pub d_delta_d_inertia: Option<f64>,
     /// ∂δ/∂M_m, per N·m.
     pub d_delta_d_breakdown_torque: Option<f64>,
-    /// δ of the steady state as the core's speed samples (`encoder.estimator_edges` edges
-    /// each) can show it (absent without an `[encoder]`; [`sampled_delta`]).
+    /// The most δ of the steady state the core's speed samples (`encoder.estimator_edges`
+    /// edges each, starting at the teeth) can show, over the load's phase against the teeth
+    /// (absent without an `[encoder]`; [`sampled_delta`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_through_samples: Option<f64>,
+    /// The least δ those samples show over the load's phase against the teeth: what the δ
+    /// alarm can count on (the WARNING is judged on it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_through_samples_least: Option<f64>,
+    /// What those samples show with the teeth where the scene has them (the simulator's
+    /// wheel: tooth 0 at the load's φ = 0): what `run` measures.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_through_samples_at_scene_phase: Option<f64>,
     /// The report's warning when those samples lose more than 1 % of δ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sampling_warning: Option<String>,
@@ -1253,7 +1271,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             stall,
             working_branch_warning,
             generator_note,
-            delta_through_samples: sampled.map(|s| s.delta),
+            delta_through_samples: sampled.map(|s| s.most),
+            delta_through_samples_least: sampled.map(|s| s.least),
+            delta_through_samples_at_scene_phase: sampled.map(|s| s.at_scene_phase),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
             kloss_curve,

@@ -111,11 +111,36 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
         }
         match (r.delta_measured, r.delta_predicted) {
             (Some(m), Some(p)) => {
-                // The speed samples average away more than 1 % of the predicted δ: say what
-                // they can show (the prediction's WARNING says why).
-                let sampled = match r.delta_predicted_through_samples {
-                    Some(d) if d < 0.99 * p => {
-                        format!(" ({} through the core's speed samples)", fmt_delta(d))
+                // The speed samples can read more than 1 % less than the predicted δ: say what
+                // they show with this scene's teeth, which the measurement is compared with,
+                // and over the load's phase against the teeth (the prediction's WARNING says
+                // why).
+                let through = match (
+                    r.delta_predicted_through_samples,
+                    r.delta_predicted_through_samples_least,
+                    r.delta_predicted_through_samples_most,
+                ) {
+                    (Some(d), Some(lo), Some(hi)) if lo < 0.99 * p => Some((d, lo, hi)),
+                    _ => None,
+                };
+                let shown = |d: f64| predict::fmt_sampled(d, p);
+                let sampled = match through {
+                    Some((d, lo, hi)) if predict::sampled_spread(p, lo, hi) => {
+                        format!(
+                            " ({} through the core's speed samples with the teeth where this \
+                             scene has them, {} to {} over the load's phase against the teeth)",
+                            shown(d),
+                            shown(lo),
+                            shown(hi)
+                        )
+                    }
+                    Some((d, ..)) => format!(" ({} through the core's speed samples)", shown(d)),
+                    None => String::new(),
+                };
+                // Against what the samples show, where that is above the noise floor.
+                let against = match (through, r.noise_floor) {
+                    (Some((d, ..)), f) if d > f.unwrap_or(0.0) && d > 0.0 => {
+                        format!(" ({:+.2} % against the samples)", 100.0 * (m / d - 1.0))
                     }
                     _ => String::new(),
                 };
@@ -133,7 +158,7 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                         Some(f) if m <= f && p <= f => {
                             ": neither above the noise floor, not resolved".to_string()
                         }
-                        _ if p > 0.0 => format!(": {:+.2} %", 100.0 * (m / p - 1.0)),
+                        _ if p > 0.0 => format!(": {:+.2} %{against}", 100.0 * (m / p - 1.0)),
                         _ => String::new(),
                     },
                     floor(r.noise_floor)

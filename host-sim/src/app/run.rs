@@ -163,10 +163,18 @@ pub struct RunReport {
     pub delta_measured: Option<f64>,
     /// δ predicted by the drive model.
     pub delta_predicted: Option<f64>,
-    /// The predicted δ as the core's speed samples (`encoder.estimator_edges` edges each) can
-    /// show it ([`predict::sampled_delta`]): what the measurement is to be compared with.
+    /// The predicted δ as the core's speed samples (`encoder.estimator_edges` edges each,
+    /// starting at the teeth) show it with the teeth where the scene has them (the
+    /// simulator's wheel: tooth 0 at the load's φ = 0; [`predict::sampled_delta`]): what the
+    /// measurement is to be compared with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_predicted_through_samples: Option<f64>,
+    /// The least δ those samples show over the load's phase against the teeth.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_predicted_through_samples_least: Option<f64>,
+    /// The most δ those samples show over the load's phase against the teeth.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_predicted_through_samples_most: Option<f64>,
     /// Windows reported by the core.
     pub windows: u32,
     /// Of which invalid.
@@ -1655,8 +1663,10 @@ pub fn run_with(
         .filter(|_| predict::irregularity_not_predicted(scene).is_none())
     {
         report.delta_predicted = model.predict().steady().map(|s| s.delta);
-        report.delta_predicted_through_samples =
-            predict::sampled_delta(scene, file, model)?.map(|s| s.delta);
+        let sampled = predict::sampled_delta(scene, file, model)?;
+        report.delta_predicted_through_samples = sampled.map(|s| s.at_scene_phase);
+        report.delta_predicted_through_samples_least = sampled.map(|s| s.least);
+        report.delta_predicted_through_samples_most = sampled.map(|s| s.most);
     }
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
         Samples::All(v) => v,
