@@ -9,7 +9,8 @@
 //! sample rate). Then `$enddefinitions $end` and the changes: `#T` (the time in units, never
 //! decreasing), scalar changes `0ID`, `1ID`, `xID`, `zID` (x and z read as no data: no edge
 //! is taken across them), vector changes `bVALUE ID` (`b0`/`b1` on a 1-bit channel) and real
-//! ones `rVALUE ID` (skipped), the `$dumpvars`, `$dumpall`, `$dumpon`, `$dumpoff` blocks, any
+//! ones `rVALUE ID` and strings `sTEXT ID` (skipped; variables of type real, realtime,
+//! string or event are no channels whatever their size), the `$dumpvars`, `$dumpall`, `$dumpon`, `$dumpoff` blocks, any
 //! number of them on a line. A row is the levels once every change at a time is applied, at
 //! that time; a `#T` without changes (the end of a recording) is a row too. Times are read
 //! exactly in attoseconds and counted from the first time's whole seconds when they are
@@ -130,14 +131,20 @@ impl<R: BufRead> CaptureReader<R> {
                 "$var" => {
                     let text = self.vcd_section(&keyword)?;
                     let f: Vec<&str> = text.split_whitespace().collect();
-                    let [_kind, size, id, name, bits @ ..] = f.as_slice() else {
+                    let [kind, size, id, name, bits @ ..] = f.as_slice() else {
                         return Err(self.err_here(&format!(
                             "`$var {}`: expected `$var TYPE SIZE ID NAME $end`",
                             clip(&text)
                         )));
                     };
-                    if *size != "1" {
-                        // A vector (a bus) or a real, not a channel: its changes are skipped.
+                    // Reals, strings and events carry no level whatever size a writer gives
+                    // them (GTKWave's lxt2vcd declares a real `$var real 1`).
+                    let levelless = ["real", "realtime", "string", "event"]
+                        .iter()
+                        .any(|k| kind.eq_ignore_ascii_case(k));
+                    if *size != "1" || levelless {
+                        // A vector (a bus), a real, a string or an event, not a channel: its
+                        // changes are skipped.
                         self.vcd.vectors.insert((*id).to_string());
                         continue;
                     }
@@ -250,7 +257,7 @@ impl<R: BufRead> CaptureReader<R> {
                     }
                     self.vcd_change(&id, first)?;
                 }
-                'b' | 'B' | 'r' | 'R' => {
+                'b' | 'B' | 'r' | 'R' | 's' | 'S' => {
                     let Some(id) = self.vcd_token()? else {
                         return Err(self.err_here(&format!(
                             "`{}`: the file ends before the identifier of this change",
@@ -258,7 +265,7 @@ impl<R: BufRead> CaptureReader<R> {
                         )));
                     };
                     // On a channel a vector change is its one bit (the last, should a writer pad
-                    // it); a real on a channel is no level.
+                    // it); a real or a string (`sTEXT ID`) on a channel is no level.
                     let bit = match first {
                         'b' | 'B' => token.chars().last().filter(|_| token.len() > 1),
                         _ => None,
@@ -420,6 +427,26 @@ mod tests {
         }
         let r = open(text, None).unwrap();
         assert_eq!(r.channels(), ["a", "top.sub.a", "z [0]"]);
+    }
+
+    /// Reals, strings and events are no channels whatever size they are declared with (GTKWave's
+    /// lxt2vcd writes `$var real 1`): their changes, `rVALUE ID` and `sTEXT ID`, are skipped.
+    /// A real declared with size 1 had been read as a one-bit channel and its first change
+    /// refused as "not a one-bit value"; a string change as "not a value change".
+    #[test]
+    fn reals_strings_and_events_are_no_channels() {
+        use Level::{High, Low};
+        let text = "$timescale 1 ns $end\n$var wire 1 ! a $end\n$var real 1 \" volts $end\n\
+            $var string 1 # note $end\n$var event 1 $ tick $end\n$enddefinitions $end\n\
+            #0 0! r0.0 \" shello # 1$\n#5 1! r1.5e-3 \" sworld #\n#9 0!\n";
+        let rows = reader(text, None).unwrap();
+        let r = open(text, None).unwrap();
+        assert_eq!(r.channels(), ["a"]);
+        let levels: Vec<_> = rows.iter().map(|(t, l)| (*t, l.clone())).collect();
+        assert_eq!(
+            levels,
+            [(0.0, vec![Low]), (5e-9, vec![High]), (9e-9, vec![Low])]
+        );
     }
 
     /// Times read exactly: a large time in picoseconds (20 000 s into a recording) keeps its
