@@ -4692,3 +4692,48 @@ fn a_window_whose_delta_one_displaced_edge_makes_is_marked() {
         r.displaced_edges
     );
 }
+
+/// A direction channel that hardly changes (the index channel named by mistake, or B not
+/// connected): every edge of A came with no step forward of the quadrature count and was fed
+/// as reverse, and the only hint on a wheel said no gap recurs. A WARNING now names the
+/// channel and its changes against the captures; the real B gets none.
+#[test]
+fn a_direction_channel_that_does_not_change_is_named() {
+    use host_sim::app::analyze::Channel;
+    let rev = std::f64::consts::TAU;
+    let (text, _, _) = quadrature(50, 40.0, &[8.0 * rev]);
+    let run = |direction: &str| {
+        let cfg = configure(&AnalyzeOptions {
+            channel: Some(Channel::Name("A".into())),
+            direction_channel: Some(Channel::Name(direction.into())),
+            lines: Some(50),
+            ..AnalyzeOptions::default()
+        })
+        .unwrap();
+        let mut reader = text_reader(text.clone(), "q.csv", None).unwrap();
+        analyze(&mut reader, &cfg, &mut |_| {}).unwrap()
+    };
+    let wrong = run("Z");
+    let z = wrong
+        .channel_changes
+        .iter()
+        .find(|c| c.name == "Z")
+        .unwrap()
+        .changes;
+    assert!(z <= 18 && wrong.captured >= 390, "{z} {}", wrong.captured);
+    let said = host_sim::app::analyze::text(&wrong);
+    assert!(
+        said.contains(&format!(
+            "WARNING: the direction channel `Z` changed {z} time(s) over the {} captured edges \
+             of `A`",
+            wrong.captured
+        )),
+        "{said}"
+    );
+    let right = run("B");
+    assert!(right.valid_windows >= 6, "{}", right.valid_windows);
+    assert!(
+        !host_sim::app::analyze::text(&right).contains("WARNING: the direction channel"),
+        "{right:?}"
+    );
+}

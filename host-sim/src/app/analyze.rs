@@ -1163,6 +1163,14 @@ fn seen_gaps(g: &GapsSeen, guess: bool) -> String {
     )
 }
 
+/// The direction channel, when it changed less than once in four captured edges of the
+/// encoder channel (a quadrature B channel changes twice a pitch): its name and changes.
+fn quiet_direction(r: &AnalyzeReport) -> Option<(&str, u64)> {
+    let name = r.direction_channel.as_deref()?;
+    let changes = r.channel_changes.iter().find(|c| c.name == name)?.changes;
+    (r.captured >= 16 && changes.saturating_mul(4) < r.captured).then_some((name, changes))
+}
+
 /// Why the core did not sync on this capture, from the evidence in it (`runs`: the pattern's,
 /// see [`pattern_runs`]).
 fn sync_hint(
@@ -1310,6 +1318,17 @@ fn sync_hint(
                 intervals.longs,
                 swinging(p.teeth())
             )),
+            None if !short && !noisy && quiet_direction(r).is_some() => {
+                if let Some((name, changes)) = quiet_direction(r) {
+                    causes.push(format!(
+                        "no sync: the direction channel `{name}` changed {changes} time(s) over \
+                         the {} captured edges, so nearly every edge came with no step forward \
+                         of the quadrature count and was fed as reverse, which no gap can be \
+                         counted among (see the WARNING)",
+                        r.captured
+                    ));
+                }
+            }
             None if !short && !noisy => causes.push(format!(
                 "no sync: the configured {name} {expected}, but no gap recurs in the capture \
                  ({} interval(s) more than {LONG_RATIO} times their neighbours, at no regular \
@@ -2145,6 +2164,18 @@ pub fn analyze<R: BufRead>(
             changes,
         })
         .collect();
+    if let Some((name, changes)) = quiet_direction(&report) {
+        report.warnings.push(format!(
+            "WARNING: the direction channel `{name}` changed {changes} time(s) over the {} \
+             captured edges of `{}`, where a quadrature B channel changes twice a pitch: it is \
+             not this encoder's B, or not connected (or the shaft only rocked across one of \
+             A's line edges). Each edge of `{}` without a change of B is \
+             no step forward of the quadrature count, and two such are fed as reverse (a shaft \
+             at rest rocking across a line edge): leave --direction-channel out, or name the B \
+             channel",
+            report.captured, report.channel, report.channel
+        ));
+    }
     if cfg.framing_default {
         report.framing_note = Some(framing_note(&report, enc.config().wheel, ch, &among_read));
     }
