@@ -244,6 +244,19 @@ pub struct WindowOut {
     pub displaced_edge: Option<DisplacedEdge>,
 }
 
+/// How far the edges lie off the cubic through their neighbours ([`AnalyzeReport::edge_scatter`]):
+/// a sensor's or comparator's timing jitter, or the shaft's own speed changes from tooth to
+/// tooth, which the edges cannot tell apart.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct EdgeScatter {
+    /// The timing jitter that would give it, standard deviation in pitches.
+    pub pitches: f64,
+    /// About the most δ such jitter reads in a window of the capture's K-edge samples.
+    pub delta: f64,
+    /// The windows' median noise floor, for comparison.
+    pub floor: f64,
+}
+
 /// An edge off the line of its neighbours ([`WindowOut::displaced_edge`]).
 #[derive(Debug, Clone, Copy, Serialize, PartialEq)]
 pub struct DisplacedEdge {
@@ -574,6 +587,10 @@ pub struct AnalyzeReport {
     /// edges.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ringing_other_polarity: Option<Ringing>,
+    /// The edges' scatter about the cubic through their neighbours, where what it can read
+    /// as δ is more than twice the windows' median floor (the report notes it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_scatter: Option<EdgeScatter>,
     /// Valid windows whose δ one edge off the line of its neighbours makes by itself (half
     /// of it or more: [`WindowOut::displaced_edge`]); the report warns.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -838,6 +855,20 @@ impl DisplacedEdges {
                 .push((self.block_start, self.block_sum / self.block_n as f64));
         }
         (self.block_sum, self.block_n) = (0.0, 0);
+    }
+
+    /// The scatter of the edges about the cubic through their neighbours, as the standard
+    /// deviation of a timing jitter that would give it, in pitches: the median of the blocks'
+    /// mean displacements over 1.112 (white jitter σ leaves each edge off that cubic by a
+    /// normal error of σ·√(1 + 34/36), whose mean magnitude is 1.112·σ). `None` without a
+    /// block.
+    fn jitter(&self) -> Option<f64> {
+        let mut means: Vec<f64> = self.blocks.iter().map(|b| b.1).collect();
+        if means.is_empty() {
+            return None;
+        }
+        means.sort_by(f64::total_cmp);
+        Some(means[means.len() / 2] / ((1.0 + 34.0 / 36.0) * 2.0 / std::f64::consts::PI).sqrt())
     }
 
     /// The edge of `[start, end]` that lies farthest off its neighbours' line, with its
@@ -2132,6 +2163,34 @@ pub fn analyze<R: BufRead>(
     displaced.close_block();
     let Estimator::Edges(k) = cfg.encoder.estimator;
     let k = f64::from(k.max(1));
+    // What the edges' scatter about their neighbours' cubic can read as δ, where it is more
+    // than the floor: jitter σ (pitches) moves each K-edge sample by √2·σ/K, and the extremes
+    // of N samples lie about 2·√(2·ln N) of that apart.
+    let floors: Vec<f64> = report
+        .windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.floor_with_sampling.or(w.noise_floor))
+        .collect();
+    if let (Some(sigma), false) = (displaced.jitter(), floors.is_empty()) {
+        let n = report
+            .windows
+            .iter()
+            .filter(|w| w.valid)
+            .map(|w| f64::from(w.end_edge.wrapping_sub(w.start_edge)))
+            .fold(2.0f64, f64::max);
+        let delta = 2.0 * (2.0 * n.ln()).sqrt() * std::f64::consts::SQRT_2 * sigma / k;
+        let mut sorted = floors;
+        sorted.sort_by(f64::total_cmp);
+        let floor = sorted[sorted.len() / 2];
+        if delta > 2.0 * floor {
+            report.edge_scatter = Some(EdgeScatter {
+                pitches: sigma,
+                delta,
+                floor,
+            });
+        }
+    }
     for w in &mut report.windows {
         // (A δ within its floor is said to be no measurement already.)
         let Some(d) = w.delta.filter(|_| w.valid && w.resolved != Some(false)) else {
@@ -3126,6 +3185,18 @@ pub fn text(r: &AnalyzeReport) -> String {
          include them (the core's per-tooth learner, learn::ToothLearner, measures and removes \
          them)"
     );
+    if let Some(e) = &r.edge_scatter {
+        let _ = writeln!(
+            s,
+            "NOTE: the edges scatter about the cubic through their neighbours as a timing \
+             jitter of {:.2e} pitch (standard deviation) would: a sensor's or comparator's \
+             jitter, or the shaft's own speed changing from tooth to tooth, which the edges \
+             cannot tell apart. Jitter that size reads as δ up to about {:.2e} in a window, \
+             beyond the floor ({:.2e}, the timer's and the sampling's resolution only): a δ \
+             within it of the truth may be jitter",
+            e.pitches, e.delta, e.floor
+        );
+    }
     let _ = writeln!(
         s,
         "edges: {} fed, {} accepted as teeth{}; revolutions counted in sync: {}",
