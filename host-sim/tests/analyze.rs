@@ -968,6 +968,28 @@ fn each_parser_names_the_bad_line() {
     );
     let e = reader_error("hello,world\n1,2\n");
     assert!(e.starts_with("cap.csv:1:") && e.contains("--format"), "{e}");
+    // A European locale's exports: `;` between fields, decimal commas (they had been called
+    // "not a time in seconds", or "found 2 fields: a file of edge times has one column").
+    for (text, line, want) in [
+        ("Time [s];Channel 0\n0;0\n0,0001;1\n", 1, "separated by `;`"),
+        ("time_s;level\n0,0001;1\n", 1, "separated by `;`"),
+        (
+            "0,000100000\n0,001147198\n",
+            1,
+            "`0,000100000` has a decimal comma",
+        ),
+        (
+            "time_s\n0,000100000\n0,001147198\n",
+            2,
+            "`0,000100000` has a decimal comma",
+        ),
+    ] {
+        let e = reader_error(text);
+        assert!(
+            e.starts_with(&format!("cap.csv:{line}:")) && e.contains(want) && e.contains("decimal"),
+            "{e}"
+        );
+    }
     let long = format!("time_s,level\n0,{}\n", "0".repeat(5000));
     let e = reader_error(&long);
     assert!(

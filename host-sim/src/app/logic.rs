@@ -556,6 +556,26 @@ impl<R: BufRead> CaptureReader<R> {
             }
         };
         let head = first.split(',').next().unwrap_or("").trim();
+        // A European locale's export: `;` between the fields, a decimal comma in the numbers
+        // (`Time [s];Channel 0`, `0,000100000;1`), or a headerless column of such times
+        // (`0,001147198`): said, not read as something else.
+        let semicolons = first.contains(';') && !first.contains(',');
+        if semicolons && !first.trim_start().starts_with([';', '$']) {
+            return Err(r.err_here(&format!(
+                "the header `{}` is separated by `;`, as exports in a locale with a decimal \
+                 comma are: analyze reads comma-separated files with decimal points; export \
+                 with the locale (or the software's number format) set to decimal points",
+                clip(&first)
+            )));
+        }
+        if decimal_comma(&first) {
+            return Err(r.err_here(&format!(
+                "`{}` has a decimal comma: analyze reads times with decimal points (a file of \
+                 edge times has one column); export with the locale (or the software's number \
+                 format) set to decimal points",
+                clip(first.trim())
+            )));
+        }
         // Logic 1.x (and Kingst's software) export tab-separated on request: said, not read as
         // one column.
         let tabbed = first.contains('\t') && !first.contains(',');
@@ -1119,6 +1139,13 @@ impl<R: BufRead> CaptureReader<R> {
     /// reads high: every row is an edge).
     fn times_row(&mut self, line: &str) -> Result<Option<(f64, &[Level])>, CaptureError> {
         let f = line.trim();
+        if decimal_comma(f) {
+            return Err(self.err_here(&format!(
+                "`{}` has a decimal comma: analyze reads times with decimal points; export with \
+                 the locale (or the software's number format) set to decimal points",
+                clip(f)
+            )));
+        }
         if f.contains(',') {
             return Err(self.err_here(&format!(
                 "expected one field (an edge time in seconds), found {}: a file of edge times \
@@ -1234,6 +1261,19 @@ impl<R: BufRead> CaptureReader<R> {
         // resolution.
         atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64
     }
+}
+
+/// Whether `line` is one number written with a decimal comma (`0,001147198`, `-1,5`): digits,
+/// one comma, digits, nothing else.
+fn decimal_comma(line: &str) -> bool {
+    let t = line.trim().trim_start_matches(['+', '-']);
+    let Some((whole, frac)) = t.split_once(',') else {
+        return false;
+    };
+    !whole.is_empty()
+        && !frac.is_empty()
+        && whole.bytes().all(|b| b.is_ascii_digit())
+        && frac.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// At most 40 characters of `s`, for error messages.
