@@ -4816,3 +4816,25 @@ fn edge_jitter_is_estimated_and_noted() {
     assert!(host_sim::app::analyze::text(&r).contains("NOTE: the edges scatter"));
     assert_eq!(analyzed(&times(0.0)).edge_scatter, None);
 }
+
+/// The core counts the teeth an interval lost by how many of the last interval it took fit
+/// in it: after ringing edges taken as teeth it counted 78 400 missing edges among 5 762
+/// captures, printed as a fact about the wheel. More missing edges than captures are now said
+/// to be the core's judgement; a count within the captures is printed as it was.
+#[test]
+fn more_missing_edges_than_captures_are_said_to_be_a_judgement() {
+    let said = |missing: u32, captured: u64| {
+        host_sim::app::analyze::text(&AnalyzeReport {
+            missing,
+            captured,
+            ..AnalyzeReport::default()
+        })
+    };
+    let many = said(78_400, 5_762);
+    assert!(
+        many.contains("78400 missing edges")
+            && many.contains("(more missing edges than the 5762 captured: the core counts"),
+        "{many}"
+    );
+    assert!(!said(12, 5_762).contains("more missing edges than"));
+}

@@ -3251,6 +3251,18 @@ pub fn text(r: &AnalyzeReport) -> String {
         "faults: {} glitches, {} missing edges, {} extra edges, {} missing frames, {} reversals, {} timeouts, {} unexplained edges",
         r.glitches, r.missing, r.extra, r.missing_frames, r.reversals, r.timeouts, r.unexplained
     );
+    if u64::from(r.missing) > r.captured {
+        // The core counts the teeth an interval lost as the interval over the last it took:
+        // after an edge just after another taken as a tooth (ringing), dozens each.
+        let _ = writeln!(
+            s,
+            "  (more missing edges than the {} captured: the core counts the teeth lost in an \
+             interval as how many of the last interval it took fit in it, and after a very short \
+             one, as of an edge just after another, that is many; a count of the core's \
+             judgement, not of the wheel's teeth)",
+            r.captured
+        );
+    }
     match r.sync_acquired {
         Some(t) => {
             let _ = writeln!(
