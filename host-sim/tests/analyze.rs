@@ -4759,6 +4759,15 @@ fn times_held_as_floats_are_resolved_to_the_float_grid() {
         said.contains("lies on a 2^-22 s grid") && said.contains("64-bit float"),
         "{said}"
     );
+    // Printed in full (shortest round trip, Python's `repr`): seven decimals, on 100 ns, which
+    // is no sample period.
+    let repr = csv_of(header, None, &exact, ",", |t| {
+        format!("{:?}", 1_764_306_000.0 + t)
+    });
+    let report = analyze_text(repr, "repr.csv", 360, 1);
+    let f = report.float_grid.expect("a float grid");
+    assert_eq!((f.exponent, report.time_grid), (22, None), "{f:?}");
+    none_resolved(&report, "f64 Unix times in full");
     let f32_at5 = csv_of(header, None, &exact, ",", |t| {
         format!("{:.9}", (5.0 + t) as f32)
     });

@@ -1909,6 +1909,13 @@ pub fn analyze<R: BufRead>(
             _ => report.time_grid = whole,
         }
     }
+    // A grid of the sampling finer than the floats' is the digits' own (Unix times in an f64
+    // printed to seven decimals lie on 100 ns, and on 2^-22 s to their rounding): no sample
+    // period.
+    let float_step = float_grid.step().map(|(e, _, _)| 2f64.powi(-e));
+    if report.time_grid.zip(float_step).is_some_and(|(g, f)| g < f) {
+        (report.time_grid, report.grid_of_rate) = (None, None);
+    }
     report.float_grid = float_grid
         .step()
         .map(|(e, at, written)| FloatSpacing::of(e, at, written, report.time_origin));

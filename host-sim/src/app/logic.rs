@@ -1022,14 +1022,22 @@ impl<R: BufRead> CaptureReader<R> {
                     .position(|u| u.1 == unit_rate)
                     .unwrap_or(0);
                 let from = at.checked_sub(1).map_or(0, |k| SIGROK_UNITS[k].1);
+                let source = self
+                    .rate_source
+                    .clone()
+                    .unwrap_or_else(|| "the file".into());
+                let fix = if source.starts_with("--sample-rate") {
+                    "give --sample-rate the capture's rate"
+                } else {
+                    "correct the comment, or delete it and give --sample-rate the capture's rate"
+                };
                 return Err(self.err_here(&format!(
-                    "the time column is in `{column}`, which libsigrok writes for a sample rate \
-                     over {} up to {}, but {} states {} (for which it writes `{label}`): the \
-                     rate or the column is wrong, and every time and speed would be off by \
-                     their ratio; correct the rate (a comment removed, give --sample-rate)",
+                    "the time column is in `{column}`, which libsigrok writes at a sample rate \
+                     over {} up to {}, but {source} states {}, at which it writes `{label}`: \
+                     one of them is wrong, and read at that rate every time and speed would be \
+                     off by their ratio; {fix}",
                     sigrok_rate_string(from),
                     sigrok_rate_string(unit_rate),
-                    self.rate_source.as_deref().unwrap_or("the file"),
                     sigrok_rate_string(rate.round() as u64),
                 )));
             }
