@@ -1617,7 +1617,9 @@ pub fn analyze<R: BufRead>(
                 .any(|(a, b)| a != b && *a != Level::Unknown && *b != Level::Unknown);
         if transition {
             grid.row(t);
-            rate_grid.row(t, precision);
+            if period.is_none() {
+                rate_grid.row(t, precision);
+            }
             float_grid.row(t, precision);
         }
         // (Every row to the resolution of the blocks: a row off the grid only makes a block's
@@ -2343,6 +2345,9 @@ impl RateGrid {
             return;
         };
         let d = t - t0;
+        if self.dead.iter().all(|&d| d) {
+            return;
+        }
         let tol = written_tolerance(t, precision) + written_tolerance(t0, p0);
         for (i, rate) in ODD_RATES.iter().enumerate() {
             if self.dead[i] {
@@ -2357,7 +2362,9 @@ impl RateGrid {
             if 4.0 * tol <= period {
                 self.telling[i] += 1;
             }
-            self.multiple[i] = gcd(self.multiple[i], k as u64);
+            if self.multiple[i] != 1 {
+                self.multiple[i] = gcd(self.multiple[i], k as u64);
+            }
         }
     }
 
@@ -2440,10 +2447,17 @@ const FLOAT_EXPONENTS: usize = 64;
 /// is written to, and how many of them tell each grid (written to a quarter of its step or
 /// finer). Times counted from whole seconds lie on such a grid of 1 s or finer as the
 /// absolute times do.
+///
+/// A time within `tol` of a point of 2^-e s lies within `2·tol` of one of 2^-(e+1) s, which is
+/// the same tolerance on that grid: the grids a time lies on are every one from some exponent
+/// on, and those every time lies on are every one from the largest such exponent (`from`). So
+/// each row is tested at `from` alone (and `from` moved on while it fails), and a row tells
+/// every grid up to its own exponent ([`Self::telling`] counts rows by it).
 #[derive(Default)]
 struct FloatGrid {
-    /// Bit `e`: every time so far lies on 2^-e s.
-    dead: u64,
+    /// The coarsest grid every time so far lies on: 2^-`from` s (`FLOAT_EXPONENTS`: none).
+    from: usize,
+    /// Rows by the finest grid they tell (its exponent).
     telling: Vec<u64>,
     first: Option<f64>,
     /// The coarsest precision of the times.
@@ -2458,26 +2472,35 @@ impl FloatGrid {
         self.first.get_or_insert(t);
         self.coarsest = self.coarsest.max(precision);
         let tol = written_tolerance(t, precision);
-        for e in 0..FLOAT_EXPONENTS {
-            if self.dead >> e & 1 == 1 {
-                continue;
-            }
-            let scale = 2f64.powi(e as i32);
+        while self.from < FLOAT_EXPONENTS {
+            let scale = f64::from_bits((1023 + self.from as u64) << 52);
             let x = t * scale;
-            if (x - x.round()).abs() > tol * scale {
-                self.dead |= 1 << e;
-            } else if 4.0 * tol * scale <= 1.0 {
-                self.telling[e] += 1;
+            if (x - x.round()).abs() <= tol * scale {
+                break;
             }
+            self.from += 1;
+        }
+        // The finest grid 2^-e s with 4·tol·2^e ≤ 1: tol = m·2^q (1 ≤ m < 2) tells down to
+        // e = −q − 2, one less when m > 1 (a normal tol; a subnormal one tells every grid).
+        let bits = tol.to_bits();
+        let q = ((bits >> 52) & 0x7ff) as i64 - 1023;
+        let finest = if tol > 0.0 && q > -1023 {
+            -q - 2 - i64::from(bits & ((1 << 52) - 1) != 0)
+        } else {
+            (FLOAT_EXPONENTS - 1) as i64
+        };
+        if let Ok(e) = usize::try_from(finest) {
+            self.telling[e.min(FLOAT_EXPONENTS - 1)] += 1;
         }
     }
 
-    /// The coarsest grid alive that [`GRID_ROWS`] transitions or more tell: its exponent, and
-    /// the first transition's time, and the coarsest precision the times are written to.
+    /// The coarsest grid every time lies on that [`GRID_ROWS`] transitions or more tell: its
+    /// exponent, the first transition's time, and the coarsest precision the times are
+    /// written to.
     fn step(&self) -> Option<(i32, f64, f64)> {
-        let e = (0..self.telling.len())
-            .find(|&e| self.dead >> e & 1 == 0 && self.telling[e] >= GRID_ROWS)?;
-        Some((e as i32, self.first?, self.coarsest))
+        let from = self.from;
+        let told: u64 = self.telling.get(from..)?.iter().sum();
+        (told >= GRID_ROWS).then_some((from as i32, self.first?, self.coarsest))
     }
 }
 

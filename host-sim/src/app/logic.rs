@@ -475,7 +475,16 @@ fn decimal_precision(text: &str) -> f64 {
         None => (text, 0),
     };
     let decimals = number.split_once('.').map_or(0, |(_, f)| f.len());
-    10f64.powi(exponent.saturating_sub(i32::try_from(decimals).unwrap_or(i32::MAX)))
+    let power = exponent.saturating_sub(i32::try_from(decimals).unwrap_or(i32::MAX));
+    // The nearest f64 to each power of ten written out (`powi` may miss it by a unit).
+    const TENS: [f64; 19] = [
+        1.0, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
+        1e-14, 1e-15, 1e-16, 1e-17, 1e-18,
+    ];
+    match usize::try_from(-i64::from(power)) {
+        Ok(k) if k < TENS.len() => TENS[k],
+        _ => 10f64.powi(power),
+    }
 }
 
 impl CaptureReader<std::io::BufReader<std::fs::File>> {
