@@ -1971,7 +1971,7 @@ fn the_time_grid_of_a_capture_without_a_rate_widens_the_floor() {
     assert_eq!(beyond_timer, valid.len());
     let said = host_sim::app::analyze::text(&report);
     assert!(
-        said.contains("every time lies on a 5.000e-6 s grid"),
+        said.contains("every transition's time lies on a 5.000e-6 s grid"),
         "{said}"
     );
     // Times not on a common grid of 2 ns or more (full precision) give none.
@@ -2034,8 +2034,8 @@ fn a_grid_of_a_rate_whose_period_is_not_whole_nanoseconds_is_found() {
     let said = host_sim::app::analyze::text(&report);
     assert!(
         said.contains(
-            "every time lies on a 8.333e-8 s grid, to the nanosecond its times are written to \
-             (a 12000000 Hz analyser's)"
+            "every transition's time lies on a 8.333e-8 s grid, to the nanosecond its times \
+             are written to (a 12000000 Hz analyser's)"
         ),
         "{said}"
     );
@@ -4837,4 +4837,318 @@ fn more_missing_edges_than_captures_are_said_to_be_a_judgement() {
         "{many}"
     );
     assert!(!said(12, 5_762).contains("more missing edges than"));
+}
+
+/// The rising edges of a `lines`-line disc turning at a constant `omega` rad/s from `start` to
+/// `stop` s, drawn from the angle (the true δ of every window is 0).
+fn steady_disc(lines: u32, omega: f64, start: f64, stop: f64) -> Vec<f64> {
+    let pitch = std::f64::consts::TAU / f64::from(lines) / omega;
+    (0..)
+        .map(|k: u32| start + f64::from(k) * pitch)
+        .take_while(|&t| t < stop)
+        .collect()
+}
+
+/// The transitions of a capture sampled at `rate` Hz on the grid `origin + j/rate` (each
+/// edge at the first sample at or after it) of a disc rising at `rising` and falling halfway
+/// to the next rise: (time, level).
+fn on_grid(rising: &[f64], rate: f64, origin: f64) -> Vec<(f64, u8)> {
+    let at = |t: f64| origin + ((t - origin) * rate).ceil() / rate;
+    let mut rows = Vec::new();
+    for (i, &t) in rising.iter().enumerate() {
+        let next = rising.get(i + 1).copied().unwrap_or(t + 1e-3);
+        rows.push((at(t), 1));
+        rows.push((at(0.5 * (t + next)), 0));
+    }
+    rows
+}
+
+/// A one-channel CSV (`header`, then `first` and `rows`) with each time as `time` writes it.
+fn csv_of(
+    header: &str,
+    first: Option<f64>,
+    rows: &[(f64, u8)],
+    sep: &str,
+    time: impl Fn(f64) -> String,
+) -> String {
+    let mut s = format!("{header}\n");
+    for (t, v) in first.map(|t| (t, 0)).iter().chain(rows) {
+        s.push_str(&format!("{}{sep}{v}\n", time(*t)));
+    }
+    s
+}
+
+/// Analyzes `text` (read as the file `name`) with a `lines`-line disc, an 84 MHz timer and
+/// `k` edges a speed sample.
+fn analyze_text(text: String, name: &str, lines: u16, k: u16) -> AnalyzeReport {
+    let cfg = configure(&AnalyzeOptions {
+        lines: Some(lines),
+        timer_hz: Some(84e6),
+        estimator_edges: Some(k),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut reader = text_reader(text, name, None).unwrap();
+    analyze(&mut reader, &cfg, &mut |_| {}).unwrap()
+}
+
+/// The windows of a steady shaft: at least 3 valid, and the δ of each (the times' quantization
+/// alone) within the floor given, not resolved.
+fn none_resolved(report: &AnalyzeReport, what: &str) {
+    let valid: Vec<_> = report.windows.iter().filter(|w| w.valid).collect();
+    assert!(valid.len() >= 3, "{what}: {} valid windows", valid.len());
+    for w in valid {
+        assert_eq!(
+            w.resolved,
+            Some(false),
+            "{what}: window at {} s, δ {:?} (truth 0), floor {:?}, grid {:?}",
+            w.start,
+            w.delta,
+            w.floor_with_sampling.or(w.noise_floor),
+            report.time_grid
+        );
+    }
+}
+
+fn grid_is(report: &AnalyzeReport, period: f64, what: &str) {
+    assert!(
+        report
+            .time_grid
+            .is_some_and(|g| (g / period - 1.0).abs() < 1e-9),
+        "{what}: grid {:?}, truth {period:e}",
+        report.time_grid
+    );
+}
+
+/// A row that carries no transition need lie on no sample grid: a Saleae export's first row
+/// (the initial level, at 0 s, the transitions at 0.1234567 s + k·0.5 µs), a last row at the
+/// end of the recording off the grid, a value change dump's `#0` dump, a Saleae binary
+/// export's begin time. The grid is the transitions' (2 MS/s), and a steady shaft's δ (the
+/// sampling's) is within the floor; one such row had made the grid 100 ns, the floor 4.6
+/// times too small, and δ 0.0086 of a constant shaft read as resolved.
+#[test]
+fn a_row_without_a_transition_does_not_set_the_grid() {
+    let rising = steady_disc(360, 300.0, 0.13, 0.25);
+    let nine = |t: f64| format!("{t:.9}");
+    let header = "Time [s],Channel 0";
+    let offset = on_grid(&rising, 2e6, 0.1234567);
+    let first_off = csv_of(header, Some(0.0), &offset, ",", nine);
+    let report = analyze_text(first_off.clone(), "first.csv", 360, 1);
+    grid_is(&report, 5e-7, "first row at 0 s");
+    none_resolved(&report, "first row at 0 s");
+    let text = host_sim::app::analyze::text(&report);
+    assert!(
+        text.contains("every transition's time lies on a 5.000e-7 s grid"),
+        "{text}"
+    );
+    // Transitions on the grid from 0, a last row 12.3 µs after the last transition.
+    let from0 = on_grid(&rising, 2e6, 0.0);
+    let mut last_off = csv_of(header, Some(0.0), &from0, ",", nine);
+    let end = from0.last().unwrap().0 + 12.3e-6;
+    last_off.push_str(&format!("{end:.9},0\n"));
+    let report = analyze_text(last_off, "last.csv", 360, 1);
+    grid_is(&report, 5e-7, "last row off the grid");
+    none_resolved(&report, "last row off the grid");
+    // A value change dump in nanoseconds: `#0` with the initial level, then the transitions.
+    let mut vcd = String::from(
+        "$timescale 1 ns $end\n$scope module top $end\n$var wire 1 ! ch0 $end\n$upscope $end\n\
+         $enddefinitions $end\n#0\n$dumpvars\n0!\n$end\n",
+    );
+    for (t, v) in &offset {
+        vcd.push_str(&format!("#{}\n{v}!\n", (t * 1e9).round() as u64));
+    }
+    let report = analyze_text(vcd, "dump.vcd", 360, 1);
+    grid_is(&report, 5e-7, "value change dump");
+    none_resolved(&report, "value change dump");
+    // Saleae's binary export, begin time 0 s.
+    let (_scratch, dir) = tmp("bin");
+    saleae_binary(&first_off, &dir, 0, 0.0, None);
+    let (report, _) = run_analyze(
+        &dir.join("digital_0.bin"),
+        AnalyzeOptions {
+            lines: Some(360),
+            timer_hz: Some(84e6),
+            ..AnalyzeOptions::default()
+        },
+    );
+    grid_is(&report, 5e-7, "binary export");
+    none_resolved(&report, "binary export");
+}
+
+/// Rates whose period is not whole nanoseconds are found at whatever precision the times are
+/// written to: Saleae Logic 1.x's fifteen decimals (`Time[s], Channel 0`), a value change
+/// dump in picoseconds, a Saleae binary export's doubles. Each grid is the rate's period, and
+/// a steady shaft's δ is within the floor (at 24 MS/s it read 2.5 times the timer's floor,
+/// resolved, with no grid found).
+#[test]
+fn a_grid_of_a_rate_not_whole_nanoseconds_is_found_at_any_precision() {
+    let rising = steady_disc(1024, 300.0, 0.0012, 0.2);
+    for rate in [24e6, 12e6, 3e6] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time[s], Channel 0", Some(0.0), &rows, ", ", |t| {
+            format!("{t:.15}")
+        });
+        let report = analyze_text(text.clone(), "logic1.csv", 1024, 16);
+        let what = format!("{rate} Hz at fifteen decimals");
+        grid_is(&report, 1.0 / rate, &what);
+        none_resolved(&report, &what);
+        if rate == 24e6 {
+            let mut vcd = String::from(
+                "$timescale 1 ps $end\n$var wire 1 ! ch0 $end\n$enddefinitions $end\n#0\n0!\n",
+            );
+            for (t, v) in &rows {
+                vcd.push_str(&format!("#{}\n{v}!\n", (t * 1e12).round() as u64));
+            }
+            let report = analyze_text(vcd, "dump.vcd", 1024, 16);
+            grid_is(&report, 1.0 / rate, "24 MHz in picoseconds");
+            none_resolved(&report, "24 MHz in picoseconds");
+            let csv = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", |t| {
+                format!("{t:e}")
+            });
+            let (_scratch, dir) = tmp("bin");
+            saleae_binary(&csv, &dir, 0, 0.0, None);
+            let (report, _) = run_analyze(
+                &dir.join("digital_0.bin"),
+                AnalyzeOptions {
+                    lines: Some(1024),
+                    timer_hz: Some(84e6),
+                    estimator_edges: Some(16),
+                    ..AnalyzeOptions::default()
+                },
+            );
+            grid_is(&report, 1.0 / rate, "24 MHz in doubles");
+            none_resolved(&report, "24 MHz in doubles");
+        }
+    }
+    // Times at 1 GS/s written to fifteen decimals lie on no such grid, nor do exact times.
+    let exact: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 1e-6, 0)])
+        .collect();
+    let text = csv_of("Time[s], Channel 0", Some(0.0), &exact, ", ", |t| {
+        format!("{t:.15}")
+    });
+    let report = analyze_text(text, "exact.csv", 1024, 16);
+    assert_eq!(
+        (report.time_grid, report.float_grid.is_some()),
+        (None, false)
+    );
+}
+
+/// A rate that is a sub-multiple of one whose period is not whole nanoseconds (750 kHz, 3 MHz
+/// over 4; 2.4 MHz, 12 MHz over 5; 1.5 MHz) lies on that rate's grid too, every so many
+/// points: the grid found is the longest step every transition lies on, the true period (it
+/// had been the listed rate's, the floor a quarter of the sampling's and a steady shaft's δ
+/// resolved).
+#[test]
+fn a_sub_multiple_of_a_listed_rate_gets_its_own_period() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    for rate in [750e3, 2.4e6, 1.5e6] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", |t| {
+            format!("{t:.9}")
+        });
+        let report = analyze_text(text, "sub.csv", 360, 1);
+        let what = format!("{rate} Hz");
+        grid_is(&report, 1.0 / rate, &what);
+        none_resolved(&report, &what);
+    }
+    let rows = on_grid(&rising, 750e3, 0.0);
+    let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", |t| {
+        format!("{t:.9}")
+    });
+    let said = host_sim::app::analyze::text(&analyze_text(text, "sub.csv", 360, 1));
+    assert!(
+        said.contains("4 periods of a 3000000 Hz analyser's"),
+        "{said}"
+    );
+}
+
+/// Times held as floats before they were written lie on the float's power-of-two grid: Unix
+/// times in an f64 printed to nine decimals, 2^-22 s (0.24 µs) apart near 1.76e9 s, or an
+/// f32's at 5 s, 2^-21 s. That grid is their resolution (a steady shaft's δ 0.0043 had read
+/// 10 times the timer's floor, resolved). The same instants written exactly lie on none.
+#[test]
+fn times_held_as_floats_are_resolved_to_the_float_grid() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    let exact: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 1e-5, 0)])
+        .collect();
+    let header = "Time [s],Channel 0";
+    let f64_epoch = csv_of(header, None, &exact, ",", |t| {
+        format!("{:.9}", 1_764_306_000.0 + t)
+    });
+    let report = analyze_text(f64_epoch, "epoch.csv", 360, 1);
+    let f = report.float_grid.expect("a float grid");
+    assert_eq!((f.exponent, f.float), (22, Some("f64")), "{f:?}");
+    assert_eq!(report.time_grid, None);
+    none_resolved(&report, "f64 Unix times");
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("lies on a 2^-22 s grid") && said.contains("64-bit float"),
+        "{said}"
+    );
+    // Printed in full (shortest round trip, Python's `repr`): seven decimals, on 100 ns, which
+    // is no sample period.
+    let repr = csv_of(header, None, &exact, ",", |t| {
+        format!("{:?}", 1_764_306_000.0 + t)
+    });
+    let report = analyze_text(repr, "repr.csv", 360, 1);
+    let f = report.float_grid.expect("a float grid");
+    assert_eq!((f.exponent, report.time_grid), (22, None), "{f:?}");
+    none_resolved(&report, "f64 Unix times in full");
+    let f32_at5 = csv_of(header, None, &exact, ",", |t| {
+        format!("{:.9}", (5.0 + t) as f32)
+    });
+    let report = analyze_text(f32_at5, "f32.csv", 360, 1);
+    let f = report.float_grid.expect("a float grid");
+    assert_eq!((f.exponent, f.float), (21, Some("f32")), "{f:?}");
+    none_resolved(&report, "f32 times at 5 s");
+    // The same instants as exact decimals, at the Unix time and from 0: no grid of any kind.
+    for (name, text) in [
+        (
+            "exact epoch",
+            csv_of(header, None, &exact, ",", |t| {
+                format!("1764306000.{:09}", (t * 1e9).round() as u64)
+            }),
+        ),
+        (
+            "exact",
+            csv_of(header, None, &exact, ",", |t| format!("{t:.9}")),
+        ),
+    ] {
+        let report = analyze_text(text, name, 360, 1);
+        assert!(
+            report.time_grid.is_none() && report.float_grid.is_none(),
+            "{name}: {:?} {:?}",
+            report.time_grid,
+            report.float_grid
+        );
+    }
+}
+
+/// libsigrok writes the time column in the unit its sample rate calls for: a `; Samplerate:
+/// 10 MHz` over whole microseconds (a 1 MHz capture's) contradicts itself, and read at the rate
+/// every speed was 10 times off. Refused, naming both; so is --sample-rate against the column.
+#[test]
+fn a_sigrok_rate_against_its_time_column_is_refused() {
+    let rows = "microseconds,logic\n1,0\n1001,1\n1574,0\n";
+    let commented = format!("; CSV generated by libsigrok 0.5.2\n; Samplerate: 10 MHz\n{rows}");
+    let e = sigrok_times(&commented, None).unwrap_err();
+    assert!(
+        e.contains("`microseconds`")
+            && e.contains("Samplerate: 10 MHz")
+            && e.contains("nanoseconds"),
+        "{e}"
+    );
+    let e = sigrok_times(rows, Some(10e6)).unwrap_err();
+    assert!(
+        e.contains("`microseconds`") && e.contains("--sample-rate"),
+        "{e}"
+    );
+    assert_eq!(
+        sigrok_times(rows, Some(1e6)).unwrap(),
+        vec![0.0, 1000e-6, 1573e-6]
+    );
 }

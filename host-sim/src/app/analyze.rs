@@ -548,6 +548,15 @@ pub struct AnalyzeReport {
     /// less finely, and an f64 resolves times far from their origin only so far (see
     /// [`WindowOut::time_resolution`]).
     pub coarser_times: Option<(f64, f64)>,
+    /// When `time_grid` is a whole multiple of the period of one of [`ODD_RATES`] (a period
+    /// not whole nanoseconds), found to the precision the times are written to.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid_of_rate: Option<RateGridFound>,
+    /// When every transition's time, as written, lies on a power-of-two grid of seconds
+    /// coarser than the precision it is written to: the times were held as floats (an f64
+    /// near a Unix time resolves 2^-22 s), and the floor includes that grid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub float_grid: Option<FloatSpacing>,
     /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
     pub warnings: Vec<String>,
     /// Rows read.
@@ -1757,7 +1766,8 @@ pub fn analyze<R: BufRead>(
     let mut among_read = vec![Spacing::default(); channels.len()];
     let mut read_among = vec![Spacing::default(); channels.len()];
     let mut grid = TimeGrid::default();
-    let mut odd_grid = OddGrid::default();
+    let mut rate_grid = RateGrid::default();
+    let mut float_grid = FloatGrid::default();
     let mut resolution = Resolution {
         hz: cfg.encoder.timer_hz,
         ..Resolution::default()
@@ -1797,19 +1807,21 @@ pub fn analyze<R: BufRead>(
     let longest_gap = runs.iter().map(|&(_, g)| g as f64).fold(1.0, f64::max);
     // A row read ahead (to see whether B comes back just after an edge of A), and the time
     // of B's last change and of the capture before.
-    let (mut ahead, mut row): (Option<(f64, Vec<Level>)>, Vec<Level>) = (None, Vec::new());
+    // (With the precision its time is written to.)
+    let mut ahead: Option<(f64, Vec<Level>, f64)> = None;
+    let mut row: Vec<Level> = Vec::new();
     let (mut b_changed_at, mut captured_at) = (f64::NEG_INFINITY, None::<f64>);
     loop {
-        let t = match ahead.take() {
-            Some((t, l)) => {
+        let (t, precision) = match ahead.take() {
+            Some((t, l, p)) => {
                 row = l;
-                t
+                (t, p)
             }
             None => match reader.next_row()? {
                 Some((t, l)) => {
                     row.clear();
                     row.extend_from_slice(l);
-                    t
+                    (t, reader.time_precision())
                 }
                 None => break,
             },
@@ -1819,8 +1831,24 @@ pub fn analyze<R: BufRead>(
             report.span[0] = t;
             prev = levels.to_vec();
         }
-        grid.row(t);
-        odd_grid.row(t);
+        // The times' grid from the transitions alone (every row of a file of edge times): a
+        // row where no level changes (a first row of the initial levels, a last at the end of
+        // the recording, a dump's `#0`, a binary export's begin time) need lie on no sample
+        // grid, and one such row off it had made the step found a fifth of the sampling's.
+        let transition = times
+            || prev
+                .iter()
+                .zip(levels)
+                .any(|(a, b)| a != b && *a != Level::Unknown && *b != Level::Unknown);
+        if transition {
+            grid.row(t);
+            if period.is_none() {
+                rate_grid.row(t, precision);
+            }
+            float_grid.row(t, precision);
+        }
+        // (Every row to the resolution of the blocks: a row off the grid only makes a block's
+        // step finer, and the floor never takes a block's finer than the grid above.)
         resolution.row(t);
         for ((n, a), b) in changes.iter_mut().zip(&prev).zip(levels) {
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
@@ -1968,7 +1996,10 @@ pub fn analyze<R: BufRead>(
                     direction = Some(Direction::Forward);
                     report.direction_glitches += 1;
                 }
-                ahead = Some((t2, l.to_vec()));
+                ahead = Some((t2, l.to_vec(), 0.0));
+            }
+            if let Some(a) = ahead.as_mut() {
+                a.2 = reader.time_precision();
             }
         }
         if direction == Some(Direction::Reverse) {
@@ -2113,19 +2144,37 @@ pub fn analyze<R: BufRead>(
         .captured
         .saturating_sub(u64::from(e.accepted) + u64::from(e.glitches) + report.reverse_edges);
     if report.sample_rate.is_none() {
-        // Times to the nanosecond that share no coarser whole-nanosecond step: an analyser's
-        // rate whose period is not whole nanoseconds, if one fits.
-        report.time_grid = grid
-            .step()
-            .or_else(|| (grid.gcd == Some(1)).then(|| odd_grid.step()).flatten());
+        // The whole-nanosecond step, or a whole multiple of the period of an analyser's rate
+        // that is not whole nanoseconds, to the precision the times are written to, if one
+        // is longer.
+        let whole = grid.step();
+        match rate_grid.step() {
+            Some(r) if whole.is_none_or(|w| r.period > w * (1.0 + 1e-9)) => {
+                report.time_grid = Some(r.period);
+                report.grid_of_rate = Some(r);
+            }
+            _ => report.time_grid = whole,
+        }
     }
+    // A grid of the sampling finer than the floats' is the digits' own (Unix times in an f64
+    // printed to seven decimals lie on 100 ns, and on 2^-22 s to their rounding): no sample
+    // period.
+    let float_step = float_grid.step().map(|(e, _, _)| 2f64.powi(-e));
+    if report.time_grid.zip(float_step).is_some_and(|(g, f)| g < f) {
+        (report.time_grid, report.grid_of_rate) = (None, None);
+    }
+    report.float_grid = float_grid
+        .step()
+        .map(|(e, at, written)| FloatSpacing::of(e, at, written, report.time_origin));
     // Each window's floor takes the file's sampling, or the resolution of its own rows where
-    // that is coarser (a time is known to no better than either).
+    // that is coarser (a time is known to no better than either), and the grid of the floats
+    // the times were held in where that is coarser still.
     let file_step = report
         .sample_rate
         .map(|r| 1.0 / r)
         .or(report.time_grid)
-        .unwrap_or(0.0);
+        .unwrap_or(0.0)
+        .max(report.float_grid.as_ref().map_or(0.0, |f| f.resolution));
     let tick = 1.0 / cfg.encoder.timer_hz;
     for w in &mut report.windows {
         let local = resolution.over(w.start, w.end);
@@ -2547,56 +2596,225 @@ impl TimeGrid {
 
 /// Sample rates of logic analysers whose period is not a whole number of nanoseconds (the
 /// FX2-based analysers' 48, 24, 16, 12, 6 and 3 MHz), Hz: a file that writes their times to
-/// the nanosecond lies on no whole-nanosecond grid ([`TimeGrid`]), and is tested against
-/// each ([`OddGrid`]).
+/// the nanosecond lies on no whole-nanosecond grid ([`TimeGrid`]), nor one written to finer
+/// digits on any whole-unit grid, and is tested against each ([`RateGrid`]), and so is a rate
+/// whose period is a whole multiple of one of theirs (750 kHz, 4 periods of 3 MHz).
 pub const ODD_RATES: [f64; 6] = [48e6, 24e6, 16e6, 12e6, 6e6, 3e6];
 
-/// Rows [`OddGrid`] needs before it names a rate: a time written to the nanosecond lies
-/// within a nanosecond of a 48 MHz grid (20.8 ns) by chance about one time in seven, of 64
-/// such times practically never.
-const ODD_GRID_ROWS: u64 = 64;
+/// Transitions a grid test needs whose time is written finely enough to tell the grid (the
+/// precision a quarter of its step or less) before it names a grid: such a time lies on a
+/// grid by chance at most one time in two, 64 of them practically never.
+const GRID_ROWS: u64 = 64;
 
-/// Which of [`ODD_RATES`] every row's time lies on from the first row's, to the nanosecond
-/// each was written to (a 12 MS/s capture's times in a Saleae export: 83.333 ns apart,
-/// rounded; their whole-nanosecond steps share no divisor but 1, and the windows' floor was
-/// the timer's alone, a third of δ's error).
-#[derive(Default)]
-struct OddGrid {
-    first: Option<f64>,
-    /// Bit `i`: every time so far lies on the grid of `ODD_RATES[i]`.
-    alive: u8,
-    rows: u64,
+/// The greatest common divisor (`gcd(0, b)` is `b`).
+fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
 }
 
-impl OddGrid {
-    fn row(&mut self, t: f64) {
-        let Some(first) = self.first else {
-            self.first = Some(t);
-            self.alive = (1 << ODD_RATES.len()) - 1;
+/// How far a time, written to `precision` s, may lie from the instant it stands for, s: half
+/// the precision, and the rounding of an f64 near `t` (a few units in the last place, as
+/// times computed in floating point and written in full carry).
+fn written_tolerance(t: f64, precision: f64) -> f64 {
+    0.5 * precision + 8.0 * f64::EPSILON * t.abs()
+}
+
+/// A grid of a whole multiple of the period of one of [`ODD_RATES`], from [`RateGrid`].
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct RateGridFound {
+    /// The grid's step, s: `multiple` periods of `rate`.
+    pub period: f64,
+    /// The analyser rate whose grid the times lie on, Hz.
+    pub rate: f64,
+    /// How many of its periods the step is (the greatest common divisor of every
+    /// transition's count of periods from the first).
+    pub multiple: u64,
+    /// The coarsest precision the transitions' times are written to, s.
+    pub written_to: f64,
+}
+
+/// For each of [`ODD_RATES`]: whether every transition's time lies on its grid from the first
+/// transition's, to the precision each is written to (a 12 MS/s capture's times in a Saleae
+/// export: 83.333 ns apart, rounded to the nanosecond, or to 1e-15 s in Logic 1.x's fifteen
+/// decimals, or to a value change dump's picosecond), and the greatest common divisor of their
+/// counts of periods (a 750 kS/s capture lies on the 3 MHz grid too, every fourth point).
+#[derive(Default)]
+struct RateGrid {
+    /// The first transition's time and precision.
+    first: Option<(f64, f64)>,
+    dead: [bool; ODD_RATES.len()],
+    multiple: [u64; ODD_RATES.len()],
+    /// Transitions written finely enough to tell the grid.
+    telling: [u64; ODD_RATES.len()],
+    coarsest: f64,
+}
+
+impl RateGrid {
+    fn row(&mut self, t: f64, precision: f64) {
+        self.coarsest = self.coarsest.max(precision);
+        let Some((t0, p0)) = self.first else {
+            self.first = Some((t, precision));
             return;
         };
-        self.rows += 1;
-        let ns = (t - first) * 1e9;
+        let d = t - t0;
+        if self.dead.iter().all(|&d| d) {
+            return;
+        }
+        let tol = written_tolerance(t, precision) + written_tolerance(t0, p0);
         for (i, rate) in ODD_RATES.iter().enumerate() {
-            let period = 1e9 / rate;
-            // Both times rounded to the nanosecond: within 1 ns of a multiple of the period.
-            if (ns - (ns / period).round() * period).abs() > 1.0 + 1e-9 * ns.abs() {
-                self.alive &= !(1 << i);
+            if self.dead[i] {
+                continue;
+            }
+            let period = 1.0 / rate;
+            let k = (d * rate).round();
+            if !(k < 9e15 && (d - k * period).abs() <= tol) {
+                self.dead[i] = true;
+                continue;
+            }
+            if 4.0 * tol <= period {
+                self.telling[i] += 1;
+            }
+            if self.multiple[i] != 1 {
+                self.multiple[i] = gcd(self.multiple[i], k as u64);
             }
         }
     }
 
-    /// The period, s, of the slowest rate every time lies on, after [`ODD_GRID_ROWS`] rows.
-    fn step(&self) -> Option<f64> {
-        if self.rows < ODD_GRID_ROWS {
-            return None;
+    /// The longest step every transition lies on, of the rates alive after [`GRID_ROWS`]
+    /// transitions that tell their grid.
+    fn step(&self) -> Option<RateGridFound> {
+        (0..ODD_RATES.len())
+            .filter(|&i| !self.dead[i] && self.telling[i] >= GRID_ROWS && self.multiple[i] > 0)
+            .map(|i| RateGridFound {
+                period: self.multiple[i] as f64 / ODD_RATES[i],
+                rate: ODD_RATES[i],
+                multiple: self.multiple[i],
+                written_to: self.coarsest,
+            })
+            // The slowest rate of a step found on several (750 kHz: 4 periods of 3 MHz, not
+            // 8 of 6 MHz).
+            .reduce(|a, b| {
+                if b.period >= a.period * (1.0 - 1e-9) {
+                    b
+                } else {
+                    a
+                }
+            })
+    }
+}
+
+/// A power-of-two grid of seconds that every transition's time lies on, coarser than the
+/// precision they are written to: times held as floats before they were written (an f64 near
+/// a Unix time of 1.76e9 s resolves 2^-22 s, 0.24 µs; an f32 at 5 s 2^-21 s), which a reader
+/// of their decimals cannot see.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FloatSpacing {
+    /// The grid, s (2^-`exponent`).
+    pub step: f64,
+    /// The resolution taken for the floor, s: the grid (a float rounds the instant to the
+    /// nearest point of it), and the precision the times are written to, up to one step
+    /// more (printed from the float, a time lies within half a step of it: `5.001029` for an
+    /// f32 at 5 s).
+    pub resolution: f64,
+    /// The grid's exponent: the step is 2^-exponent s.
+    pub exponent: i32,
+    /// The first transition's time, s, as the file writes it (before the whole seconds are
+    /// counted off).
+    pub at: f64,
+    /// The float whose spacing the grid is at that time: `f64`, `f32`, or none of them (a
+    /// sample clock of a power of two of Hz).
+    pub float: Option<&'static str>,
+}
+
+impl FloatSpacing {
+    /// The grid `2^-exponent` s found on times from `first` s (counted from `origin` s).
+    fn of(exponent: i32, first: f64, written_to: f64, origin: i64) -> Self {
+        let at = origin as f64 + first;
+        let step = 2f64.powi(-exponent);
+        // Spacing of a float of `bits` mantissa bits (the leading one included) at `at`.
+        let spacing = |bits: i32| 2f64.powi(at.abs().log2().floor() as i32 - (bits - 1));
+        let float = if at == 0.0 {
+            None
+        } else if spacing(53) == step {
+            Some("f64")
+        } else if spacing(24) == step {
+            Some("f32")
+        } else {
+            None
+        };
+        FloatSpacing {
+            step,
+            resolution: step + written_to.min(step),
+            exponent,
+            at,
+            float,
         }
-        ODD_RATES
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| self.alive >> i & 1 == 1)
-            .map(|(_, r)| 1.0 / r)
-            .reduce(f64::max)
+    }
+}
+
+/// Exponents of the power-of-two grids [`FloatGrid`] tests: 2^0 down to 2^-63 s.
+const FLOAT_EXPONENTS: usize = 64;
+
+/// Which power-of-two grids of seconds every transition's time lies on, to the precision it
+/// is written to, and how many of them tell each grid (written to a quarter of its step or
+/// finer). Times counted from whole seconds lie on such a grid of 1 s or finer as the
+/// absolute times do.
+///
+/// A time within `tol` of a point of 2^-e s lies within `2·tol` of one of 2^-(e+1) s, which is
+/// the same tolerance on that grid: the grids a time lies on are every one from some exponent
+/// on, and those every time lies on are every one from the largest such exponent (`from`). So
+/// each row is tested at `from` alone (and `from` moved on while it fails), and a row tells
+/// every grid up to its own exponent ([`Self::telling`] counts rows by it).
+#[derive(Default)]
+struct FloatGrid {
+    /// The coarsest grid every time so far lies on: 2^-`from` s (`FLOAT_EXPONENTS`: none).
+    from: usize,
+    /// Rows by the finest grid they tell (its exponent).
+    telling: Vec<u64>,
+    first: Option<f64>,
+    /// The coarsest precision of the times.
+    coarsest: f64,
+}
+
+impl FloatGrid {
+    fn row(&mut self, t: f64, precision: f64) {
+        if self.telling.is_empty() {
+            self.telling = vec![0; FLOAT_EXPONENTS];
+        }
+        self.first.get_or_insert(t);
+        self.coarsest = self.coarsest.max(precision);
+        let tol = written_tolerance(t, precision);
+        while self.from < FLOAT_EXPONENTS {
+            let scale = f64::from_bits((1023 + self.from as u64) << 52);
+            let x = t * scale;
+            if (x - x.round()).abs() <= tol * scale {
+                break;
+            }
+            self.from += 1;
+        }
+        // The finest grid 2^-e s with 4·tol·2^e ≤ 1: tol = m·2^q (1 ≤ m < 2) tells down to
+        // e = −q − 2, one less when m > 1 (a normal tol; a subnormal one tells every grid).
+        let bits = tol.to_bits();
+        let q = ((bits >> 52) & 0x7ff) as i64 - 1023;
+        let finest = if tol > 0.0 && q > -1023 {
+            -q - 2 - i64::from(bits & ((1 << 52) - 1) != 0)
+        } else {
+            (FLOAT_EXPONENTS - 1) as i64
+        };
+        if let Ok(e) = usize::try_from(finest) {
+            self.telling[e.min(FLOAT_EXPONENTS - 1)] += 1;
+        }
+    }
+
+    /// The coarsest grid every time lies on that [`GRID_ROWS`] transitions or more tell: its
+    /// exponent, the first transition's time, and the coarsest precision the times are
+    /// written to.
+    fn step(&self) -> Option<(i32, f64, f64)> {
+        let from = self.from;
+        let told: u64 = self.telling.get(from..)?.iter().sum();
+        (told >= GRID_ROWS).then_some((from as i32, self.first?, self.coarsest))
     }
 }
 
@@ -3119,19 +3337,42 @@ pub fn text(r: &AnalyzeReport) -> String {
             Some(g) => {
                 let _ = writeln!(
                     s,
-                    "sampling: rate not stated; every time lies on a {g:.3e} s grid{} ({:.3} \
-                     timer ticks), taken as the sample period: the floor below includes it, \
-                     {:.3} times the timer's alone (give --sample-rate to state the rate)",
-                    if ((g * 1e9).round() - g * 1e9).abs() > 1e-6 {
-                        format!(
-                            ", to the nanosecond its times are written to (a {:.0} Hz analyser's)",
-                            1.0 / g
-                        )
-                    } else {
-                        String::new()
+                    "sampling: rate not stated; every transition's time lies on a {g:.3e} s \
+                     grid{} ({:.3} timer ticks), taken as the sample period: the floor below \
+                     includes it, {:.3} times the timer's alone (give --sample-rate to state the \
+                     rate)",
+                    match r.grid_of_rate {
+                        Some(f) => format!(
+                            ", to the {} its times are written to ({})",
+                            if f.written_to == 1e-9 {
+                                "nanosecond".to_string()
+                            } else {
+                                format!("{:.0e} s", f.written_to)
+                            },
+                            if f.multiple == 1 {
+                                format!("a {:.0} Hz analyser's", f.rate)
+                            } else {
+                                format!(
+                                    "{:.0} Hz: {} periods of a {:.0} Hz analyser's, the longest \
+                                     step every one lies on",
+                                    1.0 / g,
+                                    f.multiple,
+                                    f.rate
+                                )
+                            }
+                        ),
+                        None => String::new(),
                     },
                     r.timer_hz * g,
                     1.0 + r.timer_hz * g
+                );
+            }
+            None if r.float_grid.is_some() => {
+                let _ = writeln!(
+                    s,
+                    "sampling: rate not stated (give --sample-rate); the floor below includes \
+                     the times' float grid (below), and a capture sampled more slowly still \
+                     resolves δ less finely"
                 );
             }
             None => {
@@ -3143,6 +3384,34 @@ pub fn text(r: &AnalyzeReport) -> String {
                 );
             }
         },
+    }
+    if let Some(f) = &r.float_grid {
+        let _ = writeln!(
+            s,
+            "times: every transition's time lies on a 2^-{} s grid ({:.3e} s, {:.3} timer \
+             ticks), coarser than the digits they are written to: {}; their resolution is \
+             taken as {:.3e} s (the grid, and the digits' rounding up to one step more), and \
+             the floor below includes it",
+            f.exponent,
+            f.step,
+            f.step * r.timer_hz,
+            match f.float {
+                Some(kind) => format!(
+                    "the spacing of {} numbers at {:.0} s, so the times were held as {kind} \
+                     before they were written, and each is off its instant by up to half of it",
+                    if kind == "f64" {
+                        "64-bit float (f64)"
+                    } else {
+                        "32-bit float (f32)"
+                    },
+                    f.at
+                ),
+                None => "a power of two of seconds, as floats held the times or a clock of \
+                         a power of two of Hz sampled them"
+                    .to_string(),
+            },
+            f.resolution
+        );
     }
     if let Some((worst, from)) = r.coarser_times {
         let _ = writeln!(

@@ -356,6 +356,10 @@ pub struct CaptureReader<R> {
     binary: Option<Box<saleae_bin::Export>>,
     /// Values read as levels through a threshold (`--threshold`), in place of 0 and 1.
     threshold: Option<Threshold>,
+    /// The precision, s, the last row's time is written to (see [`Self::time_precision`]).
+    precision: f64,
+    /// Where the sample rate came from, as the file or the option states it (for messages).
+    rate_source: Option<String>,
 }
 
 /// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
@@ -463,6 +467,26 @@ fn decimal_attoseconds(text: &str) -> Option<i128> {
     Some(if negative { -atto } else { atto })
 }
 
+/// The unit of the last digit `text` (a decimal time as [`decimal_attoseconds`] reads it)
+/// is written to, s: `0.001010250000000` 1e-15, `1.5e-3` 1e-4, `12` 1.
+fn decimal_precision(text: &str) -> f64 {
+    let (number, exponent) = match text.find(['e', 'E']) {
+        Some(k) => (&text[..k], text[k + 1..].parse::<i32>().unwrap_or(0)),
+        None => (text, 0),
+    };
+    let decimals = number.split_once('.').map_or(0, |(_, f)| f.len());
+    let power = exponent.saturating_sub(i32::try_from(decimals).unwrap_or(i32::MAX));
+    // The nearest f64 to each power of ten written out (`powi` may miss it by a unit).
+    const TENS: [f64; 19] = [
+        1.0, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
+        1e-14, 1e-15, 1e-16, 1e-17, 1e-18,
+    ];
+    match usize::try_from(-i64::from(power)) {
+        Ok(k) if k < TENS.len() => TENS[k],
+        _ => 10f64.powi(power),
+    }
+}
+
 impl CaptureReader<std::io::BufReader<std::fs::File>> {
     /// Opens `path`; the format is `format`, or detected from the first lines.
     /// `sample_rate` (Hz) is used for a sigrok file whose samplerate comment is missing.
@@ -521,6 +545,8 @@ impl<R: BufRead> CaptureReader<R> {
             session: None,
             binary: None,
             threshold: None,
+            precision: 0.0,
+            rate_source: sample_rate.map(|r| format!("--sample-rate {r}")),
         };
         if let Some(rate) = sample_rate {
             if !(rate.is_finite() && rate > 0.0) {
@@ -776,6 +802,14 @@ impl<R: BufRead> CaptureReader<R> {
         self.sample_column.as_deref()
     }
 
+    /// The precision, s, the last row's time is written to: the unit of its last decimal
+    /// (`0.001010250000000` is written to 1e-15 s), a value change dump's `$timescale`, the
+    /// spacing of f64 numbers at a Saleae binary export's double; 0 where the time is a
+    /// sample's of a stated rate. A time lies within half of it of the instant it stands for.
+    pub fn time_precision(&self) -> f64 {
+        self.precision
+    }
+
     /// The whole seconds subtracted from every time the file writes (its first time's, when
     /// that is 10 000 s or more, such as a Unix time: read as it is, an f64 would lose the
     /// ticks); 0 when times are as written. Known once the first row is read.
@@ -949,6 +983,7 @@ impl<R: BufRead> CaptureReader<R> {
                     ))
                 })?;
                 self.stated_rate(rate, &format!("Samplerate: {}", rest.trim()))?;
+                self.rate_source = Some(format!("`; Samplerate: {}`", rest.trim()));
             }
             line = loop {
                 match self.read_line()? {
@@ -1002,6 +1037,40 @@ impl<R: BufRead> CaptureReader<R> {
             None => (SigrokTime::None, &fields[..]),
         };
         self.sigrok_time = time;
+        // libsigrok writes the time column in the unit its sample rate calls for: a column in
+        // another contradicts the rate stated, and every time and speed would be off by their
+        // ratio (a `; Samplerate: 10 MHz` over whole microseconds read a 150 rad/s shaft as
+        // 1498 rad/s).
+        if let (SigrokTime::Column { unit_rate, .. }, Some(rate)) = (time, self.sample_rate) {
+            let (label, per_s, _) = sigrok_unit(rate.round() as u64);
+            // (A column of `samples` counts samples at any rate.)
+            if per_s != unit_rate && unit_rate > 1 {
+                let column = fields.first().copied().unwrap_or("");
+                let at = SIGROK_UNITS
+                    .iter()
+                    .position(|u| u.1 == unit_rate)
+                    .unwrap_or(0);
+                let from = at.checked_sub(1).map_or(0, |k| SIGROK_UNITS[k].1);
+                let source = self
+                    .rate_source
+                    .clone()
+                    .unwrap_or_else(|| "the file".into());
+                let fix = if source.starts_with("--sample-rate") {
+                    "give --sample-rate the capture's rate"
+                } else {
+                    "correct the comment, or delete it and give --sample-rate the capture's rate"
+                };
+                return Err(self.err_here(&format!(
+                    "the time column is in `{column}`, which libsigrok writes at a sample rate \
+                     over {} up to {}, but {source} states {}, at which it writes `{label}`: \
+                     one of them is wrong, and read at that rate every time and speed would be \
+                     off by their ratio; {fix}",
+                    sigrok_rate_string(from),
+                    sigrok_rate_string(unit_rate),
+                    sigrok_rate_string(rate.round() as u64),
+                )));
+            }
+        }
         self.channels = if labels.iter().all(|l| *l == "logic") && names.len() == labels.len() {
             names
         } else {
@@ -1035,6 +1104,8 @@ impl<R: BufRead> CaptureReader<R> {
             let Some(time) = row.map_err(|m| self.err_here(&m))? else {
                 return Ok(None);
             };
+            // A double as stored: it resolves the spacing of f64 numbers at it.
+            self.precision = f64::from_bits(time.abs().to_bits() + 1) - time.abs();
             self.advance(time)?;
             return Ok(Some((time, &self.levels)));
         }
@@ -1225,6 +1296,7 @@ impl<R: BufRead> CaptureReader<R> {
                         Err(_) => bad("a time in seconds"),
                     });
                 };
+                self.precision = decimal_precision(f);
                 Ok(self.seconds_from_atto(atto))
             }
         }

@@ -338,6 +338,7 @@ impl<R: BufRead> CaptureReader<R> {
                 ))
             })?;
         let time = self.seconds_from_atto(atto);
+        self.precision = self.vcd.unit_atto as f64 * 1e-18;
         self.last_time = time;
         self.rows += 1;
         Ok(Some((time, &self.levels)))
