@@ -448,7 +448,7 @@ fn a_mean_load_beyond_breakdown_stalls_without_a_common_period() {
 }
 
 /// A common period beyond what the host integrates (orders 1/1023 and 200: 1023 revolutions,
-/// 204 600 cycles of order 200, 6.5 M steps at 32 a cycle, more than 2²²) is predicted
+/// 204 600 cycles of order 200, 6.5 M steps at 32 a cycle, more than 2²⁰) is predicted
 /// through the parabola at the operating point, marked approximate, and the note names the
 /// period and the reason (not "no common period").
 #[test]

@@ -12,12 +12,13 @@
 //! ## Method
 //! Butcher's sixth-order, seven-stage Runge–Kutta method (the core's) on `N` equal steps a
 //! period, [`STEPS_PER_CYCLE`] = 32 a cycle of the fastest order (the core takes 128 on its
-//! shorter periods; at 32 the sixth-order error is about `4⁶` times its 1e-13 of the swing,
-//! measured below 1e-9 of δ on the test scenes), raised so that `h·λ ≤ 1/4` for the largest
+//! shorter periods; at 32 the sixth-order error is at most about `4⁶` times its 1e-13 of the
+//! swing; measured 7e-12 of δ on the 0.333/12 scene against a DOP853 integration), raised so that `h·λ ≤ 1/4` for the largest
 //! rate `λ = |dM_d/dω|/(J·ω)` down to half of `ω̄`, at most [`MAX_STEPS`]. The periodic start
 //! is found as the map over a period contracts it: the drive is first settled from `ω̄` over
-//! [`SETTLE_FOLDS`] e-foldings of its damping at `ω̄` (at most one period) ending at φ = 0 of
-//! the period (the forcing is periodic), then the period is integrated with `L = ∫∂F/∂y dφ`
+//! [`SETTLE_FOLDS`] e-foldings of its damping at `ω̄` ending at φ = 0 of the period (the
+//! forcing is periodic; not where that would take a period or more), then the period is
+//! integrated with `L = ∫∂F/∂y dφ`
 //! (the map's derivative `μ = e^L`), and Newton's step `(y(T) − y(0))/(1 − μ)` repeats the
 //! period until `|y(T) − y(0)|` is within the rounding floor of the largest `|y|` (the core's
 //! tolerance); on a loaded drive the settling alone leaves the start within rounding and one
@@ -27,19 +28,23 @@
 //!
 //! ## Cost
 //! About `7·(N + settling steps)` evaluations of the curve and the load per solution (one
-//! period when the settling converged it), plus the refinements: on the 0.333/12 scene
-//! (`N` = 128 000, 84 292 settling steps) about 0.1 s in a release build; the prediction with
-//! its four solutions for the sensitivities 0.5 s, with the flywheel for a limit 1 s.
+//! period when the settling converged it), plus the refinements. Measured (release build, CPU
+//! time of `drive-sim predict`): the 0.333/12 scene (`N` = 128 000, 84 292 settling steps)
+//! 0.22 s with the sensitivities (five solutions), 0.53 s with the flywheel for δ ≤ 0.004; at
+//! the bound (orders 1/1024 and 32: 32 768 cycles, δ 0.10) 1.3 s with the sensitivities and
+//! 14 s with the flywheel for δ ≤ 0.004 (270 kg·m², where the drive is so weakly damped that
+//! it does not settle within a period and Newton's method takes three periods a solution).
 
 use drive_monitor::drive::{period_revolutions, Harmonic, Kloss, Load};
 use std::f64::consts::TAU;
 
 /// Runge–Kutta steps per cycle of the fastest order.
 pub const STEPS_PER_CYCLE: u64 = 32;
-/// The most steps over one period the host integrates: 2²² (131 072 cycles of the fastest
-/// order at 32 steps a cycle, about 0.2 s a solution); a longer period is predicted through
-/// the parabola at the operating point instead ([`crate::app::predict`]).
-pub const MAX_STEPS: u64 = 1 << 22;
+/// The most steps over one period the host integrates: 2²⁰ (32 768 cycles of the fastest
+/// order at 32 steps a cycle, 16 times the core's 2048; about 0.25 s a solution there); a
+/// longer period is predicted through the parabola at the operating point instead
+/// ([`crate::app::predict`]).
+pub const MAX_STEPS: u64 = 1 << 20;
 /// Largest `h·λ` of a step (`λ` the rate of the linearised equation).
 const MAX_STEP_RATE: f64 = 0.25;
 /// E-foldings of the damping at the operating point the drive settles over before the
@@ -237,9 +242,11 @@ impl Drive {
         self.mean
     }
 
-    /// The periodic steady state over `period`.
-    pub fn solve(&self, period: &Period) -> Result<Steady, Failure> {
-        Setup::new(self, period)?.solve()
+    /// The periodic steady state over `period`; `start`, an estimate of ω² at φ = 0 (s⁻²),
+    /// is where Newton's method starts on a drive too weakly damped to settle within a period
+    /// (without it, or for a settled drive: from `ω̄`).
+    pub fn solve(&self, period: &Period, start: Option<f64>) -> Result<Steady, Failure> {
+        Setup::new(self, period)?.solve(start)
     }
 }
 
@@ -265,16 +272,39 @@ struct Scan {
     sum: f64,
 }
 
+/// The Kloss curve's constants about the operating point.
+#[derive(Debug, Clone, Copy, Default)]
+struct Curve {
+    ws: f64,
+    inv_ws: f64,
+    sm: f64,
+    sm2: f64,
+    /// `σ̄`.
+    sb: f64,
+    /// `2·M_m·σ_m/(σ̄² + σ_m²)`.
+    factor: f64,
+    /// `−2·M_m·σ_m/ω_s`.
+    slope: f64,
+}
+
 struct Setup<'a> {
     drive: &'a Drive,
     omega_ref: f64,
     u_ref: f64,
     /// `M_d(ω̄) − M1`, N·m (rounding only).
     c0: f64,
+    /// The curve's constants about `ω̄`.
+    curve: Curve,
+    /// `1/J`.
+    inv_j: f64,
     /// `|dM_d/dω|/(J·ω̄)` at `ω̄`, per rad.
     damping: f64,
     period: f64,
     steps: u64,
+    /// The step, `period/steps`, rad.
+    h: f64,
+    /// `sin_cos(order·C[i]·h)` for each oscillating harmonic and stage.
+    stage_turns: Vec<[(f64, f64); 7]>,
 }
 
 impl<'a> Setup<'a> {
@@ -303,7 +333,19 @@ impl<'a> Setup<'a> {
         if !(j > 0.0 && steps.is_finite() && steps <= MAX_STEPS as f64) {
             return Err(Failure::Steps);
         }
+        let sb = (ws - omega_ref) / ws;
+        let curve = Curve {
+            ws,
+            inv_ws: 1.0 / ws,
+            sm,
+            sm2: sm * sm,
+            sb,
+            factor: 2.0 * mm * sm / (sb * sb + sm * sm),
+            slope: -2.0 * mm * sm / ws,
+        };
         let mut s = Self {
+            curve,
+            inv_j: 1.0 / j,
             drive,
             omega_ref,
             u_ref: omega_ref * omega_ref,
@@ -311,43 +353,42 @@ impl<'a> Setup<'a> {
             damping: 0.0,
             period: period.radians,
             steps: steps as u64,
+            h: period.radians / steps,
+            stage_turns: Vec::new(),
         };
+        s.stage_turns = drive
+            .load
+            .iter()
+            .map(|harmonic| C.map(|c| (harmonic.order() * (c * s.h)).sin_cos()))
+            .collect();
         let (_, slope) = s.change(omega_ref, 0.0);
         s.damping = slope.abs() / (j * omega_ref);
         Ok(s)
     }
 
-    /// `M_d(ω) − M_d(ω̄)` from `ω` and `d = ω − ω̄`, and `dM_d/dω` at `ω` (the core's form).
+    /// `M_d(ω) − M_d(ω̄)` from `ω` and `d = ω − ω̄`, and `dM_d/dω` at `ω` (the core's form,
+    /// `2·M_m·σ_m·(σ − σ̄)·(σ_m² − σ·σ̄)/((σ² + σ_m²)(σ̄² + σ_m²))`, with the constants of `ω̄`
+    /// taken once).
     fn change(&self, omega: f64, d: f64) -> (f64, f64) {
-        let k = &self.drive.kloss;
-        let ws = k.synchronous_speed();
-        let (sm, mm) = (k.breakdown_slip(), k.breakdown_torque());
-        let s = (ws - omega) / ws;
-        let sb = (ws - self.omega_ref) / ws;
-        let ds = -d / ws;
-        let q = s * s + sm * sm;
-        let qb = sb * sb + sm * sm;
-        let change = 2.0 * mm * sm * ds * ((sm * sm - s * sb) / q / qb);
-        let slope = -2.0 * mm * sm * ((sm - s) * (sm + s) / q / q) / ws;
+        let c = &self.curve;
+        let s = (c.ws - omega) * c.inv_ws;
+        let ds = -d * c.inv_ws;
+        let inv_q = 1.0 / (s * s + c.sm2);
+        let change = c.factor * ds * ((c.sm2 - s * c.sb) * inv_q);
+        let slope = c.slope * ((c.sm - s) * (c.sm + s) * inv_q * inv_q);
         (change, slope)
     }
 
-    /// `dy/dφ` and `∂(dy/dφ)/∂y`.
-    fn rhs(&self, phi: f64, y: f64) -> Result<(f64, f64), Stalled> {
+    /// `dy/dφ` and `∂(dy/dφ)/∂y` with the load's oscillating torque `mc` at that angle.
+    fn rhs(&self, mc: f64, y: f64) -> Result<(f64, f64), Stalled> {
         let j = self.drive.inertia;
-        let s = y / j;
+        let s = y * self.inv_j;
         let u = self.u_ref + s;
         if !(u > 0.0 && u.is_finite()) {
             return Err(Stalled);
         }
         let omega = u.sqrt();
         let (dm, slope) = self.change(omega, s / (omega + self.omega_ref));
-        let mc: f64 = self
-            .drive
-            .load
-            .iter()
-            .map(|h| h.amplitude() * (h.order() * phi + h.phase()).sin())
-            .sum();
         let f = 2.0 * ((dm + self.c0) - mc);
         let df = slope / (j * omega);
         if f.is_finite() && df.is_finite() {
@@ -357,8 +398,31 @@ impl<'a> Setup<'a> {
         }
     }
 
+    /// The load's oscillating torque at the seven stages of a step of length `h` from `phi`:
+    /// one `sin_cos` a harmonic at `phi`, the stages by the angle-addition formulas with the
+    /// sines and cosines of `order·C[i]·h` (from the table for the period's own step, which the
+    /// node differences match to their rounding).
+    fn load_at_stages(&self, phi: f64, h: f64) -> [f64; 7] {
+        let mut mc = [0.0f64; 7];
+        let tabled = (h - self.h).abs() <= 1e-9 * self.h;
+        for (k, harmonic) in self.drive.load.iter().enumerate() {
+            let (s0, c0) = (harmonic.order() * phi + harmonic.phase()).sin_cos();
+            let a = harmonic.amplitude();
+            for (i, m) in mc.iter_mut().enumerate() {
+                let (si, ci) = if tabled {
+                    self.stage_turns[k][i]
+                } else {
+                    (harmonic.order() * (C[i] * h)).sin_cos()
+                };
+                *m += a * (s0 * ci + c0 * si);
+            }
+        }
+        mc
+    }
+
     /// One step of length `h` from `(phi, y)`: `y` after it and the increment of `L`.
     fn step(&self, phi: f64, y: f64, h: f64) -> Result<(f64, f64), Stalled> {
+        let mc = self.load_at_stages(phi, h);
         let mut k = [0.0f64; 7];
         let mut l = [0.0f64; 7];
         for i in 0..7 {
@@ -366,7 +430,7 @@ impl<'a> Setup<'a> {
             for jj in 0..i {
                 acc += A[i][jj] * k[jj];
             }
-            let (f, df) = self.rhs(phi + C[i] * h, y + h * acc)?;
+            let (f, df) = self.rhs(mc[i], y + h * acc)?;
             k[i] = f;
             l[i] = df;
         }
@@ -387,15 +451,15 @@ impl<'a> Setup<'a> {
         y / self.drive.inertia
     }
 
-    /// `y` at φ = 0 after settling from `ω̄` over the last stretch of a period.
+    /// `y` at φ = 0 after settling from `ω̄` over the last stretch of a period, and the steps
+    /// taken; none where the settling would take a whole period or more (a weakly damped drive,
+    /// whose period map is nearly affine: Newton's method from `ω̄` converges in a few periods).
     fn settle(&self) -> Result<(f64, u64), Stalled> {
-        let h = self.period / self.steps as f64;
-        let want = (SETTLE_FOLDS / self.damping / h).ceil();
-        let count = if want.is_finite() && want < self.steps as f64 {
-            want as u64
-        } else {
-            self.steps
-        };
+        let want = (SETTLE_FOLDS / self.damping / self.h).ceil();
+        if !(want.is_finite() && want < self.steps as f64) {
+            return Ok((0.0, 0));
+        }
+        let count = want as u64;
         let mut y = 0.0;
         for j in self.steps - count..self.steps {
             let phi = self.node(j);
@@ -459,8 +523,13 @@ impl<'a> Setup<'a> {
         (8.0 * f64::EPSILON * (self.steps as f64).sqrt()).max(1e-13)
     }
 
-    fn solve(&self) -> Result<Steady, Failure> {
+    fn solve(&self, start: Option<f64>) -> Result<Steady, Failure> {
         let (mut y0, settle_steps) = self.settle().map_err(|_| Failure::Stalls)?;
+        if settle_steps == 0 {
+            if let Some(u) = start.filter(|u| *u > 0.0 && u.is_finite()) {
+                y0 = self.drive.inertia * (u - self.u_ref);
+            }
+        }
         let tol = self.tolerance();
         for periods in 1..=MAX_MAPS {
             let mut scan = Scan::default();

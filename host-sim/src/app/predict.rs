@@ -782,7 +782,7 @@ pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
     let Some(period) = kloss_period::common_period(&orders) else {
         return Some(LongKloss::Approximate(Approximation::NoCommonPeriod));
     };
-    Some(match drive.solve(&period) {
+    Some(match drive.solve(&period, Some(model.omega_squared(0.0))) {
         Ok(steady) => LongKloss::Integrated { period, steady },
         Err(kloss_period::Failure::MeanLoad) => LongKloss::MeanLoad,
         Err(kloss_period::Failure::Steps) => LongKloss::Approximate(Approximation::TooLong(period)),
@@ -813,15 +813,30 @@ pub fn long_kloss_sensitivity(
 ) -> Option<drive_monitor::drive::Sensitivity> {
     let k = *model.motor().kloss_curve()?;
     let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
-    let delta = |d: Option<kloss_period::Drive>| d?.solve(period).ok().map(|s| s.delta);
+    // Each from the start the operating point's parabola gives the stepped drive.
+    let delta = |d: Option<kloss_period::Drive>, m: Option<DriveModel>| {
+        let start = m.map(|m| m.omega_squared(0.0));
+        d?.solve(period, start).ok().map(|s| s.delta)
+    };
     let j = drive.inertia();
     let h = SENSITIVITY_STEP * j;
-    let d_inertia = (delta(Some(drive.with_inertia(j + h)))?
-        - delta(Some(drive.with_inertia(j - h)))?)
+    let fly = |x: f64| model.with_flywheel(model.flywheel() + x).ok();
+    let d_inertia = (delta(Some(drive.with_inertia(j + h)), fly(h))?
+        - delta(Some(drive.with_inertia(j - h)), fly(-h))?)
         / (2.0 * h);
-    let d_torque = (delta(drive.scaled(1.0 + SENSITIVITY_STEP))?
-        - delta(drive.scaled(1.0 - SENSITIVITY_STEP))?)
-        / (2.0 * SENSITIVITY_STEP * k.breakdown_torque());
+    let scaled = |f: f64| {
+        model
+            .motor()
+            .scaled(f)
+            .and_then(|m| model.with_motor(m).ok())
+    };
+    let d_torque = (delta(
+        drive.scaled(1.0 + SENSITIVITY_STEP),
+        scaled(1.0 + SENSITIVITY_STEP),
+    )? - delta(
+        drive.scaled(1.0 - SENSITIVITY_STEP),
+        scaled(1.0 - SENSITIVITY_STEP),
+    )?) / (2.0 * SENSITIVITY_STEP * k.breakdown_torque());
     (d_inertia.is_finite() && d_torque.is_finite()).then_some(drive_monitor::drive::Sensitivity {
         d_delta_d_inertia: d_inertia,
         d_delta_d_breakdown_torque: d_torque,
@@ -848,7 +863,11 @@ pub fn long_kloss_flywheel(
     }
     // f(x) = 1/δ − 1/limit at J + x: negative below the answer.
     let f = |x: f64| -> Option<f64> {
-        let s = drive.with_inertia(j + x).solve(period).ok()?;
+        let start = model
+            .with_flywheel(model.flywheel() + x)
+            .ok()
+            .map(|m| m.omega_squared(0.0));
+        let s = drive.with_inertia(j + x).solve(period, start).ok()?;
         Some(1.0 / s.delta - 1.0 / limit)
     };
     let (mut lo, mut f_lo) = (0.0, 1.0 / delta - 1.0 / limit);
