@@ -400,7 +400,7 @@ fn a_short_load_period_stays_with_the_core() {
 /// the unbounded horizon ω reaches the supremum over that phase of the periodic drive with
 /// orders 1 and 1.5, which the core integrates with the curve itself; 96 phases of it give
 /// the reference. The prediction's ω max and ω min are within 2e-5 relative of it (measured
-/// 5e-6; the tangent at synchronous speed was 3.5 % high), its δ within 0.5 % (measured 0.04 %),
+/// 5e-6; the tangent at synchronous speed was 3.5 % high), its δ within 1e-4 (measured 7.5e-6),
 /// and its mean speed within the tester's range 137.19–137.58 rad/s.
 #[test]
 fn incommensurate_orders_take_the_parabola_at_the_operating_point() {
@@ -439,11 +439,15 @@ fn incommensurate_orders_take_the_parabola_at_the_operating_point() {
         inf = inf.min(s.omega_min);
     }
     let reference = delta_of((sup, inf));
-    eprintln!("predicted {hi:.6} {lo:.6} δ {delta:.7}; over the phases {sup:.6} {inf:.6} δ {reference:.7}");
+    eprintln!(
+        "predicted {hi:.6} {lo:.6} δ {delta:.7}; over the phases {sup:.6} {inf:.6} δ \
+         {reference:.7} ({:.1e})",
+        delta / reference - 1.0
+    );
     assert!((hi / sup - 1.0).abs() < 2e-5, "{hi} against {sup}");
     assert!((lo / inf - 1.0).abs() < 2e-5, "{lo} against {inf}");
     assert!(
-        (delta / reference - 1.0).abs() < 5e-3,
+        (delta / reference - 1.0).abs() < 1e-4,
         "{delta} against {reference}"
     );
     let mean = 0.5 * (hi + lo);
