@@ -146,7 +146,8 @@ pub enum Failure {
     MeanLoad,
     /// The period needs more than [`MAX_STEPS`] steps.
     Steps,
-    /// The speed falls to zero (or overflows) on the way.
+    /// The speed falls to zero from above every periodic solution: none exists, the drive
+    /// stalls under the peak load (or a Newton step's trajectory kept falling to zero).
     Stalls,
     /// Newton's method did not converge within [`MAX_MAPS`] periods, or to a repelling
     /// solution.
@@ -452,16 +453,17 @@ impl<'a> Setup<'a> {
         y / self.drive.inertia
     }
 
-    /// `y` at φ = 0 after settling from `ω̄` over the last stretch of a period, and the steps
-    /// taken; none where the settling would take a whole period or more (a weakly damped drive,
-    /// whose period map is nearly affine: Newton's method from `ω̄` converges in a few periods).
-    fn settle(&self) -> Result<(f64, u64), Stalled> {
+    /// `y` at φ = 0 after settling from `y = from` over the last stretch of a period, and the
+    /// steps taken; none (`from` itself) where the settling would take a whole period or more
+    /// (a weakly damped drive, whose period map is nearly affine: Newton's method converges in
+    /// a few periods).
+    fn settle(&self, from: f64) -> Result<(f64, u64), Stalled> {
         let want = (SETTLE_FOLDS / self.damping / self.h).ceil();
         if !(want.is_finite() && want < self.steps as f64) {
-            return Ok((0.0, 0));
+            return Ok((from, 0));
         }
         let count = want as u64;
-        let mut y = 0.0;
+        let mut y = from;
         for j in self.steps - count..self.steps {
             let phi = self.node(j);
             (y, _) = self.step(phi, y, self.node(j + 1) - phi)?;
@@ -524,8 +526,22 @@ impl<'a> Setup<'a> {
         (8.0 * f64::EPSILON * (self.steps as f64).sqrt()).max(1e-13)
     }
 
+    /// The periodic solution: settled from `ω̄` (from `start` on a drive too weakly damped to
+    /// settle within a period), then Newton's method over whole periods. Where the drive falls
+    /// to standstill from there, it starts again from above every periodic solution, past the
+    /// curve's generating breakdown point (`ω_s·(1 + σ_m)`, the core's start from above):
+    /// solutions of a scalar equation do not cross, so a fall from there means no periodic
+    /// solution exists, a stall ([`Failure::Stalls`]).
     fn solve(&self, start: Option<f64>) -> Result<Steady, Failure> {
-        let (mut y0, settle_steps) = self.settle().map_err(|_| Failure::Stalls)?;
+        let top = self.curve.ws * (1.0 + self.curve.sm);
+        let y_top = self.drive.inertia * ((top - self.omega_ref) * (top + self.omega_ref));
+        let (mut y0, settle_steps, mut from_top) = match self.settle(0.0) {
+            Ok((y, n)) => (y, n, false),
+            Err(Stalled) => {
+                let (y, n) = self.settle(y_top).map_err(|_| Failure::Stalls)?;
+                (y, n, true)
+            }
+        };
         if settle_steps == 0 {
             if let Some(u) = start.filter(|u| *u > 0.0 && u.is_finite()) {
                 y0 = self.drive.inertia * (u - self.u_ref);
@@ -534,7 +550,14 @@ impl<'a> Setup<'a> {
         let tol = self.tolerance();
         for periods in 1..=MAX_MAPS {
             let mut scan = Scan::default();
-            let (yt, l, big) = self.map(y0, Some(&mut scan)).map_err(|_| Failure::Stalls)?;
+            let (yt, l, big) = match self.map(y0, Some(&mut scan)) {
+                Ok(m) => m,
+                Err(Stalled) if !from_top => {
+                    (y0, from_top) = (y_top, true);
+                    continue;
+                }
+                Err(Stalled) => return Err(Failure::Stalls),
+            };
             let g = yt - y0;
             if g.abs() <= tol * big.max(f64::MIN_POSITIVE) {
                 if l >= 0.0 {

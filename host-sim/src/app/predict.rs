@@ -739,9 +739,18 @@ pub enum LongKloss {
         /// The periodic steady state.
         steady: kloss_period::Steady,
     },
-    /// No steady state on the host's integration, or none at all: the mean load is at or
-    /// beyond the curve's breakdown torque (`|M1| ≥ M_m`), no speed carries it.
+    /// No steady state at all: the mean load is at or beyond the curve's breakdown torque
+    /// (`|M1| ≥ M_m`), no speed carries it.
     MeanLoad,
+    /// No steady state on the host's integration over the period: the drive falls to
+    /// standstill from above every periodic solution, it stalls under the peak load (more
+    /// flywheel can help).
+    Stalls {
+        /// The period.
+        period: kloss_period::Period,
+        /// `ω̄²`, the square of the speed that carries the mean load, s⁻².
+        u_mean: f64,
+    },
     /// Predicted through the parabola at the operating point (approximate): why.
     Approximate(Approximation),
 }
@@ -785,6 +794,10 @@ pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
     Some(match drive.solve(&period, Some(model.omega_squared(0.0))) {
         Ok(steady) => LongKloss::Integrated { period, steady },
         Err(kloss_period::Failure::MeanLoad) => LongKloss::MeanLoad,
+        Err(kloss_period::Failure::Stalls) => LongKloss::Stalls {
+            period,
+            u_mean: model.u_mean(),
+        },
         Err(kloss_period::Failure::Steps) => LongKloss::Approximate(Approximation::TooLong(period)),
         Err(e) => LongKloss::Approximate(Approximation::Failed(period, e)),
     })
@@ -796,7 +809,7 @@ pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
 pub fn predicted_delta(model: &DriveModel) -> Option<f64> {
     match long_kloss(model) {
         Some(LongKloss::Integrated { steady, .. }) => Some(steady.delta),
-        Some(LongKloss::MeanLoad) => None,
+        Some(LongKloss::MeanLoad | LongKloss::Stalls { .. }) => None,
         Some(LongKloss::Approximate(_)) | None => model.predict().steady().map(|s| s.delta),
     }
 }
@@ -845,8 +858,9 @@ pub fn long_kloss_sensitivity(
 
 /// The extra flywheel (kg·m²) that brings the host-integrated δ of `model` to `limit` (0 if
 /// within), as the core sizes it on `Horizon::Shooting`: the upper end of a bracket of the
-/// added inertia within 1e-10 relative where δ ≤ `limit` holds. The bracket's upper end starts
-/// from δ ∝ 1/J and doubles until the limit is met; it is narrowed by regula falsi (Illinois)
+/// added inertia within 1e-10 relative where δ ≤ `limit` holds (`delta` infinite for a drive
+/// that stalls). The bracket's upper end starts from δ ∝ 1/J and doubles until the limit is
+/// met; it is narrowed by regula falsi (Illinois)
 /// on `1/δ`, nearly linear in J, then bisection where that stalls. `None` when no flywheel up
 /// to 2⁶⁰ times the inertia reaches it, or a solution fails.
 pub fn long_kloss_flywheel(
@@ -861,17 +875,25 @@ pub fn long_kloss_flywheel(
     if delta <= limit {
         return Some(0.0);
     }
-    // f(x) = 1/δ − 1/limit at J + x: negative below the answer.
+    // f(x) = 1/δ − 1/limit at J + x: negative below the answer (a stall as δ = ∞).
     let f = |x: f64| -> Option<f64> {
         let start = model
             .with_flywheel(model.flywheel() + x)
             .ok()
             .map(|m| m.omega_squared(0.0));
-        let s = drive.with_inertia(j + x).solve(period, start).ok()?;
-        Some(1.0 / s.delta - 1.0 / limit)
+        match drive.with_inertia(j + x).solve(period, start) {
+            Ok(s) => Some(1.0 / s.delta - 1.0 / limit),
+            Err(kloss_period::Failure::Stalls) => Some(-1.0 / limit),
+            Err(_) => None,
+        }
     };
     let (mut lo, mut f_lo) = (0.0, 1.0 / delta - 1.0 / limit);
-    let mut hi = j * (delta / limit - 1.0) * 1.01;
+    // From δ ∝ 1/J; a stalled drive (δ = ∞) from doubling its inertia.
+    let mut hi = if delta.is_finite() {
+        j * (delta / limit - 1.0) * 1.01
+    } else {
+        j
+    };
     let mut f_hi = f(hi)?;
     let mut doublings = 0;
     while f_hi < 0.0 {
@@ -923,7 +945,8 @@ pub fn long_kloss_flywheel(
 /// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
 /// step count. A common period too long for the core's samples is integrated on the host over
 /// the whole period (`long` is [`LongKloss::Integrated`]: [`crate::app::kloss_period`]); the
-/// note gives the period, the steps and the settling. Without a common period (no periodic
+/// note gives the period, the steps and the settling, or says that the drive stalls
+/// ([`LongKloss::Stalls`]). Without a common period (no periodic
 /// solution exists), or one beyond the host's [`kloss_period::MAX_STEPS`], the Kloss curve is
 /// replaced by the parabola through its operating point with its slope there
 /// ([`Kloss::operating_point_fit`]), the result is marked approximate (`approximate` in the
@@ -998,6 +1021,16 @@ pub fn kloss_note(
                 "the mean load is at or beyond the Kloss curve's breakdown torque M_m = {} N·m: \
                  no speed carries it",
                 k.breakdown_torque()
+            ))
+        }
+        Some(LongKloss::Stalls { period, .. }) => {
+            return Some(format!(
+                "the Kloss motor's curve, integrated on the host over the load's whole common \
+                 period, {} ({} cycles of the fastest order), falls to standstill even from \
+                 above every periodic solution (from ω_s·(1 + σ_m)): no periodic steady state \
+                 exists; `run` integrates the same curve",
+                revolutions(period),
+                period.cycles
             ))
         }
         Some(LongKloss::Approximate(Approximation::TooLong(p))) => format!(
@@ -1430,6 +1463,22 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 prediction =
                     drive_monitor::drive::Prediction::Stalls(drive_monitor::drive::Stall {
                         u_mean: 0.0,
+                        u_min: 0.0,
+                    });
+            }
+            Some(LongKloss::Stalls { period, u_mean }) => {
+                irr = drive_monitor::drive::Irregularity {
+                    omega_max: 0.0,
+                    omega_min: 0.0,
+                    delta: 2.0,
+                    steady_state: false,
+                    flywheel_for_limit: limit
+                        .and_then(|l| long_kloss_flywheel(&model, period, f64::INFINITY, l)),
+                };
+                sens = None;
+                prediction =
+                    drive_monitor::drive::Prediction::Stalls(drive_monitor::drive::Stall {
+                        u_mean: *u_mean,
                         u_min: 0.0,
                     });
             }
