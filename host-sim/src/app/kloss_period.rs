@@ -149,7 +149,7 @@ pub enum Failure {
     /// The speed falls to zero from above every periodic solution: none exists, the drive
     /// stalls under the peak load (or a Newton step's trajectory kept falling to zero).
     Stalls,
-    /// Newton's method did not converge within [`MAX_MAPS`] periods, or to a repelling
+    /// Newton's method did not converge within 12 periods, or to a repelling
     /// solution.
     NoConvergence,
 }
