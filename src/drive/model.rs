@@ -87,11 +87,15 @@ pub enum Horizon {
     /// one longer than [`MAX_SAMPLES`] samples: the extrema are `ū ± Σ R_k` of the parabola
     /// motor. For that motor it is the exact supremum over an unbounded horizon for rationally
     /// independent orders (Kronecker), and a conservative bound (δ too large, flywheel too big)
-    /// for commensurate ones. A Kloss motor has no periodic solution to shoot for here and is
-    /// predicted through its tangent parabola at synchronous speed, which is no bound for it:
-    /// at a loaded drive's slip the curve lies below the parabola and is flatter in `w = J·ω²`,
-    /// so the drive runs slower than predicted and its δ can be larger (the flywheel sized from
-    /// it too small).
+    /// for commensurate ones. A Kloss motor is not shot for here and is predicted through the
+    /// parabola it was built with: the tangent at synchronous speed
+    /// ([`KlossFit::SynchronousTangent`](crate::drive::KlossFit)) is no bound for it (at a
+    /// loaded drive's slip the curve lies below the parabola and is flatter in `w = J·ω²`, so
+    /// the drive runs slower than predicted and its δ can be larger); the host builds such a
+    /// drive with the parabola at the operating point instead
+    /// ([`Kloss::operating_point_fit`](crate::drive::Kloss::operating_point_fit),
+    /// [`Motor::kloss_with`](crate::drive::Motor::kloss_with)), right to first order in the
+    /// swing, and integrates the curve itself over a common period too long for the samples.
     Unbounded,
     /// The inertia depends on φ ([`DriveModel::with_inertia_harmonics`]): the periodic
     /// solution of eq. 1 in `w = J·ω²` over one common period of the load and inertia orders,
@@ -530,7 +534,7 @@ impl DriveModel {
 
     /// The steady state by shooting with `curve`; `Ok(false)` (the closed form stands in) for
     /// a constant inertia and load orders with no common period, where no periodic solution
-    /// exists: the tangent parabola's [`Horizon::Unbounded`] bound is used then. Out of line:
+    /// exists: the motor's parabola's [`Horizon::Unbounded`] bound is used then. Out of line:
     /// design-time code, off the parabola's path.
     #[inline(never)]
     fn shoot(&mut self, curve: Characteristic) -> Result<bool, ConfigError> {

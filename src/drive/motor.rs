@@ -6,7 +6,9 @@
 //! integrates the curve itself ([`Motor::torque`]), and so does the prediction (by shooting
 //! over one period, the `shooting` module), starting from the fitted parabola
 //! ([`Motor::model`]); the parabola alone stands in only where the load's orders have no common
-//! period (no periodic solution exists: [`Horizon::Unbounded`](crate::drive::Horizon)).
+//! period the prediction samples ([`Horizon::Unbounded`](crate::drive::Horizon)), and there the
+//! host builds the motor with the parabola at the operating point
+//! ([`Kloss::operating_point_fit`], [`Motor::kloss_with`]).
 //!
 //! ## Which branch the parabola describes
 //! With `A < 0` the parabola falls monotonically for every `ω > 0` (`dM_d/dω = 2Aω < 0`), so
@@ -137,7 +139,8 @@ pub struct Kloss {
 }
 
 /// How a Kloss curve is replaced by a parabola `A·ω² + B`: the start of the prediction's
-/// shooting, and the prediction itself only for load orders with no common period.
+/// shooting, and the prediction itself only for load orders with no common period
+/// ([`Kloss::operating_point_fit`] fits it at a given mean load instead, for that case).
 ///
 /// No parabola of this family follows the Kloss curve over its whole working branch: the
 /// Kloss slope goes from `2·M_m/(σ_m·ω_s)` at synchronous speed to 0 at breakdown, while the
@@ -232,6 +235,36 @@ impl Kloss {
         }
     }
 
+    /// The parabola through the operating point: the working-branch speed `ω̄` at which the
+    /// curve gives `mean_load` (`σ̄ = σ_m·M1/(M_m + √((M_m − M1)(M_m + M1)))`), with the curve's
+    /// slope there, `2·A·ω̄ = dM_d/dω(ω̄) = −2·M_m·σ_m·(σ_m² − σ̄²)/((σ̄² + σ_m²)²·ω_s)`, and
+    /// `B = M1 − A·ω̄²`. Its steady state has the curve's mean speed and damping to first order
+    /// in the swing, where the tangent at synchronous speed puts a loaded drive too fast (at
+    /// `M1 = 0.9·M_m`, `σ_m = 0.2`: 3.5 %). The host's prediction uses it where the load's
+    /// orders have no common period the Kloss curve can be integrated over
+    /// ([`Motor::kloss_with`]). `OutOfRange("load.mean")` when `|mean_load| ≥ M_m` (no speed
+    /// carries it) or the parabola leaves f64's normal range (`B ≤ 0`: a generating mean load
+    /// far beyond synchronous speed).
+    pub fn operating_point_fit(&self, mean_load: f64) -> Result<Parabola, ConfigError> {
+        let (ws, sm, mm) = (
+            self.synchronous_speed,
+            self.breakdown_slip,
+            self.breakdown_torque,
+        );
+        if mean_load.is_nan() || libm::fabs(mean_load) >= mm {
+            return Err(ConfigError::OutOfRange("load.mean"));
+        }
+        let root = libm::sqrt((mm - mean_load) * (mm + mean_load));
+        let sb = sm * (mean_load / (mm + root));
+        let wb = ws - ws * sb;
+        let q = sb * sb + sm * sm;
+        let neg_a = mm * sm * ((sm - sb) * (sm + sb) / q / q) / ws / wb;
+        let b = mean_load + neg_a * wb * wb;
+        Parabola::checked(neg_a, b, self.breakdown_speed(), mm)
+            .filter(|_| wb > 0.0)
+            .ok_or(ConfigError::OutOfRange("load.mean"))
+    }
+
     /// Tangent parabola at synchronous speed: `M_d(ω_s) = 0` with the Kloss slope there,
     /// `dM/dω = −2·M_m/(σ_m·ω_s)`, so `A = −M_m/(σ_m·ω_s²)` and `B = M_m/σ_m`.
     fn synchronous_tangent(&self) -> Result<Parabola, ConfigError> {
@@ -268,6 +301,17 @@ impl Motor {
             kloss: Some(k),
             model: k.fit(fit)?,
         })
+    }
+
+    /// A motor with a Kloss characteristic and a parabola of the caller's (one from
+    /// [`Kloss::operating_point_fit`]): what [`Motor::kloss`] builds, with `model` in place of
+    /// the fit's parabola (the shooting's start, and the prediction where the load's orders
+    /// have no common period).
+    pub fn kloss_with(k: Kloss, model: Parabola) -> Self {
+        Self {
+            kloss: Some(k),
+            model,
+        }
     }
 
     /// Drive torque at speed `omega` (rad/s) of the real characteristic (Kloss if the motor
@@ -422,6 +466,40 @@ mod tests {
             assert!((rb - 1.0 / (2.0 - sm)).abs() < 1e-4, "{rb}");
             assert!((rt - 1.0).abs() < 1e-4, "{rt}");
         }
+    }
+
+    #[test]
+    fn operating_point_fit_matches_the_curve_there() {
+        let k = Kloss::new(157.08, 0.2, 100.0).unwrap();
+        for m1 in [-60.0, 0.0, 30.0, 90.0, 99.0] {
+            let p = k.operating_point_fit(m1).unwrap();
+            // The parabola's speed for M1 is where the curve gives M1, with the curve's slope.
+            let w = libm::sqrt((p.b() - m1) / -p.a());
+            assert!(
+                (k.torque(w) - m1).abs() < 1e-9 * 100.0,
+                "{m1}: {}",
+                k.torque(w)
+            );
+            let d = 1e-4;
+            let slope = |f: &dyn Fn(f64) -> f64| (f(w + d) - f(w - d)) / (2.0 * d);
+            let (sk, sp) = (slope(&|x| k.torque(x)), slope(&|x| p.torque(x)));
+            assert!((sp / sk - 1.0).abs() < 1e-6, "{m1}: {sp} against {sk}");
+            assert_eq!(p.breakdown_torque(), 100.0);
+            assert_eq!(p.working_min_speed(), k.breakdown_speed());
+        }
+        // At M1 = 0 it is the tangent at synchronous speed.
+        let t = k.fit(KlossFit::SynchronousTangent).unwrap();
+        let z = k.operating_point_fit(0.0).unwrap();
+        assert!((z.a() / t.a() - 1.0).abs() < 1e-12 && (z.b() / t.b() - 1.0).abs() < 1e-12);
+        for m1 in [100.0, -100.0, 150.0, f64::NAN] {
+            assert_eq!(
+                k.operating_point_fit(m1),
+                Err(ConfigError::OutOfRange("load.mean"))
+            );
+        }
+        let m = Motor::kloss_with(k, z);
+        assert_eq!(m.torque(140.0), k.torque(140.0));
+        assert_eq!(*m.model(), z);
     }
 
     #[test]

@@ -9,6 +9,7 @@ pub mod analyze;
 pub mod capture;
 pub mod check;
 pub mod emit;
+pub mod kloss_period;
 pub mod logic;
 pub mod plot;
 pub mod predict;

@@ -1,6 +1,7 @@
 //! Design-time results of a scene, computed by the core (no simulation): predicted δ and the
 //! flywheel for the limit, the support unbalances and limits, the auto-balancer's zones.
 
+use crate::app::kloss_period;
 use crate::app::scene::{BalancerKindSpec, MotorSpec, Scene, SceneError};
 use drive_monitor::balancer::{
     AutoBalancer, BalancerKind, Coupling, Machine, MachineConfig, Platform, SearchOptions,
@@ -116,8 +117,40 @@ fn constant_inertia_build(
     scene: &Scene,
     file: &Path,
 ) -> Result<Option<Result<DriveModel, ConfigError>>, SceneError> {
-    Ok(drive_parts_of(scene, file)?
-        .map(|(motor, load, inertia, flywheel)| DriveModel::new(motor, load, inertia, flywheel)))
+    Ok(
+        drive_parts_of(scene, file)?.map(|(motor, load, inertia, flywheel)| {
+            let model = DriveModel::new(motor, load, inertia, flywheel)?;
+            Ok(at_operating_point(model))
+        }),
+    )
+}
+
+/// A Kloss drive the core predicts through a parabola ([`Horizon::Unbounded`]: load orders
+/// with no common period, or one too long for its samples) rebuilt with the parabola fitted at
+/// the operating point ([`Kloss::operating_point_fit`]) in place of the tangent at synchronous
+/// speed, which puts a loaded drive too fast (3.5 % at a mean load of 0.9·M_m); the parabola is
+/// also `run`'s start. Any other drive, or one whose mean load no speed carries, as it is.
+///
+/// [`Horizon::Unbounded`]: drive_monitor::drive::Horizon::Unbounded
+fn at_operating_point(model: DriveModel) -> DriveModel {
+    let Some(k) = model.motor().kloss_curve().copied() else {
+        return model;
+    };
+    if !matches!(model.horizon(), drive_monitor::drive::Horizon::Unbounded) {
+        return model;
+    }
+    let mean =
+        crate::app::kloss_period::Drive::new(k, model.total_inertia(), model.load()).mean_load();
+    let Ok(p) = k.operating_point_fit(mean) else {
+        return model;
+    };
+    DriveModel::new(
+        Motor::kloss_with(k, p),
+        model.load().clone(),
+        model.inertia(),
+        model.flywheel(),
+    )
+    .unwrap_or(model)
 }
 
 /// What a simulation of a scene's motor-driven shaft needs: the motor, the load and the square
@@ -672,6 +705,13 @@ pub struct IrregularityOut {
     /// The steady state integrates the Kloss curve itself ([`kloss_note`]; text only).
     #[serde(skip)]
     pub kloss_curve: bool,
+    /// ω max, ω min, δ, the flywheel and the sensitivities are approximate: a Kloss motor
+    /// predicted through the parabola at its operating point, where the load's orders have no
+    /// common period or one beyond what the host integrates (`motor_note` says which and
+    /// why; [`kloss_note`]). Absent (false) where the curve itself or a parabola motor's own
+    /// characteristic is integrated.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub approximate: bool,
     /// With `[shaft] inertia_harmonics`: how the J(φ) steady state was computed (absent for a
     /// constant inertia).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -785,18 +825,239 @@ pub fn active_load_note(scene: &Scene, file: &Path) -> Option<String> {
     ))
 }
 
+/// How `predict` took a Kloss drive the core predicts through a parabola
+/// ([`drive_monitor::drive::Horizon::Unbounded`], constant inertia).
+#[derive(Debug, Clone)]
+pub enum LongKloss {
+    /// The load's orders have a common period the core does not sample (more than
+    /// [`drive_monitor::drive::MAX_SAMPLES`] samples): the curve itself integrated on the host
+    /// over the whole period ([`crate::app::kloss_period`]).
+    Integrated {
+        /// The period.
+        period: kloss_period::Period,
+        /// The periodic steady state.
+        steady: kloss_period::Steady,
+    },
+    /// No steady state at all: the mean load is at or beyond the curve's breakdown torque
+    /// (`|M1| ≥ M_m`), no speed carries it.
+    MeanLoad,
+    /// No steady state on the host's integration over the period: the drive falls to
+    /// standstill from above every periodic solution, it stalls under the peak load (more
+    /// flywheel can help).
+    Stalls {
+        /// The period.
+        period: kloss_period::Period,
+        /// `ω̄²`, the square of the speed that carries the mean load, s⁻².
+        u_mean: f64,
+    },
+    /// Predicted through the parabola at the operating point (approximate): why.
+    Approximate(Approximation),
+}
+
+/// Why a Kloss drive's steady state was not integrated.
+#[derive(Debug, Clone, Copy)]
+pub enum Approximation {
+    /// The load's orders have no common period (not rationals with denominator ≤
+    /// [`drive_monitor::drive::MAX_DENOMINATOR`]): no periodic solution exists.
+    NoCommonPeriod,
+    /// The common period needs more than [`kloss_period::MAX_STEPS`] steps.
+    TooLong(kloss_period::Period),
+    /// The host's integration over the period found no attracting steady state.
+    Failed(kloss_period::Period, kloss_period::Failure),
+}
+
+/// The host's integration of a Kloss drive the core leaves to a parabola, when it can be done
+/// ([`LongKloss`]); `None` for any other drive (a parabola motor, one the core integrates,
+/// J(φ)).
+pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
+    let k = *model.motor().kloss_curve()?;
+    if !matches!(model.horizon(), drive_monitor::drive::Horizon::Unbounded)
+        || !model.inertia_harmonics().is_empty()
+    {
+        return None;
+    }
+    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    if drive.mean_load().is_nan() || drive.mean_load().abs() >= k.breakdown_torque() {
+        return Some(LongKloss::MeanLoad);
+    }
+    let orders: Vec<f64> = model
+        .load()
+        .harmonics()
+        .iter()
+        .filter(|h| h.amplitude() != 0.0)
+        .map(|h| h.order())
+        .collect();
+    let Some(period) = kloss_period::common_period(&orders) else {
+        return Some(LongKloss::Approximate(Approximation::NoCommonPeriod));
+    };
+    Some(match drive.solve(&period, Some(model.omega_squared(0.0))) {
+        Ok(steady) => LongKloss::Integrated { period, steady },
+        Err(kloss_period::Failure::MeanLoad) => LongKloss::MeanLoad,
+        Err(kloss_period::Failure::Stalls) => LongKloss::Stalls {
+            period,
+            u_mean: model.u_mean(),
+        },
+        Err(kloss_period::Failure::Steps) => LongKloss::Approximate(Approximation::TooLong(period)),
+        Err(e) => LongKloss::Approximate(Approximation::Failed(period, e)),
+    })
+}
+
+/// The δ `predict` gives for `model`'s steady state (`None` without one): the core's, or for a
+/// Kloss drive the core leaves to a parabola, the host's integration over a long common period
+/// ([`long_kloss`]); `run` compares its measurement with this.
+pub fn predicted_delta(model: &DriveModel) -> Option<f64> {
+    match long_kloss(model) {
+        Some(LongKloss::Integrated { steady, .. }) => Some(steady.delta),
+        Some(LongKloss::MeanLoad | LongKloss::Stalls { .. }) => None,
+        Some(LongKloss::Approximate(_)) | None => model.predict().steady().map(|s| s.delta),
+    }
+}
+
+/// Relative step of the host's central differences (the core's).
+const SENSITIVITY_STEP: f64 = 1e-4;
+
+/// ∂δ/∂J and ∂δ/∂M_m of a drive the host integrates, by central differences with the core's
+/// relative step 1e-4 (the total inertia; the whole curve scaled with M_m), as the core does
+/// them for `Horizon::Shooting`. `None` when a stepped drive has no steady state.
+pub fn long_kloss_sensitivity(
+    model: &DriveModel,
+    period: &kloss_period::Period,
+) -> Option<drive_monitor::drive::Sensitivity> {
+    let k = *model.motor().kloss_curve()?;
+    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    // Each from the start the operating point's parabola gives the stepped drive.
+    let delta = |d: Option<kloss_period::Drive>, m: Option<DriveModel>| {
+        let start = m.map(|m| m.omega_squared(0.0));
+        d?.solve(period, start).ok().map(|s| s.delta)
+    };
+    let j = drive.inertia();
+    let h = SENSITIVITY_STEP * j;
+    let fly = |x: f64| model.with_flywheel(model.flywheel() + x).ok();
+    let d_inertia = (delta(Some(drive.with_inertia(j + h)), fly(h))?
+        - delta(Some(drive.with_inertia(j - h)), fly(-h))?)
+        / (2.0 * h);
+    let scaled = |f: f64| {
+        model
+            .motor()
+            .scaled(f)
+            .and_then(|m| model.with_motor(m).ok())
+    };
+    let d_torque = (delta(
+        drive.scaled(1.0 + SENSITIVITY_STEP),
+        scaled(1.0 + SENSITIVITY_STEP),
+    )? - delta(
+        drive.scaled(1.0 - SENSITIVITY_STEP),
+        scaled(1.0 - SENSITIVITY_STEP),
+    )?) / (2.0 * SENSITIVITY_STEP * k.breakdown_torque());
+    (d_inertia.is_finite() && d_torque.is_finite()).then_some(drive_monitor::drive::Sensitivity {
+        d_delta_d_inertia: d_inertia,
+        d_delta_d_breakdown_torque: d_torque,
+    })
+}
+
+/// The extra flywheel (kg·m²) that brings the host-integrated δ of `model` to `limit` (0 if
+/// within), as the core sizes it on `Horizon::Shooting`: the upper end of a bracket of the
+/// added inertia within 1e-10 relative where δ ≤ `limit` holds (`delta` infinite for a drive
+/// that stalls). The bracket's upper end starts from δ ∝ 1/J and doubles until the limit is
+/// met; it is narrowed by regula falsi (Illinois)
+/// on `1/δ`, nearly linear in J, then bisection where that stalls. `None` when no flywheel up
+/// to 2⁶⁰ times the inertia reaches it, or a solution fails.
+pub fn long_kloss_flywheel(
+    model: &DriveModel,
+    period: &kloss_period::Period,
+    delta: f64,
+    limit: f64,
+) -> Option<f64> {
+    let k = *model.motor().kloss_curve()?;
+    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    let j = drive.inertia();
+    if delta <= limit {
+        return Some(0.0);
+    }
+    // f(x) = 1/δ − 1/limit at J + x: negative below the answer (a stall as δ = ∞).
+    let f = |x: f64| -> Option<f64> {
+        let start = model
+            .with_flywheel(model.flywheel() + x)
+            .ok()
+            .map(|m| m.omega_squared(0.0));
+        match drive.with_inertia(j + x).solve(period, start) {
+            Ok(s) => Some(1.0 / s.delta - 1.0 / limit),
+            Err(kloss_period::Failure::Stalls) => Some(-1.0 / limit),
+            Err(_) => None,
+        }
+    };
+    let (mut lo, mut f_lo) = (0.0, 1.0 / delta - 1.0 / limit);
+    // From δ ∝ 1/J; a stalled drive (δ = ∞) from doubling its inertia.
+    let mut hi = if delta.is_finite() {
+        j * (delta / limit - 1.0) * 1.01
+    } else {
+        j
+    };
+    let mut f_hi = f(hi)?;
+    let mut doublings = 0;
+    while f_hi < 0.0 {
+        (lo, f_lo) = (hi, f_hi);
+        hi *= 2.0;
+        doublings += 1;
+        if doublings > 60 {
+            return None;
+        }
+        f_hi = f(hi)?;
+    }
+    // Illinois: the end kept twice in a row has its value halved.
+    let mut side = 0i8;
+    for _ in 0..200 {
+        if hi - lo <= 1e-10 * (j + hi) {
+            break;
+        }
+        let x = if f_hi > f_lo {
+            lo + (hi - lo) * (-f_lo / (f_hi - f_lo))
+        } else {
+            f64::NAN
+        };
+        let x = if x > lo && x < hi {
+            x
+        } else {
+            lo + (hi - lo) / 2.0
+        };
+        let fx = f(x)?;
+        if fx >= 0.0 {
+            (hi, f_hi) = (x, fx);
+            if side == 1 {
+                f_lo *= 0.5;
+            }
+            side = 1;
+        } else {
+            (lo, f_lo) = (x, fx);
+            if side == -1 {
+                f_hi *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    Some(hi)
+}
+
 /// What a Kloss motor's prediction stands on. With a common period of the load (and
 /// inertia) orders the core integrates the Kloss curve itself over one period
 /// ([`drive_monitor::drive::Horizon::Shooting`]: eq. 1 in `w = J·ω²`, sixth-order Runge–Kutta,
 /// Newton on the periodic start), the same curve `run` integrates; the note says so, with the
-/// step count. Without one (no periodic solution exists: `Horizon::Unbounded`) the Kloss curve
-/// is replaced by its tangent parabola at synchronous speed (exact there, above the curve
-/// towards breakdown), and the note says that, with the largest difference between the two
-/// over the predicted speeds `[omega_min, omega_max]` (65 points), in N·m and in % of the
-/// curve's torque there, and that this is no bound for the Kloss drive: the curve is softer
-/// at a loaded drive's slip, so the drive runs slower and its δ can be larger than predicted.
-/// `None` for a parabola motor.
-pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<String> {
+/// step count. A common period too long for the core's samples is integrated on the host over
+/// the whole period (`long` is [`LongKloss::Integrated`]: [`crate::app::kloss_period`]); the
+/// note gives the period, the steps and the settling, or says that the drive stalls
+/// ([`LongKloss::Stalls`]). Without a common period (no periodic
+/// solution exists), or one beyond the host's [`kloss_period::MAX_STEPS`], the Kloss curve is
+/// replaced by the parabola through its operating point with its slope there
+/// ([`Kloss::operating_point_fit`]), the result is marked approximate (`approximate` in the
+/// JSON), and the note says why, with the largest difference between the parabola and the
+/// curve over the predicted speeds `[omega_min, omega_max]` (65 points), in N·m and in % of the
+/// curve's torque there. `None` for a parabola motor.
+pub fn kloss_note(
+    model: &DriveModel,
+    omega_min: f64,
+    omega_max: f64,
+    long: Option<&LongKloss>,
+) -> Option<String> {
     use drive_monitor::drive::Horizon;
     let motor = model.motor();
     let k = motor.kloss_curve()?;
@@ -818,30 +1079,105 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
         }
         _ => {}
     }
-    let p = motor.model();
-    // Orders with a common period too long to sample (0.333 and 12: 1000 revolutions) were
-    // said to have none.
-    let why = match model.period_revolutions() {
-        Some(n) => format!(
-            "the load's common period, {n} revolutions, needs more than the {} samples (32 \
-             a cycle of the fastest order) the prediction integrates over, so its periodic \
-             steady state is not integrated",
-            drive_monitor::drive::MAX_SAMPLES
+    let revolutions = |p: &kloss_period::Period| {
+        if p.revolutions == p.whole_revolutions as f64 {
+            format!("{} revolutions", p.whole_revolutions)
+        } else {
+            format!(
+                "{:.3} revolutions ({} in whole revolutions)",
+                p.revolutions, p.whole_revolutions
+            )
+        }
+    };
+    let why = match long {
+        Some(LongKloss::Integrated { period, steady }) => {
+            return Some(format!(
+                "the Kloss motor is predicted with its curve itself over the load's whole common \
+                 period, {} ({} cycles of the fastest order: {} samples at 32 a cycle, more \
+                 than the core's {}): eq. 1 in w = J·ω² integrated on the host by sixth-order \
+                 Runge–Kutta on {} steps a period ({} a cycle of the fastest order), settled \
+                 over {} steps ({:.0} e-foldings of its damping) before the period, {} \
+                 period{} of Newton on the periodic start (|y(T) − y(0)| {:.1e} of the largest \
+                 |y|); `run` integrates the same curve; ∂δ/∂J and ∂δ/∂M_m by central \
+                 differences, the flywheel by bracketing",
+                revolutions(period),
+                period.cycles,
+                period
+                    .cycles
+                    .saturating_mul(drive_monitor::drive::SAMPLES_PER_CYCLE),
+                drive_monitor::drive::MAX_SAMPLES,
+                steady.steps,
+                steady.steps / period.cycles.max(1),
+                steady.settle_steps,
+                kloss_period::SETTLE_FOLDS,
+                steady.periods,
+                if steady.periods == 1 { "" } else { "s" },
+                steady.residual
+            ))
+        }
+        Some(LongKloss::MeanLoad) => {
+            return Some(format!(
+                "the mean load is at or beyond the Kloss curve's breakdown torque M_m = {} N·m: \
+                 no speed carries it",
+                k.breakdown_torque()
+            ))
+        }
+        Some(LongKloss::Stalls { period, .. }) => {
+            return Some(format!(
+                "the Kloss motor's curve, integrated on the host over the load's whole common \
+                 period, {} ({} cycles of the fastest order), falls to standstill even from \
+                 above every periodic solution (from ω_s·(1 + σ_m)): no periodic steady state \
+                 exists; `run` integrates the same curve",
+                revolutions(period),
+                period.cycles
+            ))
+        }
+        Some(LongKloss::Approximate(Approximation::TooLong(p))) => format!(
+            "the load's common period, {}, holds {} cycles of the fastest order, more than \
+             the {} steps the host integrates over, so its periodic steady state is not \
+             integrated",
+            revolutions(p),
+            p.cycles,
+            kloss_period::MAX_STEPS
         ),
-        None => "the load's orders have no common period, so no periodic steady state exists \
-                 to integrate"
+        Some(LongKloss::Approximate(Approximation::Failed(p, e))) => format!(
+            "the host's integration over the load's common period, {}, found no attracting \
+             periodic steady state ({e:?})",
+            revolutions(p)
+        ),
+        _ => "the load's orders have no common period, so no periodic steady state exists to \
+              integrate"
             .to_string(),
     };
-    let head = format!(
-        "{why}: the Kloss motor is predicted through its tangent parabola at synchronous \
-         speed (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve itself)",
-        p.a(),
-        p.b()
-    );
-    let caveat = "; this is no bound for the Kloss drive: at a loaded drive's slip the curve \
-                  lies below the parabola and is softer, so the drive runs slower than \
-                  predicted and its δ can be larger (the flywheel too small); `run` with a \
-                  `[monitor] window_revolutions` of many load cycles measures it";
+    let p = motor.model();
+    let tangent = k
+        .fit(drive_monitor::drive::KlossFit::SynchronousTangent)
+        .ok()
+        .is_some_and(|t| t == *p);
+    let head = if tangent {
+        format!(
+            "{why}: APPROXIMATE, the Kloss motor is predicted through its tangent parabola at \
+             synchronous speed (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the curve \
+             itself); this is no bound for the Kloss drive: at a loaded drive's slip the curve \
+             lies below the parabola and is softer, so the drive runs slower than predicted and \
+             its δ can be larger",
+            p.a(),
+            p.b()
+        )
+    } else {
+        format!(
+            "{why}: APPROXIMATE, the Kloss motor is predicted through the parabola with the \
+             curve's torque and slope at the operating point, the speed where the curve \
+             carries the mean load (A = {:.5e} N·m·s², B = {:.3} N·m; `run` integrates the \
+             curve itself), with the parabola's extrema ū ± Σ R_k over an unbounded horizon: \
+             the mean speed and the damping are the curve's to first order in the swing, the \
+             curve's bend over the swing is left out",
+            p.a(),
+            p.b()
+        )
+    };
+    let caveat = "; `run` with a `[monitor] window_revolutions` of many load cycles measures \
+                  the drive";
     if !(omega_min > 0.0 && omega_max >= omega_min) {
         return Some(format!("{head}{caveat}"));
     }
@@ -862,9 +1198,16 @@ pub fn kloss_note(model: &DriveModel, omega_min: f64, omega_max: f64) -> Option<
     } else {
         String::new()
     };
+    // Four decimals, or four significant digits below 0.01 N·m (the operating point's
+    // parabola stays that close to the curve over a small swing).
+    let worst = if worst.abs() >= 0.01 || worst == 0.0 {
+        format!("{worst:+.4}")
+    } else {
+        format!("{worst:+.3e}")
+    };
     Some(format!(
-        "{head}: over the predicted speeds the parabola differs from the curve by at most \
-         {worst:+.4} N·m at {at:.3} rad/s{share}{caveat}"
+        "{head}; over the predicted speeds the parabola differs from the curve by at most \
+         {worst} N·m at {at:.3} rad/s{share}{caveat}"
     ))
 }
 
@@ -1206,12 +1549,78 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
     }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
-        let irr = model
+        let mut irr = model
             .irregularity(limit)
             .map_err(|e| core_error(scene, file, "monitor", e))?;
-        let sens = model.sensitivity();
+        let mut sens = model.sensitivity();
         let sampled = sampled_delta(scene, file, &model)?;
-        let prediction = model.predict();
+        let mut prediction = model.predict();
+        // A Kloss drive the core leaves to a parabola: integrated here over a long common
+        // period, or a stall where no speed carries the mean load.
+        let long = long_kloss(&model);
+        match &long {
+            Some(LongKloss::Integrated { period, steady }) => {
+                irr = drive_monitor::drive::Irregularity {
+                    omega_max: steady.omega_max,
+                    omega_min: steady.omega_min,
+                    delta: steady.delta,
+                    steady_state: true,
+                    flywheel_for_limit: limit
+                        .and_then(|l| long_kloss_flywheel(&model, period, steady.delta, l)),
+                };
+                sens = long_kloss_sensitivity(&model, period);
+                let breakdown = model
+                    .motor()
+                    .kloss_curve()
+                    .map_or(0.0, |k| k.breakdown_speed());
+                prediction =
+                    drive_monitor::drive::Prediction::Steady(drive_monitor::drive::SteadyState {
+                        omega_max: steady.omega_max,
+                        omega_min: steady.omega_min,
+                        delta: steady.delta,
+                        omega_rms: steady.omega_rms,
+                        phi_max: Some(steady.phi_max),
+                        phi_min: Some(steady.phi_min),
+                        horizon: drive_monitor::drive::Horizon::Shooting {
+                            radians: period.radians,
+                            steps: u32::try_from(steady.steps).unwrap_or(u32::MAX),
+                        },
+                        within_working_branch: steady.omega_min >= breakdown,
+                    });
+            }
+            Some(LongKloss::MeanLoad) => {
+                irr = drive_monitor::drive::Irregularity {
+                    omega_max: 0.0,
+                    omega_min: 0.0,
+                    delta: 2.0,
+                    steady_state: false,
+                    flywheel_for_limit: None,
+                };
+                sens = None;
+                prediction =
+                    drive_monitor::drive::Prediction::Stalls(drive_monitor::drive::Stall {
+                        u_mean: 0.0,
+                        u_min: 0.0,
+                    });
+            }
+            Some(LongKloss::Stalls { period, u_mean }) => {
+                irr = drive_monitor::drive::Irregularity {
+                    omega_max: 0.0,
+                    omega_min: 0.0,
+                    delta: 2.0,
+                    steady_state: false,
+                    flywheel_for_limit: limit
+                        .and_then(|l| long_kloss_flywheel(&model, period, f64::INFINITY, l)),
+                };
+                sens = None;
+                prediction =
+                    drive_monitor::drive::Prediction::Stalls(drive_monitor::drive::Stall {
+                        u_mean: *u_mean,
+                        u_min: 0.0,
+                    });
+            }
+            Some(LongKloss::Approximate(_)) | None => {}
+        }
         let stall = match prediction {
             drive_monitor::drive::Prediction::Stalls(s)
                 if s.u_mean <= 0.0 && model.motor().kloss_curve().is_some() =>
@@ -1233,11 +1642,12 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             _ => None,
         };
         let kloss_curve = model.motor().kloss_curve().is_some()
-            && matches!(
+            && (matches!(
                 model.horizon(),
                 drive_monitor::drive::Horizon::Shooting { .. }
                     | drive_monitor::drive::Horizon::Constant
-            );
+            ) || matches!(long, Some(LongKloss::Integrated { .. })));
+        let approximate = matches!(long, Some(LongKloss::Approximate(_)));
         let working_branch_warning = prediction
             .steady()
             .filter(|s| !s.within_working_branch)
@@ -1277,10 +1687,12 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
             inertia_note: inertia_note(&model),
             kloss_curve,
+            approximate,
             motor_note: kloss_note(
                 &model,
                 irr.omega_min,
                 if irr.steady_state { irr.omega_max } else { 0.0 },
+                long.as_ref(),
             ),
             // Without a steady state the core's numbers describe the stall, not a δ.
             omega_max: irr.steady_state.then_some(irr.omega_max),

@@ -614,7 +614,10 @@ pub fn prediction_text(p: &Prediction) -> String {
         let _ = writeln!(
             s,
             "Predicted running irregularity (steady state, {})",
-            if i.kloss_curve && i.inertia_note.is_some() {
+            if i.approximate {
+                "APPROXIMATE: seed 000 eq. 11–13 with the Kloss curve's parabola at the \
+                 operating point, see the motor line"
+            } else if i.kloss_curve && i.inertia_note.is_some() {
                 "seed 000 eq. 1 with the Kloss curve and J(φ)"
             } else if i.kloss_curve {
                 "seed 000 eq. 1 with the Kloss curve"

@@ -161,7 +161,7 @@ pub struct RunReport {
     pub index_pulses: u64,
     /// Median δ of the valid steady windows after the settling time.
     pub delta_measured: Option<f64>,
-    /// δ predicted by the drive model.
+    /// δ predicted by the drive model, as `predict` gives it ([`predict::predicted_delta`]).
     pub delta_predicted: Option<f64>,
     /// The predicted δ as the core's speed samples (`encoder.estimator_edges` edges each,
     /// starting at the teeth) show it with the teeth where the scene has them (the
@@ -1662,7 +1662,7 @@ pub fn run_with(
         .as_ref()
         .filter(|_| predict::irregularity_not_predicted(scene).is_none())
     {
-        report.delta_predicted = model.predict().steady().map(|s| s.delta);
+        report.delta_predicted = predict::predicted_delta(model);
         let sampled = predict::sampled_delta(scene, file, model)?;
         report.delta_predicted_through_samples = sampled.map(|s| s.at_scene_phase);
         report.delta_predicted_through_samples_least = sampled.map(|s| s.least);
