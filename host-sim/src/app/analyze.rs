@@ -1712,6 +1712,12 @@ pub fn analyze<R: BufRead>(
         }
         None => None,
     };
+    // Only the channels read must hold levels (an analog column beside them is no data).
+    let read: Vec<usize> = [Some(ch), ich, dch.map(|(d, _)| d)]
+        .into_iter()
+        .flatten()
+        .collect();
+    reader.read_only(&read);
     let mut report = AnalyzeReport {
         format: reader.format().name(),
         channel: channels[ch].clone(),

@@ -356,6 +356,10 @@ pub struct CaptureReader<R> {
     binary: Option<Box<saleae_bin::Export>>,
     /// Values read as levels through a threshold (`--threshold`), in place of 0 and 1.
     threshold: Option<Threshold>,
+    /// Columns no channel of the analysis reads ([`CaptureReader::read_only`]): a value that
+    /// is no level there (an analog column beside the logic ones, as libsigrok writes mixed
+    /// captures) is no data, not an error.
+    unread: Vec<bool>,
     /// The precision, s, the last row's time is written to (see [`Self::time_precision`]).
     precision: f64,
     /// Where the sample rate came from, as the file or the option states it (for messages).
@@ -545,6 +549,7 @@ impl<R: BufRead> CaptureReader<R> {
             session: None,
             binary: None,
             threshold: None,
+            unread: Vec::new(),
             precision: 0.0,
             rate_source: sample_rate.map(|r| format!("--sample-rate {r}")),
         };
@@ -746,6 +751,15 @@ impl<R: BufRead> CaptureReader<R> {
         self.levels = vec![Level::Unknown; self.channels.len()];
         self.binary = Some(Box::new(export));
         Ok(self)
+    }
+
+    /// Reads only `columns` (channel numbers) as levels that must be valid: a value that is no
+    /// level in any other column (an analog column of a mixed capture, which the analysis
+    /// does not read) reads as no data instead of refusing the file.
+    pub fn read_only(&mut self, columns: &[usize]) {
+        self.unread = (0..self.channels.len())
+            .map(|k| !columns.contains(&k))
+            .collect();
     }
 
     /// Reads every channel's column as values, levels through `threshold` (an analog record:
@@ -1071,7 +1085,9 @@ impl<R: BufRead> CaptureReader<R> {
                 )));
             }
         }
-        self.channels = if labels.iter().all(|l| *l == "logic") && names.len() == labels.len() {
+        // The comment's names where they are one a column (libsigrok labels a logic column
+        // `logic` and an analog one by its unit, `V`, in the comment's order).
+        self.channels = if names.len() == labels.len() {
             names
         } else {
             labels.iter().map(|l| l.to_string()).collect()
@@ -1161,6 +1177,7 @@ impl<R: BufRead> CaptureReader<R> {
                 ("X" | "x", _) if self.format == CaptureFormat::Saleae => Level::Unknown,
                 (value, Some(th)) => match value.parse::<f64>() {
                     Ok(v) if v.is_finite() => th.level(v, self.levels[k]),
+                    _ if self.unread.get(k) == Some(&true) => Level::Unknown,
                     _ => {
                         return Err(self.err_here(&format!(
                             "`{}` in the column of channel `{}` is not a value (a finite number, \
@@ -1172,6 +1189,7 @@ impl<R: BufRead> CaptureReader<R> {
                 },
                 ("0", None) => Level::Low,
                 ("1", None) => Level::High,
+                (_, None) if self.unread.get(k) == Some(&true) => Level::Unknown,
                 (other, None) => {
                     let analog = other.parse::<f64>().is_ok_and(f64::is_finite);
                     return Err(self.err_here(&format!(
