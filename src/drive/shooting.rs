@@ -79,9 +79,11 @@ const MAX_HALVINGS: u32 = 60;
 /// Extremum candidates refined per direction, at most.
 const MAX_CANDIDATES: usize = 8;
 
-/// Butcher's sixth-order method: nodes, stage coefficients (lower triangle) and weights.
-const C: [f64; 7] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0, 0.5, 0.5, 1.0];
-const A: [[f64; 6]; 7] = [
+/// Butcher's sixth-order method: nodes, stage coefficients (lower triangle) and weights (the
+/// host's integration of a long load period takes the same, `RK6_*`).
+pub const C: [f64; 7] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0, 0.5, 0.5, 1.0];
+/// Stage coefficients of [`C`]'s method.
+pub const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [1.0 / 3.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [0.0, 2.0 / 3.0, 0.0, 0.0, 0.0, 0.0],
@@ -97,7 +99,8 @@ const A: [[f64; 6]; 7] = [
         -16.0 / 11.0,
     ],
 ];
-const B: [f64; 7] = [
+/// Weights of [`C`]'s method.
+pub const B: [f64; 7] = [
     11.0 / 120.0,
     0.0,
     27.0 / 40.0,

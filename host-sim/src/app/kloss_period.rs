@@ -58,33 +58,8 @@ const MAX_HALVINGS: u32 = 40;
 /// Golden-section iterations per refined extremum (bracket 0.618⁶⁴ ≈ 4e-14 of two steps).
 const GOLDEN_ITERATIONS: u32 = 64;
 
-/// Butcher's sixth-order method: nodes, stage coefficients (lower triangle) and weights.
-const C: [f64; 7] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0, 0.5, 0.5, 1.0];
-const A: [[f64; 6]; 7] = [
-    [0.0; 6],
-    [1.0 / 3.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [0.0, 2.0 / 3.0, 0.0, 0.0, 0.0, 0.0],
-    [1.0 / 12.0, 1.0 / 3.0, -1.0 / 12.0, 0.0, 0.0, 0.0],
-    [-1.0 / 16.0, 9.0 / 8.0, -3.0 / 16.0, -3.0 / 8.0, 0.0, 0.0],
-    [0.0, 9.0 / 8.0, -3.0 / 8.0, -3.0 / 4.0, 0.5, 0.0],
-    [
-        9.0 / 44.0,
-        -9.0 / 11.0,
-        63.0 / 44.0,
-        18.0 / 11.0,
-        0.0,
-        -16.0 / 11.0,
-    ],
-];
-const B: [f64; 7] = [
-    11.0 / 120.0,
-    0.0,
-    27.0 / 40.0,
-    27.0 / 40.0,
-    -4.0 / 15.0,
-    -4.0 / 15.0,
-    11.0 / 120.0,
-];
+// Butcher's sixth-order method, as the core's shooting integrates with it.
+use drive_monitor::drive::{RK6_A as A, RK6_B as B, RK6_C as C};
 
 /// The common period of a load's oscillating orders.
 #[derive(Debug, Clone, Copy, PartialEq)]
