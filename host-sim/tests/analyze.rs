@@ -5197,3 +5197,31 @@ fn a_mixed_capture_is_read_on_its_logic_channel() {
         "{e}"
     );
 }
+
+/// A 36-2 wheel at 150 rad/s under `--min-speed 200`: the no-sync hint gave the slowest speed
+/// seen as 50 rad/s when the capture started in the gap, its first interval (three pitches,
+/// no neighbour before it) read as one pitch. Judged against the interval after it, the
+/// slowest speed is the shaft's.
+#[test]
+fn a_capture_starting_in_a_gap_gives_the_shafts_slowest_speed() {
+    // The teeth from the one before the first gap: the first interval spans the gap.
+    let teeth: Vec<f64> = wheel_teeth(36, 2, 150.0, 0.3)
+        .into_iter()
+        .skip(33)
+        .collect();
+    assert!((teeth[1] - teeth[0]) / (teeth[2] - teeth[1]) > 2.9);
+    let text = saleae_of_rising(&teeth, 1e9, 0.301);
+    let cfg = configure(&AnalyzeOptions {
+        wheel: Some("36-2".into()),
+        min_speed: Some(200.0),
+        ..AnalyzeOptions::default()
+    })
+    .unwrap();
+    let mut r = text_reader(text, "g.csv", Some(1e9)).unwrap();
+    let report = analyze(&mut r, &cfg, &mut |_| {}).unwrap();
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("the slowest speed seen is about 150.000 rad/s"),
+        "{said}"
+    );
+}

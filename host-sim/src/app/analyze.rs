@@ -943,10 +943,24 @@ struct Intervals {
     short: u64,
     ringing: u64,
     longest_ring: f64,
+    /// The configured wheel's longest gap, in pitches (as `capture` was last given it).
+    longest: f64,
     /// Of the short intervals, those under [`BOUNCE_RATIO`] of their neighbours, with the
     /// longest of them, s (the test of the polarity not read).
     bounces: u64,
     longest_bounce: f64,
+}
+
+/// The pitches an interval `b` spans judged against one neighbour `a` alone: as many as its
+/// ratio rounds to where it is a long one ([`LONG_RATIO`]), up to the wheel's `longest` gap;
+/// else one.
+fn pitches_against(b: f64, a: f64, longest: f64) -> f64 {
+    let ratio = b / a;
+    if ratio > LONG_RATIO {
+        ratio.round().clamp(1.0, longest.max(1.0))
+    } else {
+        1.0
+    }
 }
 
 /// An interval less than this many times the geometric mean of its two neighbours is an edge
@@ -981,16 +995,20 @@ impl Intervals {
         (self.long_before, self.short_middle) = (false, false);
     }
 
-    /// The newest interval, never judged against a next one: taken as one pitch.
+    /// The newest interval, never judged against a next one: against the one before it.
     fn finish(&mut self) {
         if let Some(b) = self.middle {
-            self.slowest_pitch = self.slowest_pitch.max(b);
+            let pitches = self
+                .before
+                .map_or(1.0, |a| pitches_against(b, a, self.longest));
+            self.slowest_pitch = self.slowest_pitch.max(b / pitches);
         }
     }
 
     /// A forward capture at `t`: with `timeout` (s) and `longest` (the configured wheel's
     /// longest gap, in pitches).
     fn capture(&mut self, t: f64, timeout: f64, longest: f64) {
+        self.longest = longest;
         let Some(t0) = self.last.replace(t) else {
             return;
         };
@@ -1046,8 +1064,12 @@ impl Intervals {
                 }
                 self.slowest_pitch = self.slowest_pitch.max(b / pitches);
             }
-            // The first interval has no neighbour before it: one pitch.
-            (None, Some(b)) => self.slowest_pitch = self.slowest_pitch.max(b),
+            // The first interval has no neighbour before it: judged against the one after (a
+            // capture that starts in a gap had its 3 pitches read as one, the shaft 3 times
+            // slower than it ran).
+            (None, Some(b)) => {
+                self.slowest_pitch = self.slowest_pitch.max(b / pitches_against(b, i, longest));
+            }
             _ => {}
         }
         (self.before, self.middle) = (self.middle, Some(i));
