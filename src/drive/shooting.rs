@@ -80,10 +80,10 @@ const MAX_HALVINGS: u32 = 60;
 const MAX_CANDIDATES: usize = 8;
 
 /// Butcher's sixth-order method: nodes, stage coefficients (lower triangle) and weights (the
-/// host's integration of a long load period takes the same, `RK6_*`).
+/// host's integration of a long load period steps with it too: [`rk6_step`], `RK6_C`).
 pub const C: [f64; 7] = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0, 0.5, 0.5, 1.0];
 /// Stage coefficients of [`C`]'s method.
-pub const A: [[f64; 6]; 7] = [
+const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [1.0 / 3.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [0.0, 2.0 / 3.0, 0.0, 0.0, 0.0, 0.0],
@@ -100,7 +100,7 @@ pub const A: [[f64; 6]; 7] = [
     ],
 ];
 /// Weights of [`C`]'s method.
-pub const B: [f64; 7] = [
+const B: [f64; 7] = [
     11.0 / 120.0,
     0.0,
     27.0 / 40.0,
@@ -109,6 +109,34 @@ pub const B: [f64; 7] = [
     -4.0 / 15.0,
     11.0 / 120.0,
 ];
+
+/// One step of length `h` of Butcher's sixth-order method from `y`: `stage(i, y)` gives the
+/// slope at stage `i` (at `C[i]` of the step, [`RK6_C`](crate::drive::RK6_C)) and state `y`,
+/// with its derivative in `y`. Returns `y` after the step and the step's increment of
+/// `∫∂F/∂y`; the first error `stage` gives ends the step.
+pub fn rk6_step<E>(
+    y: f64,
+    h: f64,
+    mut stage: impl FnMut(usize, f64) -> Result<(f64, f64), E>,
+) -> Result<(f64, f64), E> {
+    let mut k = [0.0f64; 7];
+    let mut l = [0.0f64; 7];
+    for i in 0..7 {
+        let mut acc = 0.0;
+        for j in 0..i {
+            acc += A[i][j] * k[j];
+        }
+        let (f, df) = stage(i, y + h * acc)?;
+        k[i] = f;
+        l[i] = df;
+    }
+    let (mut dy, mut dl) = (0.0, 0.0);
+    for i in 0..7 {
+        dy += B[i] * k[i];
+        dl += B[i] * l[i];
+    }
+    Ok((y + h * dy, h * dl))
+}
 
 /// The motor characteristic the shooting integrates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -375,23 +403,7 @@ impl<'a> Shooter<'a> {
     /// One Runge–Kutta step of length `h` from `(phi, y)`: `y` after it and the increment of
     /// `L = ∫∂F/∂y`.
     fn step(&self, phi: f64, y: f64, h: f64) -> Result<(f64, f64), Stalled> {
-        let mut k = [0.0f64; 7];
-        let mut l = [0.0f64; 7];
-        for i in 0..7 {
-            let mut acc = 0.0;
-            for j in 0..i {
-                acc += A[i][j] * k[j];
-            }
-            let (f, df) = self.rhs(phi + C[i] * h, y + h * acc)?;
-            k[i] = f;
-            l[i] = df;
-        }
-        let (mut dy, mut dl) = (0.0, 0.0);
-        for i in 0..7 {
-            dy += B[i] * k[i];
-            dl += B[i] * l[i];
-        }
-        Ok((y + h * dy, h * dl))
+        rk6_step(y, h, |i, y| self.rhs(phi + C[i] * h, y))
     }
 
     fn node(&self, j: u32) -> f64 {

@@ -59,7 +59,7 @@ const MAX_HALVINGS: u32 = 40;
 const GOLDEN_ITERATIONS: u32 = 64;
 
 // Butcher's sixth-order method, as the core's shooting integrates with it.
-use drive_monitor::drive::{RK6_A as A, RK6_B as B, RK6_C as C};
+use drive_monitor::drive::{rk6_step, RK6_C as C};
 
 /// The common period of a load's oscillating orders.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -400,23 +400,7 @@ impl<'a> Setup<'a> {
     /// One step of length `h` from `(phi, y)`: `y` after it and the increment of `L`.
     fn step(&self, phi: f64, y: f64, h: f64) -> Result<(f64, f64), Stalled> {
         let mc = self.load_at_stages(phi, h);
-        let mut k = [0.0f64; 7];
-        let mut l = [0.0f64; 7];
-        for i in 0..7 {
-            let mut acc = 0.0;
-            for jj in 0..i {
-                acc += A[i][jj] * k[jj];
-            }
-            let (f, df) = self.rhs(mc[i], y + h * acc)?;
-            k[i] = f;
-            l[i] = df;
-        }
-        let (mut dy, mut dl) = (0.0, 0.0);
-        for i in 0..7 {
-            dy += B[i] * k[i];
-            dl += B[i] * l[i];
-        }
-        Ok((y + h * dy, h * dl))
+        rk6_step(y, h, |i, y| self.rhs(mc[i], y))
     }
 
     /// Node `j` (`j` may exceed the step count: the next period).
