@@ -2808,6 +2808,37 @@ mod tests {
     }
 
     #[test]
+    fn ringing_after_every_tooth_counts_extra_edges_not_lost_teeth() {
+        // A 360-line unframed disc at 150 rad/s (pitch 116 µs), every line followed by a
+        // second edge 4 µs later: read on the polarity that rings. A lost tooth's interval is
+        // judged against the one interval since a new reference, here the ringing's 4 µs, so
+        // every real tooth after a ringing one looked like a run of 28 lost teeth.
+        let lines = 360u16;
+        let hz = 84e6;
+        let pitch = core::f64::consts::TAU / f64::from(lines) / 150.0;
+        let teeth = 8 * u32::from(lines);
+        let mut evs = Vec::new();
+        for i in 0..teeth {
+            let t = 0.001 + f64::from(i) * pitch;
+            evs.push(Ev::Edge((t * hz) as u32));
+            evs.push(Ev::Edge(((t + 4e-6) * hz) as u32));
+        }
+        let mut c = EncoderConfig::unframed(lines, hz);
+        c.min_speed = 20.0;
+        let mut m = monitor(c, 2);
+        let out = run(&mut m, &evs);
+        let d = m.diagnostics().edges;
+        // No window is valid, and no count exceeds the edges there were: one extra edge for
+        // at most every ringing one, no tooth lost.
+        assert!(out.iter().all(|o| !o.report.valid()), "{out:?}");
+        assert_eq!(d.missing, 0, "{d:?}");
+        assert!(
+            d.extra + d.glitches >= teeth / 2 && d.extra + d.glitches <= teeth,
+            "{d:?}"
+        );
+    }
+
+    #[test]
     fn faults_invalidate_windows_with_their_reason() {
         let base = stream(&uniform(256), Some(0.0), 40, 84e6, u32::MAX, &kneader(0.01));
         let edges: Vec<usize> = (0..base.len())

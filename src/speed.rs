@@ -620,7 +620,9 @@ enum Verdict {
     /// Not enough edges yet to judge.
     Wait,
     /// An interval longer than any two lost teeth explain (a run of captures lost, e.g. a DMA
-    /// ring overrun), `n` teeth lost: a new time reference, the count given up.
+    /// ring overrun), `n` teeth lost: a new time reference, the count given up. `n` = 0: the
+    /// edge before was an extra one (the interval judged against was the only one since a
+    /// new time reference or a fault).
     Dropout(u16),
 }
 
@@ -1369,7 +1371,14 @@ impl SpeedTracker {
             // makes pitches no count of teeth (two lost before a 36-2 wheel's gap read as
             // four, and the sync lost). Lost: as many as the last interval fits in it, less
             // this edge.
-            return Verdict::Dropout((x / r as f32 - 0.5) as u16);
+            // Against the only interval since a new time reference or a fault (the ring
+            // holds one), no count: that interval is as likely an extra edge's (ringing just
+            // after a tooth) as the teeth are lost, and is counted so, one extra edge (a
+            // 360-line disc ringing on the polarity read counted 27 teeth lost a tooth,
+            // 78 400 in a capture of 5 762 edges). The ring's fill, not a flag of its own:
+            // 16 bytes of code, a flag 24.
+            let lost = (x / r as f32 - 0.5) as u16;
+            return Verdict::Dropout(lost.wrapping_mul(u16::from(self.fill != 1)));
         }
         if !synced && enc.framing() == Framing::Pattern {
             // Unsynced on a pattern wheel the expected pitch is unknown: take every edge that

@@ -4817,10 +4817,11 @@ fn edge_jitter_is_estimated_and_noted() {
     assert_eq!(analyzed(&times(0.0)).edge_scatter, None);
 }
 
-/// The core counts the teeth an interval lost by how many of the last interval it took fit
-/// in it: after ringing edges taken as teeth it counted 78 400 missing edges among 5 762
-/// captures, printed as a fact about the wheel. More missing edges than captures are now said
-/// to be the core's judgement; a count within the captures is printed as it was.
+/// The core counts the teeth a long interval lost by how many of the interval it judged
+/// before fit in it (a run of teeth lost, e.g. a sensor's dropout): more missing edges than
+/// captures are said to be the core's judgement; a count within the captures is printed as it
+/// was. (Ringing read on the polarity that rings once counted 78 400 missing edges among 5 762
+/// captures that way; the core now counts extra edges there: `monitor::tests::ringing_after_every_tooth_counts_extra_edges_not_lost_teeth`.)
 #[test]
 fn more_missing_edges_than_captures_are_said_to_be_a_judgement() {
     let said = |missing: u32, captured: u64| {

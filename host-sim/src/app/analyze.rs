@@ -3258,8 +3258,8 @@ pub fn text(r: &AnalyzeReport) -> String {
             "WARNING: `{}` rings: {} of its {} captured edges came within {:.3e} s of the edge \
              before (a tenth of the intervals beside them or less): the signal crosses the \
              threshold again at a transition (ringing, or a contact's bounce), and each crossing \
-             is an edge; the core rejects them as glitches, but a window holding a glitch is \
-             invalid. The edges of the other polarity are no cure: a crossing back is one of \
+             is an edge; the core rejects them as glitches or counts them as extra edges, but a \
+             window holding either is invalid. The edges of the other polarity are no cure: a crossing back is one of \
              them. Filter the crossings out before the edges are timed (analyze takes the edges \
              as recorded): a Schmitt-trigger input or the sensor's own hysteresis on the line, \
              or the capture timer's input filter, which takes a level only once it has held \
@@ -3549,14 +3549,14 @@ pub fn text(r: &AnalyzeReport) -> String {
         r.glitches, r.missing, r.extra, r.missing_frames, r.reversals, r.timeouts, r.unexplained
     );
     if u64::from(r.missing) > r.captured {
-        // The core counts the teeth an interval lost as the interval over the last it took:
-        // after an edge just after another taken as a tooth (ringing), dozens each.
+        // The core counts the teeth a long interval lost as how many of the last interval
+        // it judged fit in it (after the only interval since a new reference it counts an
+        // extra edge instead: ringing read 27 lost teeth a tooth that way).
         let _ = writeln!(
             s,
-            "  (more missing edges than the {} captured: the core counts the teeth lost in an \
-             interval as how many of the last interval it took fit in it, and after a very short \
-             one, as of an edge just after another, that is many; a count of the core's \
-             judgement, not of the wheel's teeth)",
+            "  (more missing edges than the {} captured: the core counts the teeth lost in a \
+             long interval as how many of the interval it judged before fit in it; a count of \
+             the core's judgement, not of edges seen)",
             r.captured
         );
     }
