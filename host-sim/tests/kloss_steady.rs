@@ -1021,3 +1021,36 @@ fn varying_inertia_on_the_host_agrees_with_the_core() {
         assert!(rel.iter().all(|r| r.abs() < 1e-9), "case {c}: {rel:?}");
     }
 }
+
+/// With J(φ) at order 2 the period is 1000 revolutions, 12 000 cycles of order 12: integrated
+/// on the host (384 000 steps), but its time table for the speed samples would take 6.1 M
+/// values of ω, more than the 4 M `sampled` holds; `predict` gives δ and says in a NOTE why δ
+/// through the samples is not given (none in the JSON), rather than leaving it out silently.
+#[test]
+fn samples_too_many_to_tabulate_are_not_given_and_the_report_says_why() {
+    let path = std::path::Path::new("t1.toml");
+    let text = "[shaft]\ninertia = 0.5\n\
+                inertia_harmonics = [{ order = 2.0, amplitude = 0.01, phase = 0.3 }]\n\
+                [motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+                breakdown_slip = 0.2\nbreakdown_torque = 100.0\n[load]\nmean = 90.0\n\
+                harmonics = [{ order = 0.333, amplitude = 10.0, phase = 0.0 }, \
+                { order = 12.0, amplitude = 5.0, phase = 1.0 }]\n\
+                [encoder]\nlines = 60\nestimator_edges = 8\ntimer_hz = 84e6\n";
+    let scene = host_sim::app::scene::Scene::parse(text, path).unwrap();
+    let p = host_sim::app::predict::predict(&scene, path).unwrap();
+    let i = p.irregularity.clone().unwrap();
+    assert!(i.steady_state && i.delta.is_some() && !i.approximate);
+    assert!(i
+        .motor_note
+        .as_deref()
+        .unwrap()
+        .contains("1000 revolutions (12000 cycles of the fastest order"));
+    assert_eq!(i.delta_through_samples, None);
+    let note = i.sampling_note.as_deref().unwrap();
+    assert!(
+        note.contains("not given") && note.contains("4194304"),
+        "{note}"
+    );
+    let text = host_sim::app::report::prediction_text(&p);
+    assert!(text.contains(note), "{text}");
+}

@@ -1062,20 +1062,11 @@ pub fn long_kloss_time(
         .into_iter()
         .map(f64::abs)
         .fold(0.0f64, f64::max);
-    // The table spans the period, or the whole revolutions where it does not divide them.
-    let span = if ((period.whole_revolutions as f64 / period.revolutions).round()
-        - period.whole_revolutions as f64 / period.revolutions)
-        .abs()
-        <= 1e-9 * period.whole_revolutions as f64
-    {
-        period.radians
-    } else {
-        std::f64::consts::TAU * period.whole_revolutions as f64
-    };
-    if SteadyTime::points(span, fastest).is_none() {
+    // The period, Q/G revolutions, divides the whole revolutions Q: the table spans it.
+    if SteadyTime::points(period.radians, fastest).is_none() {
         return Err(format!(
-            "the time over the load's period, {} cycles of its fastest order at 512 values of \
-             ω a cycle, would take more than the {MAX_SAMPLED_POINTS} values the table holds",
+            "the time over the period, {} cycles of its fastest order at 512 values of ω a \
+             cycle, would take more than the {MAX_SAMPLED_POINTS} values the table holds",
             period.cycles
         ));
     }
