@@ -1054,3 +1054,59 @@ fn samples_too_many_to_tabulate_are_not_given_and_the_report_says_why() {
     let text = host_sim::app::report::prediction_text(&p);
     assert!(text.contains(note), "{text}");
 }
+
+/// T1's drive with a constant inertia (orders 0.333 and 12, the host's integration over
+/// 1000/3 revolutions), now with a 60-line disc and 8-edge speed samples: `predict` gives their
+/// δ (before, none on the host's path), with the teeth where the scene has them within 1e-8
+/// relative of the direct DOP853 integration's pitch times (measured 6.4e-11; δ 0.006429
+/// read as 0.006335), between the least and the most over the teeth's phase.
+#[test]
+fn the_speed_samples_of_a_long_period_match_a_direct_integration() {
+    let path = std::path::Path::new("t1.toml");
+    let scene = t1_scene(
+        "0.333",
+        "[encoder]\nlines = 60\nestimator_edges = 8\ntimer_hz = 84e6\n",
+    );
+    let i = host_sim::app::predict::predict(&scene, path)
+        .unwrap()
+        .irregularity
+        .unwrap();
+    let at = i.delta_through_samples_at_scene_phase.unwrap();
+    let (least, most) = (
+        i.delta_through_samples_least.unwrap(),
+        i.delta_through_samples.unwrap(),
+    );
+    assert_eq!(i.sampling_note, None);
+    let mut d = VaryingDrive {
+        kloss: Kloss::new(157.08, 0.2, 100.0).unwrap(),
+        j0: 0.5,
+        inertia: Vec::new(),
+        load: Load::new(
+            90.0,
+            &[
+                Harmonic::new(0.333, 10.0, 0.0).unwrap(),
+                Harmonic::new(12.0, 5.0, 1.0).unwrap(),
+            ],
+        )
+        .unwrap(),
+        offset: 0.0,
+    };
+    let polys = direct_steps(&mut d, TAU * 1000.0, 2.0, 137.4);
+    let times = pitch_times(&d, &polys, TAU / 60.0, 60_000);
+    let (mut vmax, mut vmin) = (f64::NEG_INFINITY, f64::INFINITY);
+    for g in 0..times.len() {
+        let t: f64 = (0..8).map(|k| times[(g + k) % times.len()]).sum();
+        let v = 8.0 * (TAU / 60.0) / t;
+        vmax = vmax.max(v);
+        vmin = vmin.min(v);
+    }
+    let direct = delta_of((vmax, vmin));
+    eprintln!(
+        "δ {:.9} through 8-edge samples {at:.12} against {direct:.12} ({:.1e}); least \
+         {least:.9}, most {most:.9}",
+        i.delta.unwrap(),
+        at / direct - 1.0
+    );
+    assert!((at / direct - 1.0).abs() < 1e-8, "{at} against {direct}");
+    assert!(least <= at && at <= most && most < i.delta.unwrap());
+}
