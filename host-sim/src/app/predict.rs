@@ -33,7 +33,8 @@ pub fn core_error(scene: &Scene, file: &Path, section: &str, e: ConfigError) -> 
 /// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
 /// or without a `[load]`), with J(φ) from `[shaft] inertia_harmonics`. Where the core does
 /// not predict that J(φ) ([`irregularity_not_predicted`] says why) the model has the constant
-/// inertia, for what does not depend on it (the motor, the mean of ω²).
+/// inertia, for what does not depend on it (the motor, the mean of ω²); so does a Kloss drive
+/// whose J(φ) the host integrates instead ([`long_period_inertia`], [`long_kloss`]).
 pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
     let Some(base) = constant_inertia_model(scene, file)? else {
         return Ok(None);
@@ -917,7 +918,9 @@ pub fn active_load_note(scene: &Scene, file: &Path) -> Option<String> {
 }
 
 /// How `predict` took a Kloss drive the core predicts through a parabola
-/// ([`drive_monitor::drive::Horizon::Unbounded`], constant inertia).
+/// ([`drive_monitor::drive::Horizon::Unbounded`], constant inertia), or whose J(φ) it refuses
+/// for a common period of the load and inertia orders too long for its shooting
+/// ([`long_period_inertia`]).
 #[derive(Debug, Clone)]
 pub enum LongKloss {
     /// The load's orders have a common period the core does not sample (more than
@@ -1741,7 +1744,9 @@ impl Prediction {
 /// out (its ½·ω²·dJ/dφ term alone makes ω swing), so none is given; `run` simulates the drive.
 /// A Kloss drive the core refuses is named here too: one so stiff against its inertia that a
 /// period needs more than [`drive_monitor::drive::MAX_STEPS`] steps, or one with no attracting
-/// periodic steady state found.
+/// periodic steady state found. A Kloss drive's J(φ) that the core refuses only for a common
+/// period too long for its shooting is integrated on the host ([`long_period_inertia`]) and is
+/// not named here.
 pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
     let base = match constant_inertia_build(scene, Path::new("scene")).ok()?? {
         Ok(base) => base,
