@@ -816,8 +816,10 @@ fn pitch_times(
 /// 1e-11 relative, δ within 1e-9 (measured 2.6e-14, 4.3e-14 and 2.6e-12, δ = 0.026346602944);
 /// the speed samples with the teeth where the scene has them read δ 0.021462 by `predict` and
 /// by the direct integration's pitch times within 1e-8 relative (measured 1.3e-10), between the
-/// least and most over the teeth's phase; `run`'s report predicts the same figures. The
-/// flywheel for δ ≤ 0.004 meets the limit by the direct integration and 1e-4 less does not.
+/// least and most over the teeth's phase; `run`'s report predicts the same figures. ∂δ/∂J
+/// (on the constant part of J) and ∂δ/∂M_m within 1e-5 relative of central differences of the
+/// direct integration (measured 3.3e-8 and 6.4e-7). The flywheel for δ ≤ 0.004 (2.7954
+/// kg·m²) meets the limit by the direct integration and 1e-4 less does not.
 #[test]
 fn a_long_period_with_varying_inertia_is_integrated_on_the_host() {
     let path = std::path::Path::new("t1.toml");
@@ -925,11 +927,28 @@ fn a_long_period_with_varying_inertia_is_integrated_on_the_host() {
     assert_eq!(s_run.map(|s| s.at_scene_phase), Some(at));
     // The flywheel for δ ≤ 0.004 on the constant part of J.
     let flywheel = i.flywheel_for_limit.unwrap().unwrap();
-    let at_j = |j0: f64| {
+    let at_scaled = |j0: f64, scale: f64| {
         let mut d = drive(j0);
+        d.kloss = Kloss::new(157.08, 0.2, 100.0 * scale).unwrap();
         let polys = direct_steps(&mut d, period, 3.0, 137.4);
         delta_of(direct_varying_extremes(&d, &polys))
     };
+    let at_j = |j0: f64| at_scaled(j0, 1.0);
+    // Sensitivities against central differences of the direct integration.
+    let d_j = (at_j(0.5001) - at_j(0.4999)) / 2e-4;
+    let d_m = (at_scaled(0.5, 1.0002) - at_scaled(0.5, 0.9998)) / 0.04;
+    let (pj, pm) = (
+        i.d_delta_d_inertia.unwrap(),
+        i.d_delta_d_breakdown_torque.unwrap(),
+    );
+    eprintln!(
+        "∂δ/∂J {pj:.6e} against {d_j:.6e} ({:.1e}), ∂δ/∂M_m {pm:.6e} against {d_m:.6e} \
+         ({:.1e})",
+        pj / d_j - 1.0,
+        pm / d_m - 1.0
+    );
+    assert!((pj / d_j - 1.0).abs() < 1e-5, "{pj} against {d_j}");
+    assert!((pm / d_m - 1.0).abs() < 1e-5, "{pm} against {d_m}");
     let with = at_j(0.5 + flywheel);
     let short = at_j(0.5 + flywheel * (1.0 - 1e-4));
     eprintln!("flywheel {flywheel:.6}: δ {with:.9}, with 1e-4 less {short:.9}");
