@@ -1129,3 +1129,65 @@ fn the_speed_samples_of_a_long_period_match_a_direct_integration() {
     assert!((at / direct - 1.0).abs() < 1e-8, "{at} against {direct}");
     assert!(least <= at && at <= most && most < i.delta.unwrap());
 }
+
+/// Load orders 1 and 6 repeat every revolution, and the core shoots the drive with the constant
+/// part of J; J(φ) at order 0.333 makes the common period 1000 revolutions (6000 cycles of
+/// order 6), which the core refuses for its J(φ): `predict` integrates it on the host (not the
+/// constant part's δ 0.002229 the core gives), within 1e-9 of a direct DOP853 integration of
+/// eq. 1 with J(φ) (measured δ 0.042109, 6.8e-13; ω 3.6e-14).
+#[test]
+fn an_inertia_order_that_makes_the_period_long_is_integrated_on_the_host() {
+    let path = std::path::Path::new("t1.toml");
+    let text = "[shaft]\ninertia = 0.5\n\
+                inertia_harmonics = [{ order = 0.333, amplitude = 0.02, phase = 0.3 }]\n\
+                [motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+                breakdown_slip = 0.2\nbreakdown_torque = 100.0\n[load]\nmean = 90.0\n\
+                harmonics = [{ order = 1.0, amplitude = 10.0, phase = 0.0 }, \
+                { order = 6.0, amplitude = 5.0, phase = 1.0 }]\n";
+    let scene = host_sim::app::scene::Scene::parse(text, path).unwrap();
+    let base = host_sim::app::predict::drive_model(&scene, path)
+        .unwrap()
+        .unwrap();
+    assert!(matches!(base.horizon(), Horizon::Shooting { .. }));
+    let constant = base.predict().steady().unwrap().delta;
+    let i = host_sim::app::predict::predict(&scene, path)
+        .unwrap()
+        .irregularity
+        .unwrap();
+    assert!(i.steady_state && !i.approximate);
+    let note = i.motor_note.unwrap();
+    assert!(
+        note.contains("whole common period, 1000 revolutions (6000 cycles of the fastest order"),
+        "{note}"
+    );
+    let (hi, lo, delta) = (i.omega_max.unwrap(), i.omega_min.unwrap(), i.delta.unwrap());
+    let mut d = VaryingDrive {
+        kloss: Kloss::new(157.08, 0.2, 100.0).unwrap(),
+        j0: 0.5,
+        inertia: vec![InertiaHarmonic::new(0.333, 0.02, 0.3).unwrap()],
+        load: Load::new(
+            90.0,
+            &[
+                Harmonic::new(1.0, 10.0, 0.0).unwrap(),
+                Harmonic::new(6.0, 5.0, 1.0).unwrap(),
+            ],
+        )
+        .unwrap(),
+        offset: 0.0,
+    };
+    let polys = direct_steps(&mut d, TAU * 1000.0, 2.0, 137.4);
+    let (dh, dl) = direct_varying_extremes(&d, &polys);
+    let reference = delta_of((dh, dl));
+    eprintln!(
+        "δ {delta:.12} against {reference:.12} ({:.1e}), ω {:.1e} {:.1e}; constant part {constant:.6}",
+        delta / reference - 1.0,
+        hi / dh - 1.0,
+        lo / dl - 1.0
+    );
+    assert!((hi / dh - 1.0).abs() < 1e-11 && (lo / dl - 1.0).abs() < 1e-11);
+    assert!(
+        (delta / reference - 1.0).abs() < 1e-9,
+        "{delta} against {reference}"
+    );
+    assert!(delta > 10.0 * constant);
+}
