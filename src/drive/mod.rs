@@ -24,5 +24,5 @@ pub use model::{
     SAMPLES_PER_CYCLE,
 };
 pub use motor::{Kloss, KlossFit, Motor, Parabola};
-pub use shooting::{rk6_step, C as RK6_C, MAX_STEPS};
+pub use shooting::{inertia_and_slope, rk6_step, C as RK6_C, MAX_STEPS};
 pub use varying::{InertiaHarmonic, MAX_INERTIA_HARMONICS, MAX_NODES};

@@ -138,6 +138,19 @@ pub fn rk6_step<E>(
     Ok((y + h * dy, h * dl))
 }
 
+/// `J(φ) = j0 + Σ a_k·cos(n_k·φ + ψ_k)` and its derivative `J'(φ)` at `phi`, as the
+/// shooting's eq. 1 in `w = J·ω²` takes them (its term `−J'(φ)·ω̄²`); the host's integration
+/// of a period too long for the shooting evaluates the same. Design-time code.
+pub fn inertia_and_slope(j0: f64, harmonics: &[InertiaHarmonic], phi: f64) -> (f64, f64) {
+    let (mut j, mut dj) = (j0, 0.0);
+    for h in harmonics {
+        let t = h.order() * phi + h.phase();
+        j += h.amplitude() * libm::cos(t);
+        dj -= h.amplitude() * h.order() * libm::sin(t);
+    }
+    (j, dj)
+}
+
 /// The motor characteristic the shooting integrates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -359,13 +372,7 @@ impl<'a> Shooter<'a> {
 
     /// `J(φ)` and `J'(φ)`.
     fn inertia_at(&self, phi: f64) -> (f64, f64) {
-        let (mut j, mut dj) = (self.j0, 0.0);
-        for h in self.inertia {
-            let t = h.order() * phi + h.phase();
-            j += h.amplitude() * libm::cos(t);
-            dj -= h.amplitude() * h.order() * libm::sin(t);
-        }
-        (j, dj)
+        inertia_and_slope(self.j0, self.inertia, phi)
     }
 
     /// `s = ω² − ω̄²` from `y` at `phi`.

@@ -9,6 +9,13 @@
 //! mean load, the curve's change `M_d(ω) − M_d(ω̄)` formed without cancellation, so the swing
 //! keeps its relative precision. `run` integrates the same curve in time.
 //!
+//! With an inertia that depends on the angle, `J(φ) = J0 + Σ a_k·cos(n_k·φ + ψ_k)` (the
+//! period then common to the load and inertia orders), it is the core's shooting equation for
+//! J(φ): `w = J(φ)·ω²`, `y = w − J(φ)·ω̄²`, `dy/dφ = 2·(M_d(ω) − M_d(ω̄)) + 2·(M_d(ω̄) − M1) −
+//! 2·M̃_c(φ) − J'(φ)·ω̄²` and `s = y/J(φ)`, `J` and `J'` from the core's
+//! [`inertia_and_slope`]; the steps are sized on the least J(φ) (as the core sizes them), the
+//! settling on the damping at the largest bound `J0 + Σ|a_k|`.
+//!
 //! ## Method
 //! Butcher's sixth-order, seven-stage Runge–Kutta method (the core's) on `N` equal steps a
 //! period, [`STEPS_PER_CYCLE`] = 32 a cycle of the fastest order (the core takes 128 on its
@@ -35,8 +42,15 @@
 //! the bound (orders 1/1024 and 32: 32 768 cycles, δ 0.10) 1.3 s with the sensitivities and
 //! 14 s with the flywheel for δ ≤ 0.004 (270 kg·m², where the drive is so weakly damped that
 //! it does not settle within a period and Newton's method takes three periods a solution).
+//! With J(φ) each stage also evaluates J and J' (one `sin` and `cos` a harmonic): the 0.333/12
+//! scene with `J = 0.5 + 0.01·cos(3φ + 0.3)` 0.40 s with the sensitivities, 1.61 s with the
+//! δ through 8-edge speed samples of a 60-line disc as well (the time table's ω at 2 M angles
+//! through [`Cursor`] and the scans of the teeth's phase), 2.55 s with the flywheel for
+//! δ ≤ 0.004 too.
 
-use drive_monitor::drive::{period_revolutions, Harmonic, Kloss, Load};
+use drive_monitor::drive::{
+    inertia_and_slope, least_inertia, period_revolutions, Harmonic, InertiaHarmonic, Kloss, Load,
+};
 use std::f64::consts::TAU;
 
 /// Runge–Kutta steps per cycle of the fastest order.
@@ -152,16 +166,22 @@ pub struct Steady {
     pub periods: u32,
     /// `|y(T) − y(0)|/max|y|` of the scanned period.
     pub residual: f64,
+    /// `y(0) = J(0)·(ω(0)² − ω̄²)` of the scanned period, kg·m²·s⁻² (where [`Drive::cursor`]
+    /// starts).
+    pub y0: f64,
 }
 
-/// A Kloss drive with a constant inertia.
+/// A Kloss drive with a constant inertia, or with `J(φ) = J0 + Σ a_k·cos(n_k·φ + ψ_k)`.
 #[derive(Debug, Clone)]
 pub struct Drive {
     kloss: Kloss,
+    /// The constant inertia `J0`, kg·m².
     inertia: f64,
     mean: f64,
     /// The oscillating harmonics (order > 0, amplitude ≠ 0).
     load: Vec<Harmonic>,
+    /// The inertia's harmonics (amplitude ≠ 0; none: a constant inertia).
+    inertia_harmonics: Vec<InertiaHarmonic>,
 }
 
 impl Drive {
@@ -182,7 +202,43 @@ impl Drive {
                 .filter(|h| h.order() > 0.0 && h.amplitude() != 0.0)
                 .copied()
                 .collect(),
+            inertia_harmonics: Vec::new(),
         }
+    }
+
+    /// The same drive with the inertia `J(φ) = J0 + Σ harmonics` (`J0` this drive's inertia;
+    /// harmonics of amplitude 0 are dropped), replacing any given before. The caller checks
+    /// that `J(φ) > 0` (the core's [`least_inertia`]); the steps are sized on its least value.
+    pub fn with_inertia_harmonics(&self, harmonics: &[InertiaHarmonic]) -> Self {
+        Self {
+            inertia_harmonics: harmonics
+                .iter()
+                .filter(|h| h.amplitude() != 0.0)
+                .copied()
+                .collect(),
+            ..self.clone()
+        }
+    }
+
+    /// The inertia's harmonics (empty for a constant inertia).
+    pub fn inertia_harmonics(&self) -> &[InertiaHarmonic] {
+        &self.inertia_harmonics
+    }
+
+    /// Whether `period` is within the steps the host integrates ([`MAX_STEPS`]; `true` also
+    /// where no speed carries the mean load, which [`Self::solve`] reports as such).
+    pub fn fits(&self, period: &Period) -> bool {
+        !matches!(Setup::new(self, period), Err(Failure::Steps))
+    }
+
+    /// A cursor over the periodic steady state `steady` (from [`Self::solve`] over `period`),
+    /// for ω at ascending angles.
+    pub fn cursor(&self, period: &Period, steady: &Steady) -> Result<Cursor<'_>, Failure> {
+        Ok(Cursor {
+            setup: Setup::new(self, period)?,
+            node: 0,
+            y: steady.y0,
+        })
     }
 
     /// The same drive with another total inertia.
@@ -209,7 +265,7 @@ impl Drive {
         })
     }
 
-    /// The total inertia, kg·m².
+    /// The total inertia, kg·m² (with J(φ), its constant part `J0`).
     pub fn inertia(&self) -> f64 {
         self.inertia
     }
@@ -272,9 +328,11 @@ struct Setup<'a> {
     c0: f64,
     /// The curve's constants about `ω̄`.
     curve: Curve,
-    /// `1/J`.
+    /// `1/J` (with J(φ), `1/J0`).
     inv_j: f64,
-    /// `|dM_d/dω|/(J·ω̄)` at `ω̄`, per rad.
+    /// The inertia depends on φ.
+    varying: bool,
+    /// `|dM_d/dω|/(J·ω̄)` at `ω̄`, per rad (with J(φ), at its largest bound `J0 + Σ|a_k|`).
     damping: f64,
     period: f64,
     steps: u64,
@@ -302,12 +360,25 @@ impl<'a> Setup<'a> {
             return Err(Failure::MeanLoad);
         }
         let j = drive.inertia;
+        // J(φ)'s bounds: its least value sizes the steps (as the core's shooting takes it), its
+        // largest bound the damping the settling counts on.
+        let swing: f64 = drive
+            .inertia_harmonics
+            .iter()
+            .map(|h| h.amplitude().abs())
+            .sum();
+        let j_min = if swing < j {
+            j - swing
+        } else {
+            least_inertia(j, &drive.inertia_harmonics).map_or(0.0, |(_, least)| least)
+        };
+        let j_max = j + swing;
         // The largest rate down to half of ω̄: |dM/dσ| is largest at σ = 0, 2·M_m/σ_m.
-        let rate = 2.0 * mm / sm / ws / (0.5 * omega_ref) / j;
+        let rate = 2.0 * mm / sm / ws / (0.5 * omega_ref) / j_min;
         let by_rate = (period.radians * rate / MAX_STEP_RATE).ceil();
         let by_cycles = period.cycles.saturating_mul(STEPS_PER_CYCLE) as f64;
         let steps = by_rate.max(by_cycles).max(16.0);
-        if !(j > 0.0 && steps.is_finite() && steps <= MAX_STEPS as f64) {
+        if !(j > 0.0 && j_min > 0.0 && steps.is_finite() && steps <= MAX_STEPS as f64) {
             return Err(Failure::Steps);
         }
         let sb = (ws - omega_ref) / ws;
@@ -323,6 +394,7 @@ impl<'a> Setup<'a> {
         let mut s = Self {
             curve,
             inv_j: 1.0 / j,
+            varying: !drive.inertia_harmonics.is_empty(),
             drive,
             omega_ref,
             u_ref: omega_ref * omega_ref,
@@ -339,7 +411,7 @@ impl<'a> Setup<'a> {
             .map(|harmonic| C.map(|c| (harmonic.order() * (c * s.h)).sin_cos()))
             .collect();
         let (_, slope) = s.change(omega_ref, 0.0);
-        s.damping = slope.abs() / (j * omega_ref);
+        s.damping = slope.abs() / (j_max * omega_ref);
         Ok(s)
     }
 
@@ -356,17 +428,30 @@ impl<'a> Setup<'a> {
         (change, slope)
     }
 
-    /// `dy/dφ` and `∂(dy/dφ)/∂y` with the load's oscillating torque `mc` at that angle.
-    fn rhs(&self, mc: f64, y: f64) -> Result<(f64, f64), Stalled> {
-        let j = self.drive.inertia;
-        let s = y * self.inv_j;
+    /// `J(φ)` and `J'(φ)` (the core's [`inertia_and_slope`]; `(J, 0)` for a constant inertia).
+    fn inertia_at(&self, phi: f64) -> (f64, f64) {
+        if self.varying {
+            inertia_and_slope(self.drive.inertia, &self.drive.inertia_harmonics, phi)
+        } else {
+            (self.drive.inertia, 0.0)
+        }
+    }
+
+    /// `dy/dφ` and `∂(dy/dφ)/∂y` with the load's oscillating torque `mc` and `(J, J')` at that
+    /// angle: the core's shooting equation, `2·((M_d(ω) − M_d(ω̄)) + (M_d(ω̄) − M1) − M̃_c) −
+    /// J'·ω̄²` in `y = w − J(φ)·ω̄²` (its last term only with J(φ)).
+    fn rhs(&self, mc: f64, (j, dj): (f64, f64), y: f64) -> Result<(f64, f64), Stalled> {
+        let s = if self.varying { y / j } else { y * self.inv_j };
         let u = self.u_ref + s;
         if !(u > 0.0 && u.is_finite()) {
             return Err(Stalled);
         }
         let omega = u.sqrt();
         let (dm, slope) = self.change(omega, s / (omega + self.omega_ref));
-        let f = 2.0 * ((dm + self.c0) - mc);
+        let mut f = 2.0 * ((dm + self.c0) - mc);
+        if self.varying {
+            f -= dj * self.u_ref;
+        }
         let df = slope / (j * omega);
         if f.is_finite() && df.is_finite() {
             Ok((f, df))
@@ -400,7 +485,14 @@ impl<'a> Setup<'a> {
     /// One step of length `h` from `(phi, y)`: `y` after it and the increment of `L`.
     fn step(&self, phi: f64, y: f64, h: f64) -> Result<(f64, f64), Stalled> {
         let mc = self.load_at_stages(phi, h);
-        rk6_step(y, h, |i, y| self.rhs(mc[i], y))
+        if self.varying {
+            rk6_step(y, h, |i, y| {
+                self.rhs(mc[i], self.inertia_at(phi + C[i] * h), y)
+            })
+        } else {
+            let j = (self.drive.inertia, 0.0);
+            rk6_step(y, h, |i, y| self.rhs(mc[i], j, y))
+        }
     }
 
     /// Node `j` (`j` may exceed the step count: the next period).
@@ -408,8 +500,9 @@ impl<'a> Setup<'a> {
         self.period * (j as f64 / self.steps as f64)
     }
 
-    fn swing(&self, y: f64) -> f64 {
-        y / self.drive.inertia
+    /// `s = ω² − ω̄²` from `y` at `phi`.
+    fn swing(&self, phi: f64, y: f64) -> f64 {
+        y / self.inertia_at(phi).0
     }
 
     /// `y` at φ = 0 after settling from `y = from` over the last stretch of a period, and the
@@ -436,7 +529,7 @@ impl<'a> Setup<'a> {
         let n = self.steps;
         let (mut y, mut l, mut big) = (y0, 0.0, y0.abs());
         let (mut y_prev, mut s_prev) = (f64::NAN, f64::NAN);
-        let mut s_cur = self.swing(y0);
+        let mut s_cur = self.swing(0.0, y0);
         let mut y_end = f64::NAN;
         // Steps 0..N make the map; step N (to node N + 1) completes the scan of node N.
         let last = if scan.is_some() { n + 1 } else { n };
@@ -451,7 +544,7 @@ impl<'a> Setup<'a> {
                 y_end = ny;
             }
             if let Some(sc) = scan.as_deref_mut() {
-                let s_next = self.swing(ny);
+                let s_next = self.swing(self.node(j + 1), ny);
                 if j >= 1 {
                     sc.sum += s_cur;
                     sc.curvature = sc.curvature.max((s_next - 2.0 * s_cur + s_prev).abs());
@@ -493,7 +586,7 @@ impl<'a> Setup<'a> {
     /// solution exists, a stall ([`Failure::Stalls`]).
     fn solve(&self, start: Option<f64>) -> Result<Steady, Failure> {
         let top = self.curve.ws * (1.0 + self.curve.sm);
-        let y_top = self.drive.inertia * ((top - self.omega_ref) * (top + self.omega_ref));
+        let y_top = self.inertia_at(0.0).0 * ((top - self.omega_ref) * (top + self.omega_ref));
         let (mut y0, settle_steps, mut from_top) = match self.settle(0.0) {
             Ok((y, n)) => (y, n, false),
             Err(Stalled) => {
@@ -503,7 +596,7 @@ impl<'a> Setup<'a> {
         };
         if settle_steps == 0 {
             if let Some(u) = start.filter(|u| *u > 0.0 && u.is_finite()) {
-                y0 = self.drive.inertia * (u - self.u_ref);
+                y0 = self.inertia_at(0.0).0 * (u - self.u_ref);
             }
         }
         let tol = self.tolerance();
@@ -525,6 +618,7 @@ impl<'a> Setup<'a> {
                 return self
                     .extrema(
                         &scan,
+                        y0,
                         settle_steps,
                         periods,
                         g.abs() / big.max(f64::MIN_POSITIVE),
@@ -552,7 +646,7 @@ impl<'a> Setup<'a> {
     fn swing_within(&self, j: u64, y: f64, phi: f64) -> f64 {
         let p = self.node(j);
         match self.step(p, y, phi - p) {
-            Ok((y, _)) => self.swing(y),
+            Ok((y, _)) => self.swing(phi, y),
             Err(Stalled) => f64::NAN,
         }
     }
@@ -561,6 +655,7 @@ impl<'a> Setup<'a> {
     fn extrema(
         &self,
         scan: &Scan,
+        y0: f64,
         settle_steps: u64,
         periods: u32,
         residual: f64,
@@ -617,7 +712,40 @@ impl<'a> Setup<'a> {
             settle_steps,
             periods,
             residual,
+            y0,
         })
+    }
+}
+
+/// ω of a periodic steady state at ascending angles ([`Drive::cursor`]): the period's nodes
+/// integrated once from `y(0)` as the solution's last period was, each angle reached by a
+/// partial Runge–Kutta step from the node before it (so it carries the integration's own
+/// accuracy, as the refined extrema do). Angles past the period continue into the next one
+/// (the solution repeats within its residual).
+pub struct Cursor<'a> {
+    setup: Setup<'a>,
+    node: u64,
+    y: f64,
+}
+
+impl Cursor<'_> {
+    /// ω at `phi`, rad/s (`phi` at least the last one asked, from 0); `None` where the
+    /// trajectory stalls.
+    pub fn omega(&mut self, phi: f64) -> Option<f64> {
+        let s = &self.setup;
+        while s.node(self.node + 1) <= phi {
+            let p = s.node(self.node);
+            self.y = s.step(p, self.y, s.node(self.node + 1) - p).ok()?.0;
+            self.node += 1;
+        }
+        let p = s.node(self.node);
+        let y = if phi > p {
+            s.step(p, self.y, phi - p).ok()?.0
+        } else {
+            self.y
+        };
+        let u = s.u_ref + s.swing(phi, y);
+        (u > 0.0 && u.is_finite()).then(|| u.sqrt())
     }
 }
 

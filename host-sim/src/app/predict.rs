@@ -33,7 +33,8 @@ pub fn core_error(scene: &Scene, file: &Path, section: &str, e: ConfigError) -> 
 /// The drive model of a scene with a torque motor and a load (`None` for a prescribed speed
 /// or without a `[load]`), with J(φ) from `[shaft] inertia_harmonics`. Where the core does
 /// not predict that J(φ) ([`irregularity_not_predicted`] says why) the model has the constant
-/// inertia, for what does not depend on it (the motor, the mean of ω²).
+/// inertia, for what does not depend on it (the motor, the mean of ω²); so does a Kloss drive
+/// whose J(φ) the host integrates instead ([`long_period_inertia`], [`long_kloss`]).
 pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, SceneError> {
     let Some(base) = constant_inertia_model(scene, file)? else {
         return Ok(None);
@@ -47,18 +48,73 @@ pub fn drive_model(scene: &Scene, file: &Path) -> Result<Option<DriveModel>, Sce
 
 /// The scene's inertia harmonics on `base` (`base` itself without any).
 fn with_inertia(scene: &Scene, base: &DriveModel) -> Result<DriveModel, ConfigError> {
-    let Some(shaft) = &scene.shaft else {
-        return Ok(base.clone());
-    };
-    if shaft.inertia_harmonics.iter().all(|h| h.amplitude == 0.0) {
+    let harmonics = scene_inertia(scene)?;
+    if harmonics.is_empty() {
         return Ok(base.clone());
     }
-    let harmonics = shaft
+    base.with_inertia_harmonics(&harmonics)
+}
+
+/// The scene's inertia harmonics as the core validates them (none where every amplitude is 0).
+fn scene_inertia(scene: &Scene) -> Result<Vec<InertiaHarmonic>, ConfigError> {
+    let Some(shaft) = &scene.shaft else {
+        return Ok(Vec::new());
+    };
+    if shaft.inertia_harmonics.iter().all(|h| h.amplitude == 0.0) {
+        return Ok(Vec::new());
+    }
+    shaft
         .inertia_harmonics
         .iter()
         .map(|h| InertiaHarmonic::new(h.order, h.amplitude, h.phase))
-        .collect::<Result<Vec<_>, _>>()?;
-    base.with_inertia_harmonics(&harmonics)
+        .collect()
+}
+
+/// The scene's J(φ) harmonics that the host integrates with a Kloss drive ([`long_kloss`]):
+/// where the core refuses them because the common period of the load and inertia orders holds
+/// more cycles of the fastest order than its shooting samples (more than
+/// [`drive_monitor::drive::MAX_SAMPLES`] samples at 32 a cycle), and that period is one the host
+/// integrates (within [`kloss_period::MAX_STEPS`] steps). Empty otherwise: a constant inertia,
+/// a J(φ) the core predicts, or one neither does ([`irregularity_not_predicted`] says why).
+/// [`drive_model`] gives such a scene the constant part of the inertia; the host integrates
+/// eq. 1 with the whole J(φ).
+pub fn long_period_inertia(scene: &Scene) -> Vec<InertiaHarmonic> {
+    match constant_inertia_build(scene, Path::new("scene")) {
+        Ok(Some(Ok(base))) => long_period_inertia_of(scene, &base).unwrap_or_default(),
+        _ => Vec::new(),
+    }
+}
+
+fn long_period_inertia_of(scene: &Scene, base: &DriveModel) -> Option<Vec<InertiaHarmonic>> {
+    let k = *base.motor().kloss_curve()?;
+    // The core checks J(φ) > 0 before the period: refused for the period, J(φ) is positive.
+    if !matches!(
+        with_inertia(scene, base).err()?,
+        ConfigError::Inconsistent("inertia_harmonic.order")
+    ) {
+        return None;
+    }
+    let harmonics = scene_inertia(scene).ok()?;
+    let period = kloss_period::common_period(&long_orders(base.load(), &harmonics))?;
+    let drive = kloss_period::Drive::new(k, base.total_inertia(), base.load())
+        .with_inertia_harmonics(&harmonics);
+    drive.fits(&period).then_some(harmonics)
+}
+
+/// The orders the host's periodic solution repeats over: every load harmonic that is there
+/// (order and amplitude non-zero) and every inertia harmonic.
+fn long_orders(load: &Load, inertia: &[InertiaHarmonic]) -> Vec<f64> {
+    load.harmonics()
+        .iter()
+        .filter(|h| h.amplitude() != 0.0)
+        .map(|h| h.order())
+        .chain(
+            inertia
+                .iter()
+                .filter(|h| h.amplitude() != 0.0)
+                .map(|h| h.order()),
+        )
+        .collect()
 }
 
 /// Why the core does not predict a J(φ) it rejected with `e`, if `e` is such a limit of the
@@ -294,11 +350,27 @@ pub fn sampled_delta(
     file: &Path,
     model: &DriveModel,
 ) -> Result<Option<SampledDelta>, SceneError> {
-    use crate::app::sampled::{sampled_range, SteadyTime, SCAN_BUDGET};
-    let Some(e) = &scene.encoder else {
+    use crate::app::sampled::SteadyTime;
+    if scene.encoder.is_none() {
+        return Ok(None);
+    }
+    let Some(predicted) = model.predict().steady().map(|s| s.delta) else {
         return Ok(None);
     };
-    let Some(predicted) = model.predict().steady().map(|s| s.delta) else {
+    sampled_delta_of(scene, file, predicted, || SteadyTime::new(model))
+}
+
+/// [`SampledDelta`] of a scene's steady state of δ `predicted` whose time over the angle
+/// `time` tabulates (asked for only with an `[encoder]`, after its wheel is checked; `None`
+/// from it: none given).
+pub fn sampled_delta_of(
+    scene: &Scene,
+    file: &Path,
+    predicted: f64,
+    time: impl FnOnce() -> Option<crate::app::sampled::SteadyTime>,
+) -> Result<Option<SampledDelta>, SceneError> {
+    use crate::app::sampled::{sampled_range, SCAN_BUDGET};
+    let Some(e) = &scene.encoder else {
         return Ok(None);
     };
     let desc = crate::app::check::wheel(e, &scene.checker(file))?;
@@ -306,7 +378,7 @@ pub fn sampled_delta(
     // Edges per revolution the core sees: the wheel's teeth, one in `prescaler` captured.
     let pitch = std::f64::consts::TAU / wheel.teeth.len().max(1) as f64;
     let span = |k: u16| f64::from(k) * pitch;
-    let Some(time) = SteadyTime::new(model) else {
+    let Some(time) = time() else {
         return Ok(None);
     };
     let Some(range) = sampled_range(&time, &wheel, e.estimator_edges, SCAN_BUDGET) else {
@@ -698,6 +770,10 @@ pub struct IrregularityOut {
     /// The report's warning when those samples lose more than 1 % of δ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sampling_warning: Option<String>,
+    /// Why δ through the speed samples is not given for a steady state the host integrated
+    /// over a long period, where the scene has an `[encoder]` ([`long_kloss_sampled`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampling_note: Option<String>,
     /// For a Kloss motor: the prediction's parabola against the Kloss curve over the
     /// predicted speeds ([`kloss_note`]).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -752,6 +828,22 @@ pub fn inertia_note(model: &DriveModel) -> Option<String> {
         },
         radians
     ))
+}
+
+/// The note for a J(φ) the host integrates with the Kloss curve over a long common period
+/// ([`long_period_inertia`]; `None` without one).
+fn long_inertia_note(inertia: &[InertiaHarmonic]) -> Option<String> {
+    let n = inertia.iter().filter(|h| h.amplitude() != 0.0).count();
+    (n > 0).then(|| {
+        format!(
+            "J(φ) from shaft.inertia_harmonics ({n} harmonic{}): eq. 1 in w = J·ω² with the \
+             Kloss curve, integrated on the host over the common period of the load and \
+             inertia orders (see the motor line; the core's shooting takes the same equation \
+             over shorter periods); ∂δ/∂J (on the constant part of J) and ∂δ/∂M_m by central \
+             differences",
+            if n == 1 { "" } else { "s" }
+        )
+    })
 }
 
 /// The note for a steady state that runs above the motor's no-load speed (the synchronous
@@ -826,7 +918,9 @@ pub fn active_load_note(scene: &Scene, file: &Path) -> Option<String> {
 }
 
 /// How `predict` took a Kloss drive the core predicts through a parabola
-/// ([`drive_monitor::drive::Horizon::Unbounded`], constant inertia).
+/// ([`drive_monitor::drive::Horizon::Unbounded`], constant inertia), or whose J(φ) it refuses
+/// for a common period of the load and inertia orders too long for its shooting
+/// ([`long_period_inertia`]).
 #[derive(Debug, Clone)]
 pub enum LongKloss {
     /// The load's orders have a common period the core does not sample (more than
@@ -866,27 +960,36 @@ pub enum Approximation {
     Failed(kloss_period::Period, kloss_period::Failure),
 }
 
-/// The host's integration of a Kloss drive the core leaves to a parabola, when it can be done
-/// ([`LongKloss`]); `None` for any other drive (a parabola motor, one the core integrates,
-/// J(φ)).
-pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
+/// The host's drive for `model` with the J(φ) harmonics `inertia` (none: `model`'s constant
+/// inertia); `None` without a Kloss motor.
+fn long_drive(model: &DriveModel, inertia: &[InertiaHarmonic]) -> Option<kloss_period::Drive> {
     let k = *model.motor().kloss_curve()?;
-    if !matches!(model.horizon(), drive_monitor::drive::Horizon::Unbounded)
-        || !model.inertia_harmonics().is_empty()
+    Some(
+        kloss_period::Drive::new(k, model.total_inertia(), model.load())
+            .with_inertia_harmonics(inertia),
+    )
+}
+
+/// The host's integration of a Kloss drive the core leaves to a parabola, when it can be done
+/// ([`LongKloss`]): `model` with a constant inertia and [`Horizon::Unbounded`] and `inertia`
+/// empty, or `model` the constant part of a J(φ) drive and `inertia` its harmonics
+/// ([`long_period_inertia`]). `None` for any other drive (a parabola motor, one the core
+/// integrates).
+///
+/// [`Horizon::Unbounded`]: drive_monitor::drive::Horizon::Unbounded
+pub fn long_kloss(model: &DriveModel, inertia: &[InertiaHarmonic]) -> Option<LongKloss> {
+    let k = *model.motor().kloss_curve()?;
+    if !model.inertia_harmonics().is_empty()
+        || (inertia.is_empty()
+            && !matches!(model.horizon(), drive_monitor::drive::Horizon::Unbounded))
     {
         return None;
     }
-    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    let drive = long_drive(model, inertia)?;
     if drive.mean_load().is_nan() || drive.mean_load().abs() >= k.breakdown_torque() {
         return Some(LongKloss::MeanLoad);
     }
-    let orders: Vec<f64> = model
-        .load()
-        .harmonics()
-        .iter()
-        .filter(|h| h.amplitude() != 0.0)
-        .map(|h| h.order())
-        .collect();
+    let orders = long_orders(model.load(), inertia);
     let Some(period) = kloss_period::common_period(&orders) else {
         return Some(LongKloss::Approximate(Approximation::NoCommonPeriod));
     };
@@ -904,13 +1007,118 @@ pub fn long_kloss(model: &DriveModel) -> Option<LongKloss> {
 
 /// The δ `predict` gives for `model`'s steady state (`None` without one): the core's, or for a
 /// Kloss drive the core leaves to a parabola, the host's integration over a long common period
-/// ([`long_kloss`]); `run` compares its measurement with this.
-pub fn predicted_delta(model: &DriveModel) -> Option<f64> {
-    match long_kloss(model) {
+/// ([`long_kloss`], with the J(φ) harmonics `inertia` of [`long_period_inertia`]); `run`
+/// compares its measurement with this.
+pub fn predicted_delta(model: &DriveModel, inertia: &[InertiaHarmonic]) -> Option<f64> {
+    predicted_delta_of(model, inertia, long_kloss(model, inertia).as_ref())
+}
+
+/// [`predicted_delta`] with the host's outcome `long` at hand.
+fn predicted_delta_of(
+    model: &DriveModel,
+    inertia: &[InertiaHarmonic],
+    long: Option<&LongKloss>,
+) -> Option<f64> {
+    match long {
         Some(LongKloss::Integrated { steady, .. }) => Some(steady.delta),
         Some(LongKloss::MeanLoad | LongKloss::Stalls { .. }) => None,
+        // A J(φ) the host did not solve: the constant part's δ is not this drive's.
+        Some(LongKloss::Approximate(_)) if !inertia.is_empty() => None,
         Some(LongKloss::Approximate(_)) | None => model.predict().steady().map(|s| s.delta),
     }
+}
+
+/// The δ `predict` gives (as [`predicted_delta`]) and what the speed samples read of it (as
+/// `predict` gives them: [`sampled_delta`], or for the host's integration
+/// [`long_kloss_sampled`]), for `run`'s report.
+pub fn predicted_and_sampled(
+    scene: &Scene,
+    file: &Path,
+    model: &DriveModel,
+) -> Result<(Option<f64>, Option<SampledDelta>), SceneError> {
+    let inertia = long_period_inertia(scene);
+    let long = long_kloss(model, &inertia);
+    let delta = predicted_delta_of(model, &inertia, long.as_ref());
+    let sampled = match &long {
+        Some(LongKloss::Integrated { period, steady }) => {
+            long_kloss_sampled(scene, file, model, &inertia, period, steady)?.0
+        }
+        Some(LongKloss::MeanLoad | LongKloss::Stalls { .. }) => None,
+        Some(LongKloss::Approximate(_)) if !inertia.is_empty() => None,
+        Some(LongKloss::Approximate(_)) | None => sampled_delta(scene, file, model)?,
+    };
+    Ok((delta, sampled))
+}
+
+/// The time over the angle of the host's periodic steady state `steady` of `model` with the
+/// J(φ) harmonics `inertia` over `period` ([`crate::app::sampled::SteadyTime::tabulate`],
+/// ω from the integration's own steps: [`kloss_period::Drive::cursor`]), or why there is none.
+pub fn long_kloss_time(
+    model: &DriveModel,
+    inertia: &[InertiaHarmonic],
+    period: &kloss_period::Period,
+    steady: &kloss_period::Steady,
+) -> Result<crate::app::sampled::SteadyTime, String> {
+    use crate::app::sampled::{SteadyTime, MAX_SAMPLED_POINTS};
+    let drive = long_drive(model, inertia).ok_or("no Kloss motor")?;
+    let fastest = long_orders(model.load(), inertia)
+        .into_iter()
+        .map(f64::abs)
+        .fold(0.0f64, f64::max);
+    // The period, Q/G revolutions, divides the whole revolutions Q: the table spans it.
+    if SteadyTime::points(period.radians, fastest).is_none() {
+        return Err(format!(
+            "the time over the period, {} cycles of its fastest order at 512 values of ω a \
+             cycle, would take more than the {MAX_SAMPLED_POINTS} values the table holds",
+            period.cycles
+        ));
+    }
+    let mut cursor = drive.cursor(period, steady).map_err(|e| format!("{e:?}"))?;
+    SteadyTime::tabulate(period.radians, period.whole_revolutions, fastest, |phi| {
+        cursor.omega(phi)
+    })
+    .ok_or_else(|| "the integration stalled between its steps".to_string())
+}
+
+/// [`SampledDelta`] of the host's periodic steady state ([`long_kloss_time`]) through the
+/// scene's speed samples, and, where the scene has an `[encoder]` and none is given, the line
+/// that says why.
+pub fn long_kloss_sampled(
+    scene: &Scene,
+    file: &Path,
+    model: &DriveModel,
+    inertia: &[InertiaHarmonic],
+    period: &kloss_period::Period,
+    steady: &kloss_period::Steady,
+) -> Result<(Option<SampledDelta>, Option<String>), SceneError> {
+    if scene.encoder.is_none() {
+        return Ok((None, None));
+    }
+    let mut why = None;
+    let sampled = sampled_delta_of(scene, file, steady.delta, || {
+        long_kloss_time(model, inertia, period, steady)
+            .map_err(|e| why = Some(e))
+            .ok()
+    })?;
+    let note = match (&sampled, why) {
+        (Some(_), _) => None,
+        (None, Some(why)) => Some(why),
+        (None, None) => Some(format!(
+            "the encoder's edges over the common period of the load and the revolution \
+             ({} revolutions) are more than the {} the samples are enumerated over",
+            period.whole_revolutions,
+            crate::app::sampled::MAX_EDGES
+        )),
+    };
+    Ok((
+        sampled,
+        note.map(|n| {
+            format!(
+                "NOTE: δ through the speed samples is not given for this steady state, \
+                 integrated on the host: {n}"
+            )
+        }),
+    ))
 }
 
 /// Relative step of the host's central differences (the core's).
@@ -921,10 +1129,11 @@ const SENSITIVITY_STEP: f64 = 1e-4;
 /// them for `Horizon::Shooting`. `None` when a stepped drive has no steady state.
 pub fn long_kloss_sensitivity(
     model: &DriveModel,
+    inertia: &[InertiaHarmonic],
     period: &kloss_period::Period,
 ) -> Option<drive_monitor::drive::Sensitivity> {
     let k = *model.motor().kloss_curve()?;
-    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    let drive = long_drive(model, inertia)?;
     // Each from the start the operating point's parabola gives the stepped drive.
     let delta = |d: Option<kloss_period::Drive>, m: Option<DriveModel>| {
         let start = m.map(|m| m.omega_squared(0.0));
@@ -964,12 +1173,12 @@ pub fn long_kloss_sensitivity(
 /// to 2⁶⁰ times the inertia reaches it, or a solution fails.
 pub fn long_kloss_flywheel(
     model: &DriveModel,
+    inertia: &[InertiaHarmonic],
     period: &kloss_period::Period,
     delta: f64,
     limit: f64,
 ) -> Option<f64> {
-    let k = *model.motor().kloss_curve()?;
-    let drive = kloss_period::Drive::new(k, model.total_inertia(), model.load());
+    let drive = long_drive(model, inertia)?;
     let j = drive.inertia();
     if delta <= limit {
         return Some(0.0);
@@ -1057,11 +1266,24 @@ pub fn kloss_note(
     omega_min: f64,
     omega_max: f64,
     long: Option<&LongKloss>,
+    inertia: &[InertiaHarmonic],
 ) -> Option<String> {
     use drive_monitor::drive::Horizon;
     let motor = model.motor();
     let k = motor.kloss_curve()?;
-    match model.horizon() {
+    // The host's outcome first: with J(φ) the model is its constant part, which the core may
+    // integrate over the load's own (shorter) period.
+    let horizon = if long.is_some() {
+        Horizon::Unbounded
+    } else {
+        model.horizon()
+    };
+    let whose = if inertia.is_empty() {
+        "the load's"
+    } else {
+        "the load and inertia orders'"
+    };
+    match horizon {
         Horizon::Shooting { radians, steps } if steps > 0 => {
             return Some(format!(
                 "the Kloss motor is predicted with its curve itself (eq. 1 in w = J·ω² \
@@ -1092,7 +1314,7 @@ pub fn kloss_note(
     let why = match long {
         Some(LongKloss::Integrated { period, steady }) => {
             return Some(format!(
-                "the Kloss motor is predicted with its curve itself over the load's whole common \
+                "the Kloss motor is predicted with its curve itself over {whose} whole common \
                  period, {} ({} cycles of the fastest order: {} samples at 32 a cycle, more \
                  than the core's {}): eq. 1 in w = J·ω² integrated on the host by sixth-order \
                  Runge–Kutta on {} steps a period ({} a cycle of the fastest order), settled \
@@ -1124,7 +1346,7 @@ pub fn kloss_note(
         }
         Some(LongKloss::Stalls { period, .. }) => {
             return Some(format!(
-                "the Kloss motor's curve, integrated on the host over the load's whole common \
+                "the Kloss motor's curve, integrated on the host over {whose} whole common \
                  period, {} ({} cycles of the fastest order), falls to standstill even from \
                  above every periodic solution (from ω_s·(1 + σ_m)): no periodic steady state \
                  exists; `run` integrates the same curve",
@@ -1522,7 +1744,9 @@ impl Prediction {
 /// out (its ½·ω²·dJ/dφ term alone makes ω swing), so none is given; `run` simulates the drive.
 /// A Kloss drive the core refuses is named here too: one so stiff against its inertia that a
 /// period needs more than [`drive_monitor::drive::MAX_STEPS`] steps, or one with no attracting
-/// periodic steady state found.
+/// periodic steady state found. A Kloss drive's J(φ) that the core refuses only for a common
+/// period too long for its shooting is integrated on the host ([`long_period_inertia`]) and is
+/// not named here.
 pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
     let base = match constant_inertia_build(scene, Path::new("scene")).ok()?? {
         Ok(base) => base,
@@ -1533,7 +1757,12 @@ pub fn irregularity_not_predicted(scene: &Scene) -> Option<String> {
             ));
         }
     };
-    let why = not_covered(with_inertia(scene, &base).err()?)?;
+    let e = with_inertia(scene, &base).err()?;
+    // A Kloss drive's J(φ) over a common period too long for the core: the host integrates it.
+    if long_period_inertia_of(scene, &base).is_some() {
+        return None;
+    }
+    let why = not_covered(e)?;
     Some(format!(
         "{why}; δ is not predicted for this J(φ) (`drive-sim run` simulates it)"
     ))
@@ -1547,17 +1776,47 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
         p.irregularity_not_predicted = irregularity_not_predicted(scene);
         p.window_warning = crate::app::run::window_warning(scene);
     }
+    // A Kloss drive the core leaves to a parabola (or whose J(φ) it refuses for a common
+    // period too long for it): integrated here over a long common period, or a stall where no
+    // speed carries the mean load.
+    let inertia = if p.irregularity_not_predicted.is_none() {
+        long_period_inertia(scene)
+    } else {
+        Vec::new()
+    };
+    let long = model
+        .as_ref()
+        .filter(|_| p.irregularity_not_predicted.is_none())
+        .and_then(|m| long_kloss(m, &inertia));
+    if let (false, Some(LongKloss::Approximate(a))) = (inertia.is_empty(), &long) {
+        // No parabola stands in for a J(φ): its constant part's δ is not this drive's.
+        let why = match a {
+            Approximation::Failed(period, e) => format!(
+                "the host's integration of the Kloss drive with J(φ) over the common period \
+                 of the load and inertia orders, {} revolutions, found no attracting periodic \
+                 steady state ({e:?})",
+                period.whole_revolutions
+            ),
+            _ => "the host does not integrate this Kloss drive with J(φ)".to_string(),
+        };
+        p.irregularity_not_predicted = Some(format!(
+            "{why}; δ is not predicted for this J(φ) (`drive-sim run` simulates it)"
+        ));
+    }
     if let Some(model) = model.filter(|_| p.irregularity_not_predicted.is_none()) {
         let limit = scene.monitor.as_ref().and_then(|m| m.delta_limit);
         let mut irr = model
             .irregularity(limit)
             .map_err(|e| core_error(scene, file, "monitor", e))?;
         let mut sens = model.sensitivity();
-        let sampled = sampled_delta(scene, file, &model)?;
+        let (sampled, sampling_note) = match &long {
+            Some(LongKloss::Integrated { period, steady }) => {
+                long_kloss_sampled(scene, file, &model, &inertia, period, steady)?
+            }
+            Some(LongKloss::MeanLoad | LongKloss::Stalls { .. }) => (None, None),
+            _ => (sampled_delta(scene, file, &model)?, None),
+        };
         let mut prediction = model.predict();
-        // A Kloss drive the core leaves to a parabola: integrated here over a long common
-        // period, or a stall where no speed carries the mean load.
-        let long = long_kloss(&model);
         match &long {
             Some(LongKloss::Integrated { period, steady }) => {
                 irr = drive_monitor::drive::Irregularity {
@@ -1565,10 +1824,11 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                     omega_min: steady.omega_min,
                     delta: steady.delta,
                     steady_state: true,
-                    flywheel_for_limit: limit
-                        .and_then(|l| long_kloss_flywheel(&model, period, steady.delta, l)),
+                    flywheel_for_limit: limit.and_then(|l| {
+                        long_kloss_flywheel(&model, &inertia, period, steady.delta, l)
+                    }),
                 };
-                sens = long_kloss_sensitivity(&model, period);
+                sens = long_kloss_sensitivity(&model, &inertia, period);
                 let breakdown = model
                     .motor()
                     .kloss_curve()
@@ -1609,8 +1869,9 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                     omega_min: 0.0,
                     delta: 2.0,
                     steady_state: false,
-                    flywheel_for_limit: limit
-                        .and_then(|l| long_kloss_flywheel(&model, period, f64::INFINITY, l)),
+                    flywheel_for_limit: limit.and_then(|l| {
+                        long_kloss_flywheel(&model, &inertia, period, f64::INFINITY, l)
+                    }),
                 };
                 sens = None;
                 prediction =
@@ -1685,7 +1946,8 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
             delta_through_samples_least: sampled.map(|s| s.least),
             delta_through_samples_at_scene_phase: sampled.map(|s| s.at_scene_phase),
             sampling_warning: sampled.and_then(|s| sampled_delta_warning(irr.delta, &s)),
-            inertia_note: inertia_note(&model),
+            sampling_note,
+            inertia_note: inertia_note(&model).or_else(|| long_inertia_note(&inertia)),
             kloss_curve,
             approximate,
             motor_note: kloss_note(
@@ -1693,6 +1955,7 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 irr.omega_min,
                 if irr.steady_state { irr.omega_max } else { 0.0 },
                 long.as_ref(),
+                &inertia,
             ),
             // Without a steady state the core's numbers describe the stall, not a δ.
             omega_max: irr.steady_state.then_some(irr.omega_max),

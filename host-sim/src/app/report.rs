@@ -684,6 +684,9 @@ pub fn prediction_text(p: &Prediction) -> String {
         if let Some(w) = &i.sampling_warning {
             let _ = writeln!(s, "  {w}");
         }
+        if let Some(n) = &i.sampling_note {
+            let _ = writeln!(s, "  {n}");
+        }
         if let Some(n) = &i.motor_note {
             let _ = writeln!(s, "  {n}");
         }

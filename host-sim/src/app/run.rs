@@ -1662,8 +1662,8 @@ pub fn run_with(
         .as_ref()
         .filter(|_| predict::irregularity_not_predicted(scene).is_none())
     {
-        report.delta_predicted = predict::predicted_delta(model);
-        let sampled = predict::sampled_delta(scene, file, model)?;
+        let (delta, sampled) = predict::predicted_and_sampled(scene, file, model)?;
+        report.delta_predicted = delta;
         report.delta_predicted_through_samples = sampled.map(|s| s.at_scene_phase);
         report.delta_predicted_through_samples_least = sampled.map(|s| s.least);
         report.delta_predicted_through_samples_most = sampled.map(|s| s.most);

@@ -29,7 +29,7 @@ pub const SCAN_BUDGET: usize = 1 << 18;
 /// Most offsets on the scan's grid.
 const MAX_OFFSETS: usize = 1024;
 /// Most edges enumerated over the common period of the load and the revolution.
-const MAX_EDGES: u64 = 1 << 22;
+pub const MAX_EDGES: u64 = 1 << 22;
 
 /// The edges the core captures in a revolution of its wheel, on the wheel's grid.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -150,6 +150,30 @@ impl SteadyTime {
             Horizon::Unbounded => return None,
         };
         let revolutions = model.period_revolutions()?;
+        let fastest = model
+            .load()
+            .harmonics()
+            .iter()
+            .filter(|h| h.amplitude() != 0.0)
+            .map(|h| h.order().abs())
+            .chain(model.inertia_harmonics().iter().map(|h| h.order().abs()))
+            .fold(0.0f64, f64::max);
+        let curve = model.steady_curve();
+        Self::tabulate(period, revolutions, fastest, |phi| curve.steady_omega(phi))
+    }
+
+    /// The time table of a steady state whose ω repeats over `period` rad (a whole number of
+    /// times in `revolutions` whole revolutions, else over those), `fastest` the highest order
+    /// of the load and the inertia (cycles per revolution), `omega(φ)` its speed, asked at
+    /// ascending angles over one period, from 0 (a host integration's cursor steps on from
+    /// the last). `None` when `omega` gives none or the grid would take more than
+    /// [`MAX_SAMPLED_POINTS`] evaluations ([`Self::points`]).
+    pub fn tabulate(
+        period: f64,
+        revolutions: u64,
+        fastest: f64,
+        mut omega: impl FnMut(f64) -> Option<f64>,
+    ) -> Option<Self> {
         if !(period > 0.0 && period.is_finite() && revolutions >= 1) {
             return None;
         }
@@ -162,25 +186,11 @@ impl SteadyTime {
             } else {
                 (TAU * revolutions as f64, 1)
             };
-        let fastest = model
-            .load()
-            .harmonics()
-            .iter()
-            .filter(|h| h.amplitude() != 0.0)
-            .map(|h| h.order().abs())
-            .chain(model.inertia_harmonics().iter().map(|h| h.order().abs()))
-            .fold(0.0f64, f64::max);
-        let cycles = fastest * period / TAU;
-        let cells = (256.0 * cycles).ceil().max(512.0);
-        if !(cells.is_finite() && 2.0 * cells < MAX_SAMPLED_POINTS as f64) {
-            return None;
-        }
-        let cells = cells as usize;
+        let cells = Self::points(period, fastest)? / 2;
         let h = period / cells as f64;
-        let curve = model.steady_curve();
         let mut f = Vec::with_capacity(2 * cells + 1);
         for j in 0..2 * cells {
-            f.push(1.0 / curve.steady_omega(0.5 * h * j as f64)?);
+            f.push(1.0 / omega(0.5 * h * j as f64)?);
         }
         f.push(f[0]);
         let mut t = Vec::with_capacity(cells + 1);
@@ -198,6 +208,15 @@ impl SteadyTime {
             t,
             constant: false,
         })
+    }
+
+    /// The evaluations of ω the table of a steady state repeating over `period` rad with
+    /// `fastest` its highest order takes (node and mid-cell, 256 cells a cycle of that order
+    /// and 512 a period at least); `None` beyond [`MAX_SAMPLED_POINTS`].
+    pub fn points(period: f64, fastest: f64) -> Option<usize> {
+        let cycles = fastest * period / TAU;
+        let cells = (256.0 * cycles).ceil().max(512.0);
+        (cells.is_finite() && 2.0 * cells < MAX_SAMPLED_POINTS as f64).then_some(2 * cells as usize)
     }
 
     /// The time at angle `x`, s, counted from angle 0.
