@@ -216,21 +216,7 @@ fn direct_extremes_after(
                 continue;
             }
             for (poly, ..) in &polys[k.saturating_sub(1)..(k + 2).min(polys.len())] {
-                let f = |t: f64| sign * (poly.base + poly.eval_rel(t).0);
-                let (mut lo, mut hi) = (0.0f64, 1.0f64);
-                let r = (5f64.sqrt() - 1.0) / 2.0;
-                for _ in 0..80 {
-                    let (x1, x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
-                    if f(x1) >= f(x2) {
-                        hi = x2;
-                    } else {
-                        lo = x1;
-                    }
-                }
-                out = [0.5 * (lo + hi), 0.0, 1.0]
-                    .iter()
-                    .map(|&t| f(t))
-                    .fold(out, f64::max);
+                out = out.max(step_max(|t| sign * (poly.base + poly.eval_rel(t).0)));
             }
         }
         sign * out
@@ -238,6 +224,22 @@ fn direct_extremes_after(
     let w_max = refine(1.0) + drive.offset;
     let w_min = refine(-1.0) + drive.offset;
     ((w_max / drive.j).sqrt(), (w_min / drive.j).sqrt())
+}
+
+/// The largest value of `f` over one step, `t` in [0, 1]: golden section (80 iterations,
+/// a bracket of 0.618⁸⁰ of the step) against both ends.
+fn step_max(f: impl Fn(f64) -> f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..80 {
+        let (x1, x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
+        if f(x1) >= f(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    f(0.5 * (lo + hi)).max(f(0.0)).max(f(1.0))
 }
 
 fn delta_of((hi, lo): (f64, f64)) -> f64 {
@@ -736,21 +738,7 @@ fn direct_varying_extremes(
                 continue;
             }
             for p in &polys[k.saturating_sub(1)..(k + 2).min(polys.len())] {
-                let f = |t: f64| sign * omega_on(drive, p, t);
-                let (mut lo, mut hi) = (0.0f64, 1.0f64);
-                let r = (5f64.sqrt() - 1.0) / 2.0;
-                for _ in 0..80 {
-                    let (x1, x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
-                    if f(x1) >= f(x2) {
-                        hi = x2;
-                    } else {
-                        lo = x1;
-                    }
-                }
-                out = [0.5 * (lo + hi), 0.0, 1.0]
-                    .iter()
-                    .map(|&t| f(t))
-                    .fold(out, f64::max);
+                out = out.max(step_max(|t| sign * omega_on(drive, p, t)));
             }
         }
         sign * out
