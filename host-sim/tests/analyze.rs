@@ -3,7 +3,7 @@
 //! against the simulation's ground truth (every edge: tooth, glitch, dropped).
 
 use host_sim::app::analyze::{analyze, configure, AnalyzeOptions, AnalyzeReport, DecisionKind};
-use host_sim::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level};
+use host_sim::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level, TimeUnit};
 use host_sim::app::run::{run_with, CaptureTarget, Overrides, RunOptions, RunReport};
 use host_sim::app::scene::Scene;
 use host_sim::engine::encoder::Edge;
@@ -3413,15 +3413,24 @@ fn a_file_of_edge_times_is_read_as_the_captured_edges() {
         e.starts_with("--edge: a file of edge times") && e.contains("leave --edge out"),
         "{e}"
     );
-    // Units: named when not seconds; whole numbers only under a header saying seconds.
-    let e = reader_error("time_us\n0.5\n2084.0\n");
+    // Units: read in the one the header names (`time_us`), refused when it is none of s, ms,
+    // us, ns; whole numbers only under a header (or --time-unit) stating the unit.
+    let mut r = text_reader("time_us\n0.5\n2084\n".into(), "w.csv", None).unwrap();
+    let mut read = Vec::new();
+    while let Some((t, _)) = r.next_row().unwrap() {
+        read.push(t);
+    }
+    assert_eq!(read, [0.5e-6, 2084e-6]);
+    let e = reader_error("ticks\n5\n2084\n");
     assert!(
-        e.starts_with("cap.csv:1:") && e.contains("in us") && e.contains("seconds"),
+        e.starts_with("cap.csv:1:") && e.contains("in ticks") && e.contains("--time-unit"),
         "{e}"
     );
     let e = reader_error("0\n2084\n4146\n");
     assert!(
-        e.starts_with("cap.csv:2:") && e.contains("`2084` is a whole number"),
+        e.starts_with("cap.csv:2:")
+            && e.contains("`2084` is a whole number")
+            && e.contains("give --time-unit ms, us or ns"),
         "{e}"
     );
     let mut r = text_reader("time_s\n0\n2\n4\n".into(), "w.csv", None).unwrap();
@@ -5224,4 +5233,133 @@ fn a_capture_starting_in_a_gap_gives_the_shafts_slowest_speed() {
         said.contains("the slowest speed seen is about 150.000 rad/s"),
         "{said}"
     );
+}
+
+/// Analyzes the capture `text` (read as the file `name`, its times in `unit` when given, as
+/// `--time-unit` gives it) with `options`: the report and its text, or the error.
+fn analyze_unit(
+    text: &str,
+    name: &str,
+    unit: Option<TimeUnit>,
+    options: AnalyzeOptions,
+) -> Result<(AnalyzeReport, String), String> {
+    let cfg = configure(&options)?;
+    let mut reader = CaptureReader::new_with(
+        std::io::Cursor::new(text.to_string()),
+        Path::new(name),
+        None,
+        None,
+        unit,
+    )
+    .map_err(|e| e.to_string())?;
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).map_err(|e| e.to_string())?;
+    let said = host_sim::app::analyze::text(&report);
+    Ok((report, said))
+}
+
+/// The valid windows' mean speeds.
+fn mean_speeds(r: &AnalyzeReport) -> Vec<f64> {
+    r.windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.omega_mean)
+        .collect()
+}
+
+/// Edge times written in milliseconds or microseconds with decimals and no header are read as
+/// seconds (nothing in the file says otherwise), which makes a 150 rad/s shaft 0.15 or 1.5e-4
+/// rad/s: the no-sync hint's slowest speed and the valid windows' slow speeds say what such
+/// times give and name --time-unit; with it (or a header naming the unit) the speeds are the
+/// shaft's. Before, the slowest speed read "0.000 rad/s" for µs and nothing named the unit.
+#[test]
+fn edge_times_in_ms_or_us_name_the_time_unit_and_read_with_it() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let ms: String = rising
+        .iter()
+        .map(|t| format!("{:.6}\n", 1.0 + t * 1e3))
+        .collect();
+    let us: String = rising
+        .iter()
+        .map(|t| format!("{:.3}\n", 1000.0 + t * 1e6))
+        .collect();
+    let (r, said) = analyze_unit(&ms, "t.txt", None, wheel("36-2")).unwrap();
+    assert!(r.sync_acquired.is_none(), "{said}");
+    assert!(
+        said.contains("slowest speed seen is about 0.1")
+            && said.contains("read as seconds")
+            && said.contains("--time-unit ms"),
+        "{said}"
+    );
+    let (_, said) = analyze_unit(&us, "t.txt", None, wheel("36-2")).unwrap();
+    assert!(
+        said.contains("slowest speed seen is about 1.") && said.contains("e-4 rad/s; the file"),
+        "{said}"
+    );
+    let slow = AnalyzeOptions {
+        min_speed: Some(0.01),
+        ..wheel("36-2")
+    };
+    let (r, said) = analyze_unit(&ms, "t.txt", None, slow).unwrap();
+    assert!(r.valid_windows >= 3, "{said}");
+    assert!(
+        said.contains("NOTE: the valid windows' mean speeds are as slow as 0.150 rad/s")
+            && said.contains("--time-unit ms"),
+        "{said}"
+    );
+    for (text, unit) in [(&ms, TimeUnit::Ms), (&us, TimeUnit::Us)] {
+        let (r, said) = analyze_unit(text, "t.txt", Some(unit), wheel("36-2")).unwrap();
+        let speeds = mean_speeds(&r);
+        assert!(speeds.len() >= 3, "{said}");
+        assert!(speeds.iter().all(|w| (w - 150.0).abs() < 0.5), "{speeds:?}");
+        assert!(!said.contains("NOTE: the valid windows'"), "{said}");
+        assert!(
+            said.contains(&format!("times: in {}", unit.name())),
+            "{said}"
+        );
+    }
+    // A header naming the unit reads so; --time-unit against it is refused, and so is it for
+    // a format that states its unit.
+    let (r, _) = analyze_unit(&format!("t_ms\n{ms}"), "t.txt", None, wheel("36-2")).unwrap();
+    assert!(mean_speeds(&r).iter().all(|w| (w - 150.0).abs() < 0.5));
+    let e = analyze_unit(
+        &format!("t_ms\n{ms}"),
+        "t.txt",
+        Some(TimeUnit::Us),
+        wheel("36-2"),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("--time-unit us: the header says the times are in ms"),
+        "{e}"
+    );
+    let vcd = "$timescale 1 us $end\n$var wire 1 ! D0 $end\n$enddefinitions $end\n#0 0!\n#5 1!\n";
+    let e = analyze_unit(vcd, "t.vcd", Some(TimeUnit::Ms), wheel("36-2")).unwrap_err();
+    assert!(
+        e.contains("--time-unit ms: a vcd file states") && e.contains("$timescale"),
+        "{e}"
+    );
+    // A plain CSV in µs, whole numbers, with --time-unit us.
+    let plain: String = std::iter::once("time_s,level\n".to_string())
+        .chain(rising.iter().flat_map(|t| {
+            let up = (1000.0 + t * 1e6).round();
+            [format!("{up},1\n"), format!("{},0\n", up + 100.0)]
+        }))
+        .collect();
+    let (r, said) = analyze_unit(&plain, "p.csv", Some(TimeUnit::Us), wheel("36-2")).unwrap();
+    assert!(mean_speeds(&r).len() >= 3, "{said}");
+    assert!(mean_speeds(&r).iter().all(|w| (w - 150.0).abs() < 0.5));
+}
+
+/// An option's value far out of range is echoed as it reads (`1e300`), not as its 301 digits.
+#[test]
+fn a_huge_option_value_is_echoed_in_exponent_form() {
+    let e = configure(&AnalyzeOptions {
+        timer_hz: Some(1e300),
+        ..wheel("36-2")
+    })
+    .unwrap_err();
+    assert!(e.starts_with("--timer-hz 1e300 is out of range"), "{e}");
+    assert!(e.len() < 200, "{e}");
+    let e = host_sim::app::logic::Threshold::new(0.0, -1e300).unwrap_err();
+    assert!(e.starts_with("--hysteresis -1e300:"), "{e}");
 }

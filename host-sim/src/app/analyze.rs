@@ -559,6 +559,13 @@ pub struct AnalyzeReport {
     pub float_grid: Option<FloatSpacing>,
     /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
     pub warnings: Vec<String>,
+    /// The unit the file's times are read in (`s`, `ms`, `us`, `ns`: its header's, or
+    /// `--time-unit`'s).
+    pub time_unit: &'static str,
+    /// Whether the file or `--time-unit` states that unit (a file of edge times or a plain CSV
+    /// without either is read in seconds, and a speed implausibly slow is said to be what
+    /// times in ms or µs read as seconds give).
+    pub time_unit_stated: bool,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s, counted from `time_origin`.
@@ -1412,12 +1419,17 @@ fn sync_hint(
         causes.push(format!(
             "no sync: the shaft stopped or ran below --min-speed {} rad/s: {} interval(s) \
              between edges longer than the {:.3} s timeout it implies, {} timeout(s); the \
-             slowest speed seen is about {}",
-            cfg.min_speed,
+             slowest speed seen is about {}{}",
+            fmt_number(cfg.min_speed),
             intervals.beyond,
             timeout,
             r.timeouts,
-            slowest_speed.map_or("unknown".into(), |w| format!("{w:.3} rad/s"))
+            slowest_speed.map_or("unknown".into(), |w| format!("{} rad/s", fmt_speed(w))),
+            if slowest_speed.is_some_and(|w| w < SLOW_FOR_SECONDS) && !r.time_unit_stated {
+                format!("; {}", unit_hint())
+            } else {
+                String::new()
+            }
         ));
     }
     if noisy {
@@ -1474,6 +1486,37 @@ fn sync_hint(
         timeout,
         min_speed: cfg.min_speed,
         slowest_speed,
+    }
+}
+
+/// A mean speed below this, rad/s (under 10 rpm), read from times whose unit the file does not
+/// state, is said to be what times in ms or µs read as seconds would give.
+const SLOW_FOR_SECONDS: f64 = 1.0;
+
+/// What a speed read from times of unstated unit is, should they be ms or µs.
+fn unit_hint() -> &'static str {
+    "the file does not state the unit of its times and they are read as seconds: if they are \
+     milliseconds or microseconds, every speed is 1000 or 1 000 000 times this (δ is the same): \
+     give --time-unit ms or --time-unit us (or a header `time_ms`, `time_us`)"
+}
+
+/// A speed, rad/s, to three decimals, or to three significant digits below 0.1 (a speed of
+/// 5e-5 rad/s is not 0.000).
+fn fmt_speed(w: f64) -> String {
+    if w != 0.0 && w.abs() < 0.1 {
+        format!("{w:.3e}")
+    } else {
+        format!("{w:.3}")
+    }
+}
+
+/// A number given on the command line as it reads: as written for the usual magnitudes, in
+/// exponent form beyond them (`1e300`, not its 301 digits).
+pub fn fmt_number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
     }
 }
 
@@ -1758,6 +1801,8 @@ pub fn analyze<R: BufRead>(
         sample_rate: reader.sample_rate(),
         sample_numbers: reader.sample_column().map(str::to_string),
         threshold: reader.threshold(),
+        time_unit: reader.time_unit().name(),
+        time_unit_stated: reader.time_unit_stated(),
         sync_state: "searching",
         ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
@@ -3199,6 +3244,13 @@ pub fn text(r: &AnalyzeReport) -> String {
              than the capture's scales every time and speed by its error)"
         );
     }
+    if r.time_unit != "s" {
+        let _ = writeln!(
+            s,
+            "times: in {} (the header's unit, or --time-unit's), converted to seconds below",
+            r.time_unit
+        );
+    }
     if r.time_origin != 0 {
         let _ = writeln!(
             s,
@@ -3482,6 +3534,20 @@ pub fn text(r: &AnalyzeReport) -> String {
          include them (the core's per-tooth learner, learn::ToothLearner, measures and removes \
          them)"
     );
+    let slowest = r
+        .windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.omega_mean)
+        .fold(f64::INFINITY, f64::min);
+    if slowest < SLOW_FOR_SECONDS && !r.time_unit_stated {
+        let _ = writeln!(
+            s,
+            "NOTE: the valid windows' mean speeds are as slow as {} rad/s: {}",
+            fmt_speed(slowest),
+            unit_hint()
+        );
+    }
     if let Some(e) = &r.edge_scatter {
         let _ = writeln!(
             s,
@@ -3922,8 +3988,8 @@ fn option_given(o: &AnalyzeOptions, enc: &EncoderConfig, parameter: &str) -> Str
         }),
         "prescaler" => o.prescaler.map(|p| p.to_string()),
         "counter_bits" => o.counter_bits.map(|b| b.to_string()),
-        "timer_hz" => o.timer_hz.map(|h| h.to_string()),
-        "min_speed" => o.min_speed.map(|w| w.to_string()),
+        "timer_hz" => o.timer_hz.map(fmt_number),
+        "min_speed" => o.min_speed.map(fmt_number),
         "window.revolutions" => o.window_revolutions.map(|n| n.to_string()),
         _ => None,
     };

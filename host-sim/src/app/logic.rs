@@ -202,7 +202,8 @@ impl Threshold {
         }
         if !(hysteresis.is_finite() && hysteresis >= 0.0) {
             return Err(format!(
-                "--hysteresis {hysteresis}: a hysteresis is a finite band of 0 or more"
+                "--hysteresis {}: a hysteresis is a finite band of 0 or more",
+                crate::app::analyze::fmt_number(hysteresis)
             ));
         }
         Ok(Threshold { volts, hysteresis })
@@ -217,6 +218,58 @@ impl Threshold {
             Level::Low
         } else {
             before
+        }
+    }
+}
+
+/// The unit of the times of a file of edge times or a plain CSV (`--time-unit`): what the
+/// numbers count, when the file does not say (a header `time_ms`, `Time [us]` does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TimeUnit {
+    /// Seconds.
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+    /// Nanoseconds.
+    Ns,
+}
+
+impl TimeUnit {
+    /// The unit as the option writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TimeUnit::S => "s",
+            TimeUnit::Ms => "ms",
+            TimeUnit::Us => "us",
+            TimeUnit::Ns => "ns",
+        }
+    }
+
+    /// Units in a second.
+    fn per_second(self) -> i128 {
+        match self {
+            TimeUnit::S => 1,
+            TimeUnit::Ms => 1_000,
+            TimeUnit::Us => 1_000_000,
+            TimeUnit::Ns => 1_000_000_000,
+        }
+    }
+
+    /// The unit a word of a header names (`ms`, `usec`, `µs`, `nanoseconds`), if one of these.
+    fn of_word(word: &str) -> Option<TimeUnit> {
+        match word.to_lowercase().as_str() {
+            "s" | "sec" | "secs" | "second" | "seconds" => Some(TimeUnit::S),
+            "ms" | "msec" | "msecs" | "millis" | "millisecond" | "milliseconds" => {
+                Some(TimeUnit::Ms)
+            }
+            "us" | "µs" | "μs" | "usec" | "usecs" | "micros" | "microsecond" | "microseconds" => {
+                Some(TimeUnit::Us)
+            }
+            "ns" | "nsec" | "nsecs" | "nanos" | "nanosecond" | "nanoseconds" => Some(TimeUnit::Ns),
+            _ => None,
         }
     }
 }
@@ -263,6 +316,8 @@ enum SigrokTime {
     Labelled,
     /// No time column: one row per sample.
     None,
+    /// A column of decimal seconds (`seconds`): read as written, as a Saleae export's is.
+    Seconds,
 }
 
 /// The sigrok time units, smallest rate first: libsigrok picks the first unit whose rate
@@ -346,8 +401,14 @@ pub struct CaptureReader<R> {
     unterminated: bool,
     /// A value change dump's identifiers, time unit and pending tokens.
     vcd: vcd::Vcd,
-    /// A file of edge times whose header says seconds (a whole number is then a time).
-    times_in_seconds: bool,
+    /// The unit of the decimal times of a file of edge times, a plain or a Saleae CSV: the
+    /// header's (`time_ms`, `Time [us]`), `--time-unit`'s, or seconds.
+    time_unit: TimeUnit,
+    /// Whether the header or `--time-unit` states that unit (a whole number is then a time;
+    /// unstated, the times are read as seconds).
+    unit_stated: bool,
+    /// `--time-unit`, as given.
+    unit_given: Option<TimeUnit>,
     /// A Saleae Logic 1.x export with sample numbers for times: its first column's heading.
     sample_column: Option<String>,
     /// A sigrok session file's samples (the format `Sr`; `input` is then not read).
@@ -366,9 +427,29 @@ pub struct CaptureReader<R> {
     rate_source: Option<String>,
 }
 
-/// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
-/// (`Time[s], Channel 0, Channel 1`, a space after each comma, fifteen decimals).
-const SALEAE_TIME: [&str; 2] = ["Time [s]", "Time[s]"];
+/// The unit of a Saleae digital CSV export's time column by its heading: Logic 2's `Time [s]`,
+/// Logic 1.x's `Time[s]` (`Time[s], Channel 0, Channel 1`, a space after each comma, fifteen
+/// decimals), or another unit in the brackets (`Time [us]`, `Time [ms]`, `Time [ns]`).
+fn saleae_time_heading(head: &str) -> Option<TimeUnit> {
+    let unit = head
+        .strip_prefix("Time")?
+        .trim()
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
+    TimeUnit::of_word(unit.trim())
+}
+
+/// The unit of a plain CSV's time column by its heading: `time_s`, `time_ms`, `time_us`,
+/// `time_ns`.
+fn plain_time_heading(head: &str) -> Option<TimeUnit> {
+    match head {
+        "time_s" => Some(TimeUnit::S),
+        "time_ms" => Some(TimeUnit::Ms),
+        "time_us" => Some(TimeUnit::Us),
+        "time_ns" => Some(TimeUnit::Ns),
+        _ => None,
+    }
+}
 
 /// Whether `head` heads a column of sample numbers in a Saleae export (Logic 1.x's option of
 /// sample numbers for time stamps): `Sample Number`, `Sample`, `Sample #`, `Sample [#]`, `Sample
@@ -499,6 +580,18 @@ impl CaptureReader<std::io::BufReader<std::fs::File>> {
         format: Option<CaptureFormat>,
         sample_rate: Option<f64>,
     ) -> Result<Self, CaptureError> {
+        Self::open_with(path, format, sample_rate, None)
+    }
+
+    /// [`Self::open`], the times in `time_unit` (`--time-unit`: a file of edge times or a
+    /// plain CSV whose header does not say; refused for the formats that state their unit
+    /// otherwise, and where the header says another).
+    pub fn open_with(
+        path: &Path,
+        format: Option<CaptureFormat>,
+        sample_rate: Option<f64>,
+        time_unit: Option<TimeUnit>,
+    ) -> Result<Self, CaptureError> {
         let err = |message: String| CaptureError {
             file: path.to_path_buf(),
             line: None,
@@ -516,7 +609,13 @@ impl CaptureReader<std::io::BufReader<std::fs::File>> {
             path.to_path_buf()
         };
         let file = std::fs::File::open(&input).map_err(|e| err(format!("cannot open: {e}")))?;
-        Self::new(std::io::BufReader::new(file), path, format, sample_rate)
+        Self::new_with(
+            std::io::BufReader::new(file),
+            path,
+            format,
+            sample_rate,
+            time_unit,
+        )
     }
 }
 
@@ -527,6 +626,17 @@ impl<R: BufRead> CaptureReader<R> {
         file: &Path,
         format: Option<CaptureFormat>,
         sample_rate: Option<f64>,
+    ) -> Result<Self, CaptureError> {
+        Self::new_with(input, file, format, sample_rate, None)
+    }
+
+    /// [`Self::new`], the times in `time_unit` (see [`CaptureReader::open_with`]).
+    pub fn new_with(
+        input: R,
+        file: &Path,
+        format: Option<CaptureFormat>,
+        sample_rate: Option<f64>,
+        time_unit: Option<TimeUnit>,
     ) -> Result<Self, CaptureError> {
         let mut r = CaptureReader {
             input,
@@ -544,7 +654,9 @@ impl<R: BufRead> CaptureReader<R> {
             origin: None,
             unterminated: false,
             vcd: vcd::Vcd::default(),
-            times_in_seconds: false,
+            time_unit: TimeUnit::S,
+            unit_stated: false,
+            unit_given: time_unit,
             sample_column: None,
             session: None,
             binary: None,
@@ -621,16 +733,17 @@ impl<R: BufRead> CaptureReader<R> {
             Some(CaptureFormat::Vcd)
         } else if first.starts_with(';') {
             Some(CaptureFormat::Sigrok)
-        } else if SALEAE_TIME.contains(&head) || saleae_sample_heading(head) && first.contains(',')
+        } else if saleae_time_heading(head).is_some()
+            || saleae_sample_heading(head) && first.contains(',')
         {
             Some(CaptureFormat::Saleae)
         } else if !first.contains(',') {
             // One column: edge times (a header naming it, or none).
             Some(CaptureFormat::Times)
-        } else if first.starts_with("time_s") {
+        } else if plain_time_heading(head).is_some() {
             Some(CaptureFormat::Plain)
         } else {
-            (head == "Time" || SIGROK_UNITS.iter().any(|(u, _)| *u == head))
+            (head == "Time" || head == "seconds" || SIGROK_UNITS.iter().any(|(u, _)| *u == head))
                 .then_some(CaptureFormat::Sigrok)
         };
         r.format = match (format, detected) {
@@ -648,11 +761,18 @@ impl<R: BufRead> CaptureReader<R> {
         };
         match r.format {
             CaptureFormat::Saleae => r.header_saleae(&first)?,
-            CaptureFormat::Plain => r.header_columns(
-                &first,
-                &["time_s"],
-                "the header `time_s,level` (or `time_s,level,index`)",
-            )?,
+            CaptureFormat::Plain => {
+                r.header_columns(
+                    &first,
+                    &|h| plain_time_heading(h).is_some(),
+                    "the header `time_s,level` (or `time_s,level,index`; `time_ms`, `time_us`, \
+                     `time_ns` for times in those units)",
+                )?;
+                let head = first.split(',').next().unwrap_or("").trim();
+                if let Some(u) = plain_time_heading(head).filter(|&u| u != TimeUnit::S) {
+                    (r.time_unit, r.unit_stated) = (u, true);
+                }
+            }
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
             CaptureFormat::Vcd => r.header_vcd(first)?,
             CaptureFormat::Times => r.header_times(first)?,
@@ -662,6 +782,7 @@ impl<R: BufRead> CaptureReader<R> {
                 return r.open_binary(false, Some(CaptureFormat::SaleaeBinary))
             }
         }
+        r.take_time_unit()?;
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
         }
@@ -695,6 +816,9 @@ impl<R: BufRead> CaptureReader<R> {
                 "--format sr: the file is not a zip archive, as a sigrok session file (.sr) is: \
                  leave --format out to have the format told from the file",
             ));
+        }
+        if self.unit_given.is_some() {
+            return Err(self.unit_refused());
         }
         let session = srzip::Session::open(&self.file).map_err(|m| self.err_here(&m))?;
         self.channels = session.names.clone();
@@ -738,6 +862,9 @@ impl<R: BufRead> CaptureReader<R> {
                 "--format saleae-binary: the file does not start with `<SALEAE>`, as Saleae's \
                  binary export does: leave --format out to have the format told from the file",
             ));
+        }
+        if self.unit_given.is_some() {
+            return Err(self.unit_refused());
         }
         let export = saleae_bin::Export::open(&self.file).map_err(|m| CaptureError {
             file: self.file.clone(),
@@ -788,6 +915,22 @@ impl<R: BufRead> CaptureReader<R> {
     /// The threshold the values are read through, if any.
     pub fn threshold(&self) -> Option<Threshold> {
         self.threshold
+    }
+
+    /// The unit the times are read in (seconds unless the header or `--time-unit` says).
+    pub fn time_unit(&self) -> TimeUnit {
+        self.time_unit
+    }
+
+    /// Whether the file (its format, or its header) or `--time-unit` states the unit of its
+    /// times: a file of edge times or a plain CSV without `--time-unit` does not (a plain
+    /// CSV's `time_s` is its format's fixed heading), and is read in seconds.
+    pub fn time_unit_stated(&self) -> bool {
+        match self.format {
+            CaptureFormat::Times => self.unit_stated,
+            CaptureFormat::Plain => self.unit_given.is_some() || self.time_unit != TimeUnit::S,
+            _ => true,
+        }
     }
 
     /// The format read.
@@ -890,11 +1033,11 @@ impl<R: BufRead> CaptureReader<R> {
     fn header_columns(
         &mut self,
         first: &str,
-        time: &[&str],
+        time: &dyn Fn(&str) -> bool,
         expected: &str,
     ) -> Result<(), CaptureError> {
         let mut f = first.split(',');
-        if !f.next().map(str::trim).is_some_and(|h| time.contains(&h)) {
+        if !f.next().map(str::trim).is_some_and(time) {
             return Err(self.err_here(&format!("expected {expected}, found `{}`", clip(first))));
         }
         self.channels = f.map(|c| c.trim().to_string()).collect();
@@ -906,13 +1049,17 @@ impl<R: BufRead> CaptureReader<R> {
     fn header_saleae(&mut self, first: &str) -> Result<(), CaptureError> {
         let head = first.split(',').next().unwrap_or("").trim();
         if !saleae_sample_heading(head) {
-            return self.header_columns(
+            self.header_columns(
                 first,
-                &SALEAE_TIME,
+                &|h| saleae_time_heading(h).is_some(),
                 "a Saleae header: `Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` \
                  (Logic 1.x), the time in seconds, or `Sample Number, Channel 0, ...` (Logic \
                  1.x's sample numbers, with --sample-rate)",
-            );
+            )?;
+            if let Some(u) = saleae_time_heading(head) {
+                (self.time_unit, self.unit_stated) = (u, true);
+            }
+            return Ok(());
         }
         if self.sample_rate.is_none() {
             return Err(self.err_here(&format!(
@@ -956,23 +1103,73 @@ impl<R: BufRead> CaptureReader<R> {
             .collect();
         let other = words.iter().find(|w| {
             [
-                "ms", "us", "µs", "μs", "ns", "ps", "msec", "usec", "nsec", "millis", "micros",
-                "tick", "ticks", "cycle", "cycles", "count", "counts", "sample", "samples", "min",
+                "ps", "tick", "ticks", "cycle", "cycles", "count", "counts", "sample", "samples",
+                "min",
             ]
             .contains(&w.as_str())
         });
         if let Some(unit) = other {
             return Err(self.err_here(&format!(
-                "one column headed `{}`, in {unit}: a file of edge times is read in seconds; \
-                 convert the times to seconds (headed `time_s`)",
+                "one column headed `{}`, in {unit}: a file of edge times is read in seconds, \
+                 milliseconds, microseconds or nanoseconds; convert the times to one of them \
+                 (headed `time_s`, `time_ms`, `time_us` or `time_ns`, or give --time-unit)",
                 clip(head)
             )));
         }
-        self.times_in_seconds = words
-            .iter()
-            .any(|w| ["s", "sec", "secs", "second", "seconds"].contains(&w.as_str()));
+        // The unit the header names (`time_s`, `t [ms]`, `usec`), if any.
+        if let Some(u) = words.iter().find_map(|w| TimeUnit::of_word(w)) {
+            (self.time_unit, self.unit_stated) = (u, true);
+        }
         self.channels = vec![head.to_string()];
         Ok(())
+    }
+
+    /// Takes `--time-unit`, if given, as the unit of the times: for a file of edge times and a
+    /// plain CSV; where the header names a unit, it must be that one.
+    fn take_time_unit(&mut self) -> Result<(), CaptureError> {
+        let Some(given) = self.unit_given else {
+            return Ok(());
+        };
+        let fits = matches!(self.format, CaptureFormat::Times | CaptureFormat::Plain)
+            || self.format == CaptureFormat::Saleae && self.sample_column.is_none();
+        if !fits {
+            return Err(self.unit_refused());
+        }
+        if self.unit_stated && self.time_unit != given {
+            return Err(self.err_here(&format!(
+                "--time-unit {}: the header says the times are in {}: leave --time-unit out, or \
+                 correct the header",
+                given.name(),
+                self.time_unit.name()
+            )));
+        }
+        if self.format == CaptureFormat::Saleae && !self.unit_stated {
+            return Err(self.unit_refused());
+        }
+        (self.time_unit, self.unit_stated) = (given, true);
+        Ok(())
+    }
+
+    /// `--time-unit` given for a format whose times are not numbers in a unit the option
+    /// names.
+    fn unit_refused(&self) -> CaptureError {
+        let given = self.unit_given.map_or("", TimeUnit::name);
+        CaptureError {
+            file: self.file.clone(),
+            line: None,
+            message: format!(
+                "--time-unit {given}: a {} file states the unit of its times itself ({}); \
+                 --time-unit is for a file of edge times or a plain CSV: leave it out",
+                self.format.name(),
+                match self.format {
+                    CaptureFormat::Vcd => "its `$timescale`",
+                    CaptureFormat::Sigrok | CaptureFormat::Sr => "its samplerate and time column",
+                    CaptureFormat::SaleaeBinary => "seconds, as doubles",
+                    _ if self.sample_column.is_some() => "sample numbers, over --sample-rate",
+                    _ => "its header",
+                }
+            ),
+        }
     }
 
     fn header_sigrok(&mut self, first: String) -> Result<(), CaptureError> {
@@ -1038,6 +1235,7 @@ impl<R: BufRead> CaptureReader<R> {
         }
         let (time, labels) = match fields.first() {
             Some(&"Time") => (SigrokTime::Labelled, &fields[1..]),
+            Some(&"seconds") => (SigrokTime::Seconds, &fields[1..]),
             Some(f) => match SIGROK_UNITS.iter().find(|(u, _)| u == f) {
                 Some(&(_, per_s)) => (
                     SigrokTime::Column {
@@ -1092,7 +1290,7 @@ impl<R: BufRead> CaptureReader<R> {
         } else {
             labels.iter().map(|l| l.to_string()).collect()
         };
-        if self.sample_rate.is_none() {
+        if self.sample_rate.is_none() && time != SigrokTime::Seconds {
             return Err(self.err_here(&match time {
                 SigrokTime::Column { .. } => format!(
                     "the time of a sample cannot be told exactly: the file has no `; \
@@ -1246,11 +1444,12 @@ impl<R: BufRead> CaptureReader<R> {
         // microseconds, read a million-fold slow.
         let whole =
             !f.contains(['.', 'e', 'E']) && !f.trim_start_matches(['+', '-', '0']).is_empty();
-        if whole && !self.times_in_seconds && decimal_attoseconds(f).is_some() {
+        if whole && !self.unit_stated && decimal_attoseconds(f).is_some() {
             return Err(self.err_here(&format!(
                 "`{}` is a whole number: an edge time in seconds has decimals (`0.002084`); \
-                 convert timer ticks or microseconds to seconds, or head the column `time_s` \
-                 if these are whole seconds",
+                 give --time-unit ms, us or ns if these are milliseconds, microseconds or \
+                 nanoseconds (--time-unit s, or a header `time_s`, if whole seconds), or \
+                 convert timer ticks to seconds",
                 clip(f)
             )));
         }
@@ -1299,23 +1498,31 @@ impl<R: BufRead> CaptureReader<R> {
                 let rate = self.sample_rate.unwrap_or(1.0);
                 Ok(self.seconds_from_atto(sample_attoseconds(n, rate)))
             }
-            (CaptureFormat::Sigrok, _) => {
+            (CaptureFormat::Sigrok, s) if s != SigrokTime::Seconds => {
                 let v: u64 = f.parse().map_err(|_| bad("a whole number of time units"))?;
                 let rate = self.sample_rate.unwrap_or(1.0);
                 let (_, _, period) = sigrok_unit(rate as u64);
                 Ok((v / period).saturating_sub(1) as f64 / rate)
             }
             _ => {
+                let unit = match self.time_unit {
+                    TimeUnit::S => "seconds",
+                    TimeUnit::Ms => "milliseconds",
+                    TimeUnit::Us => "microseconds",
+                    TimeUnit::Ns => "nanoseconds",
+                };
                 let Some(atto) = decimal_attoseconds(f) else {
                     // Not a plain decimal: `inf`, `NaN`, or no number at all.
                     return Err(match f.parse::<f64>() {
                         Ok(x) if x.is_finite() => bad("a time within ±1e20 s"),
-                        Ok(_) => bad("a finite time in seconds"),
-                        Err(_) => bad("a time in seconds"),
+                        Ok(_) => bad(&format!("a finite time in {unit}")),
+                        Err(_) => bad(&format!("a time in {unit}")),
                     });
                 };
-                self.precision = decimal_precision(f);
-                Ok(self.seconds_from_atto(atto))
+                // (Written in the unit: its attoseconds are that many times fewer.)
+                let per_second = self.time_unit.per_second();
+                self.precision = decimal_precision(f) / per_second as f64;
+                Ok(self.seconds_from_atto(atto / per_second))
             }
         }
     }
