@@ -5363,3 +5363,97 @@ fn a_huge_option_value_is_echoed_in_exponent_form() {
     let e = host_sim::app::logic::Threshold::new(0.0, -1e300).unwrap_err();
     assert!(e.starts_with("--hysteresis -1e300:"), "{e}");
 }
+
+/// A threshold outside the values' range reads no edge; the report said "no channel of the
+/// capture changes level" and "no sync: the capture is too short". It now gives the values'
+/// range against the band the threshold reads them through.
+#[test]
+fn a_threshold_outside_the_values_is_named_with_their_range() {
+    // A 24-tooth sensor's sine, ±1.05 V, 20 kS/s over 0.5 s.
+    let omega = 100.0;
+    let mut csv = String::from("Time [s],Channel 0\n");
+    for i in 0..10_000 {
+        let t = i as f64 / 20e3;
+        csv.push_str(&format!("{t:.9},{:.5}\n", 1.05 * (24.0 * omega * t).sin()));
+    }
+    let lines = AnalyzeOptions {
+        lines: Some(24),
+        ..AnalyzeOptions::default()
+    };
+    for (volts, hysteresis, never) in [
+        (5.0, 0.0, "never above 5, so never high"),
+        (0.0, 3.0, "never above 1.5 nor below -1.5"),
+    ] {
+        let cfg = configure(&lines).unwrap();
+        let mut reader = text_reader(csv.clone(), "a.csv", None).unwrap();
+        reader
+            .set_threshold(host_sim::app::logic::Threshold::new(volts, hysteresis).unwrap())
+            .unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        let said = host_sim::app::analyze::text(&r);
+        assert_eq!(r.edges, 0);
+        assert!(
+            said.contains("the values of `Channel 0` range from -1.05 to 1.05")
+                && said.contains(never)
+                && said.contains("give a --threshold within their range"),
+            "{said}"
+        );
+        assert!(!said.contains("too short"), "{said}");
+    }
+}
+
+/// A value change dump whose time unit (1 ms) is coarser than the pulses (a 36-2 wheel at
+/// 150 rad/s, a tooth every 1.16 ms): a tooth's fall and the next one's rise often fall on
+/// one time stamp and cancel. It was said to be "too short" (1.4 revolutions of edges in 8);
+/// now the stamps with a change and its undoing are counted and said.
+#[test]
+fn changes_merged_by_a_coarse_timescale_are_said() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let half = std::f64::consts::TAU / 36.0 / 150.0 / 2.0;
+    let mut vcd = String::from(
+        "$timescale 1 ms $end\n$scope module logic $end\n$var wire 1 ! D0 $end\n$upscope $end\n\
+         $enddefinitions $end\n#0\n0!\n",
+    );
+    let mut stamp = 0u64;
+    for &t in &rising {
+        for (at, v) in [(t, 1), (t + half, 0)] {
+            let k = (at * 1e3).ceil() as u64;
+            if k != stamp {
+                vcd.push_str(&format!("#{k}\n"));
+                stamp = k;
+            }
+            vcd.push_str(&format!("{v}!\n"));
+        }
+    }
+    let (r, said) = analyze_unit(&vcd, "c.vcd", None, wheel("36-2")).unwrap();
+    let m = r.same_stamp.expect("merged changes counted");
+    assert!(m.times > 100 && m.timescale == Some(1e-3), "{m:?}");
+    assert!(
+        said.contains("WARNING: `D0` changes level and back at one time stamp")
+            && said.contains("lost to the time unit, not to a short capture"),
+        "{said}"
+    );
+    assert!(!said.contains("too short"), "{said}");
+}
+
+/// Two rows at one time with opposite levels (a pulse of no width as written) were counted as
+/// a glitch with no word that the file has two changes at one time stamp.
+#[test]
+fn two_rows_at_one_time_with_opposite_levels_are_named() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let mut csv = saleae_of_rising(&rising, 1e9, 0.35);
+    let at = 0.5 * (rising[100] + rising[101]) + 0.2e-3;
+    let row = format!("{at:.9},0\n");
+    let k = csv
+        .find(&format!("{:.9},1\n", sampled(rising[101], 1e9)))
+        .unwrap();
+    csv.insert_str(k, &format!("{at:.9},1\n{row}"));
+    let (r, said) = analyze_unit(&csv, "z.csv", None, wheel("36-2")).unwrap();
+    let m = r.same_stamp.expect("the pulse of no width is counted");
+    assert_eq!((m.times, m.timescale), (1, None));
+    assert!((m.first - at).abs() < 1e-9, "{m:?}");
+    assert!(
+        said.contains("WARNING: `Channel 0` changes level twice at one time 1 time(s)"),
+        "{said}"
+    );
+}

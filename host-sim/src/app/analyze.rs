@@ -566,6 +566,14 @@ pub struct AnalyzeReport {
     /// without either is read in seconds, and a speed implausibly slow is said to be what
     /// times in ms or µs read as seconds give).
     pub time_unit_stated: bool,
+    /// The smallest and largest value of the channel read, where it is read through
+    /// `--threshold`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub values: Option<[f64; 2]>,
+    /// The channel read changing level twice at one time stamp (a pulse of no width as
+    /// written), where it does.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub same_stamp: Option<SameStamp>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s, counted from `time_origin`.
@@ -1328,6 +1336,26 @@ fn sync_hint(
                 None => String::new(),
             }
         ));
+    } else if threshold_miss(r).is_some() && r.edges == 0 {
+        causes.push(
+            "no sync: no edge was read: the values never cross the band of --threshold and \
+             --hysteresis (their range above), not a short capture"
+                .to_string(),
+        );
+    } else if let Some(m) = r.same_stamp.filter(|m| short && m.timescale.is_some()) {
+        causes.push(format!(
+            "no sync: {} captured edges, {:.1} revolutions of the configured wheel ({} edges a \
+             revolution), over {:.6} s: at {} time stamp(s) `{}` changes and changes back \
+             within the dump's time unit ({:.3e} s), which leaves no pulse: edges are lost to \
+             the time unit, not to a short capture (see the WARNING)",
+            r.captured,
+            revolutions_of_edges,
+            per_rev,
+            r.span[1] - r.span[0],
+            m.times,
+            r.channel,
+            m.timescale.unwrap_or(0.0)
+        ));
     } else if short {
         causes.push(format!(
             "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
@@ -1486,6 +1514,52 @@ fn sync_hint(
         timeout,
         min_speed: cfg.min_speed,
         slowest_speed,
+    }
+}
+
+/// The channel read changing level twice at one time stamp.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct SameStamp {
+    /// How many times.
+    pub times: u64,
+    /// The first, s.
+    pub first: f64,
+    /// A value change dump's time unit, s, when the file is one: its changes at one stamp
+    /// leave one row of the last levels, and the pulse is lost; in rows it is two rows at one
+    /// time with opposite levels.
+    pub timescale: Option<f64>,
+}
+
+/// Why the channel read through `--threshold` can have no edge, if its values say: the range
+/// they span against the band the threshold reads them through.
+fn threshold_miss(r: &AnalyzeReport) -> Option<String> {
+    let (t, [min, max]) = (r.threshold?, r.values?);
+    let (lo, hi) = (t.volts - 0.5 * t.hysteresis, t.volts + 0.5 * t.hysteresis);
+    let never = match (max <= hi, min >= lo) {
+        (true, true) => format!("never above {hi} nor below {lo}"),
+        (true, false) => format!("never above {hi}, so never high"),
+        (false, true) => format!("never below {lo}, so never low"),
+        (false, false) => return None,
+    };
+    Some(format!(
+        "the values of `{}` range from {min} to {max}, {never} (--threshold {} with --hysteresis \
+         {}: high above {hi}, low below {lo}): give a --threshold within their range (their \
+         midpoint is {}) and a --hysteresis narrower than it ({})",
+        r.channel,
+        fmt_number(t.volts),
+        fmt_number(t.hysteresis),
+        fmt_value(0.5 * (min + max)),
+        fmt_value(max - min)
+    ))
+}
+
+/// A value to four significant digits or so (`0.0002`, `2.102`, `1.234e-5`).
+fn fmt_value(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        let s = format!("{x:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }
 
@@ -1828,6 +1902,8 @@ pub fn analyze<R: BufRead>(
         frames_listed: 0,
     };
     let mut prev: Vec<Level> = Vec::new();
+    // The read channel's last change of level, and its changes at that same time.
+    let (mut last_change, mut same_stamp, mut same_stamp_first) = (None::<f64>, 0u64, None::<f64>);
     let mut periods = IndexPeriods::default();
     let mut last_event: Option<f64> = None;
     let mut end = 0.0;
@@ -1927,6 +2003,16 @@ pub fn analyze<R: BufRead>(
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
                 *n += 1;
             }
+        }
+        // The channel read changing again at the time of its last change: two rows at one
+        // time with opposite levels, a pulse of no width as written.
+        let (a, b) = (prev[ch], levels[ch]);
+        if a != b && a != Level::Unknown && b != Level::Unknown {
+            if last_change == Some(t) {
+                same_stamp += 1;
+                same_stamp_first.get_or_insert(t);
+            }
+            last_change = Some(t);
         }
         // The channel read without data: from the row it went unknown to the row it came back
         // (or the end of the capture).
@@ -2132,6 +2218,19 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
+    report.values = reader.value_range(ch).map(|(a, b)| [a, b]);
+    let (merged, merged_at) = reader.merged_changes(ch);
+    if let Some(first) = [merged_at, same_stamp_first]
+        .into_iter()
+        .flatten()
+        .reduce(f64::min)
+    {
+        report.same_stamp = Some(SameStamp {
+            times: merged + same_stamp,
+            first,
+            timescale: reader.timescale(),
+        });
+    }
     no_data.extend(no_data_from.map(|f| (f, end)));
     if let Some(&first) = no_data.first() {
         report.no_data = Some(NoData {
@@ -3355,6 +3454,27 @@ pub fn text(r: &AnalyzeReport) -> String {
             r.channel, g.edges, g.of, g.longest, g.longest
         );
     }
+    if let Some(m) = &r.same_stamp {
+        let _ = match m.timescale {
+            Some(unit) => writeln!(
+                s,
+                "WARNING: `{}` changes level and back at one time stamp {} time(s) (the first at \
+                 {:.6} s): a pulse shorter than the dump's time unit ({unit:.3e} s, its \
+                 `$timescale`) leaves no row, and its edges are lost (missing edges, or too few \
+                 to sync); record the dump with a finer time unit",
+                r.channel, m.times, m.first
+            ),
+            None => writeln!(
+                s,
+                "WARNING: `{}` changes level twice at one time {} time(s) (the first at {:.6} s: \
+                 two rows at that time with opposite levels): a pulse of no width as written, \
+                 its two edges 0 s apart, which no timer resolves (the core takes the second \
+                 as a glitch); the times are written more coarsely than the pulses came, or \
+                 the rows are wrong",
+                r.channel, m.times, m.first
+            ),
+        };
+    }
     if let Some(d) = &r.repeated_times {
         let _ = writeln!(
             s,
@@ -3604,7 +3724,14 @@ pub fn text(r: &AnalyzeReport) -> String {
     if r.edges == 0 && r.edges_listed() {
         let _ = writeln!(s, "no edge: the file of edge times lists none");
     } else if r.edges == 0 {
-        let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+        match threshold_miss(r) {
+            Some(why) => {
+                let _ = writeln!(s, "no {} edge on --channel `{}`: {why}", r.edge, r.channel);
+            }
+            None => {
+                let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+            }
+        }
     }
     if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
         let _ = writeln!(s, "{}", quiet(i, "--index-channel"));

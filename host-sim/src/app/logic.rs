@@ -425,6 +425,8 @@ pub struct CaptureReader<R> {
     precision: f64,
     /// Where the sample rate came from, as the file or the option states it (for messages).
     rate_source: Option<String>,
+    /// The smallest and largest value of each column read through the threshold.
+    value_range: Vec<Option<(f64, f64)>>,
 }
 
 /// The unit of a Saleae digital CSV export's time column by its heading: Logic 2's `Time [s]`,
@@ -657,6 +659,7 @@ impl<R: BufRead> CaptureReader<R> {
             time_unit: TimeUnit::S,
             unit_stated: false,
             unit_given: time_unit,
+            value_range: Vec::new(),
             sample_column: None,
             session: None,
             binary: None,
@@ -915,6 +918,31 @@ impl<R: BufRead> CaptureReader<R> {
     /// The threshold the values are read through, if any.
     pub fn threshold(&self) -> Option<Threshold> {
         self.threshold
+    }
+
+    /// The smallest and the largest value read through the threshold in channel `k`'s column
+    /// so far (`None`: no threshold, or no value).
+    pub fn value_range(&self, k: usize) -> Option<(f64, f64)> {
+        self.value_range.get(k).copied().flatten()
+    }
+
+    /// How many times a value change dump changed channel `k` again at a time stamp at which
+    /// it had already changed (a pulse within one time unit: only the last level at a stamp
+    /// is a row, and the pulse is lost), with the first such time, s; 0 for other formats.
+    pub fn merged_changes(&self, k: usize) -> (u64, Option<f64>) {
+        let (n, first) = self.vcd.merged(k);
+        let first = first.map(|t| {
+            let atto = i128::try_from(t)
+                .unwrap_or(i128::MAX)
+                .saturating_mul(self.vcd.unit_atto());
+            atto.saturating_sub(i128::from(self.time_origin()) * ATTO) as f64 / ATTO as f64
+        });
+        (n, first)
+    }
+
+    /// A value change dump's time unit (its `$timescale`), s; `None` for other formats.
+    pub fn timescale(&self) -> Option<f64> {
+        (self.format == CaptureFormat::Vcd).then(|| self.vcd.unit_atto() as f64 * 1e-18)
     }
 
     /// The unit the times are read in (seconds unless the header or `--time-unit` says).
@@ -1374,7 +1402,14 @@ impl<R: BufRead> CaptureReader<R> {
             self.levels[k] = match (f.trim(), self.threshold) {
                 ("X" | "x", _) if self.format == CaptureFormat::Saleae => Level::Unknown,
                 (value, Some(th)) => match value.parse::<f64>() {
-                    Ok(v) if v.is_finite() => th.level(v, self.levels[k]),
+                    Ok(v) if v.is_finite() => {
+                        if self.value_range.len() != n {
+                            self.value_range = vec![None; n];
+                        }
+                        let r = self.value_range[k].get_or_insert((v, v));
+                        *r = (r.0.min(v), r.1.max(v));
+                        th.level(v, self.levels[k])
+                    }
                     _ if self.unread.get(k) == Some(&true) => Level::Unknown,
                     _ => {
                         return Err(self.err_here(&format!(

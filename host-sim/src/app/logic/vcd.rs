@@ -36,6 +36,23 @@ pub(super) struct Vcd {
     time: Option<u128>,
     /// Whether a change or a `#T` has been read since the last row was given.
     pending: bool,
+    /// Each channel's last change of level: the time, units.
+    changed_at: Vec<Option<u128>>,
+    /// Each channel's changes at a time stamp at which it had changed already, and the first
+    /// such time, units.
+    merged: Vec<(u64, Option<u128>)>,
+}
+
+impl Vcd {
+    /// Channel `k`'s changes merged into one time stamp, and the first such time, units.
+    pub(super) fn merged(&self, k: usize) -> (u64, Option<u128>) {
+        self.merged.get(k).copied().unwrap_or((0, None))
+    }
+
+    /// Attoseconds per time unit.
+    pub(super) fn unit_atto(&self) -> i128 {
+        self.unit_atto
+    }
 }
 
 /// Attoseconds in one unit of a `$timescale`.
@@ -311,8 +328,24 @@ impl<R: BufRead> CaptureReader<R> {
         self.vcd.pending = true;
         match self.vcd.ids.get(id) {
             Some(columns) => {
+                let n = self.levels.len();
+                if self.vcd.changed_at.len() != n {
+                    self.vcd.changed_at = vec![None; n];
+                    self.vcd.merged = vec![(0, None); n];
+                }
+                let now = self.vcd.time;
                 for &c in columns {
                     if let Some(l) = self.levels.get_mut(c) {
+                        // A change of a known level to the other: a second one at the same
+                        // stamp undoes the first (a pulse shorter than the time unit).
+                        if *l != level && *l != Level::Unknown && level != Level::Unknown {
+                            if self.vcd.changed_at[c] == now {
+                                let m = &mut self.vcd.merged[c];
+                                m.0 += 1;
+                                m.1 = m.1.or(now);
+                            }
+                            self.vcd.changed_at[c] = now;
+                        }
                         *l = level;
                     }
                 }
