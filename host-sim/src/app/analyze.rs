@@ -1709,6 +1709,22 @@ fn name_number(name: &str) -> Option<usize> {
     name[name.len() - digits..].parse().ok()
 }
 
+/// The channel names, each that another channel shares followed by its number
+/// (`Channel 0 (channel 1)`).
+fn distinct_names(channels: &[String]) -> Vec<String> {
+    channels
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            if channels.iter().filter(|&n| n == name).count() > 1 {
+                format!("{name} (channel {k})")
+            } else {
+                name.clone()
+            }
+        })
+        .collect()
+}
+
 fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, String> {
     // A channel whose name carries the number given, at another column: the number is read
     // as a column, but the analyzer's own numbering may be what was meant.
@@ -1727,12 +1743,44 @@ fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, Strin
                 channels[*n], channels[k], channels[k]
             )),
         },
-        Channel::Name(name) => channels.iter().position(|x| x == name).ok_or_else(|| {
-            format!(
-                "{option} {name}: no such channel (the capture has {})",
-                channels.join(", ")
-            )
-        }),
+        Channel::Name(name) => {
+            let at: Vec<usize> = (0..channels.len())
+                .filter(|&k| channels[k] == *name)
+                .collect();
+            match at.as_slice() {
+                [k] => Ok(*k),
+                [] => {
+                    // A value change dump names channels that share a name by their scopes.
+                    let scoped: Vec<&str> = channels
+                        .iter()
+                        .filter(|c| c.ends_with(&format!(".{name}")))
+                        .map(String::as_str)
+                        .collect();
+                    Err(format!(
+                        "{option} {name}: no such channel (the capture has {}){}",
+                        channels.join(", "),
+                        if scoped.is_empty() {
+                            String::new()
+                        } else {
+                            format!(
+                                "; channels that share the name `{name}` are named by their \
+                                 scopes: {}",
+                                scoped.join(", ")
+                            )
+                        }
+                    ))
+                }
+                many => Err(format!(
+                    "{option} {name}: {} channels have that name (numbers {}, counted from 0): \
+                     give the number of the one to read",
+                    many.len(),
+                    many.iter()
+                        .map(usize::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            }
+        }
         Channel::Column(n) => Err(format!(
             "{option} {n}: the capture has {} channel{} ({}), numbered from 0{}",
             channels.len(),
@@ -1851,6 +1899,9 @@ pub fn analyze<R: BufRead>(
         }
         None => None,
     };
+    // From here on, channels as the report names them: a name two columns share with its
+    // number (`Channel 0 (channel 1)`), so that the one read is told.
+    let channels = distinct_names(&channels);
     // Only the channels read must hold levels (an analog column beside them is no data).
     let read: Vec<usize> = [Some(ch), ich, dch.map(|(d, _)| d)]
         .into_iter()

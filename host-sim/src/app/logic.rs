@@ -32,9 +32,10 @@
 //!   `time,0|1` rows at each change.
 //!
 //! Reading is streamed, one line at a time: memory does not grow with the file. Line ends may
-//! be LF or CRLF, and a UTF-8 byte order mark before the first line is skipped. Limits: a line
-//! is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`] channels, times must
-//! not decrease from row to row. Every error names the file, the line and what was expected.
+//! be LF, CRLF or a CR alone, and a UTF-8 byte order mark before the first line is skipped.
+//! Limits: a line is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`]
+//! channels, times must not decrease from row to row. Every error names the file, the line and
+//! what was expected.
 //!
 //! Writing follows the sampling of a real analyzer: a transition at time `t` is recorded at the
 //! first sample at or after it (`⌈t·rate⌉ / rate`), two transitions of a channel within one
@@ -387,7 +388,6 @@ pub struct CaptureReader<R> {
     channels: Vec<String>,
     levels: Vec<Level>,
     line: u64,
-    buf: String,
     /// The first data line, when format detection had to read it.
     held: Option<String>,
     sigrok_time: SigrokTime,
@@ -647,7 +647,6 @@ impl<R: BufRead> CaptureReader<R> {
             channels: Vec::new(),
             levels: Vec::new(),
             line: 0,
-            buf: String::new(),
             held: None,
             sigrok_time: SigrokTime::None,
             sample_rate,
@@ -700,6 +699,13 @@ impl<R: BufRead> CaptureReader<R> {
                 Some(l) if l.trim().is_empty() => continue,
                 Some(l) => break l,
             }
+        };
+        // A header with its fields in double quotes (`"Time [s]","Channel 0"`, as spreadsheet
+        // programs write it) or a comma after its last field: the fields as they read.
+        let first = if first.trim_start().starts_with(['$', ';']) {
+            first
+        } else {
+            plain_header(&first)
         };
         let head = first.split(',').next().unwrap_or("").trim();
         // A European locale's export: `;` between the fields, a decimal comma in the numbers
@@ -1022,33 +1028,66 @@ impl<R: BufRead> CaptureReader<R> {
         }
     }
 
-    /// The next line without its end, or `None` at the end of the file.
+    /// The next line without its end, or `None` at the end of the file. A line ends at LF,
+    /// CRLF or a CR alone (classic Mac OS line ends, as some exports still write).
     fn read_line(&mut self) -> Result<Option<String>, CaptureError> {
-        self.buf.clear();
-        let mut limited = std::io::Read::take(&mut self.input, MAX_LINE_BYTES as u64 + 1);
-        let n = limited.read_line(&mut self.buf).map_err(|e| {
-            let what = if e.kind() == std::io::ErrorKind::InvalidData {
-                "not UTF-8 text".to_string()
-            } else {
-                format!("cannot read: {e}")
-            };
-            CaptureError {
-                file: self.file.clone(),
-                line: Some(self.line + 1),
-                message: what,
+        let mut bytes: Vec<u8> = Vec::new();
+        let mut ended = false;
+        let io_err = |e: std::io::Error, line: u64, file: &Path| CaptureError {
+            file: file.to_path_buf(),
+            line: Some(line + 1),
+            message: format!("cannot read: {e}"),
+        };
+        while bytes.len() <= MAX_LINE_BYTES {
+            let buf = self
+                .input
+                .fill_buf()
+                .map_err(|e| io_err(e, self.line, &self.file))?;
+            if buf.is_empty() {
+                break;
             }
-        })?;
-        if n == 0 {
+            match buf.iter().position(|&b| b == b'\n' || b == b'\r') {
+                Some(i) => {
+                    let cr = buf[i] == b'\r';
+                    bytes.extend_from_slice(&buf[..i]);
+                    self.input.consume(i + 1);
+                    if cr {
+                        // A CRLF's LF, if it follows.
+                        let next = self
+                            .input
+                            .fill_buf()
+                            .map_err(|e| io_err(e, self.line, &self.file))?;
+                        if next.first() == Some(&b'\n') {
+                            self.input.consume(1);
+                        }
+                    }
+                    ended = true;
+                    break;
+                }
+                None => {
+                    let n = buf.len().min(MAX_LINE_BYTES + 1 - bytes.len());
+                    bytes.extend_from_slice(&buf[..n]);
+                    self.input.consume(n);
+                }
+            }
+        }
+        if bytes.is_empty() && !ended {
             return Ok(None);
         }
         self.line += 1;
-        self.unterminated = n <= MAX_LINE_BYTES && !self.buf.ends_with('\n');
-        if n > MAX_LINE_BYTES && !self.buf.ends_with('\n') {
+        if bytes.len() > MAX_LINE_BYTES {
+            self.unterminated = false;
             return Err(self.err_here(&format!(
                 "line longer than {MAX_LINE_BYTES} bytes: not a capture row"
             )));
         }
-        let mut l = self.buf.trim_end_matches(['\n', '\r']);
+        self.unterminated = !ended;
+        let text = String::from_utf8(bytes).map_err(|_| CaptureError {
+            file: self.file.clone(),
+            line: Some(self.line),
+            message: "not UTF-8 text".to_string(),
+        })?;
+        let mut l = text.as_str();
         if self.line == 1 {
             // A UTF-8 byte order mark (Windows editors, spreadsheet exports) is not text.
             l = l.strip_prefix('\u{feff}').unwrap_or(l);
@@ -1384,7 +1423,7 @@ impl<R: BufRead> CaptureReader<R> {
         let mut count = 0usize;
         let time = if timed {
             count += 1;
-            let f = fields.next().unwrap_or("").trim();
+            let f = unquoted(fields.next().unwrap_or(""));
             self.time_of(f)?
         } else {
             let rate = self.sample_rate.unwrap_or(1.0);
@@ -1399,7 +1438,7 @@ impl<R: BufRead> CaptureReader<R> {
                 )));
             };
             count += 1;
-            self.levels[k] = match (f.trim(), self.threshold) {
+            self.levels[k] = match (unquoted(f), self.threshold) {
                 ("X" | "x", _) if self.format == CaptureFormat::Saleae => Level::Unknown,
                 (value, Some(th)) => match value.parse::<f64>() {
                     Ok(v) if v.is_finite() => {
@@ -1422,6 +1461,10 @@ impl<R: BufRead> CaptureReader<R> {
                 },
                 ("0", None) => Level::Low,
                 ("1", None) => Level::High,
+                // Levels written as numbers, `0.0` and `1.0` (exactly 0 or 1: any other value
+                // is refused below as an analog one).
+                (v, None) if v.parse::<f64>() == Ok(0.0) => Level::Low,
+                (v, None) if v.parse::<f64>() == Ok(1.0) => Level::High,
                 (_, None) if self.unread.get(k) == Some(&true) => Level::Unknown,
                 (other, None) => {
                     let analog = other.parse::<f64>().is_ok_and(f64::is_finite);
@@ -1445,7 +1488,12 @@ impl<R: BufRead> CaptureReader<R> {
                 }
             };
         }
-        let extra = fields.count();
+        // (A comma after the last column: an empty last field, no column.)
+        let rest: Vec<&str> = fields.collect();
+        let extra = match rest.as_slice() {
+            [last] if last.trim().is_empty() => 0,
+            _ => rest.len(),
+        };
         if extra > 0 {
             return Err(self.err_here(&format!(
                 "expected {expected} fields ({}{n} channel levels), found {}",
@@ -1593,6 +1641,29 @@ impl<R: BufRead> CaptureReader<R> {
         // resolution.
         atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64
     }
+}
+
+/// A CSV header's fields without the double quotes around them, and without an empty last
+/// field (a comma after the last column): `"Time [s]","Channel 0",` → `Time [s],Channel 0`.
+/// A header with neither is kept as written (its errors quote it so).
+fn plain_header(line: &str) -> String {
+    let mut fields: Vec<&str> = line.split(',').map(unquoted).collect();
+    let trailing = fields.len() > 1 && fields.last().is_some_and(|f| f.is_empty());
+    if !trailing && !line.contains('"') {
+        return line.to_string();
+    }
+    if trailing {
+        fields.pop();
+    }
+    fields.join(",")
+}
+
+/// A field trimmed, without the double quotes around it.
+fn unquoted(f: &str) -> &str {
+    let f = f.trim();
+    f.strip_prefix('"')
+        .and_then(|g| g.strip_suffix('"'))
+        .map_or(f, str::trim)
 }
 
 /// Whether `line` is one number written with a decimal comma (`0,001147198`, `-1,5`): digits,

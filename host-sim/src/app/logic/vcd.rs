@@ -106,6 +106,8 @@ impl<R: BufRead> CaptureReader<R> {
             .tokens
             .extend(first.split_whitespace().map(str::to_string));
         let mut scopes: Vec<String> = Vec::new();
+        // Each channel's full name, its scopes' and its own (`logic.sub.D0`).
+        let mut paths: Vec<String> = Vec::new();
         let mut unit: Option<i128> = None;
         loop {
             let Some(keyword) = self.vcd_token()? else {
@@ -173,15 +175,25 @@ impl<R: BufRead> CaptureReader<R> {
                         .copied()
                         .collect::<Vec<_>>()
                         .join(" ");
-                    if self.channels.contains(&channel) {
-                        channel = scopes
-                            .iter()
-                            .filter(|s| !s.is_empty())
-                            .map(String::as_str)
-                            .chain([channel.as_str()])
-                            .collect::<Vec<_>>()
-                            .join(".");
+                    let path = scopes
+                        .iter()
+                        .filter(|s| !s.is_empty())
+                        .map(String::as_str)
+                        .chain([channel.as_str()])
+                        .collect::<Vec<_>>()
+                        .join(".");
+                    // A name another channel has: both are named by their full path
+                    // (`logic.D0`, `logic.sub.D0`), so that each is given as named.
+                    let repeated: Vec<usize> = (0..self.channels.len())
+                        .filter(|&k| self.channels[k] == channel)
+                        .collect();
+                    if !repeated.is_empty() {
+                        for k in repeated {
+                            self.channels[k].clone_from(&paths[k]);
+                        }
+                        channel.clone_from(&path);
                     }
+                    paths.push(path);
                     self.vcd
                         .ids
                         .entry((*id).to_string())
@@ -460,7 +472,7 @@ mod tests {
             assert_eq!(l, wl);
         }
         let r = open(text, None).unwrap();
-        assert_eq!(r.channels(), ["a", "top.sub.a", "z [0]"]);
+        assert_eq!(r.channels(), ["top.a", "top.sub.a", "z [0]"]);
     }
 
     /// Reals, strings and events are no channels whatever size they are declared with (GTKWave's
