@@ -5608,3 +5608,35 @@ fn channels_sharing_a_name_in_a_dump_are_named_by_their_scopes() {
         "{e}"
     );
 }
+
+/// A grid found from the rows alone is the longest step they show, which the floor takes as
+/// their resolution; the report said it was "taken as the sample period", a fact the rows do
+/// not show (the analyser's period may be a whole fraction of it).
+#[test]
+fn the_grid_found_is_not_stated_as_the_sample_period() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    for (rate, text_of) in [
+        (750e3, "a 750 kS/s capture written to the nanosecond"),
+        (2e6, "a 2 MS/s capture"),
+    ] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", |t| {
+            format!("{t:.9}")
+        });
+        let said = host_sim::app::analyze::text(&analyze_text(text, "g.csv", 360, 1));
+        let line = said
+            .lines()
+            .find(|l| l.starts_with("sampling: rate not stated; every transition"))
+            .unwrap_or_else(|| panic!("{text_of}: {said}"));
+        assert!(
+            !line.contains("taken as the sample period"),
+            "{text_of}: {line}"
+        );
+        assert!(
+            line.contains("the longest step the rows show")
+                && line.contains("no sample period is stated")
+                && line.contains("this step or a whole fraction of it"),
+            "{text_of}: {line}"
+        );
+    }
+}

@@ -3589,9 +3589,12 @@ pub fn text(r: &AnalyzeReport) -> String {
                 let _ = writeln!(
                     s,
                     "sampling: rate not stated; every transition's time lies on a {g:.3e} s \
-                     grid{} ({:.3} timer ticks), taken as the sample period: the floor below \
-                     includes it, {:.3} times the timer's alone (give --sample-rate to state the \
-                     rate)",
+                     grid{} ({:.3} timer ticks): the longest step the rows show, which the floor \
+                     below takes as their resolution, {:.3} times the timer's alone; no sample \
+                     period is stated: the analyser's is this step or a whole fraction of it \
+                     (where the transitions fell on every other sample, or every k-th, only), \
+                     which the rows cannot tell, and a finer one would only narrow the floor \
+                     (give --sample-rate to state the rate)",
                     match r.grid_of_rate {
                         Some(f) => format!(
                             ", to the {} its times are written to ({})",
