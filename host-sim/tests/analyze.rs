@@ -3,7 +3,7 @@
 //! against the simulation's ground truth (every edge: tooth, glitch, dropped).
 
 use host_sim::app::analyze::{analyze, configure, AnalyzeOptions, AnalyzeReport, DecisionKind};
-use host_sim::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level};
+use host_sim::app::logic::{CaptureError, CaptureFormat, CaptureReader, Level, TimeUnit};
 use host_sim::app::run::{run_with, CaptureTarget, Overrides, RunOptions, RunReport};
 use host_sim::app::scene::Scene;
 use host_sim::engine::encoder::Edge;
@@ -3413,15 +3413,24 @@ fn a_file_of_edge_times_is_read_as_the_captured_edges() {
         e.starts_with("--edge: a file of edge times") && e.contains("leave --edge out"),
         "{e}"
     );
-    // Units: named when not seconds; whole numbers only under a header saying seconds.
-    let e = reader_error("time_us\n0.5\n2084.0\n");
+    // Units: read in the one the header names (`time_us`), refused when it is none of s, ms,
+    // us, ns; whole numbers only under a header (or --time-unit) stating the unit.
+    let mut r = text_reader("time_us\n0.5\n2084\n".into(), "w.csv", None).unwrap();
+    let mut read = Vec::new();
+    while let Some((t, _)) = r.next_row().unwrap() {
+        read.push(t);
+    }
+    assert_eq!(read, [0.5e-6, 2084e-6]);
+    let e = reader_error("ticks\n5\n2084\n");
     assert!(
-        e.starts_with("cap.csv:1:") && e.contains("in us") && e.contains("seconds"),
+        e.starts_with("cap.csv:1:") && e.contains("in ticks") && e.contains("--time-unit"),
         "{e}"
     );
     let e = reader_error("0\n2084\n4146\n");
     assert!(
-        e.starts_with("cap.csv:2:") && e.contains("`2084` is a whole number"),
+        e.starts_with("cap.csv:2:")
+            && e.contains("`2084` is a whole number")
+            && e.contains("give --time-unit ms, us or ns"),
         "{e}"
     );
     let mut r = text_reader("time_s\n0\n2\n4\n".into(), "w.csv", None).unwrap();
@@ -5225,4 +5234,410 @@ fn a_capture_starting_in_a_gap_gives_the_shafts_slowest_speed() {
         said.contains("the slowest speed seen is about 150.000 rad/s"),
         "{said}"
     );
+}
+
+/// Analyzes the capture `text` (read as the file `name`, its times in `unit` when given, as
+/// `--time-unit` gives it) with `options`: the report and its text, or the error.
+fn analyze_unit(
+    text: &str,
+    name: &str,
+    unit: Option<TimeUnit>,
+    options: AnalyzeOptions,
+) -> Result<(AnalyzeReport, String), String> {
+    let cfg = configure(&options)?;
+    let mut reader = CaptureReader::new_with(
+        std::io::Cursor::new(text.to_string()),
+        Path::new(name),
+        None,
+        None,
+        unit,
+    )
+    .map_err(|e| e.to_string())?;
+    let report = analyze(&mut reader, &cfg, &mut |_| {}).map_err(|e| e.to_string())?;
+    let said = host_sim::app::analyze::text(&report);
+    Ok((report, said))
+}
+
+/// The valid windows' mean speeds.
+fn mean_speeds(r: &AnalyzeReport) -> Vec<f64> {
+    r.windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.omega_mean)
+        .collect()
+}
+
+/// Edge times written in milliseconds or microseconds with decimals and no header are read as
+/// seconds (nothing in the file says otherwise), which makes a 150 rad/s shaft 0.15 or 1.5e-4
+/// rad/s: the no-sync hint's slowest speed and the valid windows' slow speeds say what such
+/// times give and name --time-unit; with it (or a header naming the unit) the speeds are the
+/// shaft's. Before, the slowest speed read "0.000 rad/s" for µs and nothing named the unit.
+#[test]
+fn edge_times_in_ms_or_us_name_the_time_unit_and_read_with_it() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let ms: String = rising
+        .iter()
+        .map(|t| format!("{:.6}\n", 1.0 + t * 1e3))
+        .collect();
+    let us: String = rising
+        .iter()
+        .map(|t| format!("{:.3}\n", 1000.0 + t * 1e6))
+        .collect();
+    let (r, said) = analyze_unit(&ms, "t.txt", None, wheel("36-2")).unwrap();
+    assert!(r.sync_acquired.is_none(), "{said}");
+    assert!(
+        said.contains("slowest speed seen is about 0.1")
+            && said.contains("read as seconds")
+            && said.contains("--time-unit ms"),
+        "{said}"
+    );
+    let (_, said) = analyze_unit(&us, "t.txt", None, wheel("36-2")).unwrap();
+    assert!(
+        said.contains("slowest speed seen is about 1.") && said.contains("e-4 rad/s; the file"),
+        "{said}"
+    );
+    let slow = AnalyzeOptions {
+        min_speed: Some(0.01),
+        ..wheel("36-2")
+    };
+    let (r, said) = analyze_unit(&ms, "t.txt", None, slow).unwrap();
+    assert!(r.valid_windows >= 3, "{said}");
+    assert!(
+        said.contains("NOTE: the valid windows' mean speeds are as slow as 0.150 rad/s")
+            && said.contains("--time-unit ms"),
+        "{said}"
+    );
+    for (text, unit) in [(&ms, TimeUnit::Ms), (&us, TimeUnit::Us)] {
+        let (r, said) = analyze_unit(text, "t.txt", Some(unit), wheel("36-2")).unwrap();
+        let speeds = mean_speeds(&r);
+        assert!(speeds.len() >= 3, "{said}");
+        assert!(speeds.iter().all(|w| (w - 150.0).abs() < 0.5), "{speeds:?}");
+        assert!(!said.contains("NOTE: the valid windows'"), "{said}");
+        assert!(
+            said.contains(&format!("times: in {}", unit.name())),
+            "{said}"
+        );
+    }
+    // A header naming the unit reads so; --time-unit against it is refused, and so is it for
+    // a format that states its unit.
+    let (r, _) = analyze_unit(&format!("t_ms\n{ms}"), "t.txt", None, wheel("36-2")).unwrap();
+    assert!(mean_speeds(&r).iter().all(|w| (w - 150.0).abs() < 0.5));
+    let e = analyze_unit(
+        &format!("t_ms\n{ms}"),
+        "t.txt",
+        Some(TimeUnit::Us),
+        wheel("36-2"),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("--time-unit us: the header says the times are in ms"),
+        "{e}"
+    );
+    let vcd = "$timescale 1 us $end\n$var wire 1 ! D0 $end\n$enddefinitions $end\n#0 0!\n#5 1!\n";
+    let e = analyze_unit(vcd, "t.vcd", Some(TimeUnit::Ms), wheel("36-2")).unwrap_err();
+    assert!(
+        e.contains("--time-unit ms: a vcd file states") && e.contains("$timescale"),
+        "{e}"
+    );
+    // A plain CSV in µs, whole numbers, with --time-unit us.
+    let plain: String = std::iter::once("time_s,level\n".to_string())
+        .chain(rising.iter().flat_map(|t| {
+            let up = (1000.0 + t * 1e6).round();
+            [format!("{up},1\n"), format!("{},0\n", up + 100.0)]
+        }))
+        .collect();
+    let (r, said) = analyze_unit(&plain, "p.csv", Some(TimeUnit::Us), wheel("36-2")).unwrap();
+    assert!(mean_speeds(&r).len() >= 3, "{said}");
+    assert!(mean_speeds(&r).iter().all(|w| (w - 150.0).abs() < 0.5));
+}
+
+/// An option's value far out of range is echoed as it reads (`1e300`), not as its 301 digits.
+#[test]
+fn a_huge_option_value_is_echoed_in_exponent_form() {
+    let e = configure(&AnalyzeOptions {
+        timer_hz: Some(1e300),
+        ..wheel("36-2")
+    })
+    .unwrap_err();
+    assert!(e.starts_with("--timer-hz 1e300 is out of range"), "{e}");
+    assert!(e.len() < 200, "{e}");
+    let e = host_sim::app::logic::Threshold::new(0.0, -1e300).unwrap_err();
+    assert!(e.starts_with("--hysteresis -1e300:"), "{e}");
+}
+
+/// A threshold outside the values' range reads no edge; the report said "no channel of the
+/// capture changes level" and "no sync: the capture is too short". It now gives the values'
+/// range against the band the threshold reads them through.
+#[test]
+fn a_threshold_outside_the_values_is_named_with_their_range() {
+    // A 24-tooth sensor's sine, ±1.05 V, 20 kS/s over 0.5 s.
+    let omega = 100.0;
+    let mut csv = String::from("Time [s],Channel 0\n");
+    for i in 0..10_000 {
+        let t = i as f64 / 20e3;
+        csv.push_str(&format!("{t:.9},{:.5}\n", 1.05 * (24.0 * omega * t).sin()));
+    }
+    let lines = AnalyzeOptions {
+        lines: Some(24),
+        ..AnalyzeOptions::default()
+    };
+    for (volts, hysteresis, never) in [
+        (5.0, 0.0, "never above 5, so never high"),
+        (0.0, 3.0, "never above 1.5 nor below -1.5"),
+    ] {
+        let cfg = configure(&lines).unwrap();
+        let mut reader = text_reader(csv.clone(), "a.csv", None).unwrap();
+        reader
+            .set_threshold(host_sim::app::logic::Threshold::new(volts, hysteresis).unwrap())
+            .unwrap();
+        let r = analyze(&mut reader, &cfg, &mut |_| {}).unwrap();
+        let said = host_sim::app::analyze::text(&r);
+        assert_eq!(r.edges, 0);
+        assert!(
+            said.contains("the values of `Channel 0` range from -1.05 to 1.05")
+                && said.contains(never)
+                && said.contains("give a --threshold within their range"),
+            "{said}"
+        );
+        assert!(!said.contains("too short"), "{said}");
+    }
+}
+
+/// A value change dump whose time unit (1 ms) is coarser than the pulses (a 36-2 wheel at
+/// 150 rad/s, a tooth every 1.16 ms): a tooth's fall and the next one's rise often fall on
+/// one time stamp and cancel. It was said to be "too short" (1.4 revolutions of edges in 8);
+/// now the stamps with a change and its undoing are counted and said.
+#[test]
+fn changes_merged_by_a_coarse_timescale_are_said() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let half = std::f64::consts::TAU / 36.0 / 150.0 / 2.0;
+    let mut vcd = String::from(
+        "$timescale 1 ms $end\n$scope module logic $end\n$var wire 1 ! D0 $end\n$upscope $end\n\
+         $enddefinitions $end\n#0\n0!\n",
+    );
+    let mut stamp = 0u64;
+    for &t in &rising {
+        for (at, v) in [(t, 1), (t + half, 0)] {
+            let k = (at * 1e3).ceil() as u64;
+            if k != stamp {
+                vcd.push_str(&format!("#{k}\n"));
+                stamp = k;
+            }
+            vcd.push_str(&format!("{v}!\n"));
+        }
+    }
+    let (r, said) = analyze_unit(&vcd, "c.vcd", None, wheel("36-2")).unwrap();
+    let m = r.same_stamp.expect("merged changes counted");
+    assert!(m.times > 100 && m.timescale == Some(1e-3), "{m:?}");
+    assert!(
+        said.contains("WARNING: `D0` changes level and back at one time stamp")
+            && said.contains("lost to the time unit, not to a short capture"),
+        "{said}"
+    );
+    assert!(!said.contains("too short"), "{said}");
+}
+
+/// Two rows at one time with opposite levels (a pulse of no width as written) were counted as
+/// a glitch with no word that the file has two changes at one time stamp.
+#[test]
+fn two_rows_at_one_time_with_opposite_levels_are_named() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let mut csv = saleae_of_rising(&rising, 1e9, 0.35);
+    let at = 0.5 * (rising[100] + rising[101]) + 0.2e-3;
+    let row = format!("{at:.9},0\n");
+    let k = csv
+        .find(&format!("{:.9},1\n", sampled(rising[101], 1e9)))
+        .unwrap();
+    csv.insert_str(k, &format!("{at:.9},1\n{row}"));
+    let (r, said) = analyze_unit(&csv, "z.csv", None, wheel("36-2")).unwrap();
+    let m = r.same_stamp.expect("the pulse of no width is counted");
+    assert_eq!((m.times, m.timescale), (1, None));
+    assert!((m.first - at).abs() < 1e-9, "{m:?}");
+    assert!(
+        said.contains("WARNING: `Channel 0` changes level twice at one time 1 time(s)"),
+        "{said}"
+    );
+}
+
+/// The G16 file quirks, each read as the clean Saleae export of the same edges (the same
+/// windows, δ for δ), where each was refused or misread: CR-only line ends ("line longer than
+/// 4096 bytes"), a comma after every row's last field ("`` in the column of channel ``"), a
+/// header in double quotes and `Time [us]` / `Time [ms]` headers ("cannot tell the capture
+/// format"), levels written `0.0`/`1.0` (refused as analog values), a sigrok export whose
+/// time column is `seconds` (taken as a channel).
+#[test]
+fn file_quirks_read_as_the_clean_export() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let clean = saleae_of_rising(&rising, 1e9, 0.35);
+    let deltas = |text: &str, name: &str| -> Vec<(f64, f64)> {
+        let (r, said) = analyze_unit(text, name, None, wheel("36-2")).unwrap();
+        assert!(r.valid_windows >= 3, "{name}: {said}");
+        r.windows
+            .iter()
+            .filter(|w| w.valid)
+            .map(|w| (w.start, w.delta.unwrap()))
+            .collect()
+    };
+    let want = deltas(&clean, "clean.csv");
+    let rows: Vec<(f64, &str)> = clean
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (t, v) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), v)
+        })
+        .collect();
+    let with = |header: &str, row: &dyn Fn(f64, &str) -> String, end: &str| {
+        let mut s = format!("{header}{end}");
+        for &(t, v) in &rows {
+            s.push_str(&row(t, v));
+            s.push_str(end);
+        }
+        s
+    };
+    let quirks = [
+        ("cr", with("Time [s],Channel 0", &|t, v| format!("{t:.9},{v}"), "\r")),
+        (
+            "trailing comma",
+            with("Time [s],Channel 0,", &|t, v| format!("{t:.9},{v},"), "\n"),
+        ),
+        (
+            "quoted",
+            with(
+                "\"Time [s]\",\"Channel 0\"",
+                &|t, v| format!("{t:.9},{v}"),
+                "\n",
+            ),
+        ),
+        (
+            "us",
+            with("Time [us],Channel 0", &|t, v| format!("{:.3},{v}", t * 1e6), "\n"),
+        ),
+        (
+            "ms",
+            with("Time [ms],Channel 0", &|t, v| format!("{:.6},{v}", t * 1e3), "\n"),
+        ),
+        (
+            "float levels",
+            with("Time [s],Channel 0", &|t, v| format!("{t:.9},{v}.0"), "\n"),
+        ),
+        (
+            "sigrok seconds",
+            with(
+                "; CSV generated by libsigrok\n; Channels (1/8): D0\n; Samplerate: 1 GHz\nseconds,logic",
+                &|t, v| format!("{t:.9},{v}"),
+                "\n",
+            ),
+        ),
+    ];
+    for (what, text) in &quirks {
+        let got = deltas(text, "q.csv");
+        assert_eq!(got.len(), want.len(), "{what}");
+        for ((s1, d1), (s0, d0)) in got.iter().zip(&want) {
+            assert!(
+                (s1 - s0).abs() < 1e-9 && (d1 - d0).abs() < 1e-9,
+                "{what}: {got:?} against {want:?}"
+            );
+        }
+    }
+    let (r, _) = analyze_unit(&quirks[6].1, "s.csv", None, wheel("36-2")).unwrap();
+    assert_eq!(r.channel, "D0");
+    // A level other than exactly 0 or 1 among them is still refused, as an analog value.
+    let half = with("Time [s],Channel 0", &|t, v| format!("{t:.9},{v}.5"), "\n");
+    let e = analyze_unit(&half, "h.csv", None, wheel("36-2")).unwrap_err();
+    assert!(
+        e.contains("`0.5` in the column of channel `Channel 0` is not a logic level"),
+        "{e}"
+    );
+}
+
+/// Two columns of one name: the report names the one read with its number (it said `Channel
+/// 0` whichever was read), and the name alone is refused as ambiguous.
+#[test]
+fn a_name_two_columns_share_is_told_by_number() {
+    let rising = wheel_teeth(36, 2, 150.0, 0.34);
+    let clean = saleae_of_rising(&rising, 1e9, 0.35);
+    let mut text = String::from("Time [s],Channel 0,Channel 0\n");
+    for l in clean.lines().skip(1) {
+        text.push_str(&format!("{l},0\n"));
+    }
+    let read = |c: host_sim::app::analyze::Channel| {
+        analyze_unit(
+            &text,
+            "d.csv",
+            None,
+            AnalyzeOptions {
+                channel: Some(c),
+                ..wheel("36-2")
+            },
+        )
+    };
+    let (r, said) = read(host_sim::app::analyze::Channel::Column(1)).unwrap();
+    assert_eq!(r.channel, "Channel 0 (channel 1)");
+    assert!(
+        said.contains("channel: Channel 0 (channel 1) (rising edges)"),
+        "{said}"
+    );
+    let (r, _) = read(host_sim::app::analyze::Channel::Column(0)).unwrap();
+    assert_eq!(r.channel, "Channel 0 (channel 0)");
+    assert!(r.valid_windows >= 3);
+    let e = read(host_sim::app::analyze::Channel::Name("Channel 0".into())).unwrap_err();
+    assert!(e.contains("2 channels have that name (numbers 0, 1"), "{e}");
+}
+
+/// A value change dump declaring `D0` in two scopes names both by their scope path, as the
+/// README's SCOPE.NAME says (the first was `D0`, and `--channel logic.D0` was refused).
+#[test]
+fn channels_sharing_a_name_in_a_dump_are_named_by_their_scopes() {
+    let vcd = "$timescale 1 us $end\n$scope module logic $end\n$var wire 1 ! D0 $end\n\
+               $var wire 1 \" D1 $end\n$scope module sub $end\n$var wire 1 % D0 $end\n\
+               $upscope $end\n$upscope $end\n$enddefinitions $end\n#0 0! 0\" 0%\n#5 1!\n#9\n";
+    let r = text_reader(vcd.to_string(), "s.vcd", None).unwrap();
+    assert_eq!(r.channels(), ["logic.D0", "D1", "logic.sub.D0"]);
+    let e = analyze_unit(
+        vcd,
+        "s.vcd",
+        None,
+        AnalyzeOptions {
+            channel: Some(host_sim::app::analyze::Channel::Name("D0".into())),
+            ..wheel("36-2")
+        },
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("named by their scopes: logic.D0, logic.sub.D0"),
+        "{e}"
+    );
+}
+
+/// A grid found from the rows alone is the longest step they show, which the floor takes as
+/// their resolution; the report said it was "taken as the sample period", a fact the rows do
+/// not show (the analyser's period may be a whole fraction of it).
+#[test]
+fn the_grid_found_is_not_stated_as_the_sample_period() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    for (rate, text_of) in [
+        (750e3, "a 750 kS/s capture written to the nanosecond"),
+        (2e6, "a 2 MS/s capture"),
+    ] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", |t| {
+            format!("{t:.9}")
+        });
+        let said = host_sim::app::analyze::text(&analyze_text(text, "g.csv", 360, 1));
+        let line = said
+            .lines()
+            .find(|l| l.starts_with("sampling: rate not stated; every transition"))
+            .unwrap_or_else(|| panic!("{text_of}: {said}"));
+        assert!(
+            !line.contains("taken as the sample period"),
+            "{text_of}: {line}"
+        );
+        assert!(
+            line.contains("the longest step the rows show")
+                && line.contains("no sample period is stated")
+                && line.contains("this step or a whole fraction of it"),
+            "{text_of}: {line}"
+        );
+    }
 }

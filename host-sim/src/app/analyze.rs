@@ -559,6 +559,21 @@ pub struct AnalyzeReport {
     pub float_grid: Option<FloatSpacing>,
     /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
     pub warnings: Vec<String>,
+    /// The unit the file's times are read in (`s`, `ms`, `us`, `ns`: its header's, or
+    /// `--time-unit`'s).
+    pub time_unit: &'static str,
+    /// Whether the file or `--time-unit` states that unit (a file of edge times or a plain CSV
+    /// without either is read in seconds, and a speed implausibly slow is said to be what
+    /// times in ms or µs read as seconds give).
+    pub time_unit_stated: bool,
+    /// The smallest and largest value of the channel read, where it is read through
+    /// `--threshold`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub values: Option<[f64; 2]>,
+    /// The channel read changing level twice at one time stamp (a pulse of no width as
+    /// written), where it does.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub same_stamp: Option<SameStamp>,
     /// Rows read.
     pub rows: u64,
     /// First and last time in the capture, s, counted from `time_origin`.
@@ -1321,6 +1336,26 @@ fn sync_hint(
                 None => String::new(),
             }
         ));
+    } else if threshold_miss(r).is_some() && r.edges == 0 {
+        causes.push(
+            "no sync: no edge was read: the values never cross the band of --threshold and \
+             --hysteresis (their range above), not a short capture"
+                .to_string(),
+        );
+    } else if let Some(m) = r.same_stamp.filter(|m| short && m.timescale.is_some()) {
+        causes.push(format!(
+            "no sync: {} captured edges, {:.1} revolutions of the configured wheel ({} edges a \
+             revolution), over {:.6} s: at {} time stamp(s) `{}` changes and changes back \
+             within the dump's time unit ({:.3e} s), which leaves no pulse: edges are lost to \
+             the time unit, not to a short capture (see the WARNING)",
+            r.captured,
+            revolutions_of_edges,
+            per_rev,
+            r.span[1] - r.span[0],
+            m.times,
+            r.channel,
+            m.timescale.unwrap_or(0.0)
+        ));
     } else if short {
         causes.push(format!(
             "no sync: the capture is too short: its {} captured edges are {:.1} revolutions of \
@@ -1412,12 +1447,17 @@ fn sync_hint(
         causes.push(format!(
             "no sync: the shaft stopped or ran below --min-speed {} rad/s: {} interval(s) \
              between edges longer than the {:.3} s timeout it implies, {} timeout(s); the \
-             slowest speed seen is about {}",
-            cfg.min_speed,
+             slowest speed seen is about {}{}",
+            fmt_number(cfg.min_speed),
             intervals.beyond,
             timeout,
             r.timeouts,
-            slowest_speed.map_or("unknown".into(), |w| format!("{w:.3} rad/s"))
+            slowest_speed.map_or("unknown".into(), |w| format!("{} rad/s", fmt_speed(w))),
+            if slowest_speed.is_some_and(|w| w < SLOW_FOR_SECONDS) && !r.time_unit_stated {
+                format!("; {}", unit_hint())
+            } else {
+                String::new()
+            }
         ));
     }
     if noisy {
@@ -1474,6 +1514,83 @@ fn sync_hint(
         timeout,
         min_speed: cfg.min_speed,
         slowest_speed,
+    }
+}
+
+/// The channel read changing level twice at one time stamp.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct SameStamp {
+    /// How many times.
+    pub times: u64,
+    /// The first, s.
+    pub first: f64,
+    /// A value change dump's time unit, s, when the file is one: its changes at one stamp
+    /// leave one row of the last levels, and the pulse is lost; in rows it is two rows at one
+    /// time with opposite levels.
+    pub timescale: Option<f64>,
+}
+
+/// Why the channel read through `--threshold` can have no edge, if its values say: the range
+/// they span against the band the threshold reads them through.
+fn threshold_miss(r: &AnalyzeReport) -> Option<String> {
+    let (t, [min, max]) = (r.threshold?, r.values?);
+    let (lo, hi) = (t.volts - 0.5 * t.hysteresis, t.volts + 0.5 * t.hysteresis);
+    let never = match (max <= hi, min >= lo) {
+        (true, true) => format!("never above {hi} nor below {lo}"),
+        (true, false) => format!("never above {hi}, so never high"),
+        (false, true) => format!("never below {lo}, so never low"),
+        (false, false) => return None,
+    };
+    Some(format!(
+        "the values of `{}` range from {min} to {max}, {never} (--threshold {} with --hysteresis \
+         {}: high above {hi}, low below {lo}): give a --threshold within their range (their \
+         midpoint is {}) and a --hysteresis narrower than it ({})",
+        r.channel,
+        fmt_number(t.volts),
+        fmt_number(t.hysteresis),
+        fmt_value(0.5 * (min + max)),
+        fmt_value(max - min)
+    ))
+}
+
+/// A value to four significant digits or so (`0.0002`, `2.102`, `1.234e-5`).
+fn fmt_value(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        let s = format!("{x:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// A mean speed below this, rad/s (under 10 rpm), read from times whose unit the file does not
+/// state, is said to be what times in ms or µs read as seconds would give.
+const SLOW_FOR_SECONDS: f64 = 1.0;
+
+/// What a speed read from times of unstated unit is, should they be ms or µs.
+fn unit_hint() -> &'static str {
+    "the file does not state the unit of its times and they are read as seconds: if they are \
+     milliseconds or microseconds, every speed is 1000 or 1 000 000 times this (δ is the same): \
+     give --time-unit ms or --time-unit us (or a header `time_ms`, `time_us`)"
+}
+
+/// A speed, rad/s, to three decimals, or to three significant digits below 0.1 (a speed of
+/// 5e-5 rad/s is not 0.000).
+fn fmt_speed(w: f64) -> String {
+    if w != 0.0 && w.abs() < 0.1 {
+        format!("{w:.3e}")
+    } else {
+        format!("{w:.3}")
+    }
+}
+
+/// A number given on the command line as it reads: as written for the usual magnitudes, in
+/// exponent form beyond them (`1e300`, not its 301 digits).
+pub fn fmt_number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
     }
 }
 
@@ -1592,6 +1709,22 @@ fn name_number(name: &str) -> Option<usize> {
     name[name.len() - digits..].parse().ok()
 }
 
+/// The channel names, each that another channel shares followed by its number
+/// (`Channel 0 (channel 1)`).
+fn distinct_names(channels: &[String]) -> Vec<String> {
+    channels
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            if channels.iter().filter(|&n| n == name).count() > 1 {
+                format!("{name} (channel {k})")
+            } else {
+                name.clone()
+            }
+        })
+        .collect()
+}
+
 fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, String> {
     // A channel whose name carries the number given, at another column: the number is read
     // as a column, but the analyzer's own numbering may be what was meant.
@@ -1610,12 +1743,44 @@ fn column(channels: &[String], c: &Channel, option: &str) -> Result<usize, Strin
                 channels[*n], channels[k], channels[k]
             )),
         },
-        Channel::Name(name) => channels.iter().position(|x| x == name).ok_or_else(|| {
-            format!(
-                "{option} {name}: no such channel (the capture has {})",
-                channels.join(", ")
-            )
-        }),
+        Channel::Name(name) => {
+            let at: Vec<usize> = (0..channels.len())
+                .filter(|&k| channels[k] == *name)
+                .collect();
+            match at.as_slice() {
+                [k] => Ok(*k),
+                [] => {
+                    // A value change dump names channels that share a name by their scopes.
+                    let scoped: Vec<&str> = channels
+                        .iter()
+                        .filter(|c| c.ends_with(&format!(".{name}")))
+                        .map(String::as_str)
+                        .collect();
+                    Err(format!(
+                        "{option} {name}: no such channel (the capture has {}){}",
+                        channels.join(", "),
+                        if scoped.is_empty() {
+                            String::new()
+                        } else {
+                            format!(
+                                "; channels that share the name `{name}` are named by their \
+                                 scopes: {}",
+                                scoped.join(", ")
+                            )
+                        }
+                    ))
+                }
+                many => Err(format!(
+                    "{option} {name}: {} channels have that name (numbers {}, counted from 0): \
+                     give the number of the one to read",
+                    many.len(),
+                    many.iter()
+                        .map(usize::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            }
+        }
         Channel::Column(n) => Err(format!(
             "{option} {n}: the capture has {} channel{} ({}), numbered from 0{}",
             channels.len(),
@@ -1734,6 +1899,9 @@ pub fn analyze<R: BufRead>(
         }
         None => None,
     };
+    // From here on, channels as the report names them: a name two columns share with its
+    // number (`Channel 0 (channel 1)`), so that the one read is told.
+    let channels = distinct_names(&channels);
     // Only the channels read must hold levels (an analog column beside them is no data).
     let read: Vec<usize> = [Some(ch), ich, dch.map(|(d, _)| d)]
         .into_iter()
@@ -1758,6 +1926,8 @@ pub fn analyze<R: BufRead>(
         sample_rate: reader.sample_rate(),
         sample_numbers: reader.sample_column().map(str::to_string),
         threshold: reader.threshold(),
+        time_unit: reader.time_unit().name(),
+        time_unit_stated: reader.time_unit_stated(),
         sync_state: "searching",
         ripple: ripple_readings(&cfg.encoder),
         ..Default::default()
@@ -1783,6 +1953,8 @@ pub fn analyze<R: BufRead>(
         frames_listed: 0,
     };
     let mut prev: Vec<Level> = Vec::new();
+    // The read channel's last change of level, and its changes at that same time.
+    let (mut last_change, mut same_stamp, mut same_stamp_first) = (None::<f64>, 0u64, None::<f64>);
     let mut periods = IndexPeriods::default();
     let mut last_event: Option<f64> = None;
     let mut end = 0.0;
@@ -1882,6 +2054,16 @@ pub fn analyze<R: BufRead>(
             if a != b && *a != Level::Unknown && *b != Level::Unknown {
                 *n += 1;
             }
+        }
+        // The channel read changing again at the time of its last change: two rows at one
+        // time with opposite levels, a pulse of no width as written.
+        let (a, b) = (prev[ch], levels[ch]);
+        if a != b && a != Level::Unknown && b != Level::Unknown {
+            if last_change == Some(t) {
+                same_stamp += 1;
+                same_stamp_first.get_or_insert(t);
+            }
+            last_change = Some(t);
         }
         // The channel read without data: from the row it went unknown to the row it came back
         // (or the end of the capture).
@@ -2087,6 +2269,19 @@ pub fn analyze<R: BufRead>(
         }
     }
     report.span[1] = end;
+    report.values = reader.value_range(ch).map(|(a, b)| [a, b]);
+    let (merged, merged_at) = reader.merged_changes(ch);
+    if let Some(first) = [merged_at, same_stamp_first]
+        .into_iter()
+        .flatten()
+        .reduce(f64::min)
+    {
+        report.same_stamp = Some(SameStamp {
+            times: merged + same_stamp,
+            first,
+            timescale: reader.timescale(),
+        });
+    }
     no_data.extend(no_data_from.map(|f| (f, end)));
     if let Some(&first) = no_data.first() {
         report.no_data = Some(NoData {
@@ -3199,6 +3394,13 @@ pub fn text(r: &AnalyzeReport) -> String {
              than the capture's scales every time and speed by its error)"
         );
     }
+    if r.time_unit != "s" {
+        let _ = writeln!(
+            s,
+            "times: in {} (the header's unit, or --time-unit's), converted to seconds below",
+            r.time_unit
+        );
+    }
     if r.time_origin != 0 {
         let _ = writeln!(
             s,
@@ -3303,6 +3505,27 @@ pub fn text(r: &AnalyzeReport) -> String {
             r.channel, g.edges, g.of, g.longest, g.longest
         );
     }
+    if let Some(m) = &r.same_stamp {
+        let _ = match m.timescale {
+            Some(unit) => writeln!(
+                s,
+                "WARNING: `{}` changes level and back at one time stamp {} time(s) (the first at \
+                 {:.6} s): a pulse shorter than the dump's time unit ({unit:.3e} s, its \
+                 `$timescale`) leaves no row, and its edges are lost (missing edges, or too few \
+                 to sync); record the dump with a finer time unit",
+                r.channel, m.times, m.first
+            ),
+            None => writeln!(
+                s,
+                "WARNING: `{}` changes level twice at one time {} time(s) (the first at {:.6} s: \
+                 two rows at that time with opposite levels): a pulse of no width as written, \
+                 its two edges 0 s apart, which no timer resolves (the core takes the second \
+                 as a glitch); the times are written more coarsely than the pulses came, or \
+                 the rows are wrong",
+                r.channel, m.times, m.first
+            ),
+        };
+    }
     if let Some(d) = &r.repeated_times {
         let _ = writeln!(
             s,
@@ -3366,9 +3589,12 @@ pub fn text(r: &AnalyzeReport) -> String {
                 let _ = writeln!(
                     s,
                     "sampling: rate not stated; every transition's time lies on a {g:.3e} s \
-                     grid{} ({:.3} timer ticks), taken as the sample period: the floor below \
-                     includes it, {:.3} times the timer's alone (give --sample-rate to state the \
-                     rate)",
+                     grid{} ({:.3} timer ticks): the longest step the rows show, which the floor \
+                     below takes as their resolution, {:.3} times the timer's alone; no sample \
+                     period is stated: the analyser's is this step or a whole fraction of it \
+                     (where the transitions fell on every other sample, or every k-th, only), \
+                     which the rows cannot tell, and a finer one would only narrow the floor \
+                     (give --sample-rate to state the rate)",
                     match r.grid_of_rate {
                         Some(f) => format!(
                             ", to the {} its times are written to ({})",
@@ -3482,6 +3708,20 @@ pub fn text(r: &AnalyzeReport) -> String {
          include them (the core's per-tooth learner, learn::ToothLearner, measures and removes \
          them)"
     );
+    let slowest = r
+        .windows
+        .iter()
+        .filter(|w| w.valid)
+        .filter_map(|w| w.omega_mean)
+        .fold(f64::INFINITY, f64::min);
+    if slowest < SLOW_FOR_SECONDS && !r.time_unit_stated {
+        let _ = writeln!(
+            s,
+            "NOTE: the valid windows' mean speeds are as slow as {} rad/s: {}",
+            fmt_speed(slowest),
+            unit_hint()
+        );
+    }
     if let Some(e) = &r.edge_scatter {
         let _ = writeln!(
             s,
@@ -3538,7 +3778,14 @@ pub fn text(r: &AnalyzeReport) -> String {
     if r.edges == 0 && r.edges_listed() {
         let _ = writeln!(s, "no edge: the file of edge times lists none");
     } else if r.edges == 0 {
-        let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+        match threshold_miss(r) {
+            Some(why) => {
+                let _ = writeln!(s, "no {} edge on --channel `{}`: {why}", r.edge, r.channel);
+            }
+            None => {
+                let _ = writeln!(s, "{}", quiet(&r.channel, "--channel"));
+            }
+        }
     }
     if let Some(i) = r.index_channel.as_deref().filter(|_| r.index_pulses == 0) {
         let _ = writeln!(s, "{}", quiet(i, "--index-channel"));
@@ -3922,8 +4169,8 @@ fn option_given(o: &AnalyzeOptions, enc: &EncoderConfig, parameter: &str) -> Str
         }),
         "prescaler" => o.prescaler.map(|p| p.to_string()),
         "counter_bits" => o.counter_bits.map(|b| b.to_string()),
-        "timer_hz" => o.timer_hz.map(|h| h.to_string()),
-        "min_speed" => o.min_speed.map(|w| w.to_string()),
+        "timer_hz" => o.timer_hz.map(fmt_number),
+        "min_speed" => o.min_speed.map(fmt_number),
         "window.revolutions" => o.window_revolutions.map(|n| n.to_string()),
         _ => None,
     };

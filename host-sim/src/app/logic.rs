@@ -32,9 +32,10 @@
 //!   `time,0|1` rows at each change.
 //!
 //! Reading is streamed, one line at a time: memory does not grow with the file. Line ends may
-//! be LF or CRLF, and a UTF-8 byte order mark before the first line is skipped. Limits: a line
-//! is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`] channels, times must
-//! not decrease from row to row. Every error names the file, the line and what was expected.
+//! be LF, CRLF or a CR alone, and a UTF-8 byte order mark before the first line is skipped.
+//! Limits: a line is at most [`MAX_LINE_BYTES`] bytes, a file has at most [`MAX_CHANNELS`]
+//! channels, times must not decrease from row to row. Every error names the file, the line and
+//! what was expected.
 //!
 //! Writing follows the sampling of a real analyzer: a transition at time `t` is recorded at the
 //! first sample at or after it (`⌈t·rate⌉ / rate`), two transitions of a channel within one
@@ -202,7 +203,8 @@ impl Threshold {
         }
         if !(hysteresis.is_finite() && hysteresis >= 0.0) {
             return Err(format!(
-                "--hysteresis {hysteresis}: a hysteresis is a finite band of 0 or more"
+                "--hysteresis {}: a hysteresis is a finite band of 0 or more",
+                crate::app::analyze::fmt_number(hysteresis)
             ));
         }
         Ok(Threshold { volts, hysteresis })
@@ -217,6 +219,58 @@ impl Threshold {
             Level::Low
         } else {
             before
+        }
+    }
+}
+
+/// The unit of the times of a file of edge times or a plain CSV (`--time-unit`): what the
+/// numbers count, when the file does not say (a header `time_ms`, `Time [us]` does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TimeUnit {
+    /// Seconds.
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+    /// Nanoseconds.
+    Ns,
+}
+
+impl TimeUnit {
+    /// The unit as the option writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TimeUnit::S => "s",
+            TimeUnit::Ms => "ms",
+            TimeUnit::Us => "us",
+            TimeUnit::Ns => "ns",
+        }
+    }
+
+    /// Units in a second.
+    fn per_second(self) -> i128 {
+        match self {
+            TimeUnit::S => 1,
+            TimeUnit::Ms => 1_000,
+            TimeUnit::Us => 1_000_000,
+            TimeUnit::Ns => 1_000_000_000,
+        }
+    }
+
+    /// The unit a word of a header names (`ms`, `usec`, `µs`, `nanoseconds`), if one of these.
+    fn of_word(word: &str) -> Option<TimeUnit> {
+        match word.to_lowercase().as_str() {
+            "s" | "sec" | "secs" | "second" | "seconds" => Some(TimeUnit::S),
+            "ms" | "msec" | "msecs" | "millis" | "millisecond" | "milliseconds" => {
+                Some(TimeUnit::Ms)
+            }
+            "us" | "µs" | "μs" | "usec" | "usecs" | "micros" | "microsecond" | "microseconds" => {
+                Some(TimeUnit::Us)
+            }
+            "ns" | "nsec" | "nsecs" | "nanos" | "nanosecond" | "nanoseconds" => Some(TimeUnit::Ns),
+            _ => None,
         }
     }
 }
@@ -263,6 +317,8 @@ enum SigrokTime {
     Labelled,
     /// No time column: one row per sample.
     None,
+    /// A column of decimal seconds (`seconds`): read as written, as a Saleae export's is.
+    Seconds,
 }
 
 /// The sigrok time units, smallest rate first: libsigrok picks the first unit whose rate
@@ -332,7 +388,6 @@ pub struct CaptureReader<R> {
     channels: Vec<String>,
     levels: Vec<Level>,
     line: u64,
-    buf: String,
     /// The first data line, when format detection had to read it.
     held: Option<String>,
     sigrok_time: SigrokTime,
@@ -346,8 +401,14 @@ pub struct CaptureReader<R> {
     unterminated: bool,
     /// A value change dump's identifiers, time unit and pending tokens.
     vcd: vcd::Vcd,
-    /// A file of edge times whose header says seconds (a whole number is then a time).
-    times_in_seconds: bool,
+    /// The unit of the decimal times of a file of edge times, a plain or a Saleae CSV: the
+    /// header's (`time_ms`, `Time [us]`), `--time-unit`'s, or seconds.
+    time_unit: TimeUnit,
+    /// Whether the header or `--time-unit` states that unit (a whole number is then a time;
+    /// unstated, the times are read as seconds).
+    unit_stated: bool,
+    /// `--time-unit`, as given.
+    unit_given: Option<TimeUnit>,
     /// A Saleae Logic 1.x export with sample numbers for times: its first column's heading.
     sample_column: Option<String>,
     /// A sigrok session file's samples (the format `Sr`; `input` is then not read).
@@ -364,11 +425,33 @@ pub struct CaptureReader<R> {
     precision: f64,
     /// Where the sample rate came from, as the file or the option states it (for messages).
     rate_source: Option<String>,
+    /// The smallest and largest value of each column read through the threshold.
+    value_range: Vec<Option<(f64, f64)>>,
 }
 
-/// The time column's heading in a Saleae digital CSV export: Logic 2's, and Logic 1.x's
-/// (`Time[s], Channel 0, Channel 1`, a space after each comma, fifteen decimals).
-const SALEAE_TIME: [&str; 2] = ["Time [s]", "Time[s]"];
+/// The unit of a Saleae digital CSV export's time column by its heading: Logic 2's `Time [s]`,
+/// Logic 1.x's `Time[s]` (`Time[s], Channel 0, Channel 1`, a space after each comma, fifteen
+/// decimals), or another unit in the brackets (`Time [us]`, `Time [ms]`, `Time [ns]`).
+fn saleae_time_heading(head: &str) -> Option<TimeUnit> {
+    let unit = head
+        .strip_prefix("Time")?
+        .trim()
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
+    TimeUnit::of_word(unit.trim())
+}
+
+/// The unit of a plain CSV's time column by its heading: `time_s`, `time_ms`, `time_us`,
+/// `time_ns`.
+fn plain_time_heading(head: &str) -> Option<TimeUnit> {
+    match head {
+        "time_s" => Some(TimeUnit::S),
+        "time_ms" => Some(TimeUnit::Ms),
+        "time_us" => Some(TimeUnit::Us),
+        "time_ns" => Some(TimeUnit::Ns),
+        _ => None,
+    }
+}
 
 /// Whether `head` heads a column of sample numbers in a Saleae export (Logic 1.x's option of
 /// sample numbers for time stamps): `Sample Number`, `Sample`, `Sample #`, `Sample [#]`, `Sample
@@ -499,6 +582,18 @@ impl CaptureReader<std::io::BufReader<std::fs::File>> {
         format: Option<CaptureFormat>,
         sample_rate: Option<f64>,
     ) -> Result<Self, CaptureError> {
+        Self::open_with(path, format, sample_rate, None)
+    }
+
+    /// [`Self::open`], the times in `time_unit` (`--time-unit`: a file of edge times or a
+    /// plain CSV whose header does not say; refused for the formats that state their unit
+    /// otherwise, and where the header says another).
+    pub fn open_with(
+        path: &Path,
+        format: Option<CaptureFormat>,
+        sample_rate: Option<f64>,
+        time_unit: Option<TimeUnit>,
+    ) -> Result<Self, CaptureError> {
         let err = |message: String| CaptureError {
             file: path.to_path_buf(),
             line: None,
@@ -516,7 +611,13 @@ impl CaptureReader<std::io::BufReader<std::fs::File>> {
             path.to_path_buf()
         };
         let file = std::fs::File::open(&input).map_err(|e| err(format!("cannot open: {e}")))?;
-        Self::new(std::io::BufReader::new(file), path, format, sample_rate)
+        Self::new_with(
+            std::io::BufReader::new(file),
+            path,
+            format,
+            sample_rate,
+            time_unit,
+        )
     }
 }
 
@@ -528,6 +629,17 @@ impl<R: BufRead> CaptureReader<R> {
         format: Option<CaptureFormat>,
         sample_rate: Option<f64>,
     ) -> Result<Self, CaptureError> {
+        Self::new_with(input, file, format, sample_rate, None)
+    }
+
+    /// [`Self::new`], the times in `time_unit` (see [`CaptureReader::open_with`]).
+    pub fn new_with(
+        input: R,
+        file: &Path,
+        format: Option<CaptureFormat>,
+        sample_rate: Option<f64>,
+        time_unit: Option<TimeUnit>,
+    ) -> Result<Self, CaptureError> {
         let mut r = CaptureReader {
             input,
             file: file.to_path_buf(),
@@ -535,7 +647,6 @@ impl<R: BufRead> CaptureReader<R> {
             channels: Vec::new(),
             levels: Vec::new(),
             line: 0,
-            buf: String::new(),
             held: None,
             sigrok_time: SigrokTime::None,
             sample_rate,
@@ -544,7 +655,10 @@ impl<R: BufRead> CaptureReader<R> {
             origin: None,
             unterminated: false,
             vcd: vcd::Vcd::default(),
-            times_in_seconds: false,
+            time_unit: TimeUnit::S,
+            unit_stated: false,
+            unit_given: time_unit,
+            value_range: Vec::new(),
             sample_column: None,
             session: None,
             binary: None,
@@ -586,6 +700,13 @@ impl<R: BufRead> CaptureReader<R> {
                 Some(l) => break l,
             }
         };
+        // A header with its fields in double quotes (`"Time [s]","Channel 0"`, as spreadsheet
+        // programs write it) or a comma after its last field: the fields as they read.
+        let first = if first.trim_start().starts_with(['$', ';']) {
+            first
+        } else {
+            plain_header(&first)
+        };
         let head = first.split(',').next().unwrap_or("").trim();
         // A European locale's export: `;` between the fields, a decimal comma in the numbers
         // (`Time [s];Channel 0`, `0,000100000;1`), or a headerless column of such times
@@ -621,16 +742,17 @@ impl<R: BufRead> CaptureReader<R> {
             Some(CaptureFormat::Vcd)
         } else if first.starts_with(';') {
             Some(CaptureFormat::Sigrok)
-        } else if SALEAE_TIME.contains(&head) || saleae_sample_heading(head) && first.contains(',')
+        } else if saleae_time_heading(head).is_some()
+            || saleae_sample_heading(head) && first.contains(',')
         {
             Some(CaptureFormat::Saleae)
         } else if !first.contains(',') {
             // One column: edge times (a header naming it, or none).
             Some(CaptureFormat::Times)
-        } else if first.starts_with("time_s") {
+        } else if plain_time_heading(head).is_some() {
             Some(CaptureFormat::Plain)
         } else {
-            (head == "Time" || SIGROK_UNITS.iter().any(|(u, _)| *u == head))
+            (head == "Time" || head == "seconds" || SIGROK_UNITS.iter().any(|(u, _)| *u == head))
                 .then_some(CaptureFormat::Sigrok)
         };
         r.format = match (format, detected) {
@@ -648,11 +770,18 @@ impl<R: BufRead> CaptureReader<R> {
         };
         match r.format {
             CaptureFormat::Saleae => r.header_saleae(&first)?,
-            CaptureFormat::Plain => r.header_columns(
-                &first,
-                &["time_s"],
-                "the header `time_s,level` (or `time_s,level,index`)",
-            )?,
+            CaptureFormat::Plain => {
+                r.header_columns(
+                    &first,
+                    &|h| plain_time_heading(h).is_some(),
+                    "the header `time_s,level` (or `time_s,level,index`; `time_ms`, `time_us`, \
+                     `time_ns` for times in those units)",
+                )?;
+                let head = first.split(',').next().unwrap_or("").trim();
+                if let Some(u) = plain_time_heading(head).filter(|&u| u != TimeUnit::S) {
+                    (r.time_unit, r.unit_stated) = (u, true);
+                }
+            }
             CaptureFormat::Sigrok => r.header_sigrok(first)?,
             CaptureFormat::Vcd => r.header_vcd(first)?,
             CaptureFormat::Times => r.header_times(first)?,
@@ -662,6 +791,7 @@ impl<R: BufRead> CaptureReader<R> {
                 return r.open_binary(false, Some(CaptureFormat::SaleaeBinary))
             }
         }
+        r.take_time_unit()?;
         if r.channels.is_empty() {
             return Err(r.err_here("the header names no channel"));
         }
@@ -695,6 +825,9 @@ impl<R: BufRead> CaptureReader<R> {
                 "--format sr: the file is not a zip archive, as a sigrok session file (.sr) is: \
                  leave --format out to have the format told from the file",
             ));
+        }
+        if self.unit_given.is_some() {
+            return Err(self.unit_refused());
         }
         let session = srzip::Session::open(&self.file).map_err(|m| self.err_here(&m))?;
         self.channels = session.names.clone();
@@ -738,6 +871,9 @@ impl<R: BufRead> CaptureReader<R> {
                 "--format saleae-binary: the file does not start with `<SALEAE>`, as Saleae's \
                  binary export does: leave --format out to have the format told from the file",
             ));
+        }
+        if self.unit_given.is_some() {
+            return Err(self.unit_refused());
         }
         let export = saleae_bin::Export::open(&self.file).map_err(|m| CaptureError {
             file: self.file.clone(),
@@ -788,6 +924,47 @@ impl<R: BufRead> CaptureReader<R> {
     /// The threshold the values are read through, if any.
     pub fn threshold(&self) -> Option<Threshold> {
         self.threshold
+    }
+
+    /// The smallest and the largest value read through the threshold in channel `k`'s column
+    /// so far (`None`: no threshold, or no value).
+    pub fn value_range(&self, k: usize) -> Option<(f64, f64)> {
+        self.value_range.get(k).copied().flatten()
+    }
+
+    /// How many times a value change dump changed channel `k` again at a time stamp at which
+    /// it had already changed (a pulse within one time unit: only the last level at a stamp
+    /// is a row, and the pulse is lost), with the first such time, s; 0 for other formats.
+    pub fn merged_changes(&self, k: usize) -> (u64, Option<f64>) {
+        let (n, first) = self.vcd.merged(k);
+        let first = first.map(|t| {
+            let atto = i128::try_from(t)
+                .unwrap_or(i128::MAX)
+                .saturating_mul(self.vcd.unit_atto());
+            atto.saturating_sub(i128::from(self.time_origin()) * ATTO) as f64 / ATTO as f64
+        });
+        (n, first)
+    }
+
+    /// A value change dump's time unit (its `$timescale`), s; `None` for other formats.
+    pub fn timescale(&self) -> Option<f64> {
+        (self.format == CaptureFormat::Vcd).then(|| self.vcd.unit_atto() as f64 * 1e-18)
+    }
+
+    /// The unit the times are read in (seconds unless the header or `--time-unit` says).
+    pub fn time_unit(&self) -> TimeUnit {
+        self.time_unit
+    }
+
+    /// Whether the file (its format, or its header) or `--time-unit` states the unit of its
+    /// times: a file of edge times or a plain CSV without `--time-unit` does not (a plain
+    /// CSV's `time_s` is its format's fixed heading), and is read in seconds.
+    pub fn time_unit_stated(&self) -> bool {
+        match self.format {
+            CaptureFormat::Times => self.unit_stated,
+            CaptureFormat::Plain => self.unit_given.is_some() || self.time_unit != TimeUnit::S,
+            _ => true,
+        }
     }
 
     /// The format read.
@@ -851,33 +1028,66 @@ impl<R: BufRead> CaptureReader<R> {
         }
     }
 
-    /// The next line without its end, or `None` at the end of the file.
+    /// The next line without its end, or `None` at the end of the file. A line ends at LF,
+    /// CRLF or a CR alone (classic Mac OS line ends, as some exports still write).
     fn read_line(&mut self) -> Result<Option<String>, CaptureError> {
-        self.buf.clear();
-        let mut limited = std::io::Read::take(&mut self.input, MAX_LINE_BYTES as u64 + 1);
-        let n = limited.read_line(&mut self.buf).map_err(|e| {
-            let what = if e.kind() == std::io::ErrorKind::InvalidData {
-                "not UTF-8 text".to_string()
-            } else {
-                format!("cannot read: {e}")
-            };
-            CaptureError {
-                file: self.file.clone(),
-                line: Some(self.line + 1),
-                message: what,
+        let mut bytes: Vec<u8> = Vec::new();
+        let mut ended = false;
+        let io_err = |e: std::io::Error, line: u64, file: &Path| CaptureError {
+            file: file.to_path_buf(),
+            line: Some(line + 1),
+            message: format!("cannot read: {e}"),
+        };
+        while bytes.len() <= MAX_LINE_BYTES {
+            let buf = self
+                .input
+                .fill_buf()
+                .map_err(|e| io_err(e, self.line, &self.file))?;
+            if buf.is_empty() {
+                break;
             }
-        })?;
-        if n == 0 {
+            match buf.iter().position(|&b| b == b'\n' || b == b'\r') {
+                Some(i) => {
+                    let cr = buf[i] == b'\r';
+                    bytes.extend_from_slice(&buf[..i]);
+                    self.input.consume(i + 1);
+                    if cr {
+                        // A CRLF's LF, if it follows.
+                        let next = self
+                            .input
+                            .fill_buf()
+                            .map_err(|e| io_err(e, self.line, &self.file))?;
+                        if next.first() == Some(&b'\n') {
+                            self.input.consume(1);
+                        }
+                    }
+                    ended = true;
+                    break;
+                }
+                None => {
+                    let n = buf.len().min(MAX_LINE_BYTES + 1 - bytes.len());
+                    bytes.extend_from_slice(&buf[..n]);
+                    self.input.consume(n);
+                }
+            }
+        }
+        if bytes.is_empty() && !ended {
             return Ok(None);
         }
         self.line += 1;
-        self.unterminated = n <= MAX_LINE_BYTES && !self.buf.ends_with('\n');
-        if n > MAX_LINE_BYTES && !self.buf.ends_with('\n') {
+        if bytes.len() > MAX_LINE_BYTES {
+            self.unterminated = false;
             return Err(self.err_here(&format!(
                 "line longer than {MAX_LINE_BYTES} bytes: not a capture row"
             )));
         }
-        let mut l = self.buf.trim_end_matches(['\n', '\r']);
+        self.unterminated = !ended;
+        let text = String::from_utf8(bytes).map_err(|_| CaptureError {
+            file: self.file.clone(),
+            line: Some(self.line),
+            message: "not UTF-8 text".to_string(),
+        })?;
+        let mut l = text.as_str();
         if self.line == 1 {
             // A UTF-8 byte order mark (Windows editors, spreadsheet exports) is not text.
             l = l.strip_prefix('\u{feff}').unwrap_or(l);
@@ -890,11 +1100,11 @@ impl<R: BufRead> CaptureReader<R> {
     fn header_columns(
         &mut self,
         first: &str,
-        time: &[&str],
+        time: &dyn Fn(&str) -> bool,
         expected: &str,
     ) -> Result<(), CaptureError> {
         let mut f = first.split(',');
-        if !f.next().map(str::trim).is_some_and(|h| time.contains(&h)) {
+        if !f.next().map(str::trim).is_some_and(time) {
             return Err(self.err_here(&format!("expected {expected}, found `{}`", clip(first))));
         }
         self.channels = f.map(|c| c.trim().to_string()).collect();
@@ -906,13 +1116,17 @@ impl<R: BufRead> CaptureReader<R> {
     fn header_saleae(&mut self, first: &str) -> Result<(), CaptureError> {
         let head = first.split(',').next().unwrap_or("").trim();
         if !saleae_sample_heading(head) {
-            return self.header_columns(
+            self.header_columns(
                 first,
-                &SALEAE_TIME,
+                &|h| saleae_time_heading(h).is_some(),
                 "a Saleae header: `Time [s],Channel 0,...` (Logic 2) or `Time[s], Channel 0, ...` \
                  (Logic 1.x), the time in seconds, or `Sample Number, Channel 0, ...` (Logic \
                  1.x's sample numbers, with --sample-rate)",
-            );
+            )?;
+            if let Some(u) = saleae_time_heading(head) {
+                (self.time_unit, self.unit_stated) = (u, true);
+            }
+            return Ok(());
         }
         if self.sample_rate.is_none() {
             return Err(self.err_here(&format!(
@@ -956,23 +1170,73 @@ impl<R: BufRead> CaptureReader<R> {
             .collect();
         let other = words.iter().find(|w| {
             [
-                "ms", "us", "µs", "μs", "ns", "ps", "msec", "usec", "nsec", "millis", "micros",
-                "tick", "ticks", "cycle", "cycles", "count", "counts", "sample", "samples", "min",
+                "ps", "tick", "ticks", "cycle", "cycles", "count", "counts", "sample", "samples",
+                "min",
             ]
             .contains(&w.as_str())
         });
         if let Some(unit) = other {
             return Err(self.err_here(&format!(
-                "one column headed `{}`, in {unit}: a file of edge times is read in seconds; \
-                 convert the times to seconds (headed `time_s`)",
+                "one column headed `{}`, in {unit}: a file of edge times is read in seconds, \
+                 milliseconds, microseconds or nanoseconds; convert the times to one of them \
+                 (headed `time_s`, `time_ms`, `time_us` or `time_ns`, or give --time-unit)",
                 clip(head)
             )));
         }
-        self.times_in_seconds = words
-            .iter()
-            .any(|w| ["s", "sec", "secs", "second", "seconds"].contains(&w.as_str()));
+        // The unit the header names (`time_s`, `t [ms]`, `usec`), if any.
+        if let Some(u) = words.iter().find_map(|w| TimeUnit::of_word(w)) {
+            (self.time_unit, self.unit_stated) = (u, true);
+        }
         self.channels = vec![head.to_string()];
         Ok(())
+    }
+
+    /// Takes `--time-unit`, if given, as the unit of the times: for a file of edge times and a
+    /// plain CSV; where the header names a unit, it must be that one.
+    fn take_time_unit(&mut self) -> Result<(), CaptureError> {
+        let Some(given) = self.unit_given else {
+            return Ok(());
+        };
+        let fits = matches!(self.format, CaptureFormat::Times | CaptureFormat::Plain)
+            || self.format == CaptureFormat::Saleae && self.sample_column.is_none();
+        if !fits {
+            return Err(self.unit_refused());
+        }
+        if self.unit_stated && self.time_unit != given {
+            return Err(self.err_here(&format!(
+                "--time-unit {}: the header says the times are in {}: leave --time-unit out, or \
+                 correct the header",
+                given.name(),
+                self.time_unit.name()
+            )));
+        }
+        if self.format == CaptureFormat::Saleae && !self.unit_stated {
+            return Err(self.unit_refused());
+        }
+        (self.time_unit, self.unit_stated) = (given, true);
+        Ok(())
+    }
+
+    /// `--time-unit` given for a format whose times are not numbers in a unit the option
+    /// names.
+    fn unit_refused(&self) -> CaptureError {
+        let given = self.unit_given.map_or("", TimeUnit::name);
+        CaptureError {
+            file: self.file.clone(),
+            line: None,
+            message: format!(
+                "--time-unit {given}: a {} file states the unit of its times itself ({}); \
+                 --time-unit is for a file of edge times or a plain CSV: leave it out",
+                self.format.name(),
+                match self.format {
+                    CaptureFormat::Vcd => "its `$timescale`",
+                    CaptureFormat::Sigrok | CaptureFormat::Sr => "its samplerate and time column",
+                    CaptureFormat::SaleaeBinary => "seconds, as doubles",
+                    _ if self.sample_column.is_some() => "sample numbers, over --sample-rate",
+                    _ => "its header",
+                }
+            ),
+        }
     }
 
     fn header_sigrok(&mut self, first: String) -> Result<(), CaptureError> {
@@ -1038,6 +1302,7 @@ impl<R: BufRead> CaptureReader<R> {
         }
         let (time, labels) = match fields.first() {
             Some(&"Time") => (SigrokTime::Labelled, &fields[1..]),
+            Some(&"seconds") => (SigrokTime::Seconds, &fields[1..]),
             Some(f) => match SIGROK_UNITS.iter().find(|(u, _)| u == f) {
                 Some(&(_, per_s)) => (
                     SigrokTime::Column {
@@ -1092,7 +1357,7 @@ impl<R: BufRead> CaptureReader<R> {
         } else {
             labels.iter().map(|l| l.to_string()).collect()
         };
-        if self.sample_rate.is_none() {
+        if self.sample_rate.is_none() && time != SigrokTime::Seconds {
             return Err(self.err_here(&match time {
                 SigrokTime::Column { .. } => format!(
                     "the time of a sample cannot be told exactly: the file has no `; \
@@ -1158,7 +1423,7 @@ impl<R: BufRead> CaptureReader<R> {
         let mut count = 0usize;
         let time = if timed {
             count += 1;
-            let f = fields.next().unwrap_or("").trim();
+            let f = unquoted(fields.next().unwrap_or(""));
             self.time_of(f)?
         } else {
             let rate = self.sample_rate.unwrap_or(1.0);
@@ -1173,10 +1438,17 @@ impl<R: BufRead> CaptureReader<R> {
                 )));
             };
             count += 1;
-            self.levels[k] = match (f.trim(), self.threshold) {
+            self.levels[k] = match (unquoted(f), self.threshold) {
                 ("X" | "x", _) if self.format == CaptureFormat::Saleae => Level::Unknown,
                 (value, Some(th)) => match value.parse::<f64>() {
-                    Ok(v) if v.is_finite() => th.level(v, self.levels[k]),
+                    Ok(v) if v.is_finite() => {
+                        if self.value_range.len() != n {
+                            self.value_range = vec![None; n];
+                        }
+                        let r = self.value_range[k].get_or_insert((v, v));
+                        *r = (r.0.min(v), r.1.max(v));
+                        th.level(v, self.levels[k])
+                    }
                     _ if self.unread.get(k) == Some(&true) => Level::Unknown,
                     _ => {
                         return Err(self.err_here(&format!(
@@ -1189,6 +1461,10 @@ impl<R: BufRead> CaptureReader<R> {
                 },
                 ("0", None) => Level::Low,
                 ("1", None) => Level::High,
+                // Levels written as numbers, `0.0` and `1.0` (exactly 0 or 1: any other value
+                // is refused below as an analog one).
+                (v, None) if v.parse::<f64>() == Ok(0.0) => Level::Low,
+                (v, None) if v.parse::<f64>() == Ok(1.0) => Level::High,
                 (_, None) if self.unread.get(k) == Some(&true) => Level::Unknown,
                 (other, None) => {
                     let analog = other.parse::<f64>().is_ok_and(f64::is_finite);
@@ -1212,7 +1488,12 @@ impl<R: BufRead> CaptureReader<R> {
                 }
             };
         }
-        let extra = fields.count();
+        // (A comma after the last column: an empty last field, no column.)
+        let rest: Vec<&str> = fields.collect();
+        let extra = match rest.as_slice() {
+            [last] if last.trim().is_empty() => 0,
+            _ => rest.len(),
+        };
         if extra > 0 {
             return Err(self.err_here(&format!(
                 "expected {expected} fields ({}{n} channel levels), found {}",
@@ -1246,11 +1527,12 @@ impl<R: BufRead> CaptureReader<R> {
         // microseconds, read a million-fold slow.
         let whole =
             !f.contains(['.', 'e', 'E']) && !f.trim_start_matches(['+', '-', '0']).is_empty();
-        if whole && !self.times_in_seconds && decimal_attoseconds(f).is_some() {
+        if whole && !self.unit_stated && decimal_attoseconds(f).is_some() {
             return Err(self.err_here(&format!(
                 "`{}` is a whole number: an edge time in seconds has decimals (`0.002084`); \
-                 convert timer ticks or microseconds to seconds, or head the column `time_s` \
-                 if these are whole seconds",
+                 give --time-unit ms, us or ns if these are milliseconds, microseconds or \
+                 nanoseconds (--time-unit s, or a header `time_s`, if whole seconds), or \
+                 convert timer ticks to seconds",
                 clip(f)
             )));
         }
@@ -1299,23 +1581,31 @@ impl<R: BufRead> CaptureReader<R> {
                 let rate = self.sample_rate.unwrap_or(1.0);
                 Ok(self.seconds_from_atto(sample_attoseconds(n, rate)))
             }
-            (CaptureFormat::Sigrok, _) => {
+            (CaptureFormat::Sigrok, s) if s != SigrokTime::Seconds => {
                 let v: u64 = f.parse().map_err(|_| bad("a whole number of time units"))?;
                 let rate = self.sample_rate.unwrap_or(1.0);
                 let (_, _, period) = sigrok_unit(rate as u64);
                 Ok((v / period).saturating_sub(1) as f64 / rate)
             }
             _ => {
+                let unit = match self.time_unit {
+                    TimeUnit::S => "seconds",
+                    TimeUnit::Ms => "milliseconds",
+                    TimeUnit::Us => "microseconds",
+                    TimeUnit::Ns => "nanoseconds",
+                };
                 let Some(atto) = decimal_attoseconds(f) else {
                     // Not a plain decimal: `inf`, `NaN`, or no number at all.
                     return Err(match f.parse::<f64>() {
                         Ok(x) if x.is_finite() => bad("a time within ±1e20 s"),
-                        Ok(_) => bad("a finite time in seconds"),
-                        Err(_) => bad("a time in seconds"),
+                        Ok(_) => bad(&format!("a finite time in {unit}")),
+                        Err(_) => bad(&format!("a time in {unit}")),
                     });
                 };
-                self.precision = decimal_precision(f);
-                Ok(self.seconds_from_atto(atto))
+                // (Written in the unit: its attoseconds are that many times fewer.)
+                let per_second = self.time_unit.per_second();
+                self.precision = decimal_precision(f) / per_second as f64;
+                Ok(self.seconds_from_atto(atto / per_second))
             }
         }
     }
@@ -1351,6 +1641,29 @@ impl<R: BufRead> CaptureReader<R> {
         // resolution.
         atto.saturating_sub(i128::from(origin) * ATTO) as f64 / ATTO as f64
     }
+}
+
+/// A CSV header's fields without the double quotes around them, and without an empty last
+/// field (a comma after the last column): `"Time [s]","Channel 0",` → `Time [s],Channel 0`.
+/// A header with neither is kept as written (its errors quote it so).
+fn plain_header(line: &str) -> String {
+    let mut fields: Vec<&str> = line.split(',').map(unquoted).collect();
+    let trailing = fields.len() > 1 && fields.last().is_some_and(|f| f.is_empty());
+    if !trailing && !line.contains('"') {
+        return line.to_string();
+    }
+    if trailing {
+        fields.pop();
+    }
+    fields.join(",")
+}
+
+/// A field trimmed, without the double quotes around it.
+fn unquoted(f: &str) -> &str {
+    let f = f.trim();
+    f.strip_prefix('"')
+        .and_then(|g| g.strip_suffix('"'))
+        .map_or(f, str::trim)
 }
 
 /// Whether `line` is one number written with a decimal comma (`0,001147198`, `-1,5`): digits,

@@ -73,6 +73,11 @@ enum Command {
         /// resolution (a time is known to one sample period besides the timer's tick).
         #[arg(long, allow_negative_numbers = true)]
         sample_rate: Option<f64>,
+        /// The unit of the times of a file of edge times or a plain CSV (default seconds, or
+        /// the unit its header names: `time_ms`, `time_us`; a header naming another unit than
+        /// the option is refused). Other formats state their unit, and it is refused for them.
+        #[arg(long, value_enum)]
+        time_unit: Option<host_sim::app::logic::TimeUnit>,
         /// Read the channels' columns as values (an oscilloscope's or an analog channel's CSV
         /// export, e.g. a variable-reluctance crank sensor's voltage), levels through a Schmitt
         /// trigger at this value: high above it plus half the hysteresis, low below it less
@@ -357,6 +362,7 @@ fn main() -> ExitCode {
             format,
             options,
             sample_rate,
+            time_unit,
             threshold,
             hysteresis,
             json,
@@ -368,7 +374,7 @@ fn main() -> ExitCode {
                 .transpose()?;
             analyze_cmd(
                 &capture,
-                format,
+                (format, time_unit),
                 sample_rate,
                 threshold,
                 &options,
@@ -452,7 +458,10 @@ fn writable_dir(option: &str, dir: &Path) -> Result<(), Failure> {
 
 fn analyze_cmd(
     capture: &Path,
-    format: Option<CaptureFormat>,
+    (format, time_unit): (
+        Option<CaptureFormat>,
+        Option<host_sim::app::logic::TimeUnit>,
+    ),
     sample_rate: Option<f64>,
     threshold: Option<host_sim::app::logic::Threshold>,
     options: &host_sim::app::analyze::AnalyzeOptions,
@@ -463,7 +472,8 @@ fn analyze_cmd(
     if let Some(r) = sample_rate {
         if !(r.is_finite() && (1.0..=1e12).contains(&r)) {
             return Err(Failure::Message(format!(
-                "--sample-rate {r}: allowed 1 to 1e12 Hz"
+                "--sample-rate {}: allowed 1 to 1e12 Hz",
+                analyze::fmt_number(r)
             )));
         }
     }
@@ -471,8 +481,9 @@ fn analyze_cmd(
     if let Some(dir) = plot {
         writable_dir("--plot", dir)?;
     }
-    let mut reader = host_sim::app::logic::CaptureReader::open(capture, format, sample_rate)
-        .map_err(|e| e.to_string())?;
+    let mut reader =
+        host_sim::app::logic::CaptureReader::open_with(capture, format, sample_rate, time_unit)
+            .map_err(|e| e.to_string())?;
     if let Some(t) = threshold {
         reader.set_threshold(t).map_err(|e| e.to_string())?;
     }

@@ -36,6 +36,23 @@ pub(super) struct Vcd {
     time: Option<u128>,
     /// Whether a change or a `#T` has been read since the last row was given.
     pending: bool,
+    /// Each channel's last change of level: the time, units.
+    changed_at: Vec<Option<u128>>,
+    /// Each channel's changes at a time stamp at which it had changed already, and the first
+    /// such time, units.
+    merged: Vec<(u64, Option<u128>)>,
+}
+
+impl Vcd {
+    /// Channel `k`'s changes merged into one time stamp, and the first such time, units.
+    pub(super) fn merged(&self, k: usize) -> (u64, Option<u128>) {
+        self.merged.get(k).copied().unwrap_or((0, None))
+    }
+
+    /// Attoseconds per time unit.
+    pub(super) fn unit_atto(&self) -> i128 {
+        self.unit_atto
+    }
 }
 
 /// Attoseconds in one unit of a `$timescale`.
@@ -89,6 +106,8 @@ impl<R: BufRead> CaptureReader<R> {
             .tokens
             .extend(first.split_whitespace().map(str::to_string));
         let mut scopes: Vec<String> = Vec::new();
+        // Each channel's full name, its scopes' and its own (`logic.sub.D0`).
+        let mut paths: Vec<String> = Vec::new();
         let mut unit: Option<i128> = None;
         loop {
             let Some(keyword) = self.vcd_token()? else {
@@ -156,15 +175,25 @@ impl<R: BufRead> CaptureReader<R> {
                         .copied()
                         .collect::<Vec<_>>()
                         .join(" ");
-                    if self.channels.contains(&channel) {
-                        channel = scopes
-                            .iter()
-                            .filter(|s| !s.is_empty())
-                            .map(String::as_str)
-                            .chain([channel.as_str()])
-                            .collect::<Vec<_>>()
-                            .join(".");
+                    let path = scopes
+                        .iter()
+                        .filter(|s| !s.is_empty())
+                        .map(String::as_str)
+                        .chain([channel.as_str()])
+                        .collect::<Vec<_>>()
+                        .join(".");
+                    // A name another channel has: both are named by their full path
+                    // (`logic.D0`, `logic.sub.D0`), so that each is given as named.
+                    let repeated: Vec<usize> = (0..self.channels.len())
+                        .filter(|&k| self.channels[k] == channel)
+                        .collect();
+                    if !repeated.is_empty() {
+                        for k in repeated {
+                            self.channels[k].clone_from(&paths[k]);
+                        }
+                        channel.clone_from(&path);
                     }
+                    paths.push(path);
                     self.vcd
                         .ids
                         .entry((*id).to_string())
@@ -311,8 +340,24 @@ impl<R: BufRead> CaptureReader<R> {
         self.vcd.pending = true;
         match self.vcd.ids.get(id) {
             Some(columns) => {
+                let n = self.levels.len();
+                if self.vcd.changed_at.len() != n {
+                    self.vcd.changed_at = vec![None; n];
+                    self.vcd.merged = vec![(0, None); n];
+                }
+                let now = self.vcd.time;
                 for &c in columns {
                     if let Some(l) = self.levels.get_mut(c) {
+                        // A change of a known level to the other: a second one at the same
+                        // stamp undoes the first (a pulse shorter than the time unit).
+                        if *l != level && *l != Level::Unknown && level != Level::Unknown {
+                            if self.vcd.changed_at[c] == now {
+                                let m = &mut self.vcd.merged[c];
+                                m.0 += 1;
+                                m.1 = m.1.or(now);
+                            }
+                            self.vcd.changed_at[c] = now;
+                        }
                         *l = level;
                     }
                 }
@@ -427,7 +472,7 @@ mod tests {
             assert_eq!(l, wl);
         }
         let r = open(text, None).unwrap();
-        assert_eq!(r.channels(), ["a", "top.sub.a", "z [0]"]);
+        assert_eq!(r.channels(), ["top.a", "top.sub.a", "z [0]"]);
     }
 
     /// Reals, strings and events are no channels whatever size they are declared with (GTKWave's
