@@ -635,10 +635,32 @@ fn an_index_against_the_wrong_line_count_or_read_as_the_encoder_is_named() {
     assert!(
         w.contains("`Channel 1`, the channel read, pulses once every 24 edges of `Channel 0`")
             && w.contains("read it with --channel 0")
-            && w.contains("--framing index --index-channel 1"),
+            && w.contains("--framing index --index-channel 1")
+            && w.contains("the speeds are about 24 times too low"),
         "{w}"
     );
     assert!(host_sim::app::analyze::text(&report).contains(w.as_str()));
+    // Read as a disc of 60 lines, each pulse is a 60th of a revolution: the speeds are 60
+    // times too low, not 24 (the factor said was the other channel's count).
+    let (report, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            lines: Some(60),
+            channel: Some(Channel::Name("Channel 1".into())),
+            ..AnalyzeOptions::default()
+        },
+    );
+    let w = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("the channel read"))
+        .unwrap();
+    assert!(
+        w.contains("pulses once every 24 edges of `Channel 0`")
+            && w.contains("one of the 60 pitches a revolution configured")
+            && w.contains("the speeds are about 60 times too low"),
+        "{w}"
+    );
 }
 
 /// A capture taken through the timer's input prescaler (one capture in 4 line edges): the

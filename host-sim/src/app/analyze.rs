@@ -2510,7 +2510,7 @@ pub fn analyze<R: BufRead>(
     if cfg.framing_default {
         report.framing_note = Some(framing_note(&report, enc.config().wheel, ch, &among_read));
     }
-    if let Some(w) = read_as_index(&report, ch, &read_among) {
+    if let Some(w) = read_as_index(&report, ch, &read_among, enc.edges()) {
         report.warnings.push(w);
     }
     // Never synced, or lost again and again and not synced at the end: why, from the capture
@@ -2666,8 +2666,11 @@ struct Busier {
 /// A WARNING when the channel read pulses once every so many (4 or more) edges of another
 /// channel (`among[k]`, regular as [`Spacing::regular`] says), as an index pulses among an
 /// encoder's lines: the channels are likely the other way round (an index read as a disc of
-/// lines reads a speed some lines-fold low, without another word).
-fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<String> {
+/// lines reads a speed some lines-fold low, without another word). Each pulse is read as one
+/// of the configured wheel's `edges` pitches: the speeds read are that many times too low,
+/// whatever the other channel's count (they agree only where the wheel configured is the
+/// encoder's).
+fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing], edges: u16) -> Option<String> {
     let (k, (every, n, total)) = among
         .iter()
         .enumerate()
@@ -2679,8 +2682,9 @@ fn read_as_index(r: &AnalyzeReport, ch: usize, among: &[Spacing]) -> Option<Stri
         "WARNING: `{read}`, the channel read, pulses once every {every} edges of `{other}` ({n} of \
          its {total} spacings), as an index pulses once a revolution of a disc's lines: if \
          `{other}` is the encoder, read it with --channel {k} (and frame by `{read}` with \
-         --framing index --index-channel {ch}); read as it is, the speeds are about {every} times \
-         too low",
+         --framing index --index-channel {ch}); read as it is, each of its pulses is taken for \
+         one of the {edges} pitches a revolution configured, and the speeds are about {edges} \
+         times too low",
         read = r.channel,
     ))
 }
