@@ -1907,7 +1907,10 @@ pub fn predict(scene: &Scene, file: &Path) -> Result<Prediction, SceneError> {
                 model.horizon(),
                 drive_monitor::drive::Horizon::Shooting { .. }
                     | drive_monitor::drive::Horizon::Constant
-            ) || matches!(long, Some(LongKloss::Integrated { .. })));
+            ) || matches!(
+                long,
+                Some(LongKloss::Integrated { .. } | LongKloss::Stalls { .. } | LongKloss::MeanLoad)
+            ));
         let approximate = matches!(long, Some(LongKloss::Approximate(_)));
         let working_branch_warning = prediction
             .steady()

@@ -1001,8 +1001,8 @@ pub fn prediction_text(p: &Prediction) -> String {
             let _ = writeln!(
                 s,
                 "  (balancing: loads near the balancing position stay there; started together at \
-                 rest, on a few machines they instead keep slipping 1–9 % slower than the rotor \
-                 there: docs/criterion.md)"
+                 rest, on a few machines they instead keep slipping up to about 4 % slower than \
+                 the rotor there: docs/criterion.md)"
             );
         }
     }

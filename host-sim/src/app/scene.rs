@@ -601,7 +601,9 @@ pub fn parse_wheel(text: &str) -> Result<(u16, u8), String> {
     if t.contains('+') {
         return Err(
             "\"N+1\" is ambiguous (an index on its own channel, or an extra tooth on the wheel): \
-             write lines = N with framing = \"index\", or the teeth of the wheel with lines and teeth"
+             an index is N lines with index framing (`--lines N --framing index`, or in a scene \
+             lines = N with framing = \"index\"), an extra tooth the wheel's teeth in a scene \
+             (lines and teeth, given to analyze by --scene)"
                 .to_string(),
         );
     }

@@ -34,8 +34,9 @@ enum Command {
         /// Write SVG plots into this directory.
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// Write the capture page of a run-up (loads together, prescribed ramp) into this
-        /// directory: Markdown and SVGs, the scene repeated at slower and faster ramps.
+        /// Write the capture page of a run-up (loads together, a prescribed ramp or a motor)
+        /// into this directory: Markdown and SVGs, the scene repeated at slower and faster
+        /// ramps.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Write the encoder signal (and the index channel, if any) as a logic analyzer
@@ -140,8 +141,9 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Check the auto-balancing criterion against simulation on randomised machines (seed 001):
-    /// agreement, simulated boundary shifts and the margin band they need.
+    /// Check the auto-balancing criterion of seed paper 001 against simulation on randomised
+    /// machines (drawn by --seed): agreement, simulated boundary shifts and the margin band
+    /// they need.
     Criterion {
         /// Number of machines (platforms cycle 1, 2, 3; 1 to 1000).
         #[arg(
