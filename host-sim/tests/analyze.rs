@@ -2187,6 +2187,23 @@ fn options_out_of_range_name_their_range() {
             },
             "--prescaler 3 is out of range: the input prescaler is 1, 2, 4 or 8",
         ),
+        // (Was: "--timer-hz does not fit", the speed written out to 301 digits.)
+        (
+            AnalyzeOptions {
+                min_speed: Some(1e300),
+                ..wheel("36-1")
+            },
+            "--min-speed 1e300 is out of range: the slowest speed still running is 1e-6 to 1e5 \
+             rad/s (as a scene's monitor.min_speed)",
+        ),
+        (
+            AnalyzeOptions {
+                min_speed: Some(1e-9),
+                ..wheel("36-1")
+            },
+            "--min-speed 1e-9 is out of range: the slowest speed still running is 1e-6 to 1e5 \
+             rad/s (as a scene's monitor.min_speed)",
+        ),
     ] {
         assert_eq!(err(o), said);
     }

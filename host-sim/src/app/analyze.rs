@@ -4294,6 +4294,15 @@ pub fn configure(o: &AnalyzeOptions) -> Result<AnalyzeConfig, String> {
         enc.prescaler = p;
     }
     if let Some(w) = o.min_speed {
+        // The scene's `monitor.min_speed` range: beyond it no timer fits, and the core's
+        // complaint would name the timer (with a speed written out to 301 digits).
+        if !(1e-6..=1e5).contains(&w) {
+            return Err(format!(
+                "--min-speed {} is out of range: the slowest speed still running is 1e-6 to 1e5 \
+                 rad/s (as a scene's monitor.min_speed)",
+                fmt_number(w)
+            ));
+        }
         enc.min_speed = w;
     }
     if let Some(k) = o.estimator_edges {
