@@ -1377,7 +1377,9 @@ impl SpeedTracker {
             // 360-line disc ringing on the polarity read counted 27 teeth lost a tooth,
             // 78 400 in a capture of 5 762 edges). The ring's fill, not a flag of its own:
             // 16 bytes of code, a flag 24.
-            let lost = (x / r as f32 - 0.5) as u16;
+            // Through u32 (the FPU's saturating conversion) and clamped: the same as `as u16`,
+            // 24 bytes less code (`as u16` compared the float with both ends).
+            let lost = ((x / r as f32 - 0.5) as u32).min(u32::from(u16::MAX)) as u16;
             return Verdict::Dropout(lost.wrapping_mul(u16::from(self.fill != 1)));
         }
         if !synced && enc.framing() == Framing::Pattern {
