@@ -1013,8 +1013,10 @@ impl SpeedTracker {
         let s2 = s * s;
         let s10 = (s2 * s2) * (s2 * s2) * s2;
         // (`s¹⁰ ≥ R⁹` and `s¹⁰·R⁹ ≤ 1` compared, no root taken; +∞ for a uniform disc: never.)
+        // Without pattern wheels `R⁹` is +∞ and `s¹⁰·R⁹` +∞ or NaN, never at most 1: the
+        // second test is left out (24 bytes).
         let limit = enc.pattern_swing();
-        if s10 >= limit || s10 * limit <= 1.0 {
+        if s10 >= limit || (cfg!(feature = "pattern-wheels") && s10 * limit <= 1.0) {
             1.0
         } else {
             s
@@ -1772,9 +1774,16 @@ impl SpeedTracker {
         // The same without the swings the recorded revolution does not hold.
         let mut recorded = cost;
         let (mut prev, mut tooth) = (head, first);
-        for d in rest.iter().flatten() {
+        let mut left: &[Option<u32>] = &rest;
+        while let Some((&d, tail)) = left.split_first() {
+            // Opaque, so that the loop is neither unrolled nor turned into a skipping search
+            // (24 bytes less code than `rest.iter().flatten()`).
+            left = core::hint::black_box(tail);
+            let Some(d) = d else {
+                continue;
+            };
             let next = tooth_after(tooth, 1, enc.edges());
-            let v = *d as f32 / pitch_ratio(enc, next);
+            let v = d as f32 / pitch_ratio(enc, next);
             let s = self.recorded_swing(enc, tooth, next, 0.0);
             let swing = log_sq(v, prev * if s > 0.0 { s } else { 1.0 });
             // A compare, not `f32::min` (a call of `fminf` on this FPU); never NaN.
