@@ -1013,8 +1013,10 @@ impl SpeedTracker {
         let s2 = s * s;
         let s10 = (s2 * s2) * (s2 * s2) * s2;
         // (`s¹⁰ ≥ R⁹` and `s¹⁰·R⁹ ≤ 1` compared, no root taken; +∞ for a uniform disc: never.)
+        // Without pattern wheels `R⁹` is +∞ and `s¹⁰·R⁹` +∞ or NaN, never at most 1: the
+        // second test is left out (24 bytes).
         let limit = enc.pattern_swing();
-        if s10 >= limit || s10 * limit <= 1.0 {
+        if s10 >= limit || (cfg!(feature = "pattern-wheels") && s10 * limit <= 1.0) {
             1.0
         } else {
             s
@@ -1377,7 +1379,9 @@ impl SpeedTracker {
             // 360-line disc ringing on the polarity read counted 27 teeth lost a tooth,
             // 78 400 in a capture of 5 762 edges). The ring's fill, not a flag of its own:
             // 16 bytes of code, a flag 24.
-            let lost = (x / r as f32 - 0.5) as u16;
+            // Through u32 (the FPU's saturating conversion) and clamped: the same as `as u16`,
+            // 24 bytes less code (`as u16` compared the float with both ends).
+            let lost = ((x / r as f32 - 0.5) as u32).min(u32::from(u16::MAX)) as u16;
             return Verdict::Dropout(lost.wrapping_mul(u16::from(self.fill != 1)));
         }
         if !synced && enc.framing() == Framing::Pattern {
@@ -1411,6 +1415,9 @@ impl SpeedTracker {
         }
         let d2 = (n >= 2).then(|| self.pending[1].wrapping_sub(e1) & enc.mask());
         let d3 = (n >= 3).then(|| self.pending[2].wrapping_sub(self.pending[1]) & enc.mask());
+        // The intervals after the judged edge, laid out once for the hypotheses that take them
+        // as they are (passed by value, each call made a copy of its own: 40 bytes more code).
+        let rest = [d2, d3];
         let p_next = pitch_ratio(enc, next);
         // Where the expected tooth ends a long pitch p (a gap), every fault leaves less
         // evidence than after an ordinary pitch: a tooth lost there stretches the gap by
@@ -1433,7 +1440,7 @@ impl SpeedTracker {
         };
         let here = self.tooth;
         let (mut expected_cost, mut recorded_cost) =
-            self.chain_cost(enc, here, next, x / p_next, [d2, d3], cap);
+            self.chain_cost(enc, here, next, x / p_next, &rest, cap);
         if let (true, true, 0, Some(a)) = (cfg!(feature = "pattern-wheels"), gap, self.across, d2) {
             // After a gap, also the expected tooth with the tooth after it lost (a fault of
             // its own, judged next: the margin). The interval after it spans two pitches, the
@@ -1451,7 +1458,7 @@ impl SpeedTracker {
             let (p1, p2) = (pitch_ratio(enc, one), pitch_ratio(enc, two));
             let own = a as f32 * p1 / (p1 + p2 * self.raw_swing(one, two));
             let (cost, recorded) =
-                self.chain_cost(enc, here, next, x / p_next, [Some(own as u32), None], cap);
+                self.chain_cost(enc, here, next, x / p_next, &[Some(own as u32), None], cap);
             if recorded < 0.25 * margin {
                 if cost + margin < expected_cost {
                     expected_cost = cost + margin;
@@ -1474,7 +1481,7 @@ impl SpeedTracker {
                     here,
                     next,
                     x / p_next,
-                    [Some(a.wrapping_add(b)), None],
+                    &[Some(a.wrapping_add(b)), None],
                     cap,
                 )
                 .0 + margin;
@@ -1496,7 +1503,7 @@ impl SpeedTracker {
         // A glitch: e1 and e2 merged are the expected tooth.
         let glitch = match d2 {
             Some(d2) => {
-                self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, [d3, None], cap)
+                self.chain_cost(enc, here, next, (x + d2 as f32) / p_next, &[d3, None], cap)
                     .0
             }
             None => f32::INFINITY,
@@ -1520,9 +1527,7 @@ impl SpeedTracker {
                     spans
                 };
                 // The frame tooth of an index disc is not skipped silently: the index decides.
-                let mut cost = self
-                    .chain_cost(enc, here, tooth, x / spans, [d2, d3], cap)
-                    .0;
+                let mut cost = self.chain_cost(enc, here, tooth, x / spans, &rest, cap).0;
                 if cfg!(feature = "pattern-wheels") && enc.framing() == Framing::Pattern {
                     // The tooth before the loss against the first after it as they were
                     // recorded, however far apart they swing: judging one tooth against the
@@ -1551,7 +1556,7 @@ impl SpeedTracker {
                         before_behind,
                         behind,
                         x / pitch_ratio(enc, behind),
-                        [d2, d3],
+                        &rest,
                         cap,
                     )
                     .0 + margin,
@@ -1559,7 +1564,7 @@ impl SpeedTracker {
                 );
                 let ahead = tooth_after(next, 1, edges);
                 consider(
-                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), [d2, d3], cap)
+                    self.chain_cost(enc, next, ahead, x / pitch_ratio(enc, ahead), &rest, cap)
                         .0
                         + margin,
                     Verdict::Ahead,
@@ -1760,7 +1765,7 @@ impl SpeedTracker {
         before: u16,
         first: u16,
         head: f32,
-        rest: [Option<u32>; 2],
+        rest: &[Option<u32>; 2],
         cap: f32,
     ) -> (f32, f32) {
         let mut cost = log_sq(
@@ -1770,9 +1775,16 @@ impl SpeedTracker {
         // The same without the swings the recorded revolution does not hold.
         let mut recorded = cost;
         let (mut prev, mut tooth) = (head, first);
-        for d in rest.iter().flatten() {
+        let mut left: &[Option<u32>] = rest;
+        while let Some((&d, tail)) = left.split_first() {
+            // Opaque, so that the loop is neither unrolled nor turned into a skipping search
+            // (24 bytes less code than `rest.iter().flatten()`).
+            left = core::hint::black_box(tail);
+            let Some(d) = d else {
+                continue;
+            };
             let next = tooth_after(tooth, 1, enc.edges());
-            let v = *d as f32 / pitch_ratio(enc, next);
+            let v = d as f32 / pitch_ratio(enc, next);
             let s = self.recorded_swing(enc, tooth, next, 0.0);
             let swing = log_sq(v, prev * if s > 0.0 { s } else { 1.0 });
             // A compare, not `f32::min` (a call of `fminf` on this FPU); never NaN.

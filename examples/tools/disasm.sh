@@ -15,13 +15,14 @@ objdump_path() {
 
 # `disassemble OBJDUMP ELF`: the disassembly of ELF without the linker's fill. The linker
 # fills the gap before an aligned function with 0xd4d4 halfwords, which disassemble as a
-# branch ("bmi"); a d4d4 that no instruction follows in its function is that fill, not code (a
-# conditional branch cannot end a function), and is dropped (the raw bytes are shown for this
-# only).
+# branch ("bmi"); a run of d4d4 that no other instruction follows in its function is that
+# fill, not code (a conditional branch cannot end a function), and is dropped (the raw bytes
+# are shown for this only). (A gap of two halfwords left its first one in, read as a branch
+# into whatever function its offset named.)
 disassemble() {
     "$1" -d "$2" | awk '
-        fill != "" { if ($0 ~ /^ *[0-9a-f]+:/) print fill; fill = "" }
-        /^ *[0-9a-f]+: d4d4 / { fill = $0; next }
+        /^ *[0-9a-f]+: d4d4 / { fill = fill $0 "\n"; next }
+        fill != "" { if ($0 ~ /^ *[0-9a-f]+:/) printf "%s", fill; fill = "" }
         { print }
     '
 }
