@@ -838,6 +838,41 @@ mod tests {
         }
     }
 
+    /// y'' = −c·y' − k·y, written in units that make its Jacobian far from normal.
+    struct Damped {
+        c: f64,
+        k: f64,
+        unit: f64,
+    }
+
+    impl OdeSystem for Damped {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1] / self.unit;
+            dy[1] = (-self.c * y[1] / self.unit - self.k * y[0]) * self.unit;
+        }
+    }
+
+    #[test]
+    fn the_fastest_rate_is_the_jacobians_spectral_radius() {
+        // The oscillator: eigenvalues ±i.
+        let r = fastest_rate(&mut Osc { evals: 0 }, 0.0, &[1.0, 0.0]).unwrap();
+        assert!((r - 1.0).abs() < 1e-3, "{r}");
+        // Real eigenvalues −1 and −100 (c = 101, k = 100), the velocity in units of 1e-4:
+        // the matrix norm is 1e4 times off, the radius is not.
+        for unit in [1.0, 1e-4] {
+            let mut d = Damped {
+                c: 101.0,
+                k: 100.0,
+                unit,
+            };
+            let r = fastest_rate(&mut d, 0.0, &[0.3, 2.0 * unit]).unwrap();
+            assert!((r / 100.0 - 1.0).abs() < 0.05, "{unit}: {r}");
+        }
+    }
+
     fn run(integrator: Integrator, t_end: f64) -> (Solver, f64, f64) {
         let mut sys = Osc { evals: 0 };
         let mut s = Solver::new(&integrator, 2);
