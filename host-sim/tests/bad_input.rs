@@ -817,3 +817,106 @@ fn counts_written_in_the_file_are_not_called_defaults() {
             .unwrap();
     assert!(readme.contains("`[[unbalance]]` at most 32"));
 }
+
+/// An integer key beyond its storage type (negative, or above 255 or 65535) is refused like
+/// any other value outside its range, naming the key, the value as written and the range:
+/// serde alone had said "invalid value: integer `70000`, expected u16".
+#[test]
+fn scene_integers_beyond_their_type_are_refused_with_their_range() {
+    let cases: &[(&str, &str, &str, &[&str])] = &[
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 70000",
+            &["`encoder.lines = 70000`", "allowed 2 to 8192"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = -1",
+            &["`encoder.lines = -1`", "allowed 2 to 8192"],
+        ),
+        (
+            "kneader",
+            "[monitor]",
+            "[monitor]\nwindow_revolutions = 70000",
+            &["`monitor.window_revolutions = 70000`", "allowed 1 to 1024"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 1024\ncounter_bits = 300",
+            &["`encoder.counter_bits = 300`", "allowed 16 to 32"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 1024\nprescaler = 256",
+            &["`encoder.prescaler = 256`", "allowed 1, 2, 4 or 8"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 1024\nestimator_edges = -3",
+            &["`encoder.estimator_edges = -3`", "allowed 1 to 32"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 36\nmissing = 300",
+            &["`encoder.missing = 300`", "1 to 33 on 36 positions"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 36\nteeth = [0, 1, 70000]",
+            &["`encoder.teeth[3] = 70000`", "0 to 35"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "lines = 36\ngaps = [[70000, 2]]",
+            &["`encoder.gaps[1][1] = 70000`", "0 to 35"],
+        ),
+        (
+            "kneader",
+            "lines = 1024",
+            "wheel = \"36-300\"",
+            &["`encoder.wheel = \"36-300\"`", "1 to 33 on 36 positions"],
+        ),
+        (
+            "kneader",
+            "seed = 1",
+            "seed = -1",
+            &["`simulation.seed = -1`", "allowed 0 to"],
+        ),
+        (
+            "one-mass",
+            "platform = 1",
+            "platform = 300",
+            &["`autobalancer.platform = 300`", "allowed 1 to 1"],
+        ),
+        (
+            "one-mass",
+            "loads = 2",
+            "loads = -2",
+            &["`autobalancer.loads = -2`", "allowed 2 to"],
+        ),
+        (
+            "two-mass",
+            "between = [1, 2]",
+            "between = [1, 300]",
+            &["`coupling[1].between[2] = 300`", "allowed 1 to 2"],
+        ),
+    ];
+    for (scene, from, to, want) in cases {
+        let e = error(scene, from, to);
+        assert!(!e.contains("expected u"), "{to}: {e}");
+        for w in *want {
+            assert!(e.contains(w), "{to}: `{w}` not in: {e}");
+        }
+    }
+    // A value that is no integer at all still says what is wanted, not a storage type.
+    let e = error("kneader", "lines = 1024", "lines = 2.5");
+    assert!(e.contains("expected a whole number"), "{e}");
+}

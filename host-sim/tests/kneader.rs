@@ -246,7 +246,46 @@ fn a_fixed_step_that_blows_up_names_the_step_alone() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("simulation.step = 0.2 s") && !e.contains("rtol") && !e.contains("atol"),
+        e.contains("`simulation.step = 0.2`")
+            && e.contains("diverged")
+            && e.contains("take simulation.step at most")
+            && !e.contains("rtol")
+            && !e.contains("atol"),
         "{e}"
     );
+}
+
+/// A fixed step so long that the kneader's RK4 diverges is stopped at the step that diverges,
+/// before its edges are made, naming `simulation.step`, its value and a step that runs: at
+/// `step = 2` the second step took the shaft from about 200 to 3e19 rad/s, and turning the
+/// encoder through that angle had run for more than 23 minutes; at `step = 10` the first step
+/// made 2e8 edges (42 s) and the error blamed `simulation.duration`.
+#[test]
+fn a_fixed_step_that_diverges_is_stopped_at_once_naming_the_step() {
+    for step in [1.0, 2.0, 5.0, 10.0] {
+        let (done, waiting) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = done.send(kneader_rk4(step).map(Box::new));
+        });
+        let e = waiting
+            .recv_timeout(std::time::Duration::from_secs(30))
+            .unwrap_or_else(|_| panic!("step = {step}: still running after 30 s"))
+            .unwrap_err();
+        assert!(
+            e.contains(&format!("`simulation.step = {step}`"))
+                && e.contains("diverged")
+                && !e.contains("simulation.duration"),
+            "{e}"
+        );
+        let suggested: f64 = e
+            .split("take simulation.step at most ")
+            .nth(1)
+            .and_then(|rest| rest.split(' ').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no step suggested: {e}"));
+        assert!(suggested < step / 1.9, "{suggested}");
+        let report = kneader_rk4(suggested).unwrap_or_else(|e| panic!("{suggested}: {e}"));
+        let mean = report.speed_measured.unwrap();
+        assert!((mean / 134.245 - 1.0).abs() < 1e-3, "{suggested}: {mean}");
+    }
 }

@@ -1408,6 +1408,26 @@ fn speed_bound(scene: &Scene, over: Overrides) -> f64 {
     motor.max(initial) * (1.0 + ripple)
 }
 
+/// The shaft speed beyond which an unresolved fixed step is taken as diverging, rad/s
+/// ([`Simulation::with_speed_limit`]): ten times [`speed_bound`], and at least 100 rad/s.
+/// A diverging RK4 step goes far beyond it at once (the kneader at `step = 2`: from 197 to
+/// about 2e8 rad/s in one step), and a resolved step is never stopped by it.
+fn divergence_speed(scene: &Scene, over: Overrides) -> f64 {
+    (10.0 * speed_bound(scene, over)).max(100.0)
+}
+
+/// A fixed step that would not diverge where `step` (s) did, from the system's fastest
+/// linearised rate there (1/s): half of its time scale 1/rate (RK4 is stable on it up to about
+/// 2.8 of it), and at most half of `step`; two significant digits, rounded down.
+fn suggested_step(step: f64, rate: Option<f64>) -> f64 {
+    let h = rate
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .map_or(step / 10.0, |r| 0.5 / r)
+        .min(step / 2.0);
+    let unit = 10f64.powf(h.log10().floor() - 1.0);
+    (h / unit).floor() * unit
+}
+
 /// Refuses, before anything is simulated, a run that would produce more than [`MAX_EDGES`]
 /// edges or take more than [`MAX_STEPS`] integrator steps of the largest size allowed.
 fn check_work(
@@ -1507,6 +1527,9 @@ pub fn run_with(
     }
     let mut sim = Simulation::new(system, integ.clone(), encoder)
         .map_err(|e| SceneError::value(file, "simulation", e.to_string()))?;
+    if matches!(integ, Integrator::Rk4 { .. }) {
+        sim = sim.with_speed_limit(divergence_speed(scene, over));
+    }
     let duration = scene.simulation.duration;
     let settle = scene.simulation.settle.unwrap_or(duration / 3.0);
     let lines = scene
@@ -2133,6 +2156,42 @@ fn integration_error(
 ) -> SceneError {
     let c = scene.checker(file);
     let s = &scene.simulation;
+    if let crate::engine::system::SimError::Diverged {
+        t,
+        speed,
+        limit,
+        rate,
+    } = *e
+    {
+        let reached = if speed.is_finite() {
+            format!(
+                "left the shaft turning at {speed:.3e} rad/s, beyond {limit:.3e} rad/s (ten \
+                 times the fastest speed the scene's motor or initial speed gives), with its \
+                 local error estimate beyond its scale"
+            )
+        } else {
+            "left a state that is no longer finite".to_string()
+        };
+        let scale = rate
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .map(|r| {
+                format!(
+                    " (the scene's fastest rate, linearised at the start and where it diverged, \
+                     is {r:.3} 1/s)"
+                )
+            })
+            .unwrap_or_default();
+        return c.bad(
+            "simulation.step",
+            s.step,
+            format!(
+                "the fixed step with integrator = \"rk4\" diverged: the step from t = {t:.4} s \
+                 {reached}; the run was stopped there: take simulation.step at most {:.2e} s{scale}, \
+                 or the adaptive dp5 (the default)",
+                suggested_step(s.step, rate)
+            ),
+        );
+    }
     if s.integrator == IntegratorKind::Rk4 {
         // A fixed step: rtol and atol play no part.
         return SceneError::value(

@@ -152,7 +152,7 @@ pub struct SimulationSpec {
     #[serde(default = "default_step")]
     pub step: f64,
     /// Seed of every random effect (jitter, faults, perturbations).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "seed")]
     pub seed: u64,
     /// Time to let transients settle before δ windows are counted as steady state, s.
     #[serde(default)]
@@ -290,6 +290,114 @@ where
     let n = values.len();
     values.try_into().map_err(|_| {
         serde::de::Error::invalid_length(n, &format!("an array of length {N}").as_str())
+    })
+}
+
+/// An integer key held in a narrower type than the TOML integer it is read as. A value beyond
+/// the type (negative, or above its largest) is held as the type's largest, which is outside
+/// every such key's allowed range, so that the scene's checks refuse it with the key, the value
+/// as written and the range (`` `encoder.lines = 70000`: allowed 2 to 8192 ``), where serde
+/// alone said "invalid value: integer `70000`, expected u16"
+/// (`scene_integers_beyond_their_type_are_refused_with_their_range`).
+pub trait Whole: Sized + TryFrom<i64> {
+    /// What a value beyond the type is held as.
+    const BEYOND: Self;
+    /// `v` as the type, or [`Whole::BEYOND`].
+    fn saturate(v: i64) -> Self {
+        Self::try_from(v).unwrap_or(Self::BEYOND)
+    }
+}
+
+impl Whole for u8 {
+    const BEYOND: Self = u8::MAX;
+}
+
+impl Whole for u16 {
+    const BEYOND: Self = u16::MAX;
+}
+
+/// A TOML integer, any sign ("expected a whole number" for anything else).
+struct Integer(i64);
+
+impl<'de> Deserialize<'de> for Integer {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Integer;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a whole number")
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Integer, E> {
+                Ok(Integer(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Integer, E> {
+                Ok(Integer(i64::try_from(v).unwrap_or(i64::MAX)))
+            }
+        }
+        d.deserialize_i64(V)
+    }
+}
+
+/// An integer key read as [`Whole`].
+fn whole<'de, D, T: Whole>(d: D) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    Integer::deserialize(d).map(|Integer(v)| T::saturate(v))
+}
+
+/// [`whole`] for a key that may be left out (with `#[serde(default)]`).
+fn whole_some<'de, D, T: Whole>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    whole(d).map(Some)
+}
+
+/// A list of integers read as [`Whole`], for a key that may be left out.
+fn whole_each<'de, D, T: Whole>(d: D) -> Result<Option<Vec<T>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let list = Vec::<Integer>::deserialize(d)?;
+    Ok(Some(
+        list.into_iter().map(|Integer(v)| T::saturate(v)).collect(),
+    ))
+}
+
+/// Two integers read as [`Whole`] ([`exact`]ly two).
+fn whole_pair<'de, D, T: Whole>(d: D) -> Result<[T; 2], D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    exact::<D, Integer, 2>(d).map(|p| p.map(|Integer(v)| T::saturate(v)))
+}
+
+/// A list of pairs of integers read as [`Whole`] (see [`exact_each`]).
+fn whole_pairs<'de, D, T: Whole>(d: D) -> Result<Option<Vec<[T; 2]>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let list = exact_each::<D, Integer, 2>(d)?.unwrap_or_default();
+    Ok(Some(
+        list.into_iter()
+            .map(|p| p.map(|Integer(v)| T::saturate(v)))
+            .collect(),
+    ))
+}
+
+/// `simulation.seed`: any integer from 0 (a TOML integer is at most 2⁶³ − 1); a negative one
+/// is refused naming the key and the range.
+fn seed<'de, D>(d: D) -> Result<u64, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let Integer(v) = Integer::deserialize(d)?;
+    u64::try_from(v).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "`simulation.seed = {v}`: allowed 0 to {} (a whole number)",
+            i64::MAX
+        ))
     })
 }
 
@@ -495,36 +603,36 @@ pub struct TolerancesSpec {
 pub struct EncoderSpec {
     /// Tooth positions per revolution (lines; the grid of a pattern). Required unless `wheel`
     /// gives it.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "whole_some")]
     pub lines: Option<u16>,
     /// A missing-tooth wheel in the usual notation, `"N-M"`: N positions, M missing in one gap
     /// (`"36-2"`, `"60-2"`, `"8-1"`).
     #[serde(default)]
     pub wheel: Option<String>,
     /// Gaps of a pattern wheel on the grid of `lines`: `[first missing position, count]` each.
-    #[serde(default, deserialize_with = "exact_each")]
+    #[serde(default, deserialize_with = "whole_pairs")]
     pub gaps: Option<Vec<[u16; 2]>>,
     /// Teeth of a pattern wheel: the grid positions (0 … lines−1) that carry a tooth.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "whole_each")]
     pub teeth: Option<Vec<u16>>,
     /// Capture timer clock, Hz.
     pub timer_hz: f64,
     /// Counter width, bits.
-    #[serde(default = "default_bits")]
+    #[serde(default = "default_bits", deserialize_with = "whole")]
     pub counter_bits: u8,
     /// Input prescaler of the capture (1, 2, 4 or 8; uniform discs only).
-    #[serde(default = "default_prescaler")]
+    #[serde(default = "default_prescaler", deserialize_with = "whole")]
     pub prescaler: u8,
     /// Framing (default: `index`, or what `wheel`, `missing`, `gaps` or `teeth` imply).
     #[serde(default)]
     pub framing: Option<FramingSpec>,
     /// Missing positions (missing-tooth framing, which `missing` implies).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "whole")]
     pub missing: u8,
     /// Edges averaged per speed sample (16 by default; 1 to 32, and at most the edges captured
     /// per revolution, the wheel's teeth over `prescaler`): a sample spanning a good part of a
     /// load cycle averages its ripple away (`predict` warns when more than 1 % of δ is lost).
-    #[serde(default = "default_estimator_edges")]
+    #[serde(default = "default_estimator_edges", deserialize_with = "whole")]
     pub estimator_edges: u16,
     /// The core's edge-check tolerances.
     #[serde(default)]
@@ -615,13 +723,17 @@ pub fn parse_wheel(text: &str) -> Result<(u16, u8), String> {
                 .to_string(),
         );
     };
+    // Read whole, as the integer keys are ([`Whole`]): too many positions or missing teeth
+    // are refused with the wheel's allowed range, not the storage type's.
     let n: u16 = n
         .trim()
-        .parse()
+        .parse::<i64>()
+        .map(Whole::saturate)
         .map_err(|_| format!("`{n}` is not a number of positions"))?;
     let m: u8 = m
         .trim()
-        .parse()
+        .parse::<i64>()
+        .map(Whole::saturate)
         .map_err(|_| format!("`{m}` is not a number of missing teeth"))?;
     Ok((n, m))
 }
@@ -702,6 +814,7 @@ pub struct MonitorSpec {
     /// δ window in revolutions, 1 to 1024 (default: the load's period, from all its and the
     /// inertia's orders; where no window holds that period, one cycle of the lowest order or,
     /// where that is longer, 1024, with a WARNING).
+    #[serde(default, deserialize_with = "whole_some")]
     pub window_revolutions: Option<u16>,
     /// Slowest running speed, rad/s (standstill below).
     pub min_speed: Option<f64>,
@@ -733,7 +846,7 @@ pub struct PlatformSpec {
 #[serde(deny_unknown_fields)]
 pub struct CouplingSpec {
     /// The two platforms (1-based).
-    #[serde(deserialize_with = "exact")]
+    #[serde(deserialize_with = "whole_pair")]
     pub between: [u8; 2],
     /// Stiffness, N/m.
     pub stiffness: f64,
@@ -763,8 +876,10 @@ pub struct AutobalancerSpec {
     #[serde(default)]
     pub pendulum_inertia: Option<f64>,
     /// Platform carrying it (1-based).
+    #[serde(deserialize_with = "whole")]
     pub platform: u8,
     /// Number of loads.
+    #[serde(deserialize_with = "whole")]
     pub loads: u8,
     /// Mass of each load, kg.
     pub load_mass: f64,

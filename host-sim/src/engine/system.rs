@@ -41,7 +41,7 @@ use crate::engine::cranking::SpeedProfile;
 use crate::engine::encoder::{Edge, Encoder, EncoderConfig, EncoderStats};
 use crate::engine::model::{Effect, Shaft};
 use crate::engine::ode::{
-    ComponentPoly, DenseOutput, Integrator, OdeError, OdeSystem, Solver, SolverStats,
+    fastest_rate, ComponentPoly, DenseOutput, Integrator, OdeError, OdeSystem, Solver, SolverStats,
 };
 
 /// A kinematic law for a prescribed shaft.
@@ -478,6 +478,22 @@ pub enum SimError {
     /// The integrator failed.
     #[error("integration failed: {0}")]
     Ode(#[from] OdeError),
+    /// A fixed step diverged ([`Simulation::with_speed_limit`]): the step from `t` left the
+    /// shaft turning at `speed` (rad/s; infinite for a state that is no longer finite), beyond
+    /// `limit`, while its own error estimate said it was not resolved. `rate` is the fastest
+    /// rate of the system linearised at the run's start and at that step's start
+    /// ([`crate::engine::ode::fastest_rate`]), 1/s, where it could be evaluated.
+    #[error("the fixed step diverged from t = {t} s: the shaft's speed reached {speed:.3e} rad/s, beyond {limit:.3e} rad/s")]
+    Diverged {
+        /// Start of the step, s.
+        t: f64,
+        /// The shaft's speed it reached, rad/s.
+        speed: f64,
+        /// The limit it passed, rad/s.
+        limit: f64,
+        /// The system's fastest linearised rate, 1/s.
+        rate: Option<f64>,
+    },
 }
 
 /// Cumulative work and output of a [`Simulation`].
@@ -592,6 +608,10 @@ pub struct Simulation {
     solver: Solver,
     encoder: Encoder,
     t: f64,
+    /// See [`Simulation::with_speed_limit`].
+    speed_limit: Option<f64>,
+    /// The state at the start of the step being taken (kept with a speed limit only).
+    before: Vec<f64>,
 }
 
 impl core::fmt::Debug for Simulation {
@@ -621,7 +641,39 @@ impl Simulation {
             solver,
             encoder,
             t: 0.0,
+            speed_limit: None,
+            before: Vec::new(),
         })
+    }
+
+    /// For a fixed step (RK4): a step whose state is no longer finite, or on a dynamic shaft a
+    /// step that leaves the shaft turning faster than `limit` (rad/s, at its end or on average
+    /// over it) while its estimated local error exceeds its scale
+    /// ([`Solver::last_step_error`]), ends the run with [`SimError::Diverged`] before that step's edges are made (a diverging
+    /// step can turn the shaft through more angle than any edge budget). Adaptive methods hold
+    /// their tolerance and are not checked.
+    pub fn with_speed_limit(mut self, limit: f64) -> Self {
+        self.speed_limit = Some(limit);
+        self
+    }
+
+    /// The [`SimError::Diverged`] of the step from the state in `before` at `t0`.
+    fn diverged(&mut self, t0: f64, speed: f64, limit: f64) -> SimError {
+        let start = self.system.initial_state();
+        let before = std::mem::take(&mut self.before);
+        let dim = self.system.dim();
+        let rate = [(0.0, start.as_slice()), (t0, before.as_slice())]
+            .into_iter()
+            .filter(|(_, y)| y.len() == dim)
+            .filter_map(|(t, y)| fastest_rate(&mut self.system, t, y))
+            .reduce(f64::max);
+        self.before = before;
+        SimError::Diverged {
+            t: t0,
+            speed,
+            limit,
+            rate,
+        }
     }
 
     /// Simulated time so far, s.
@@ -697,9 +749,34 @@ impl Simulation {
                     _ => None,
                 };
                 let limit = corner.map_or(t_end, |tb| tb.min(t_end));
-                self.solver.step(&mut self.system, limit)?;
+                // A fixed step with a speed limit: kept for the divergence checks.
+                let guard = self
+                    .speed_limit
+                    .filter(|_| self.solver.last_step_error().is_some());
+                if guard.is_some() {
+                    self.before.clear();
+                    self.before.extend_from_slice(self.solver.y());
+                }
+                let t0 = self.solver.t();
+                match (self.solver.step(&mut self.system, limit), guard) {
+                    (Err(OdeError::NonFinite { .. }), Some(speed_limit)) => {
+                        return Err(self.diverged(t0, f64::INFINITY, speed_limit));
+                    }
+                    (r, _) => r?,
+                }
                 let d = self.solver.dense();
-                (d.t0(), d.t1())
+                let (t0, t1) = (d.t0(), d.t1());
+                let dynamic = matches!(self.system.shaft, ShaftModel::Dynamic(_));
+                if let Some(speed_limit) = guard.filter(|_| dynamic) {
+                    let y = self.solver.y();
+                    let mean = (y[0] - self.before[0]).abs() / (t1 - t0);
+                    let speed = y[1].abs().max(mean);
+                    let unresolved = self.solver.last_step_error().is_some_and(|r| r > 1.0);
+                    if unresolved && (!speed.is_finite() || speed > speed_limit) {
+                        return Err(self.diverged(t0, speed, speed_limit));
+                    }
+                }
+                (t0, t1)
             } else {
                 (self.t, (self.t + CHUNK).min(t_end))
             };
