@@ -5138,6 +5138,38 @@ fn times_held_as_floats_are_resolved_to_the_float_grid() {
     }
 }
 
+/// Times held as f32 from near 0 s lie on no one grid: the float's spacing grows with the
+/// time (1.2e-10 s at 0.001 s, 1.2e-7 s past 1 s). Each window's floor takes the spacing at its
+/// own times, and a steady shaft's δ (the f32 rounding's alone) is within it; with the timer's
+/// floor alone 84 of 93 windows (every one past 0.1 s) had read as resolved, at up to 5.5 times
+/// it. The same instants written exactly are no float's values.
+#[test]
+fn f32_times_from_zero_take_the_spacing_at_each_window() {
+    let rising = steady_disc(60, 300.0, 0.001, 2.0);
+    let rows: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 0.5 * std::f64::consts::TAU / 60.0 / 300.0, 0)])
+        .collect();
+    let header = "Time [s],Channel 0";
+    let f32s = csv_of(header, None, &rows, ",", |t| format!("{:.9}", t as f32));
+    let report = analyze_text(f32s, "f32.csv", 60, 1);
+    let f = report.float_times.expect("f32 times");
+    assert_eq!((f.float, f.spacing_to), ("f32", 2f64.powi(-23)), "{f:?}");
+    assert!(report.float_grid.is_none() && report.time_grid.is_none());
+    none_resolved(&report, "f32 times from 0 s");
+    // The floor follows the spacing: a window past 1 s takes 2^-23 s and the digits' 1 ns.
+    let late = report.windows.iter().rev().find(|w| w.valid).unwrap();
+    assert_eq!(late.time_resolution, Some(2f64.powi(-23) + 1e-9));
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("is a 32-bit float (f32) value") && said.contains("float spacing (below)"),
+        "{said}"
+    );
+    let exact = csv_of(header, None, &rows, ",", |t| format!("{t:.9}"));
+    let report = analyze_text(exact, "exact.csv", 60, 1);
+    assert!(report.float_times.is_none(), "{:?}", report.float_times);
+}
+
 /// libsigrok writes the time column in the unit its sample rate calls for: a `; Samplerate:
 /// 10 MHz` over whole microseconds (a 1 MHz capture's) contradicts itself, and read at the rate
 /// every speed was 10 times off. Refused, naming both; so is --sample-rate against the column.

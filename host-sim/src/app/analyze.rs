@@ -557,6 +557,12 @@ pub struct AnalyzeReport {
     /// near a Unix time resolves 2^-22 s), and the floor includes that grid.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub float_grid: Option<FloatSpacing>,
+    /// When every transition's time, as written, is a value of one float type at its own
+    /// magnitude (an f32 resolves 2^-24 of it) and the times span magnitudes where that
+    /// spacing differs, so no one grid holds them (f32 times from 0 s): each window's floor
+    /// includes the spacing at its latest time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub float_times: Option<FloatTimes>,
     /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
     pub warnings: Vec<String>,
     /// The unit the file's times are read in (`s`, `ms`, `us`, `ns`: its header's, or
@@ -1968,6 +1974,7 @@ pub fn analyze<R: BufRead>(
     let mut grid = TimeGrid::default();
     let mut rate_grid = RateGrid::default();
     let mut float_grid = FloatGrid::default();
+    let mut float_values = FloatValues::default();
     let mut resolution = Resolution {
         hz: cfg.encoder.timer_hz,
         ..Resolution::default()
@@ -2046,6 +2053,7 @@ pub fn analyze<R: BufRead>(
                 rate_grid.row(t, precision);
             }
             float_grid.row(t, precision);
+            float_values.row(t, precision, reader.time_origin());
         }
         // (Every row to the resolution of the blocks: a row off the grid only makes a block's
         // step finer, and the floor never takes a block's finer than the grid above.)
@@ -2389,6 +2397,22 @@ pub fn analyze<R: BufRead>(
     report.float_grid = float_grid
         .step()
         .map(|(e, at, written)| FloatSpacing::of(e, at, written, report.time_origin));
+    // Float values whose spacing grows over the capture (f32 times from 0 s) lie on no grid
+    // coarser than their first spacing; each window takes the spacing at its own times. (Where
+    // one grid holds them all, the float grid above says it.)
+    report.float_times = float_values.found().filter(|f| {
+        report
+            .float_grid
+            .as_ref()
+            .is_none_or(|g| f.spacing_to > g.step)
+    });
+    if let Some(f) = &report.float_times {
+        report.float_grid = None;
+        // A grid of the rows finer than the floats' largest spacing is the digits' own.
+        if report.time_grid.is_some_and(|g| g < f.spacing_to) {
+            (report.time_grid, report.grid_of_rate) = (None, None);
+        }
+    }
     // Each window's floor takes the file's sampling, or the resolution of its own rows where
     // that is coarser (a time is known to no better than either), and the grid of the floats
     // the times were held in where that is coarser still.
@@ -2406,6 +2430,11 @@ pub fn analyze<R: BufRead>(
         } else {
             file_step
         };
+        let origin = report.time_origin as f64;
+        let res = report.float_times.map_or(res, |f| {
+            let at = (origin + w.start).abs().max((origin + w.end).abs());
+            res.max(f.resolution(at))
+        });
         if res > 0.0 {
             w.time_resolution = Some(res);
             w.floor_with_sampling = w.noise_floor.map(|f| f * (1.0 + res / tick));
@@ -3041,6 +3070,123 @@ impl FloatGrid {
     }
 }
 
+/// Mantissa bits (the leading one included) of the floats [`FloatValues`] tests: f32, f64.
+const FLOAT_BITS: [(i32, &str); 2] = [(24, "f32"), (53, "f64")];
+
+/// The spacing of floats of `bits` mantissa bits at `x` (s): 2^-(bits-1) of the power of two
+/// at or below |x|; 0 at 0.
+fn float_spacing(x: f64, bits: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return 0.0;
+    }
+    let e = ((x.abs().to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi(e - (bits - 1))
+}
+
+/// Times held as floats of one type, from a capture whose times span magnitudes where the
+/// float's spacing differs (from [`FloatValues`]).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FloatTimes {
+    /// `f32` or `f64`.
+    pub float: &'static str,
+    /// Mantissa bits, the leading one included: the spacing at a time is 2^-(bits-1) of the
+    /// power of two at or below it.
+    pub bits: i32,
+    /// The smallest magnitude of the transitions' times, s, as the file writes them (before
+    /// whole seconds are counted off).
+    pub from: f64,
+    /// The largest.
+    pub to: f64,
+    /// The float's spacing at `from`, s.
+    pub spacing_from: f64,
+    /// The float's spacing at `to`, s.
+    pub spacing_to: f64,
+    /// The coarsest precision the times are written to, s.
+    pub written_to: f64,
+    /// The finest.
+    pub finest_written: f64,
+}
+
+impl FloatTimes {
+    /// The resolution of a time of magnitude up to `at` s (as written): the float's spacing
+    /// there (the float rounds the instant to its nearest value), and the digits' rounding:
+    /// their precision, where times are written to fixed decimals, but no more than the
+    /// spacing where they are written as the shortest decimal that reads back as the float.
+    pub fn resolution(&self, at: f64) -> f64 {
+        let spacing = float_spacing(at, self.bits);
+        spacing + self.written_to.min(spacing.max(self.finest_written))
+    }
+}
+
+/// Whether every transition's time, as written, is a value of f32 (or f64) at its own
+/// magnitude, to the precision it is written to: the test [`FloatGrid`] makes, with the grid
+/// the float's spacing at each time rather than one for the file (an f32 near 0.001 s
+/// resolves 1.2e-10 s, near 0.1 s 7.5e-9 s, near 1 s 1.2e-7 s). A time tells its float when
+/// written to a quarter of the spacing or finer; [`GRID_ROWS`] such rows are needed.
+#[derive(Default)]
+struct FloatValues {
+    /// Per float of [`FLOAT_BITS`]: a time off its values, and rows that tell it.
+    dead: [bool; FLOAT_BITS.len()],
+    telling: [u64; FLOAT_BITS.len()],
+    /// Smallest and largest magnitude of the times, s (as written).
+    from: f64,
+    to: f64,
+    written_to: f64,
+    finest_written: f64,
+    rows: u64,
+}
+
+impl FloatValues {
+    /// A transition at `t` s counted from `origin` whole seconds, written to `precision` s.
+    fn row(&mut self, t: f64, precision: f64, origin: i64) {
+        let at = (origin as f64 + t).abs();
+        if self.rows == 0 {
+            (self.from, self.to, self.finest_written) = (at, at, precision);
+        }
+        self.rows += 1;
+        self.from = self.from.min(at);
+        self.to = self.to.max(at);
+        self.written_to = self.written_to.max(precision);
+        self.finest_written = self.finest_written.min(precision);
+        let tol = written_tolerance(t, precision);
+        for (i, &(bits, _)) in FLOAT_BITS.iter().enumerate() {
+            if self.dead[i] || at == 0.0 {
+                continue;
+            }
+            let spacing = float_spacing(at, bits);
+            // Whole seconds (and the origin, a whole number) lie on every spacing up to 1 s.
+            if !(spacing > 0.0 && spacing <= 1.0) {
+                self.dead[i] = true;
+                continue;
+            }
+            let x = t / spacing;
+            if (x - x.round()).abs() > tol / spacing {
+                self.dead[i] = true;
+                continue;
+            }
+            if 4.0 * tol <= spacing {
+                self.telling[i] += 1;
+            }
+        }
+    }
+
+    /// The narrowest float every time is a value of, when [`GRID_ROWS`] rows tell it.
+    fn found(&self) -> Option<FloatTimes> {
+        let i = (0..FLOAT_BITS.len()).find(|&i| !self.dead[i] && self.telling[i] >= GRID_ROWS)?;
+        let (bits, float) = FLOAT_BITS[i];
+        Some(FloatTimes {
+            float,
+            bits,
+            from: self.from,
+            to: self.to,
+            spacing_from: float_spacing(self.from, bits),
+            spacing_to: float_spacing(self.to, bits),
+            written_to: self.written_to,
+            finest_written: self.finest_written,
+        })
+    }
+}
+
 /// Rows a block of [`Resolution`] holds: few enough to follow a resolution that changes along
 /// the file, enough that times on a fine grid practically never share a coarser step by chance
 /// (31 offsets all even: 1 in 2·10⁹; with 16 rows, 1 in 32 768 blocks, and a capture of 10
@@ -3621,12 +3767,17 @@ pub fn text(r: &AnalyzeReport) -> String {
                     1.0 + r.timer_hz * g
                 );
             }
-            None if r.float_grid.is_some() => {
+            None if r.float_grid.is_some() || r.float_times.is_some() => {
                 let _ = writeln!(
                     s,
                     "sampling: rate not stated (give --sample-rate); the floor below includes \
-                     the times' float grid (below), and a capture sampled more slowly still \
-                     resolves δ less finely"
+                     the times' float {} (below), and a capture sampled more slowly still \
+                     resolves δ less finely",
+                    if r.float_grid.is_some() {
+                        "grid"
+                    } else {
+                        "spacing"
+                    }
                 );
             }
             None => {
@@ -3665,6 +3816,31 @@ pub fn text(r: &AnalyzeReport) -> String {
                     .to_string(),
             },
             f.resolution
+        );
+    }
+    if let Some(f) = &r.float_times {
+        let kind = if f.float == "f64" {
+            "64-bit float (f64)"
+        } else {
+            "32-bit float (f32)"
+        };
+        let _ = writeln!(
+            s,
+            "times: every transition's time, as written to {:.0e} s, is a {kind} value: they \
+             were held as {} before they were written, and each is off its instant by up to \
+             half the float's spacing at it, 2^-{} of the power of two at or below it: {:.3e} s at {:.6} s to \
+             {:.3e} s ({:.3} timer ticks) at {:.6} s, so no one grid holds them; each window's \
+             floor includes the spacing at its latest time and the digits' rounding (up to \
+             {:.3e} s)",
+            f.written_to,
+            f.float,
+            f.bits - 1,
+            f.spacing_from,
+            f.from,
+            f.spacing_to,
+            f.spacing_to * r.timer_hz,
+            f.to,
+            f.resolution(f.to)
         );
     }
     if let Some((worst, from)) = r.coarser_times {
