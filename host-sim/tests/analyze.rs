@@ -5074,6 +5074,52 @@ fn a_sub_multiple_of_a_listed_rate_gets_its_own_period() {
     );
 }
 
+/// Rates of 3 MHz and faster written to seven decimals (Logic 2 at a coarser precision, a
+/// period of 333.33 ns written as steps of 0.0000003 and 0.0000004 s) lie on the digits' own
+/// 100 ns. 3 MHz is still told from its rows (each within 100 ns of its grid has odds 0.6 by
+/// chance, so it takes 87 rows, not 64): its period and the digits' rounding are the
+/// resolution. 6 MHz fits every such time (within 83 ns of its grid), so the rows cannot tell
+/// it, nor anything faster: the floor takes the digits' step and 6 MHz's period. A steady
+/// shaft's δ had read 1.8 times the floor (3 MHz) and 1.3 times it (6 MHz), resolved.
+#[test]
+fn rates_the_digits_cannot_show_are_kept_under_the_floor() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.25);
+    let seven = |t: f64| format!("{t:.7}");
+    for rate in [3e6, 6e6, 12e6, 24e6] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", seven);
+        let report = analyze_text(text, "seven.csv", 360, 1);
+        let what = format!("{rate} Hz at seven decimals");
+        none_resolved(&report, &what);
+        if rate == 3e6 {
+            grid_is(&report, 1.0 / 3e6, &what);
+            assert!(report.digits_grid.is_none(), "{what}");
+            let w = report.windows.iter().find(|w| w.valid).unwrap();
+            assert_eq!(w.time_resolution, Some(1.0 / 3e6 + 1e-7), "{what}");
+        } else {
+            grid_is(&report, 1e-7, &what);
+            let d = report.digits_grid.expect("the digits' grid");
+            assert_eq!(d.hidden_rate, Some(6e6), "{what}");
+            assert!(
+                (d.resolution - (1e-7 + 1.0 / 6e6)).abs() < 1e-15,
+                "{what}: {d:?}"
+            );
+            let said = host_sim::app::analyze::text(&report);
+            assert!(
+                said.contains("the precision the times are written to: the digits' own step")
+                    && said.contains("a 6000000 Hz analyser's 1.667e-7 s fits every row"),
+                "{said}"
+            );
+        }
+    }
+    // A 1 MHz capture at seven decimals shows its own 1 µs: no digits' grid.
+    let rows = on_grid(&rising, 1e6, 0.0);
+    let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", seven);
+    let report = analyze_text(text, "1mhz.csv", 360, 1);
+    grid_is(&report, 1e-6, "1 MHz at seven decimals");
+    assert!(report.digits_grid.is_none());
+}
+
 /// Times held as floats before they were written lie on the float's power-of-two grid: Unix
 /// times in an f64 printed to nine decimals, 2^-22 s (0.24 µs) apart near 1.76e9 s, or an
 /// f32's at 5 s, 2^-21 s. That grid is their resolution (a steady shaft's δ 0.0043 had read
