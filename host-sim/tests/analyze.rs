@@ -5184,6 +5184,44 @@ fn times_held_as_floats_are_resolved_to_the_float_grid() {
     }
 }
 
+/// Saleae Logic 2 can export absolute times as ISO-8601 date-times
+/// (`2026-11-28T05:00:00.000623599+00:00`): read exactly, counted from the first time's whole
+/// seconds (Unix seconds), they give the windows the same rows written as decimal Unix times
+/// give, whatever the zone offset written; they had been refused as "not a time in seconds".
+#[test]
+fn iso_8601_times_read_as_the_unix_times_they_are() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    let rows: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 1e-5, 0)])
+        .collect();
+    let ns = |t: f64| (t * 1e9).round() as u64;
+    let header = "Time [s],Channel 0";
+    let unix = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("1795842000.{:09}", ns(t))
+    });
+    let utc = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("2026-11-28T05:00:00.{:09}+00:00", ns(t))
+    });
+    let paris = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("2026-11-28T06:00:00.{:09}+01:00", ns(t))
+    });
+    let want = analyze_text(unix, "unix.csv", 360, 1);
+    assert_eq!(want.time_origin, 1_795_842_000);
+    let windows = |r: &AnalyzeReport| {
+        r.windows
+            .iter()
+            .map(|w| (w.start, w.valid, w.delta, w.floor_with_sampling))
+            .collect::<Vec<_>>()
+    };
+    assert!(want.valid_windows >= 3);
+    for (name, text) in [("utc.csv", utc), ("paris.csv", paris)] {
+        let got = analyze_text(text, name, 360, 1);
+        assert_eq!(got.time_origin, want.time_origin, "{name}");
+        assert_eq!(windows(&got), windows(&want), "{name}");
+    }
+}
+
 /// Times held as f32 from near 0 s lie on no one grid: the float's spacing grows with the
 /// time (1.2e-10 s at 0.001 s, 1.2e-7 s past 1 s). Each window's floor takes the spacing at its
 /// own times, and a steady shaft's δ (the f32 rounding's alone) is within it; with the timer's
