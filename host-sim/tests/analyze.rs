@@ -5113,6 +5113,52 @@ fn a_sub_multiple_of_a_listed_rate_gets_its_own_period() {
     );
 }
 
+/// Rates of 3 MHz and faster written to seven decimals (Logic 2 at a coarser precision, a
+/// period of 333.33 ns written as steps of 0.0000003 and 0.0000004 s) lie on the digits' own
+/// 100 ns. 3 MHz is still told from its rows (each within 100 ns of its grid has odds 0.6 by
+/// chance, so it takes 87 rows, not 64): its period and the digits' rounding are the
+/// resolution. 6 MHz fits every such time (within 83 ns of its grid), so the rows cannot tell
+/// it, nor anything faster: the floor takes the digits' step and 6 MHz's period. A steady
+/// shaft's δ had read 1.8 times the floor (3 MHz) and 1.3 times it (6 MHz), resolved.
+#[test]
+fn rates_the_digits_cannot_show_are_kept_under_the_floor() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.25);
+    let seven = |t: f64| format!("{t:.7}");
+    for rate in [3e6, 6e6, 12e6, 24e6] {
+        let rows = on_grid(&rising, rate, 0.0);
+        let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", seven);
+        let report = analyze_text(text, "seven.csv", 360, 1);
+        let what = format!("{rate} Hz at seven decimals");
+        none_resolved(&report, &what);
+        if rate == 3e6 {
+            grid_is(&report, 1.0 / 3e6, &what);
+            assert!(report.digits_grid.is_none(), "{what}");
+            let w = report.windows.iter().find(|w| w.valid).unwrap();
+            assert_eq!(w.time_resolution, Some(1.0 / 3e6 + 1e-7), "{what}");
+        } else {
+            grid_is(&report, 1e-7, &what);
+            let d = report.digits_grid.expect("the digits' grid");
+            assert_eq!(d.hidden_rate, Some(6e6), "{what}");
+            assert!(
+                (d.resolution - (1e-7 + 1.0 / 6e6)).abs() < 1e-15,
+                "{what}: {d:?}"
+            );
+            let said = host_sim::app::analyze::text(&report);
+            assert!(
+                said.contains("the precision the times are written to: the digits' own step")
+                    && said.contains("a 6000000 Hz analyser's 1.667e-7 s fits every row"),
+                "{said}"
+            );
+        }
+    }
+    // A 1 MHz capture at seven decimals shows its own 1 µs: no digits' grid.
+    let rows = on_grid(&rising, 1e6, 0.0);
+    let text = csv_of("Time [s],Channel 0", Some(0.0), &rows, ",", seven);
+    let report = analyze_text(text, "1mhz.csv", 360, 1);
+    grid_is(&report, 1e-6, "1 MHz at seven decimals");
+    assert!(report.digits_grid.is_none());
+}
+
 /// Times held as floats before they were written lie on the float's power-of-two grid: Unix
 /// times in an f64 printed to nine decimals, 2^-22 s (0.24 µs) apart near 1.76e9 s, or an
 /// f32's at 5 s, 2^-21 s. That grid is their resolution (a steady shaft's δ 0.0043 had read
@@ -5175,6 +5221,76 @@ fn times_held_as_floats_are_resolved_to_the_float_grid() {
             report.float_grid
         );
     }
+}
+
+/// Saleae Logic 2 can export absolute times as ISO-8601 date-times
+/// (`2026-11-28T05:00:00.000623599+00:00`): read exactly, counted from the first time's whole
+/// seconds (Unix seconds), they give the windows the same rows written as decimal Unix times
+/// give, whatever the zone offset written; they had been refused as "not a time in seconds".
+#[test]
+fn iso_8601_times_read_as_the_unix_times_they_are() {
+    let rising = steady_disc(360, 300.0, 0.001, 0.2);
+    let rows: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 1e-5, 0)])
+        .collect();
+    let ns = |t: f64| (t * 1e9).round() as u64;
+    let header = "Time [s],Channel 0";
+    let unix = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("1795842000.{:09}", ns(t))
+    });
+    let utc = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("2026-11-28T05:00:00.{:09}+00:00", ns(t))
+    });
+    let paris = csv_of(header, Some(0.0), &rows, ",", |t| {
+        format!("2026-11-28T06:00:00.{:09}+01:00", ns(t))
+    });
+    let want = analyze_text(unix, "unix.csv", 360, 1);
+    assert_eq!(want.time_origin, 1_795_842_000);
+    let windows = |r: &AnalyzeReport| {
+        r.windows
+            .iter()
+            .map(|w| (w.start, w.valid, w.delta, w.floor_with_sampling))
+            .collect::<Vec<_>>()
+    };
+    assert!(want.valid_windows >= 3);
+    for (name, text) in [("utc.csv", utc), ("paris.csv", paris)] {
+        let got = analyze_text(text, name, 360, 1);
+        assert_eq!(got.time_origin, want.time_origin, "{name}");
+        assert_eq!(windows(&got), windows(&want), "{name}");
+    }
+}
+
+/// Times held as f32 from near 0 s lie on no one grid: the float's spacing grows with the
+/// time (1.2e-10 s at 0.001 s, 1.2e-7 s past 1 s). Each window's floor takes the spacing at its
+/// own times, and a steady shaft's δ (the f32 rounding's alone) is within it; with the timer's
+/// floor alone 84 of 93 windows (every one past 0.1 s) had read as resolved, at up to 5.5 times
+/// it. The same instants written exactly are no float's values.
+#[test]
+fn f32_times_from_zero_take_the_spacing_at_each_window() {
+    let rising = steady_disc(60, 300.0, 0.001, 2.0);
+    let rows: Vec<(f64, u8)> = rising
+        .iter()
+        .flat_map(|&t| [(t, 1), (t + 0.5 * std::f64::consts::TAU / 60.0 / 300.0, 0)])
+        .collect();
+    let header = "Time [s],Channel 0";
+    let f32s = csv_of(header, None, &rows, ",", |t| format!("{:.9}", t as f32));
+    let report = analyze_text(f32s, "f32.csv", 60, 1);
+    let f = report.float_times.expect("f32 times");
+    assert_eq!((f.float, f.spacing_to), ("f32", 2f64.powi(-23)), "{f:?}");
+    assert!(report.float_grid.is_none() && report.time_grid.is_none());
+    none_resolved(&report, "f32 times from 0 s");
+    // The floor follows the spacing: a window past 1 s takes 2^-23 s and the digits' 1 ns.
+    let late = report.windows.iter().rev().find(|w| w.valid).unwrap();
+    assert_eq!(late.time_resolution, Some(2f64.powi(-23) + 1e-9));
+    let said = host_sim::app::analyze::text(&report);
+    assert!(
+        said.contains("is a 32-bit float (f32) value") && said.contains("float spacing (below)"),
+        "{said}"
+    );
+    let exact = csv_of(header, None, &rows, ",", |t| format!("{t:.9}"));
+    let report = analyze_text(exact, "exact.csv", 60, 1);
+    assert!(report.float_times.is_none(), "{:?}", report.float_times);
 }
 
 /// libsigrok writes the time column in the unit its sample rate calls for: a `; Samplerate:

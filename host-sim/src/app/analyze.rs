@@ -557,6 +557,20 @@ pub struct AnalyzeReport {
     /// near a Unix time resolves 2^-22 s), and the floor includes that grid.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub float_grid: Option<FloatSpacing>,
+    /// When every transition's time, as written, is a value of one float type at its own
+    /// magnitude (an f32 resolves 2^-24 of it) and the times span magnitudes where that
+    /// spacing differs, so no one grid holds them (f32 times from 0 s): each window's floor
+    /// includes the spacing at its latest time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub float_times: Option<FloatTimes>,
+    /// The resolution of the times the floor takes from the file as a whole, s: the sample
+    /// period (stated, or the grid found) with the digits' rounding of each time, or the
+    /// grid of the floats the times were held in (before each window's own rows).
+    pub sampling_resolution: Option<f64>,
+    /// When `time_grid` is the precision the times are written to: what sampling it may
+    /// hide, and the resolution the floor takes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub digits_grid: Option<DigitsGrid>,
     /// What the configuration leaves out, each a WARNING ([`AnalyzeConfig::warnings`]).
     pub warnings: Vec<String>,
     /// The unit the file's times are read in (`s`, `ms`, `us`, `ns`: its header's, or
@@ -1968,6 +1982,11 @@ pub fn analyze<R: BufRead>(
     let mut grid = TimeGrid::default();
     let mut rate_grid = RateGrid::default();
     let mut float_grid = FloatGrid::default();
+    let mut float_values = FloatValues::default();
+    // The finest precision a transition's time is written to, s: the digits' rounding of
+    // every time where they are written to fixed decimals (and no more where a time printed
+    // as its shortest decimal ends early).
+    let mut written_finest = f64::INFINITY;
     let mut resolution = Resolution {
         hz: cfg.encoder.timer_hz,
         ..Resolution::default()
@@ -2046,6 +2065,8 @@ pub fn analyze<R: BufRead>(
                 rate_grid.row(t, precision);
             }
             float_grid.row(t, precision);
+            float_values.row(t, precision, reader.time_origin());
+            written_finest = written_finest.min(precision);
         }
         // (Every row to the resolution of the blocks: a row off the grid only makes a block's
         // step finer, and the floor never takes a block's finer than the grid above.)
@@ -2389,15 +2410,57 @@ pub fn analyze<R: BufRead>(
     report.float_grid = float_grid
         .step()
         .map(|(e, at, written)| FloatSpacing::of(e, at, written, report.time_origin));
+    // Float values whose spacing grows over the capture (f32 times from 0 s) lie on no grid
+    // coarser than their first spacing; each window takes the spacing at its own times. (Where
+    // one grid holds them all, the float grid above says it.)
+    report.float_times = float_values.found().filter(|f| {
+        report
+            .float_grid
+            .as_ref()
+            .is_none_or(|g| f.spacing_to > g.step)
+    });
+    if let Some(f) = &report.float_times {
+        report.float_grid = None;
+        // A grid of the rows finer than the floats' largest spacing is the digits' own.
+        if report.time_grid.is_some_and(|g| g < f.spacing_to) {
+            (report.time_grid, report.grid_of_rate) = (None, None);
+        }
+    }
+    // A grid that is the digits' own step (times written to 100 ns lie on 100 ns whatever
+    // sampled them) shows no sampling: one finer than the step lies hidden under it, and so
+    // does a listed rate's whose period the digits cannot tell (6 MHz's 166.7 ns: every time
+    // written to 100 ns lies within 50 ns of a point of it). The floor takes the digits'
+    // rounding and the longest such period, else one more step.
+    if let Some(g) = report.time_grid.filter(|_| report.grid_of_rate.is_none()) {
+        let written = rate_grid.coarsest;
+        if written > 0.0 && (g / written - 1.0).abs() < 1e-6 {
+            let hidden_rate = rate_grid.slowest_fitting().filter(|r| 1.0 / r > g);
+            report.digits_grid = Some(DigitsGrid {
+                step: g,
+                hidden_rate,
+                resolution: g + hidden_rate.map_or(g, |r| 1.0 / r),
+            });
+        }
+    }
+    // The grid's resolution: a listed rate's period, to the digits' rounding of each time.
+    let grid_resolution = match (&report.digits_grid, &report.grid_of_rate) {
+        (Some(d), _) => Some(d.resolution),
+        (None, Some(_)) => report
+            .time_grid
+            .map(|g| g + digits_rounding(g, written_finest)),
+        (None, None) => report.time_grid,
+    };
     // Each window's floor takes the file's sampling, or the resolution of its own rows where
     // that is coarser (a time is known to no better than either), and the grid of the floats
     // the times were held in where that is coarser still.
+    // (A stated rate's period, too, with the digits' rounding of each time.)
     let file_step = report
         .sample_rate
-        .map(|r| 1.0 / r)
-        .or(report.time_grid)
+        .map(|r| 1.0 / r + digits_rounding(1.0 / r, written_finest))
+        .or(grid_resolution)
         .unwrap_or(0.0)
         .max(report.float_grid.as_ref().map_or(0.0, |f| f.resolution));
+    report.sampling_resolution = (file_step > 0.0).then_some(file_step);
     let tick = 1.0 / cfg.encoder.timer_hz;
     for w in &mut report.windows {
         let local = resolution.over(w.start, w.end);
@@ -2406,6 +2469,11 @@ pub fn analyze<R: BufRead>(
         } else {
             file_step
         };
+        let origin = report.time_origin as f64;
+        let res = report.float_times.map_or(res, |f| {
+            let at = (origin + w.start).abs().max((origin + w.end).abs());
+            res.max(f.resolution(at))
+        });
         if res > 0.0 {
             w.time_resolution = Some(res);
             w.floor_with_sampling = w.noise_floor.map(|f| f * (1.0 + res / tick));
@@ -2873,8 +2941,11 @@ struct RateGrid {
     first: Option<(f64, f64)>,
     dead: [bool; ODD_RATES.len()],
     multiple: [u64; ODD_RATES.len()],
-    /// Transitions written finely enough to tell the grid.
-    telling: [u64; ODD_RATES.len()],
+    /// What the transitions tell of the grid, in bits: a time within `tol` of the grid by
+    /// chance has odds `2·tol/period`, and each counts `log2(period/(2·tol))`, at most 1 (a
+    /// time written to a quarter of the period or finer counts 1; one written to 1e-7 s of a
+    /// 3 MHz grid, 0.74; one whose tolerance spans half the period or more, nothing).
+    telling: [f64; ODD_RATES.len()],
     coarsest: f64,
 }
 
@@ -2900,8 +2971,8 @@ impl RateGrid {
                 self.dead[i] = true;
                 continue;
             }
-            if 4.0 * tol <= period {
-                self.telling[i] += 1;
+            if 2.0 * tol < period {
+                self.telling[i] += (period / (2.0 * tol)).log2().min(1.0);
             }
             if self.multiple[i] != 1 {
                 self.multiple[i] = gcd(self.multiple[i], k as u64);
@@ -2909,11 +2980,13 @@ impl RateGrid {
         }
     }
 
-    /// The longest step every transition lies on, of the rates alive after [`GRID_ROWS`]
-    /// transitions that tell their grid.
+    /// The longest step every transition lies on, of the rates alive once the transitions
+    /// tell their grid by [`GRID_ROWS`] bits.
     fn step(&self) -> Option<RateGridFound> {
         (0..ODD_RATES.len())
-            .filter(|&i| !self.dead[i] && self.telling[i] >= GRID_ROWS && self.multiple[i] > 0)
+            .filter(|&i| {
+                !self.dead[i] && self.telling[i] >= GRID_ROWS as f64 && self.multiple[i] > 0
+            })
             .map(|i| RateGridFound {
                 period: self.multiple[i] as f64 / ODD_RATES[i],
                 rate: ODD_RATES[i],
@@ -2930,6 +3003,46 @@ impl RateGrid {
                 }
             })
     }
+}
+
+impl RateGrid {
+    /// The slowest of [`ODD_RATES`] every transition lies on, told or not: a grid of one the
+    /// digits cannot tell (6 MHz's 166.7 ns in times written to 100 ns) may have sampled
+    /// them.
+    fn slowest_fitting(&self) -> Option<f64> {
+        (0..ODD_RATES.len())
+            .filter(|&i| self.first.is_some() && !self.dead[i])
+            .map(|i| ODD_RATES[i])
+            .reduce(f64::min)
+    }
+}
+
+/// What rounding to `written` s adds to a time known to a sample `period` (s): the
+/// precision, up to one period, where the period is no whole number of it (333.33 ns written
+/// to 100 ns; a period of 20 ns written to 1 ns, or a dump's samples in its time unit, are
+/// exact), and none where it is below a thousandth of the period.
+fn digits_rounding(period: f64, written: f64) -> f64 {
+    let n = period / written;
+    if !(written > 0.0 && written.is_finite() && n < 1e3) || (n - n.round()).abs() < 1e-6 * n {
+        0.0
+    } else {
+        written.min(period)
+    }
+}
+
+/// A grid of the rows that is the precision their times are written to (100 ns at seven
+/// decimals): the digits' own step, under which any sampling finer than it, and that of a rate
+/// the digits cannot tell, lies hidden (a 6 MHz capture written to 100 ns).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct DigitsGrid {
+    /// The step, s: the grid the rows show and the precision they are written to.
+    pub step: f64,
+    /// The slowest analyser rate of [`ODD_RATES`] every transition fits, when its period is
+    /// longer than the step, Hz.
+    pub hidden_rate: Option<f64>,
+    /// The resolution taken for the floor, s: the digits' rounding (the step) and a sampling
+    /// hidden under them (that rate's period, else up to one step).
+    pub resolution: f64,
 }
 
 /// A power-of-two grid of seconds that every transition's time lies on, coarser than the
@@ -3042,6 +3155,123 @@ impl FloatGrid {
         let from = self.from;
         let told: u64 = self.telling.get(from..)?.iter().sum();
         (told >= GRID_ROWS).then_some((from as i32, self.first?, self.coarsest))
+    }
+}
+
+/// Mantissa bits (the leading one included) of the floats [`FloatValues`] tests: f32, f64.
+const FLOAT_BITS: [(i32, &str); 2] = [(24, "f32"), (53, "f64")];
+
+/// The spacing of floats of `bits` mantissa bits at `x` (s): 2^-(bits-1) of the power of two
+/// at or below |x|; 0 at 0.
+fn float_spacing(x: f64, bits: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return 0.0;
+    }
+    let e = ((x.abs().to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    2f64.powi(e - (bits - 1))
+}
+
+/// Times held as floats of one type, from a capture whose times span magnitudes where the
+/// float's spacing differs (from [`FloatValues`]).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FloatTimes {
+    /// `f32` or `f64`.
+    pub float: &'static str,
+    /// Mantissa bits, the leading one included: the spacing at a time is 2^-(bits-1) of the
+    /// power of two at or below it.
+    pub bits: i32,
+    /// The smallest magnitude of the transitions' times, s, as the file writes them (before
+    /// whole seconds are counted off).
+    pub from: f64,
+    /// The largest.
+    pub to: f64,
+    /// The float's spacing at `from`, s.
+    pub spacing_from: f64,
+    /// The float's spacing at `to`, s.
+    pub spacing_to: f64,
+    /// The coarsest precision the times are written to, s.
+    pub written_to: f64,
+    /// The finest.
+    pub finest_written: f64,
+}
+
+impl FloatTimes {
+    /// The resolution of a time of magnitude up to `at` s (as written): the float's spacing
+    /// there (the float rounds the instant to its nearest value), and the digits' rounding:
+    /// their precision, where times are written to fixed decimals, but no more than the
+    /// spacing where they are written as the shortest decimal that reads back as the float.
+    pub fn resolution(&self, at: f64) -> f64 {
+        let spacing = float_spacing(at, self.bits);
+        spacing + self.written_to.min(spacing.max(self.finest_written))
+    }
+}
+
+/// Whether every transition's time, as written, is a value of f32 (or f64) at its own
+/// magnitude, to the precision it is written to: the test [`FloatGrid`] makes, with the grid
+/// the float's spacing at each time rather than one for the file (an f32 near 0.001 s
+/// resolves 1.2e-10 s, near 0.1 s 7.5e-9 s, near 1 s 1.2e-7 s). A time tells its float when
+/// written to a quarter of the spacing or finer; [`GRID_ROWS`] such rows are needed.
+#[derive(Default)]
+struct FloatValues {
+    /// Per float of [`FLOAT_BITS`]: a time off its values, and rows that tell it.
+    dead: [bool; FLOAT_BITS.len()],
+    telling: [u64; FLOAT_BITS.len()],
+    /// Smallest and largest magnitude of the times, s (as written).
+    from: f64,
+    to: f64,
+    written_to: f64,
+    finest_written: f64,
+    rows: u64,
+}
+
+impl FloatValues {
+    /// A transition at `t` s counted from `origin` whole seconds, written to `precision` s.
+    fn row(&mut self, t: f64, precision: f64, origin: i64) {
+        let at = (origin as f64 + t).abs();
+        if self.rows == 0 {
+            (self.from, self.to, self.finest_written) = (at, at, precision);
+        }
+        self.rows += 1;
+        self.from = self.from.min(at);
+        self.to = self.to.max(at);
+        self.written_to = self.written_to.max(precision);
+        self.finest_written = self.finest_written.min(precision);
+        let tol = written_tolerance(t, precision);
+        for (i, &(bits, _)) in FLOAT_BITS.iter().enumerate() {
+            if self.dead[i] || at == 0.0 {
+                continue;
+            }
+            let spacing = float_spacing(at, bits);
+            // Whole seconds (and the origin, a whole number) lie on every spacing up to 1 s.
+            if !(spacing > 0.0 && spacing <= 1.0) {
+                self.dead[i] = true;
+                continue;
+            }
+            let x = t / spacing;
+            if (x - x.round()).abs() > tol / spacing {
+                self.dead[i] = true;
+                continue;
+            }
+            if 4.0 * tol <= spacing {
+                self.telling[i] += 1;
+            }
+        }
+    }
+
+    /// The narrowest float every time is a value of, when [`GRID_ROWS`] rows tell it.
+    fn found(&self) -> Option<FloatTimes> {
+        let i = (0..FLOAT_BITS.len()).find(|&i| !self.dead[i] && self.telling[i] >= GRID_ROWS)?;
+        let (bits, float) = FLOAT_BITS[i];
+        Some(FloatTimes {
+            float,
+            bits,
+            from: self.from,
+            to: self.to,
+            spacing_from: float_spacing(self.from, bits),
+            spacing_to: float_spacing(self.to, bits),
+            written_to: self.written_to,
+            finest_written: self.finest_written,
+        })
     }
 }
 
@@ -3579,22 +3809,58 @@ pub fn text(r: &AnalyzeReport) -> String {
     }
     match r.sample_rate {
         Some(rate) => {
+            let known = r.sampling_resolution.unwrap_or(1.0 / rate);
             let _ = writeln!(
                 s,
-                "sampling: {rate} Hz (a time known to {:.3e} s, {:.3} timer ticks): the floor \
-                 below includes it, {:.3} times the timer's alone",
-                1.0 / rate,
-                r.timer_hz / rate,
-                1.0 + r.timer_hz / rate
+                "sampling: {rate} Hz (a time known to {:.3e} s, {:.3} timer ticks{}): the \
+                 floor below includes it, {:.3} times the timer's alone",
+                known,
+                r.timer_hz * known,
+                if known >= 1.01 / rate {
+                    ", the period and the digits' rounding"
+                } else {
+                    ""
+                },
+                1.0 + r.timer_hz * known
             );
         }
         None => match r.time_grid {
+            Some(g) if r.digits_grid.is_some() => {
+                let d = r.digits_grid.unwrap_or(DigitsGrid {
+                    step: g,
+                    hidden_rate: None,
+                    resolution: 2.0 * g,
+                });
+                let _ = writeln!(
+                    s,
+                    "sampling: rate not stated; every transition's time lies on a {g:.3e} s grid \
+                     ({:.3} timer ticks), the precision the times are written to: the digits' \
+                     own step, which shows no sample period: {}, so the floor below takes their \
+                     resolution as {:.3e} s (the digits' rounding and that period, {:.3} timer \
+                     ticks), {:.3} times the timer's alone (give --sample-rate to state the \
+                     rate, or export the times to more decimals)",
+                    r.timer_hz * g,
+                    match d.hidden_rate {
+                        Some(rate) => format!(
+                            "a {rate:.0} Hz analyser's {:.3e} s fits every row (the digits \
+                             cannot tell its grid), and so does any finer",
+                            1.0 / rate
+                        ),
+                        None => "an analyser's period up to the step fits every row, hidden \
+                                 under the digits"
+                            .to_string(),
+                    },
+                    d.resolution,
+                    r.timer_hz * d.resolution,
+                    1.0 + r.timer_hz * d.resolution
+                );
+            }
             Some(g) => {
                 let _ = writeln!(
                     s,
                     "sampling: rate not stated; every transition's time lies on a {g:.3e} s \
                      grid{} ({:.3} timer ticks): the longest step the rows show, which the floor \
-                     below takes as their resolution, {:.3} times the timer's alone; no sample \
+                     below takes as their resolution{}, {:.3} times the timer's alone; no sample \
                      period is stated: the analyser's is this step or a whole fraction of it \
                      (where the transitions fell on every other sample, or every k-th, only), \
                      which the rows cannot tell, and a finer one would only narrow the floor \
@@ -3622,15 +3888,25 @@ pub fn text(r: &AnalyzeReport) -> String {
                         None => String::new(),
                     },
                     r.timer_hz * g,
-                    1.0 + r.timer_hz * g
+                    match r.sampling_resolution {
+                        Some(res) if res >= 1.01 * g =>
+                            format!(" with the digits' rounding ({res:.3e} s in all)"),
+                        _ => String::new(),
+                    },
+                    1.0 + r.timer_hz * r.sampling_resolution.unwrap_or(g)
                 );
             }
-            None if r.float_grid.is_some() => {
+            None if r.float_grid.is_some() || r.float_times.is_some() => {
                 let _ = writeln!(
                     s,
                     "sampling: rate not stated (give --sample-rate); the floor below includes \
-                     the times' float grid (below), and a capture sampled more slowly still \
-                     resolves δ less finely"
+                     the times' float {} (below), and a capture sampled more slowly still \
+                     resolves δ less finely",
+                    if r.float_grid.is_some() {
+                        "grid"
+                    } else {
+                        "spacing"
+                    }
                 );
             }
             None => {
@@ -3669,6 +3945,31 @@ pub fn text(r: &AnalyzeReport) -> String {
                     .to_string(),
             },
             f.resolution
+        );
+    }
+    if let Some(f) = &r.float_times {
+        let kind = if f.float == "f64" {
+            "64-bit float (f64)"
+        } else {
+            "32-bit float (f32)"
+        };
+        let _ = writeln!(
+            s,
+            "times: every transition's time, as written to {:.0e} s, is a {kind} value: they \
+             were held as {} before they were written, and each is off its instant by up to \
+             half the float's spacing at it, 2^-{} of the power of two at or below it: {:.3e} s at {:.6} s to \
+             {:.3e} s ({:.3} timer ticks) at {:.6} s, so no one grid holds them; each window's \
+             floor includes the spacing at its latest time and the digits' rounding (up to \
+             {:.3e} s)",
+            f.written_to,
+            f.float,
+            f.bits - 1,
+            f.spacing_from,
+            f.from,
+            f.spacing_to,
+            f.spacing_to * r.timer_hz,
+            f.to,
+            f.resolution(f.to)
         );
     }
     if let Some((worst, from)) = r.coarser_times {

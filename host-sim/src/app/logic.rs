@@ -554,6 +554,74 @@ fn decimal_attoseconds(text: &str) -> Option<i128> {
     Some(if negative { -atto } else { atto })
 }
 
+/// `text` as an ISO-8601 date and time, `YYYY-MM-DDTHH:MM:SS[.fraction][Z|±HH:MM]` (a space
+/// for the `T` too; no zone: UTC), in attoseconds from 1970-01-01T00:00:00Z, exactly (digits
+/// past the 18th decimal dropped), and the precision of its last decimal, s.
+fn iso8601_attoseconds(text: &str) -> Option<(i128, f64)> {
+    let b = text.as_bytes();
+    let num = |r: std::ops::Range<usize>| num_in(text, r);
+    if b.len() < 19 || b[4] != b'-' || b[7] != b'-' || !matches!(b[10], b'T' | b't' | b' ') {
+        return None;
+    }
+    if b[13] != b':' || b[16] != b':' {
+        return None;
+    }
+    let (y, mo, d) = (num(0..4)?, num(5..7)?, num(8..10)?);
+    let (h, mi, sec) = (num(11..13)?, num(14..16)?, num(17..19)?);
+    if !(1..=12).contains(&mo) || !(1..=31).contains(&d) || h > 23 || mi > 59 || sec > 60 {
+        return None;
+    }
+    let mut rest = &text[19..];
+    let (mut frac_atto, mut precision) = (0i128, 1.0);
+    if let Some(f) = rest.strip_prefix('.') {
+        let digits = f.bytes().take_while(u8::is_ascii_digit).count();
+        if digits == 0 {
+            return None;
+        }
+        let kept = &f[..digits.min(18)];
+        frac_atto = kept.parse::<i128>().ok()? * 10i128.pow(18 - kept.len() as u32);
+        precision = decimal_precision(&format!("0.{}", &f[..digits]));
+        rest = &f[digits..];
+    }
+    let offset = match rest {
+        "" | "Z" | "z" => 0,
+        _ => {
+            let r = rest.as_bytes();
+            let sign = match r.first()? {
+                b'+' => 1,
+                b'-' => -1,
+                _ => return None,
+            };
+            let (oh, om) = match r.len() {
+                6 if r[3] == b':' => (num_in(rest, 1..3)?, num_in(rest, 4..6)?),
+                5 => (num_in(rest, 1..3)?, num_in(rest, 3..5)?),
+                3 => (num_in(rest, 1..3)?, 0),
+                _ => return None,
+            };
+            sign * (oh * 3600 + om * 60)
+        }
+    };
+    // Days from 1970-01-01 of the proleptic Gregorian date (Howard Hinnant's days_from_civil).
+    let y = if mo <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let mp = (mo + 9) % 12;
+    let doy = (153 * mp + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    let days = era * 146_097 + doe - 719_468;
+    let seconds = days * 86_400 + h * 3600 + mi * 60 + sec - offset;
+    Some((i128::from(seconds) * ATTO + frac_atto, precision))
+}
+
+/// The whole number written at `r` of `text` (digits only).
+fn num_in(text: &str, r: std::ops::Range<usize>) -> Option<i64> {
+    let f = text.get(r)?;
+    if f.is_empty() || !f.bytes().all(|c| c.is_ascii_digit()) {
+        return None;
+    }
+    f.parse().ok()
+}
+
 /// The unit of the last digit `text` (a decimal time as [`decimal_attoseconds`] reads it)
 /// is written to, s: `0.001010250000000` 1e-15, `1.5e-3` 1e-4, `12` 1.
 fn decimal_precision(text: &str) -> f64 {
@@ -1594,6 +1662,14 @@ impl<R: BufRead> CaptureReader<R> {
                     TimeUnit::Us => "microseconds",
                     TimeUnit::Ns => "nanoseconds",
                 };
+                // An ISO-8601 date and time (Saleae Logic 2 exports absolute times so), in
+                // attoseconds from 1970 exactly, then counted from the first's whole seconds.
+                if let Some((atto, precision)) = iso8601_attoseconds(f) {
+                    if self.time_unit == TimeUnit::S {
+                        self.precision = precision;
+                        return Ok(self.seconds_from_atto(atto));
+                    }
+                }
                 let Some(atto) = decimal_attoseconds(f) else {
                     // Not a plain decimal: `inf`, `NaN`, or no number at all.
                     return Err(match f.parse::<f64>() {
