@@ -136,7 +136,11 @@ pub struct SupportsRunOut {
 pub struct RunReport {
     /// The scene file.
     pub scene: String,
-    /// Effects simulated, in assembly order.
+    /// How the shaft moves: "motor-driven" (integrated under `effects`' torques),
+    /// "prescribed" (`[motor]` model `speed`, `ramp` or `profile`, or the sweep's speed), or
+    /// "prescribed with a cranking ripple" (`[cranking]`, integrated as φ from ω(φ, t)).
+    pub shaft: &'static str,
+    /// Effects simulated, in assembly order (a prescribed shaft is none).
     pub effects: Vec<&'static str>,
     /// Integrator used.
     pub integrator: &'static str,
@@ -175,6 +179,12 @@ pub struct RunReport {
     /// The most δ those samples show over the load's phase against the teeth.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_predicted_through_samples_most: Option<f64>,
+    /// How the core's speed samples read the scene's `[cranking]` ripple (with an
+    /// `[encoder]`): a prescribed speed has no prediction to compare the measured δ with, so
+    /// the share of the ripple's own δ the samples show is given, and a WARNING under the δ
+    /// line where they read less than [`RIPPLE_READ_SHARE`] of it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cranking_ripple: Option<RippleRead>,
     /// Windows reported by the core.
     pub windows: u32,
     /// Of which invalid.
@@ -308,6 +318,140 @@ pub struct RunReport {
     /// δ limit (`[monitor] delta_limit`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_limit: Option<f64>,
+}
+
+/// How the core's speed samples read a `[cranking]` ripple ω̄·(1 + ripple·sin(strokes·φ +
+/// phase)) at a steady mean speed, by [`predict::sampled_delta_of`] (the machinery `predict`
+/// and `run` take the predicted δ through the samples with): each sample is the mean speed
+/// over `encoder.estimator_edges` edges and starts only at a tooth, so a ripple of a few
+/// cycles a revolution is averaged away or read between its peaks.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct RippleRead {
+    /// The ripple's own δ, 2·ripple (ω̄·(1 ± ripple): 2(ω_max − ω_min)/(ω_max + ω_min)).
+    pub delta: f64,
+    /// Its order, cycles a revolution (`cranking.strokes`).
+    pub order: f64,
+    /// Edges per speed sample (`encoder.estimator_edges`).
+    pub estimator_edges: u16,
+    /// δ the samples show with the teeth where the scene has them (the simulator's wheel,
+    /// tooth 0 at φ = 0): what the run measures, to the ripple's change of mean speed.
+    pub through_samples: f64,
+    /// The least δ they show over the ripple's phase against the teeth.
+    pub through_samples_least: f64,
+    /// The most δ they show over that phase.
+    pub through_samples_most: f64,
+    /// `through_samples / delta`: the share of the ripple's δ the measured δ is.
+    pub share: f64,
+    /// The most edges per sample whose least over the phase reads [`RIPPLE_READ_SHARE`] of
+    /// the ripple's δ (`null` when even one edge does not).
+    pub edges_for_95_percent: Option<u16>,
+    /// The least share of the ripple's δ one-edge samples read over the phase: the most any
+    /// number of edges a sample can count on, on this wheel.
+    pub share_one_edge: f64,
+}
+
+/// Below this share of a `[cranking]` ripple's δ read through the samples (at the scene's
+/// phase, or the least over the phase), `run` WARNs under its δ line (`analyze` states its
+/// ripple table below the same share).
+pub const RIPPLE_READ_SHARE: f64 = 0.95;
+
+/// [`RippleRead`] of the scene's `[cranking]` ripple: `None` without a ripple or an
+/// `[encoder]`, or where the strokes have no period of whole revolutions the samples can be
+/// tabulated over.
+pub fn cranking_ripple_read(scene: &Scene, file: &Path) -> Result<Option<RippleRead>, SceneError> {
+    use crate::app::sampled::{sampled_range, SteadyTime, SCAN_BUDGET};
+    let Some(c) = scene.cranking.filter(|c| c.ripple > 0.0 && c.strokes > 0.0) else {
+        return Ok(None);
+    };
+    let Some(e) = &scene.encoder else {
+        return Ok(None);
+    };
+    let Some(revolutions) = drive_monitor::drive::period_revolutions(&[c.strokes]) else {
+        return Ok(None);
+    };
+    let delta = 2.0 * c.ripple;
+    // δ does not depend on the mean speed: ω̄ = 1.
+    let omega = |phi: f64| Some(1.0 + c.ripple * (c.strokes * phi + c.phase).sin());
+    let Some(time) = SteadyTime::tabulate(
+        std::f64::consts::TAU / c.strokes,
+        revolutions,
+        c.strokes,
+        omega,
+    ) else {
+        return Ok(None);
+    };
+    let Some(s) = predict::sampled_delta_of(scene, file, delta, || Some(time.clone()))? else {
+        return Ok(None);
+    };
+    // Fewer edges a sample: the least each reads over the phase, as `sampled_delta_of` scans
+    // them for the predicted δ.
+    let wheel = predict::sample_wheel(e, &crate::app::check::wheel(e, &scene.checker(file))?);
+    let least = |k: u16| {
+        if k == e.estimator_edges {
+            Some(s.least)
+        } else {
+            sampled_range(&time, &wheel, k, SCAN_BUDGET / 4).map(|r| r.least)
+        }
+    };
+    let edges_for_95_percent = (1..=e.estimator_edges)
+        .rev()
+        .find(|&k| least(k).is_some_and(|d| d >= RIPPLE_READ_SHARE * delta));
+    Ok(Some(RippleRead {
+        delta,
+        order: c.strokes,
+        estimator_edges: e.estimator_edges,
+        through_samples: s.at_scene_phase,
+        through_samples_least: s.least,
+        through_samples_most: s.most,
+        share: s.at_scene_phase / delta,
+        edges_for_95_percent,
+        share_one_edge: least(1).unwrap_or(0.0) / delta,
+    }))
+}
+
+/// The WARNING under `run`'s δ line where the samples read less than [`RIPPLE_READ_SHARE`] of
+/// the `[cranking]` ripple's δ (at the scene's phase or at the least over it): the measured δ
+/// is that share, not the shaft's, and fewer edges per sample read more of it.
+pub fn cranking_ripple_warning(r: &RippleRead) -> Option<String> {
+    let low = RIPPLE_READ_SHARE * r.delta;
+    if r.through_samples >= low && r.through_samples_least >= low {
+        return None;
+    }
+    let over_phase =
+        if predict::sampled_spread(r.delta, r.through_samples_least, r.through_samples_most) {
+            format!(
+                ", {:.3}–{:.3} of it over the ripple's phase against the teeth",
+                r.through_samples_least / r.delta,
+                r.through_samples_most / r.delta
+            )
+        } else {
+            String::new()
+        };
+    let share = 100.0 * RIPPLE_READ_SHARE;
+    let more = match r.edges_for_95_percent {
+        Some(k) => format!(
+            "`encoder.estimator_edges = {k}` or fewer reads {share:.0} % of it at any phase \
+             (fewer edges a sample raise the noise floor)"
+        ),
+        None if r.estimator_edges > 1 => format!(
+            "fewer edges a sample read more of it (`encoder.estimator_edges = 1` reads {:.3} at \
+             the least over the phase), and a wheel with more teeth a ripple cycle more still",
+            r.share_one_edge
+        ),
+        None => "a wheel with more teeth a ripple cycle reads more of it".to_string(),
+    };
+    Some(format!(
+        "WARNING: the core's speed samples of `encoder.estimator_edges = {}` edges read only \
+         {:.3} of the [cranking] ripple's δ with the teeth where this scene has them{over_phase}: \
+         the ripple (±{} %, order {}) has δ {}, the samples show about {}, and the δ measured is \
+         theirs, not the shaft's; {more}",
+        r.estimator_edges,
+        r.share,
+        100.0 * r.delta / 2.0,
+        r.order,
+        predict::fmt_delta(r.delta),
+        predict::fmt_delta(r.through_samples),
+    ))
 }
 
 /// How a run may deviate from the scene (the sweep's knobs).
@@ -1215,6 +1359,8 @@ pub fn regime_classifier(
 /// The machine a run simulates: the system and what the report needs to know of it.
 struct Assembly {
     system: System,
+    /// How the shaft moves ([`RunReport::shaft`]).
+    law: &'static str,
     names: Vec<&'static str>,
     vib_params: Option<VibrationMachineParams>,
     vib_machine: Option<VibrationMachine>,
@@ -1352,6 +1498,13 @@ fn assemble(
         effects.push(Box::new(model.load.clone()));
         names.push("load");
     }
+    let law = match &shaft {
+        ShaftModel::Dynamic(_) => "motor-driven",
+        ShaftModel::Profile(p) if p.ripple.is_some_and(|r| r.amplitude > 0.0) => {
+            "prescribed with a cranking ripple"
+        }
+        _ => "prescribed",
+    };
     let rotor_speed0 = match &shaft {
         ShaftModel::Prescribed(law) => law.shaft(0.0).omega,
         ShaftModel::Dynamic(d) => d.omega0,
@@ -1376,6 +1529,7 @@ fn assemble(
     let system = System::new(shaft, effects).map_err(|e| core_error(scene, file, "shaft", e))?;
     Ok(Assembly {
         system,
+        law,
         names,
         vib_params,
         vib_machine,
@@ -1480,6 +1634,7 @@ pub fn run_with(
     let parts = predict::drive_parts(scene, file, model.as_ref())?;
     let Assembly {
         system,
+        law,
         names,
         vib_params,
         vib_machine,
@@ -1616,6 +1771,7 @@ pub fn run_with(
     let step_warning = fixed_step_warning(scene, file, sim.fixed_step_error());
     let mut report = RunReport {
         scene: file.display().to_string(),
+        shaft: law,
         effects: names,
         integrator: integ.name(),
         simulated_seconds: stats.time,
@@ -1668,6 +1824,7 @@ pub fn run_with(
         report.delta_predicted_through_samples_least = sampled.map(|s| s.least);
         report.delta_predicted_through_samples_most = sampled.map(|s| s.most);
     }
+    report.cranking_ripple = cranking_ripple_read(scene, file)?;
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
         Samples::All(v) => v,
         Samples::Stream(s) => s.samples(),
@@ -1700,6 +1857,11 @@ pub fn run_with(
             .and(model.as_ref())
             .filter(|_| over.speed.is_none())
             .and_then(|m| settle_note(m, settle, scene.simulation.settle.is_none())),
+        report
+            .cranking_ripple
+            .filter(|_| report.delta_measured.is_some())
+            .as_ref()
+            .and_then(cranking_ripple_warning),
     ]
     .into_iter()
     .flatten()
