@@ -1087,6 +1087,9 @@ struct Collector<'a> {
     edges: u64,
     all_edges: u64,
     reverse_edges: u64,
+    /// When the shaft first turned backwards (a line edge in reverse), s, with or without a
+    /// scene `[encoder]` (the run's internal one sees it too).
+    reversed_at: Option<f64>,
     steps: u64,
     stop: Option<Stop>,
     last_window: Option<Measurement>,
@@ -1233,6 +1236,12 @@ impl Observer for Collector<'_> {
         // The capture unit is set to the rising edges.
         if !edge.rising {
             return;
+        }
+        if !edge.index
+            && edge.direction == crate::engine::encoder::Direction::Reverse
+            && self.reversed_at.is_none()
+        {
+            self.reversed_at = Some(edge.true_time);
         }
         let Some(m) = self.monitor.as_mut() else {
             return;
@@ -1411,27 +1420,20 @@ fn shaft_model(
             })?;
             effects.push(Box::new(model.motor));
             names.push("motor");
-            // No speed carries a mean load at or above the torque at standstill: started at
-            // rest the shaft is driven backwards without bound (the integration failed, naming
-            // the step size, not the load). Said, unless a start is given (a run-down).
-            let mean = scene.load.as_ref().map_or(0.0, |l| l.mean);
-            let standstill = model.motor.torque(0.0);
-            if shaft.initial_speed.is_none() && model.u_start <= 0.0 && standstill <= mean {
-                return Err(scene.checker(file).bad(
-                    "load.mean",
-                    mean,
-                    format!(
-                        "the mean load is at least the motor's torque at standstill ({standstill:.4} \
-                         N·m): started at rest the shaft would be driven backwards, and no speed \
-                         the drive model finds carries it (`drive-sim predict` shows the drive); \
-                         give `shaft.initial_speed` to simulate a run-down"
-                    ),
-                ));
-            }
             // Start at the predicted mean speed (or the given one) to shorten the transient.
             let omega0 = shaft
                 .initial_speed
                 .unwrap_or_else(|| model.u_start.max(0.0).sqrt());
+            // A default start at the drive model's mean speed is where a speed carries the
+            // load; a given start, or none carrying it, is checked.
+            let checked = shaft.initial_speed.is_some() || model.u_start <= 0.0;
+            if let Some(why) = driven_backwards(scene, &model.motor, omega0).filter(|_| checked) {
+                return Err(scene.checker(file).bad(
+                    "load.mean",
+                    scene.load.as_ref().map_or(0.0, |l| l.mean),
+                    why,
+                ));
+            }
             Ok(ShaftModel::Dynamic(DynamicShaft {
                 inertia: shaft.inertia,
                 flywheel: shaft.flywheel,
@@ -1454,6 +1456,84 @@ fn shaft_model(
             "missing: a scene to run needs [motor] (a torque model or a prescribed speed)",
         )),
     }
+}
+
+/// Why a motor-driven shaft started at `omega0` rad/s would be driven backwards (`None` where
+/// it would not, to the mean load): the mean load is at least the motor's torque at standstill
+/// and the motor's torque stays below it at every speed from standstill up to the start, so
+/// the shaft slows to a stop and the load, an active torque (its sign whatever the speed),
+/// turns it backwards ever faster. `run` does not simulate that: the parabola continued to
+/// negative speeds falls without bound and the speed runs away in finite time (the kneader at
+/// a mean load of 200 N·m, started at 130 rad/s, failed at 1.83 s with a step size underflow
+/// that named the inertias), and the Kloss curve's braking branch leaves the load's excess to
+/// accelerate the shaft backwards without limit (22 M reverse edges in 10 s, reported as a
+/// standstill). The same for every motor kind, with or without an `[encoder]`.
+pub fn driven_backwards(
+    scene: &Scene,
+    motor: &drive_monitor::drive::Motor,
+    omega0: f64,
+) -> Option<String> {
+    let mean = scene.load.as_ref().map_or(0.0, |l| l.mean);
+    let standstill = motor.torque(0.0);
+    if mean.partial_cmp(&standstill) == Some(std::cmp::Ordering::Less) || mean.is_nan() {
+        return None;
+    }
+    // The motor's torque over [0, ω0] (smooth and single-peaked: 4096 points find where it
+    // reaches the load).
+    const POINTS: u32 = 4096;
+    let grid = |top: f64| (0..=POINTS).map(move |i| top * f64::from(i) / f64::from(POINTS));
+    if grid(omega0.max(0.0)).any(|w| motor.torque(w) > mean) {
+        return None;
+    }
+    // The lowest speed where the motor's torque exceeds the mean load, up to its no-load
+    // (synchronous) speed: a start above it reaches the working point.
+    let top = motor
+        .kloss_curve()
+        .map_or(motor.model().no_load_speed(), |k| k.synchronous_speed());
+    let above = grid(top).find(|&w| motor.torque(w) > mean);
+    let given = scene.shaft.as_ref().and_then(|s| s.initial_speed);
+    let start_text = match given {
+        _ if omega0 <= 0.0 => format!(
+            "the shaft starts at rest ({}), where the motor's torque is below it",
+            if given.is_some() {
+                "`shaft.initial_speed = 0`"
+            } else {
+                "no `shaft.initial_speed`, and no speed of the drive model carries the load"
+            }
+        ),
+        Some(w) => format!(
+            "from `shaft.initial_speed = {w}` rad/s down to standstill the motor's torque stays \
+             below it: the shaft would slow to a stop"
+        ),
+        None => format!(
+            "from the start at {omega0:.3} rad/s (the drive model's mean speed) down to \
+             standstill the motor's torque stays below it: the shaft would slow to a stop"
+        ),
+    };
+    let cure = match above {
+        // Rounded up: the start is above the point.
+        Some(w) => format!(
+            "a mean load below {standstill:.4} N·m runs, and a start above {:.3} rad/s \
+             (`shaft.initial_speed`), where the motor's torque first exceeds the mean load, can \
+             reach the motor's working point (the load's ripple may still turn it back, which \
+             the run then says)",
+            (w * 1e3).ceil() / 1e3
+        ),
+        None => format!(
+            "no speed of the motor carries it (its torque peaks at {:.4} N·m): a mean load \
+             below {standstill:.4} N·m, or a stronger motor, runs",
+            grid(top)
+                .map(|w| motor.torque(w))
+                .fold(f64::NEG_INFINITY, f64::max)
+        ),
+    };
+    Some(format!(
+        "the mean load {mean} N·m is at least the motor's torque at standstill ({standstill:.4} \
+         N·m), and {start_text}, and the load, modelled as an active torque (its sign whatever \
+         the speed, as a hoist's weight), would turn it backwards ever faster, which `run` does \
+         not simulate (a reactive load, friction or kneading, would stall it \
+         instead; `drive-sim predict` shows the drive); {cure}"
+    ))
 }
 
 /// The speed profile of a scene whose prescribed speed is a profile (`[motor] model =
@@ -1709,6 +1789,7 @@ pub fn run_with(
         edges: 0,
         all_edges: 0,
         reverse_edges: 0,
+        reversed_at: None,
         steps: 0,
         stop: None,
         last_window: None,
@@ -1733,9 +1814,10 @@ pub fn run_with(
         state: vec![0.0; dim],
         progress: Progress::new(duration, options.progress),
     };
-    let stats = sim
-        .run_observed(duration, &mut col)
-        .map_err(|e| integration_error(scene, file, &e))?;
+    let stats = match sim.run_observed(duration, &mut col) {
+        Ok(stats) => stats,
+        Err(e) => return Err(integration_error(scene, file, &e, col.reversed_at)),
+    };
     drop(std::mem::replace(
         &mut col.progress,
         Progress::new(0.0, false),
@@ -1835,10 +1917,13 @@ pub fn run_with(
         col.outcome(stats.time, o);
     }
     measurement(&mut report, &mut col);
-    if col.reverse_edges > 0 {
-        report
-            .model_warnings
-            .extend(predict::active_load_note(scene, file));
+    // A motor-driven shaft the load turned backwards (its peak beyond the motor's torque at
+    // standstill), said with or without an [encoder].
+    if let (Some(t), "motor-driven") = (col.reversed_at, report.shaft) {
+        report.model_warnings.extend(
+            predict::active_load_note(scene, file)
+                .map(|n| format!("{n} (this run: backwards first at t = {t:.4} s)")),
+        );
     }
     // The vibration machine's torque is in the run (a motor-driven shaft integrates it) and
     // not in the prediction; the encoder's errors are in the measured δ and not its floor.
@@ -2287,14 +2372,32 @@ fn fixed_step_warning(scene: &Scene, file: &Path, error: Option<(f64, f64)>) -> 
     ))
 }
 
-/// An integration failure, with the scene keys that set the integration up.
+/// An integration failure, with the scene keys that set the integration up; where the shaft
+/// had turned backwards (at `reversed_at`, s) under a motor, that is said first: a load beyond
+/// the motor's torque runs the shaft away backwards (the parabola continued to negative speeds
+/// without bound, in finite time), which no tolerance resolves.
 fn integration_error(
     scene: &Scene,
     file: &Path,
     e: &crate::engine::system::SimError,
+    reversed_at: Option<f64>,
 ) -> SceneError {
     let c = scene.checker(file);
     let s = &scene.simulation;
+    if let (Some(t), Some(note)) = (
+        reversed_at,
+        reversed_at.and_then(|_| predict::active_load_note(scene, file)),
+    ) {
+        return SceneError::value(
+            file,
+            "simulation",
+            format!(
+                "{e}: the shaft turned backwards at t = {t:.4} s and ran away ({}); the \
+                 integration's settings are not the cause",
+                note.trim_start_matches("NOTE: ")
+            ),
+        );
+    }
     if s.integrator == IntegratorKind::Rk4 {
         // A fixed step: rtol and atol play no part.
         return SceneError::value(
@@ -2413,6 +2516,13 @@ fn nothing_measured(
             r.invalid_windows,
             reasons.join(", ")
         ));
+    } else if edges > 0 && reverse == edges {
+        // Reverse edges are no forward time reference: the core measures forward rotation.
+        why.push(
+            "no window was completed: the core measures δ of forward rotation, and every edge \
+             came in reverse"
+                .to_string(),
+        );
     } else if edges > 0 && core.accepted == 0 {
         // Edges slower than the minimum speed allows are a shaft at rest: no window completes,
         // and the run is not too short.
