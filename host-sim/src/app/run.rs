@@ -930,7 +930,14 @@ pub struct RunOptions {
     /// Keep every edge the encoder produced, dropped ones included, in
     /// [`RunReport::edge_list`] (the ground truth of a test; memory grows with the run).
     pub keep_edges: bool,
+    /// The largest capture file a run writes, bytes: a sigrok file of every sample estimated
+    /// larger is refused before anything is simulated ([`CAPTURE_MAX_BYTES`] by default).
+    pub capture_max_bytes: f64,
 }
+
+/// The largest capture file `run` writes unasked, bytes (`--capture-max-bytes` raises it):
+/// the kneader's 30 s as sigrok rows at 50 MHz had written 23.4 GB without a word.
+pub const CAPTURE_MAX_BYTES: f64 = 1e9;
 
 impl Default for RunOptions {
     fn default() -> Self {
@@ -939,6 +946,7 @@ impl Default for RunOptions {
             keep_windows: true,
             capture: None,
             keep_edges: false,
+            capture_max_bytes: CAPTURE_MAX_BYTES,
         }
     }
 }
@@ -1766,7 +1774,7 @@ pub fn run_with(
         .as_ref()
         .is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
     let capture = match &options.capture {
-        Some(t) => Some(open_capture(scene, file, t)?),
+        Some(t) => Some(open_capture(scene, file, t, options.capture_max_bytes)?),
         None => None,
     };
     let mut col = Collector {
@@ -2311,6 +2319,7 @@ fn open_capture(
     scene: &Scene,
     file: &Path,
     target: &CaptureTarget,
+    max_bytes: f64,
 ) -> Result<CaptureWriter<std::io::BufWriter<std::fs::File>>, SceneError> {
     let spec = scene.capture.unwrap_or_default();
     let index = matches!(
@@ -2331,6 +2340,34 @@ fn open_capture(
             format!("cannot write {}: {e}", target.path.display()),
         )
     };
+    // A file of every sample grows with the duration and the rate, not the edges: its size
+    // is known before anything is written.
+    let duration = scene.simulation.duration;
+    let estimate = CaptureWriter::new(Vec::new(), settings)
+        .map_err(fail)?
+        .every_sample_bytes(duration);
+    if let Some(bytes) = estimate.filter(|&b| b > max_bytes) {
+        return Err(SceneError::value(
+            file,
+            "capture",
+            format!(
+                "{} would be about {:.3e} bytes ({:.3e} rows, a row for every sample of {} s at \
+                 `capture.sample_rate = {}`), more than the {max_bytes:.0e} bytes `run` writes \
+                 unasked: `[capture] dedup = true` writes only the rows where a level changes, a \
+                 shorter `simulation.duration` or a lower `capture.sample_rate` fewer rows, \
+                 another --capture-format (saleae, plain, vcd) only the changes, and \
+                 `--capture-max-bytes {:.0}` accepts it",
+                target.path.display(),
+                bytes,
+                (duration * spec.sample_rate).ceil() + 1.0,
+                duration,
+                scene
+                    .checker(file)
+                    .shown("capture.sample_rate", spec.sample_rate),
+                bytes.ceil()
+            ),
+        ));
+    }
     let f = std::fs::File::create(&target.path).map_err(fail)?;
     CaptureWriter::new(std::io::BufWriter::new(f), settings).map_err(fail)
 }
