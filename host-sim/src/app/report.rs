@@ -117,6 +117,13 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             r.rejected_edges[1],
             r.rejected_edges[2]
         );
+        if r.timeouts > 0 {
+            let _ = writeln!(
+                s,
+                "  standstill: the core found the shaft stopped {} time(s) (its timeout)",
+                r.timeouts
+            );
+        }
         if let Some(w) = r.speed_measured {
             let _ = writeln!(s, "  mean speed {w:.3} rad/s");
         }

@@ -200,6 +200,8 @@ pub struct RunReport {
     pub alarm_judged: Option<AlarmJudged>,
     /// Edges the core rejected or found missing: glitches, missing edges, extra edges.
     pub rejected_edges: [u32; 3],
+    /// Times the core's standstill check found the shaft stopped (as `analyze` counts them).
+    pub timeouts: u32,
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
     /// The fastest speed the core measured in any valid window of the run (its ω max), rad/s:
@@ -1095,6 +1097,13 @@ struct Collector<'a> {
     edges: u64,
     all_edges: u64,
     reverse_edges: u64,
+    /// The firmware's periodic standstill check, as `analyze` makes it
+    /// ([`crate::app::analyze::poll_interval`]): its interval and the core's timeout, s, the
+    /// timer's rate, Hz, and counter mask (`None` without a monitor).
+    poll: Option<(f64, f64, f64, u64)>,
+    /// The last event fed to the core (a capture or an index pulse) and the last poll, s.
+    last_event: Option<f64>,
+    last_poll: f64,
     /// When the shaft first turned backwards (a line edge in reverse), s, with or without a
     /// scene `[encoder]` (the run's internal one sees it too).
     reversed_at: Option<f64>,
@@ -1162,6 +1171,39 @@ impl Drop for Progress {
 }
 
 impl Collector<'_> {
+    /// The core's periodic standstill check up to `t` (s, exclusive) since the last event, as
+    /// firmware's periodic task and `analyze` make it: only the polls around the timeout,
+    /// where one can find something. Without it a shaft that stopped left its window in
+    /// progress unjudged and no timeout, where `analyze` of the run's capture found them.
+    fn polls_until(&mut self, t: f64) {
+        let (Some((every, timeout, hz, mask)), Some(t0)) = (self.poll, self.last_event) else {
+            return;
+        };
+        let mut p = self.last_poll.max(t0 + timeout - 2.0 * every).max(t0) + every;
+        while p < t && p <= t0 + timeout + 2.0 * every {
+            self.last_poll = p;
+            self.poll_at(p, hz, mask);
+            p += every;
+        }
+    }
+
+    /// One poll of the core at `p`, s.
+    fn poll_at(&mut self, p: f64, hz: f64, mask: u64) {
+        // A real timer latches the count of whole ticks elapsed.
+        let ticks = ((p * hz).floor() as i64 as u64 & mask) as u32;
+        if let Some(o) = self.monitor.as_mut().and_then(|m| m.poll(ticks)) {
+            self.outcome(p, o);
+        }
+    }
+
+    /// The end of the run at `end`, s: the polls up to it and one there.
+    fn polls_to_end(&mut self, end: f64) {
+        self.polls_until(end);
+        if let (Some((_, _, hz, mask)), Some(_)) = (self.poll, self.last_event) {
+            self.poll_at(end, hz, mask);
+        }
+    }
+
     /// A window the core returned at time `t`, s, and its alarm event.
     fn outcome(&mut self, t: f64, o: drive_monitor::monitor::WindowOutcome) {
         self.window(t, o.report);
@@ -1251,11 +1293,15 @@ impl Observer for Collector<'_> {
         {
             self.reversed_at = Some(edge.true_time);
         }
-        let Some(m) = self.monitor.as_mut() else {
+        if self.monitor.is_none() {
             return;
-        };
+        }
         if edge.index {
-            m.on_index(edge.ticks);
+            self.polls_until(edge.seen_time);
+            self.last_event = Some(edge.seen_time);
+            if let Some(m) = self.monitor.as_mut() {
+                m.on_index(edge.ticks);
+            }
             return;
         }
         // The timer's input prescaler: one capture in `prescaler` line edges, the first at the
@@ -1265,6 +1311,11 @@ impl Observer for Collector<'_> {
             return;
         }
         self.prescaled = 0;
+        self.polls_until(edge.seen_time);
+        self.last_event = Some(edge.seen_time);
+        let Some(m) = self.monitor.as_mut() else {
+            return;
+        };
         self.edges += 1;
         if edge.direction == crate::engine::encoder::Direction::Reverse {
             self.reverse_edges += 1;
@@ -1777,8 +1828,21 @@ pub fn run_with(
         Some(t) => Some(open_capture(scene, file, t, options.capture_max_bytes)?),
         None => None,
     };
+    let monitor = core_monitor(scene, file)?;
+    let poll = monitor.as_ref().zip(scene.encoder.as_ref()).map(|(m, e)| {
+        let enc = m.encoder();
+        (
+            crate::app::analyze::poll_interval(enc),
+            f64::from(enc.timeout_ticks()) / e.timer_hz,
+            e.timer_hz,
+            u64::from(enc.mask()),
+        )
+    });
     let mut col = Collector {
-        monitor: core_monitor(scene, file)?,
+        monitor,
+        poll,
+        last_event: None,
+        last_poll: f64::NEG_INFINITY,
         capture,
         capture_error: None,
         edge_list: options.keep_edges.then(Vec::new),
@@ -1921,6 +1985,7 @@ pub fn run_with(
     };
     // The end of the run: a window held for the edge after its frame is released as it is,
     // and a second window the last edge ended (handed by the next call).
+    col.polls_to_end(stats.time);
     while let Some(o) = col.monitor.as_mut().and_then(|m| m.release_held()) {
         col.outcome(stats.time, o);
     }
@@ -2490,6 +2555,7 @@ fn measurement(report: &mut RunReport, col: &mut Collector) {
     report.windows = d.valid_windows + d.invalid_windows;
     report.invalid_windows = d.invalid_windows;
     report.rejected_edges = [d.edges.glitches, d.edges.missing, d.edges.extra];
+    report.timeouts = d.edges.timeouts;
     report.invalid_reasons = std::mem::take(&mut col.invalid_reasons);
     report.delta_measured = median(
         &mut col
