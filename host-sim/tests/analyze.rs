@@ -5796,3 +5796,33 @@ fn the_grid_found_is_not_stated_as_the_sample_period() {
         );
     }
 }
+
+/// A cranking stall read clean in `run` (0 faults, 0 invalid windows) while `analyze` of the
+/// run's own capture found 2 missing edges, a timeout and an invalid window: `run` fed the core
+/// its edges only, without the firmware's periodic standstill check that `analyze` makes
+/// between events and at the end of the recording, so the window in progress at the stall was
+/// never judged. `run` polls the core alike now: the same windows, faults and timeout.
+#[test]
+fn a_stall_reads_alike_in_run_and_in_analyze_of_its_capture() {
+    let scene = "[motor]\nmodel = \"profile\"\n\
+        points = [[0.0, 0.0], [1.0, 25.0], [3.0, 25.0], [3.5, 0.0]]\n\
+        [cranking]\nripple = 0.4\nstrokes = 2\nphase = 0.0\n[encoder]\nwheel = \"36-2\"\n\
+        timer_hz = 1e6\nestimator_edges = 4\n[simulation]\nduration = 4.0\n";
+    let (_scratch, file) = tmp("stall.csv");
+    let run = simulate(scene, CaptureFormat::Saleae, &file);
+    let (a, _) = run_analyze(
+        &file,
+        AnalyzeOptions {
+            estimator_edges: Some(4),
+            ..wheel("36-2")
+        },
+    );
+    assert_eq!(
+        (run.windows, run.invalid_windows),
+        (a.valid_windows + a.invalid_windows, a.invalid_windows)
+    );
+    assert_eq!(run.rejected_edges, [a.glitches, a.missing, a.extra]);
+    assert_eq!(run.timeouts, a.timeouts);
+    // The stall is seen: a timeout once the shaft has stopped, and the window it cut short.
+    assert!(run.timeouts >= 1 && run.invalid_windows >= 1, "{run:?}");
+}

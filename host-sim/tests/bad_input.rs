@@ -920,3 +920,59 @@ fn scene_integers_beyond_their_type_are_refused_with_their_range() {
     let e = error("kneader", "lines = 1024", "lines = 2.5");
     assert!(e.contains("expected a whole number"), "{e}");
 }
+
+/// `run kneader --capture … --capture-format sigrok` wrote 23.4 GB (a row for every sample of
+/// 30 s at 50 MHz) without a word. A sigrok file of every sample is now estimated before the
+/// run and refused above the bound (1e9 bytes unless raised), with the estimate and what makes
+/// it smaller; nothing is written then. Under the bound the file is written, and the estimate
+/// holds it; `dedup` writes only the changes and is never refused for its size.
+#[test]
+fn a_capture_of_every_sample_too_large_is_refused_with_its_size() {
+    use host_sim::app::run::CaptureTarget;
+    let text = "[motor]\nmodel = \"speed\"\nspeed = 100.0\n[encoder]\nlines = 64\n\
+                timer_hz = 1e6\n[simulation]\nduration = 0.2\n[capture]\nsample_rate = 1e6\nDEDUP\n";
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("cap.csv");
+    let capture = |text: &str, max: f64| {
+        let scene = Scene::parse(text, Path::new("bad.toml")).unwrap();
+        let options = RunOptions {
+            capture: Some(CaptureTarget {
+                path: file.clone(),
+                format: host_sim::app::logic::CaptureFormat::Sigrok,
+            }),
+            capture_max_bytes: max,
+            ..RunOptions::default()
+        };
+        run_with(&scene, Path::new("bad.toml"), Overrides::default(), options)
+    };
+    let every = text.replace("DEDUP", "");
+    let e = capture(&every, 1e5).unwrap_err().to_string();
+    assert_names(
+        &e,
+        &[
+            "would be about",
+            "2.000e5 rows",
+            "more than the 1e5 bytes",
+            "`[capture] dedup = true`",
+            "--capture-max-bytes",
+        ],
+    );
+    assert!(!file.exists(), "nothing is written when refused");
+    // The estimate, from the message, against the file written under a raised bound.
+    let estimate: f64 = e
+        .split("would be about ")
+        .nth(1)
+        .and_then(|x| x.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    capture(&every, 1e9).unwrap();
+    let written = std::fs::metadata(&file).unwrap().len() as f64;
+    assert!(
+        written <= estimate * 1.001 && written > 0.8 * estimate,
+        "{written} {estimate}"
+    );
+    // Only the changes: written under the same small bound.
+    let r = capture(&text.replace("DEDUP", "dedup = true"), 1e5).unwrap();
+    assert!(r.capture_rows.unwrap() < 1000, "{:?}", r.capture_rows);
+}

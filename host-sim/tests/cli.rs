@@ -630,7 +630,8 @@ fn numbers_out_of_range_name_the_value_and_the_range() {
         ),
         (
             &["--lines", "500", "--min-speed", "-1"],
-            "--min-speed -1 is out of range: the slowest speed still running is above 0 rad/s",
+            "--min-speed -1 is out of range: the slowest speed still running is 1e-6 to 1e5 \
+             rad/s",
         ),
         (
             &["--lines", "70000"],

@@ -1232,8 +1232,14 @@ fn a_minimum_speed_above_the_shafts_is_named_when_nothing_is_measured() {
 }
 
 /// A mean load above the motor's torque at standstill: no speed carries it, and started at rest
-/// the shaft ran backwards until the integration failed, naming the step size. Refused naming
-/// `load.mean`, the standstill torque and `shaft.initial_speed` (a run-down's start).
+/// the shaft ran backwards until the integration failed, naming the step size; from
+/// `shaft.initial_speed = 130`, which the refusal advised, the integration failed alike at
+/// 1.83 s, blaming the inertias (the parabola continued to negative speeds runs away in finite
+/// time), and a Kloss motor from rest ran away backwards, reported as a standstill with an
+/// encoder and said nothing without one. Refused up front for every motor kind, with or without
+/// an `[encoder]`, naming `load.mean`, the mean load against the standstill torque and what
+/// runs: a start above the speed where a Kloss motor's torque first exceeds the load runs to
+/// its working point.
 #[test]
 fn a_load_the_motor_cannot_start_is_named() {
     let kneader = include_str!("../scenes/kneader.toml");
@@ -1242,17 +1248,60 @@ fn a_load_the_motor_cannot_start_is_named() {
         stalled, kneader,
         "the kneader's mean load is written as 24.0"
     );
-    let path = std::path::Path::new("stall.toml");
-    let scene = host_sim::app::scene::Scene::parse(&stalled, path).unwrap();
-    let e = host_sim::app::run::run(&scene, path, host_sim::app::run::Overrides::default())
-        .unwrap_err()
-        .to_string();
+    let refused = |text: &str| {
+        let path = std::path::Path::new("stall.toml");
+        let scene = host_sim::app::scene::Scene::parse(text, path).unwrap();
+        host_sim::app::run::run(&scene, path, host_sim::app::run::Overrides::default())
+            .unwrap_err()
+            .to_string()
+    };
+    let from_speed = stalled.replace("flywheel = 0.0 ", "flywheel = 0.0\ninitial_speed = 130.0 ");
+    assert!(from_speed.contains("initial_speed = 130.0"));
+    let (start, after) = stalled.split_at(stalled.find("[encoder]").unwrap());
+    let no_encoder = format!("{start}{}", &after[after.find("[monitor]").unwrap()..]);
+    assert!(!no_encoder.contains("[encoder]"));
+    for text in [&stalled, &from_speed, &no_encoder] {
+        let e = refused(text);
+        assert!(
+            e.contains("`load.mean = 200.0`")
+                && e.contains(
+                    "the mean load 200 N·m is at least the motor's torque at standstill (168."
+                )
+                && e.contains("active torque")
+                && e.contains(&format!(
+                    "standstill ({:.4} N·m)",
+                    kneader_standstill_torque()
+                ))
+                && e.contains("no speed of the motor carries it")
+                && !e.contains("step size"),
+            "{e}"
+        );
+    }
     assert!(
-        e.contains("`load.mean = 200.0`")
-            && e.contains("the motor's torque at standstill (168.")
-            && e.contains("shaft.initial_speed"),
-        "{e}"
+        refused(&from_speed).contains("from `shaft.initial_speed = 130` rad/s down to standstill")
     );
+    // A Kloss motor whose torque rises above the load past standstill: from rest, refused
+    // with the start that runs; from above it, the working point and no reversal.
+    let kloss = "[simulation]\nduration = 2.0\nsettle = 1.0\n[shaft]\ninertia = 0.05\n\
+        initial_speed = START\n[motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+        breakdown_slip = 0.25\nbreakdown_torque = 158.0\n[load]\nmean = 140.0\n\
+        harmonics = [{ order = 1.0, amplitude = 25.0, phase = 0.0 }]\n";
+    for encoder in ["", "[encoder]\nlines = 1024\ntimer_hz = 84e6\n"] {
+        let e = refused(&format!("{}{encoder}", kloss.replace("START", "0.0")));
+        assert!(
+            e.contains("`load.mean = 140.0`")
+                && e.contains("the motor's torque at standstill (74.3529 N·m)")
+                && e.contains("starts at rest (`shaft.initial_speed = 0`)")
+                && e.contains("a start above 92.231 rad/s"),
+            "{e}"
+        );
+        let r = run_trial(&format!("{}{encoder}", kloss.replace("START", "120.0")));
+        assert!(
+            r.model_warnings.iter().all(|w| !w.contains("backwards")),
+            "{:?}",
+            r.model_warnings
+        );
+    }
 }
 
 /// The maximum safe speed was printed in fixed point with one decimal: 1.069e152 rad/s as a
@@ -1617,32 +1666,50 @@ fn a_drive_above_its_no_load_speed_is_said_to_generate() {
     assert!(host_sim::app::report::prediction_text(&p).contains(note));
 }
 
-/// A load above the motor's torque at standstill turns the shaft backwards in `run` (the load
-/// is an active torque): the run says so beside its reversed edges, with the standstill torque.
-/// The kneader as bundled, whose load never reaches it, says nothing.
+/// A load whose peak is above the motor's torque at standstill turns the shaft backwards in
+/// `run` (the load is an active torque): the run says so with the standstill torque and when,
+/// with or without an `[encoder]` (without one it had said nothing). Where the shaft turned
+/// only backwards, the core's report no longer blames the standstill timeout. The kneader as
+/// bundled, whose load never reaches it, says nothing.
 #[test]
 fn a_load_that_turns_the_shaft_backwards_is_said_to_be_active() {
-    let kneader =
-        include_str!("../scenes/kneader.toml").replace("duration = 30.0", "duration = 2.0");
-    let backwards = kneader
-        .replace("mean = 24.0", "mean = 170.0")
-        .replace("flywheel = 0.0 ", "flywheel = 0.0\ninitial_speed = 0.0 ")
-        .replace("settle = 10.0", "settle = 0.5");
-    assert!(backwards.contains("initial_speed = 0.0") && backwards.contains("mean = 170.0"));
-    let r = run_trial(&backwards);
-    let standstill = kneader_standstill_torque();
-    let note = r
+    let kloss = "[simulation]\nduration = 2.0\nsettle = 1.0\n[shaft]\ninertia = 0.05\n\
+        initial_speed = 0.0\n[motor]\nmodel = \"kloss\"\nsynchronous_speed = 157.08\n\
+        breakdown_slip = 0.25\nbreakdown_torque = 158.0\n[load]\nmean = 60.0\n\
+        harmonics = [{ order = 1.0, amplitude = 30.0, phase = 1.5707963 }]\n";
+    for encoder in ["", "[encoder]\nlines = 1024\ntimer_hz = 84e6\n"] {
+        let r = run_trial(&format!("{kloss}{encoder}"));
+        let note = r
+            .model_warnings
+            .iter()
+            .find(|w| w.contains("active torque"))
+            .unwrap_or_else(|| panic!("{:?} {:?}", r.model_warnings, r.no_measurement));
+        assert!(
+            note.contains(
+                "the load's peak 90.0000 N·m exceeds the motor's torque at standstill, 74.3529 N·m"
+            ) && note.contains("(this run: backwards first at t = "),
+            "{note}"
+        );
+    }
+    // A shaft that turned only backwards (a prescribed negative speed): the core measures
+    // forward rotation, which is what is said, not a standstill timeout.
+    let r = run_trial(
+        "[motor]\nmodel = \"speed\"\nspeed = -50.0\n[encoder]\nlines = 256\ntimer_hz = 10e6\n\
+         [simulation]\nduration = 0.5\n",
+    );
+    let why = r.no_measurement.unwrap();
+    assert!(
+        why.contains("came in reverse")
+            && why.contains("every edge came in reverse")
+            && !why.contains("standstill timeout"),
+        "{why}"
+    );
+    assert!(r
         .model_warnings
         .iter()
-        .find(|w| w.contains("active torque"))
-        .unwrap_or_else(|| panic!("{:?} {:?}", r.model_warnings, r.no_measurement));
-    assert!(
-        note.contains(&format!(
-            "the mean load 170 N·m exceeds the motor's torque at standstill, {standstill:.4} N·m"
-        )),
-        "{note}"
-    );
-    assert!(r.no_measurement.unwrap().contains("came in reverse"));
+        .all(|w| !w.contains("active torque")));
+    let kneader =
+        include_str!("../scenes/kneader.toml").replace("duration = 30.0", "duration = 2.0");
     let r = run_trial(&kneader.replace("settle = 10.0", "settle = 0.5"));
     assert!(
         r.model_warnings

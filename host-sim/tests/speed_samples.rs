@@ -293,3 +293,106 @@ fn whole_cycles_a_sample_collapse_the_range() {
     assert!((r.most / delta / (x.sin() / x) - 1.0).abs() < 2e-3, "{r:?}");
     assert!((r.least / r.most / x.cos() - 1.0).abs() < 2e-3, "{r:?}");
 }
+
+/// A cranking scene at a prescribed speed (±40 % ripple, two strokes a revolution, 36-2 wheel)
+/// read δ 0.105 with the scene's default 16-edge samples against the ripple's own 0.8, with no
+/// word: a prescribed speed has no prediction to compare with. The share the samples read is
+/// now given (the same sampled machinery as the predicted δ through the samples), it is what
+/// the run measures, and a WARNING under the δ line says it with the number of edges that reads
+/// 95 %; with that many edges the run reads the ripple's δ and says nothing.
+#[test]
+fn a_cranking_ripple_the_samples_read_low_is_said() {
+    const CRANK: &str = "[motor]\nmodel = \"speed\"\nspeed = 100.0\n[cranking]\nripple = 0.4\n\
+        strokes = 2\nphase = 0.0\n[encoder]\nwheel = \"36-2\"\ntimer_hz = 1e6\nEDGES\n\
+        [simulation]\nduration = 3.0\n";
+    let r = run_trial(&CRANK.replace("EDGES", ""));
+    let c = r
+        .cranking_ripple
+        .expect("a cranking ripple with an encoder is read");
+    assert_eq!((c.delta, c.order, c.estimator_edges), (0.8, 2.0, 16));
+    let measured = r.delta_measured.unwrap();
+    // What the samples show is what the run measures (to the ripple's second order: 2e-4).
+    assert!(
+        (measured - c.through_samples).abs() < 1e-3 * c.delta,
+        "{measured} {c:?}"
+    );
+    assert!(
+        c.share < 0.2 && (c.share - measured / 0.8).abs() < 1e-3,
+        "{c:?}"
+    );
+    let k = c.edges_for_95_percent.expect("fewer edges read 95 %");
+    assert!((1..16).contains(&k), "{c:?}");
+    let warning = r
+        .delta_notes
+        .iter()
+        .find(|n| n.starts_with("WARNING") && n.contains("[cranking] ripple"))
+        .unwrap_or_else(|| panic!("{:?}", r.delta_notes));
+    assert!(
+        warning.contains(&format!("read only {:.3}", c.share))
+            && warning.contains("has δ 0.800000")
+            && warning.contains(&format!("`encoder.estimator_edges = {k}` or fewer")),
+        "{warning}"
+    );
+    // In the text and in the JSON.
+    let scene_ = scene(&CRANK.replace("EDGES", ""));
+    assert!(host_sim::app::report::run_text(&scene_, &r).contains(warning.as_str()));
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["cranking_ripple"]["estimator_edges"], 16);
+    assert!(json["delta_notes"]
+        .to_string()
+        .contains("[cranking] ripple"));
+    // With that many edges a sample: 95 % of the ripple's δ read, nothing said.
+    let r = run_trial(&CRANK.replace("EDGES", &format!("estimator_edges = {k}")));
+    let c = r.cranking_ripple.unwrap();
+    assert!(c.share >= 0.95, "{c:?}");
+    assert!(
+        r.delta_measured.unwrap() >= 0.95 * 0.8 - 1e-3,
+        "{:?}",
+        r.delta_measured
+    );
+    assert!(
+        r.delta_notes
+            .iter()
+            .all(|n| !n.contains("[cranking] ripple")),
+        "{:?}",
+        r.delta_notes
+    );
+}
+
+/// A prescribed speed's report said "(0 effects: )" (and "1 effects"), and its δ below the
+/// noise floor had no "not resolved", which `analyze` and a run with a prediction say. The
+/// header now names the shaft's law and counts its effects in words; the δ line says a δ within
+/// its floor is not resolved.
+#[test]
+fn a_prescribed_run_says_what_it_simulated_and_what_it_resolved() {
+    let steady = "[motor]\nmodel = \"speed\"\nspeed = 100.0\n[encoder]\nwheel = \"36-2\"\n\
+        timer_hz = 1e6\n[simulation]\nduration = 1.0\n";
+    let r = run_trial(steady);
+    let text = host_sim::app::report::run_text(&scene(steady), &r);
+    assert!(text.contains("(shaft prescribed; no effects)"), "{text}");
+    let (m, f) = (r.delta_measured.unwrap(), r.noise_floor.unwrap());
+    assert!(m <= f, "{m} {f}");
+    assert!(
+        text.contains(": within the noise floor, not resolved"),
+        "{text}"
+    );
+    let crank = steady.replace(
+        "[encoder]",
+        "[cranking]\nripple = 0.4\nstrokes = 2\n[encoder]",
+    );
+    let r = run_trial(&crank);
+    let text = host_sim::app::report::run_text(&scene(&crank), &r);
+    assert!(
+        text.contains("(shaft prescribed with a cranking ripple; no effects)")
+            && !text.contains("not resolved"),
+        "{text}"
+    );
+    assert_eq!(r.shaft, "prescribed with a cranking ripple");
+    let kneader = include_str!("../scenes/kneader.toml")
+        .replace("duration = 30.0", "duration = 1.0")
+        .replace("settle = 10.0", "settle = 0.5");
+    let r = run_trial(&kneader);
+    let text = host_sim::app::report::run_text(&scene(&kneader), &r);
+    assert!(text.contains("(2 effects: motor, load)"), "{text}");
+    assert_eq!(r.shaft, "motor-driven");
+}

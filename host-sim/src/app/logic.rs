@@ -1980,6 +1980,18 @@ impl<W: Write> CaptureWriter<W> {
         Ok(w)
     }
 
+    /// The bytes a capture of `duration` s writes where it writes a row for every sample
+    /// (sigrok without `dedup`): the rows times the longest row, the header aside. `None` for a
+    /// file of level changes, whose size follows the edges.
+    pub fn every_sample_bytes(&self, duration: f64) -> Option<f64> {
+        if !matches!(self.rows, Rows::Every) {
+            return None;
+        }
+        let rows = (duration * self.s.sample_rate).ceil() + 1.0;
+        let time = (rows * self.period as f64).max(1.0).log10().floor() + 1.0;
+        Some(rows * (time + 2.0 * self.levels.len() as f64 + 1.0))
+    }
+
     /// Records one edge of the simulated encoder (dropped edges are not seen).
     pub fn edge(&mut self, e: &Edge) -> std::io::Result<()> {
         if e.dropped {

@@ -51,6 +51,21 @@ fn edges_text(r: &RunReport) -> String {
     s
 }
 
+/// What a run simulated: a prescribed shaft's law (with its cranking ripple), then the
+/// effects, counted in the singular for one ("1 effect: rotor-loads"; a prescribed speed
+/// without any had printed "0 effects: ").
+fn effects_text(r: &RunReport) -> String {
+    let effects = match r.effects.len() {
+        0 => "no effects".to_string(),
+        1 => format!("1 effect: {}", r.effects[0]),
+        n => format!("{n} effects: {}", r.effects.join(", ")),
+    };
+    match r.shaft {
+        "motor-driven" | "" => effects,
+        law => format!("shaft {law}; {effects}"),
+    }
+}
+
 /// A run as text.
 pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     let mut s = String::new();
@@ -60,11 +75,10 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
     }
     let _ = writeln!(
         s,
-        "Simulated {:.1} s with {} ({} effects: {}) in {:.3} s wall: {} RHS evaluations, {} steps ({} rejected), {}",
+        "Simulated {:.1} s with {} ({}) in {:.3} s wall: {} RHS evaluations, {} steps ({} rejected), {}",
         r.simulated_seconds,
         r.integrator,
-        r.effects.len(),
-        r.effects.join(", "),
+        effects_text(r),
         r.wall_seconds,
         r.rhs_evaluations,
         r.steps[0],
@@ -103,6 +117,13 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
             r.rejected_edges[1],
             r.rejected_edges[2]
         );
+        if r.timeouts > 0 {
+            let _ = writeln!(
+                s,
+                "  standstill: the core found the shaft stopped {} time(s) (its timeout)",
+                r.timeouts
+            );
+        }
         if let Some(w) = r.speed_measured {
             let _ = writeln!(s, "  mean speed {w:.3} rad/s");
         }
@@ -165,11 +186,17 @@ pub fn run_text(scene: &Scene, r: &RunReport) -> String {
                 );
             }
             (Some(m), None) => {
+                // Within the noise floor (at it counts as within, as `analyze` judges a
+                // window): not resolved, as the line with a prediction says.
                 let _ = writeln!(
                     s,
-                    "  δ measured {}, noise floor {}",
+                    "  δ measured {}, noise floor {}{}",
                     fmt_delta(m),
-                    floor(r.noise_floor)
+                    floor(r.noise_floor),
+                    match r.noise_floor {
+                        Some(f) if m <= f => ": within the noise floor, not resolved",
+                        _ => "",
+                    }
                 );
             }
             _ => {}

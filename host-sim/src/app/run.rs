@@ -136,7 +136,11 @@ pub struct SupportsRunOut {
 pub struct RunReport {
     /// The scene file.
     pub scene: String,
-    /// Effects simulated, in assembly order.
+    /// How the shaft moves: "motor-driven" (integrated under `effects`' torques),
+    /// "prescribed" (`[motor]` model `speed`, `ramp` or `profile`, or the sweep's speed), or
+    /// "prescribed with a cranking ripple" (`[cranking]`, integrated as φ from ω(φ, t)).
+    pub shaft: &'static str,
+    /// Effects simulated, in assembly order (a prescribed shaft is none).
     pub effects: Vec<&'static str>,
     /// Integrator used.
     pub integrator: &'static str,
@@ -175,6 +179,12 @@ pub struct RunReport {
     /// The most δ those samples show over the load's phase against the teeth.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_predicted_through_samples_most: Option<f64>,
+    /// How the core's speed samples read the scene's `[cranking]` ripple (with an
+    /// `[encoder]`): a prescribed speed has no prediction to compare the measured δ with, so
+    /// the share of the ripple's own δ the samples show is given, and a WARNING under the δ
+    /// line where they read less than [`RIPPLE_READ_SHARE`] of it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cranking_ripple: Option<RippleRead>,
     /// Windows reported by the core.
     pub windows: u32,
     /// Of which invalid.
@@ -190,6 +200,8 @@ pub struct RunReport {
     pub alarm_judged: Option<AlarmJudged>,
     /// Edges the core rejected or found missing: glitches, missing edges, extra edges.
     pub rejected_edges: [u32; 3],
+    /// Times the core's standstill check found the shaft stopped (as `analyze` counts them).
+    pub timeouts: u32,
     /// Mean speed measured by the core over the last window, rad/s.
     pub speed_measured: Option<f64>,
     /// The fastest speed the core measured in any valid window of the run (its ω max), rad/s:
@@ -308,6 +320,140 @@ pub struct RunReport {
     /// δ limit (`[monitor] delta_limit`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_limit: Option<f64>,
+}
+
+/// How the core's speed samples read a `[cranking]` ripple ω̄·(1 + ripple·sin(strokes·φ +
+/// phase)) at a steady mean speed, by [`predict::sampled_delta_of`] (the machinery `predict`
+/// and `run` take the predicted δ through the samples with): each sample is the mean speed
+/// over `encoder.estimator_edges` edges and starts only at a tooth, so a ripple of a few
+/// cycles a revolution is averaged away or read between its peaks.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct RippleRead {
+    /// The ripple's own δ, 2·ripple (ω̄·(1 ± ripple): 2(ω_max − ω_min)/(ω_max + ω_min)).
+    pub delta: f64,
+    /// Its order, cycles a revolution (`cranking.strokes`).
+    pub order: f64,
+    /// Edges per speed sample (`encoder.estimator_edges`).
+    pub estimator_edges: u16,
+    /// δ the samples show with the teeth where the scene has them (the simulator's wheel,
+    /// tooth 0 at φ = 0): what the run measures, to the ripple's change of mean speed.
+    pub through_samples: f64,
+    /// The least δ they show over the ripple's phase against the teeth.
+    pub through_samples_least: f64,
+    /// The most δ they show over that phase.
+    pub through_samples_most: f64,
+    /// `through_samples / delta`: the share of the ripple's δ the measured δ is.
+    pub share: f64,
+    /// The most edges per sample whose least over the phase reads [`RIPPLE_READ_SHARE`] of
+    /// the ripple's δ (`null` when even one edge does not).
+    pub edges_for_95_percent: Option<u16>,
+    /// The least share of the ripple's δ one-edge samples read over the phase: the most any
+    /// number of edges a sample can count on, on this wheel.
+    pub share_one_edge: f64,
+}
+
+/// Below this share of a `[cranking]` ripple's δ read through the samples (at the scene's
+/// phase, or the least over the phase), `run` WARNs under its δ line (`analyze` states its
+/// ripple table below the same share).
+pub const RIPPLE_READ_SHARE: f64 = 0.95;
+
+/// [`RippleRead`] of the scene's `[cranking]` ripple: `None` without a ripple or an
+/// `[encoder]`, or where the strokes have no period of whole revolutions the samples can be
+/// tabulated over.
+pub fn cranking_ripple_read(scene: &Scene, file: &Path) -> Result<Option<RippleRead>, SceneError> {
+    use crate::app::sampled::{sampled_range, SteadyTime, SCAN_BUDGET};
+    let Some(c) = scene.cranking.filter(|c| c.ripple > 0.0 && c.strokes > 0.0) else {
+        return Ok(None);
+    };
+    let Some(e) = &scene.encoder else {
+        return Ok(None);
+    };
+    let Some(revolutions) = drive_monitor::drive::period_revolutions(&[c.strokes]) else {
+        return Ok(None);
+    };
+    let delta = 2.0 * c.ripple;
+    // δ does not depend on the mean speed: ω̄ = 1.
+    let omega = |phi: f64| Some(1.0 + c.ripple * (c.strokes * phi + c.phase).sin());
+    let Some(time) = SteadyTime::tabulate(
+        std::f64::consts::TAU / c.strokes,
+        revolutions,
+        c.strokes,
+        omega,
+    ) else {
+        return Ok(None);
+    };
+    let Some(s) = predict::sampled_delta_of(scene, file, delta, || Some(time.clone()))? else {
+        return Ok(None);
+    };
+    // Fewer edges a sample: the least each reads over the phase, as `sampled_delta_of` scans
+    // them for the predicted δ.
+    let wheel = predict::sample_wheel(e, &crate::app::check::wheel(e, &scene.checker(file))?);
+    let least = |k: u16| {
+        if k == e.estimator_edges {
+            Some(s.least)
+        } else {
+            sampled_range(&time, &wheel, k, SCAN_BUDGET / 4).map(|r| r.least)
+        }
+    };
+    let edges_for_95_percent = (1..=e.estimator_edges)
+        .rev()
+        .find(|&k| least(k).is_some_and(|d| d >= RIPPLE_READ_SHARE * delta));
+    Ok(Some(RippleRead {
+        delta,
+        order: c.strokes,
+        estimator_edges: e.estimator_edges,
+        through_samples: s.at_scene_phase,
+        through_samples_least: s.least,
+        through_samples_most: s.most,
+        share: s.at_scene_phase / delta,
+        edges_for_95_percent,
+        share_one_edge: least(1).unwrap_or(0.0) / delta,
+    }))
+}
+
+/// The WARNING under `run`'s δ line where the samples read less than [`RIPPLE_READ_SHARE`] of
+/// the `[cranking]` ripple's δ (at the scene's phase or at the least over it): the measured δ
+/// is that share, not the shaft's, and fewer edges per sample read more of it.
+pub fn cranking_ripple_warning(r: &RippleRead) -> Option<String> {
+    let low = RIPPLE_READ_SHARE * r.delta;
+    if r.through_samples >= low && r.through_samples_least >= low {
+        return None;
+    }
+    let over_phase =
+        if predict::sampled_spread(r.delta, r.through_samples_least, r.through_samples_most) {
+            format!(
+                ", {:.3}–{:.3} of it over the ripple's phase against the teeth",
+                r.through_samples_least / r.delta,
+                r.through_samples_most / r.delta
+            )
+        } else {
+            String::new()
+        };
+    let share = 100.0 * RIPPLE_READ_SHARE;
+    let more = match r.edges_for_95_percent {
+        Some(k) => format!(
+            "`encoder.estimator_edges = {k}` or fewer reads {share:.0} % of it at any phase \
+             (fewer edges a sample raise the noise floor)"
+        ),
+        None if r.estimator_edges > 1 => format!(
+            "fewer edges a sample read more of it (`encoder.estimator_edges = 1` reads {:.3} at \
+             the least over the phase), and a wheel with more teeth a ripple cycle more still",
+            r.share_one_edge
+        ),
+        None => "a wheel with more teeth a ripple cycle reads more of it".to_string(),
+    };
+    Some(format!(
+        "WARNING: the core's speed samples of `encoder.estimator_edges = {}` edges read only \
+         {:.3} of the [cranking] ripple's δ with the teeth where this scene has them{over_phase}: \
+         the ripple (±{} %, order {}) has δ {}, the samples show about {}, and the δ measured is \
+         theirs, not the shaft's; {more}",
+        r.estimator_edges,
+        r.share,
+        100.0 * r.delta / 2.0,
+        r.order,
+        predict::fmt_delta(r.delta),
+        predict::fmt_delta(r.through_samples),
+    ))
 }
 
 /// How a run may deviate from the scene (the sweep's knobs).
@@ -786,7 +932,14 @@ pub struct RunOptions {
     /// Keep every edge the encoder produced, dropped ones included, in
     /// [`RunReport::edge_list`] (the ground truth of a test; memory grows with the run).
     pub keep_edges: bool,
+    /// The largest capture file a run writes, bytes: a sigrok file of every sample estimated
+    /// larger is refused before anything is simulated ([`CAPTURE_MAX_BYTES`] by default).
+    pub capture_max_bytes: f64,
 }
+
+/// The largest capture file `run` writes unasked, bytes (`--capture-max-bytes` raises it):
+/// the kneader's 30 s as sigrok rows at 50 MHz had written 23.4 GB without a word.
+pub const CAPTURE_MAX_BYTES: f64 = 1e9;
 
 impl Default for RunOptions {
     fn default() -> Self {
@@ -795,6 +948,7 @@ impl Default for RunOptions {
             keep_windows: true,
             capture: None,
             keep_edges: false,
+            capture_max_bytes: CAPTURE_MAX_BYTES,
         }
     }
 }
@@ -943,6 +1097,16 @@ struct Collector<'a> {
     edges: u64,
     all_edges: u64,
     reverse_edges: u64,
+    /// The firmware's periodic standstill check, as `analyze` makes it
+    /// ([`crate::app::analyze::poll_interval`]): its interval and the core's timeout, s, the
+    /// timer's rate, Hz, and counter mask (`None` without a monitor).
+    poll: Option<(f64, f64, f64, u64)>,
+    /// The last event fed to the core (a capture or an index pulse) and the last poll, s.
+    last_event: Option<f64>,
+    last_poll: f64,
+    /// When the shaft first turned backwards (a line edge in reverse), s, with or without a
+    /// scene `[encoder]` (the run's internal one sees it too).
+    reversed_at: Option<f64>,
     steps: u64,
     stop: Option<Stop>,
     last_window: Option<Measurement>,
@@ -1007,6 +1171,39 @@ impl Drop for Progress {
 }
 
 impl Collector<'_> {
+    /// The core's periodic standstill check up to `t` (s, exclusive) since the last event, as
+    /// firmware's periodic task and `analyze` make it: only the polls around the timeout,
+    /// where one can find something. Without it a shaft that stopped left its window in
+    /// progress unjudged and no timeout, where `analyze` of the run's capture found them.
+    fn polls_until(&mut self, t: f64) {
+        let (Some((every, timeout, hz, mask)), Some(t0)) = (self.poll, self.last_event) else {
+            return;
+        };
+        let mut p = self.last_poll.max(t0 + timeout - 2.0 * every).max(t0) + every;
+        while p < t && p <= t0 + timeout + 2.0 * every {
+            self.last_poll = p;
+            self.poll_at(p, hz, mask);
+            p += every;
+        }
+    }
+
+    /// One poll of the core at `p`, s.
+    fn poll_at(&mut self, p: f64, hz: f64, mask: u64) {
+        // A real timer latches the count of whole ticks elapsed.
+        let ticks = ((p * hz).floor() as i64 as u64 & mask) as u32;
+        if let Some(o) = self.monitor.as_mut().and_then(|m| m.poll(ticks)) {
+            self.outcome(p, o);
+        }
+    }
+
+    /// The end of the run at `end`, s: the polls up to it and one there.
+    fn polls_to_end(&mut self, end: f64) {
+        self.polls_until(end);
+        if let (Some((_, _, hz, mask)), Some(_)) = (self.poll, self.last_event) {
+            self.poll_at(end, hz, mask);
+        }
+    }
+
     /// A window the core returned at time `t`, s, and its alarm event.
     fn outcome(&mut self, t: f64, o: drive_monitor::monitor::WindowOutcome) {
         self.window(t, o.report);
@@ -1090,11 +1287,21 @@ impl Observer for Collector<'_> {
         if !edge.rising {
             return;
         }
-        let Some(m) = self.monitor.as_mut() else {
+        if !edge.index
+            && edge.direction == crate::engine::encoder::Direction::Reverse
+            && self.reversed_at.is_none()
+        {
+            self.reversed_at = Some(edge.true_time);
+        }
+        if self.monitor.is_none() {
             return;
-        };
+        }
         if edge.index {
-            m.on_index(edge.ticks);
+            self.polls_until(edge.seen_time);
+            self.last_event = Some(edge.seen_time);
+            if let Some(m) = self.monitor.as_mut() {
+                m.on_index(edge.ticks);
+            }
             return;
         }
         // The timer's input prescaler: one capture in `prescaler` line edges, the first at the
@@ -1104,6 +1311,11 @@ impl Observer for Collector<'_> {
             return;
         }
         self.prescaled = 0;
+        self.polls_until(edge.seen_time);
+        self.last_event = Some(edge.seen_time);
+        let Some(m) = self.monitor.as_mut() else {
+            return;
+        };
         self.edges += 1;
         if edge.direction == crate::engine::encoder::Direction::Reverse {
             self.reverse_edges += 1;
@@ -1215,6 +1427,8 @@ pub fn regime_classifier(
 /// The machine a run simulates: the system and what the report needs to know of it.
 struct Assembly {
     system: System,
+    /// How the shaft moves ([`RunReport::shaft`]).
+    law: &'static str,
     names: Vec<&'static str>,
     vib_params: Option<VibrationMachineParams>,
     vib_machine: Option<VibrationMachine>,
@@ -1265,27 +1479,20 @@ fn shaft_model(
             })?;
             effects.push(Box::new(model.motor));
             names.push("motor");
-            // No speed carries a mean load at or above the torque at standstill: started at
-            // rest the shaft is driven backwards without bound (the integration failed, naming
-            // the step size, not the load). Said, unless a start is given (a run-down).
-            let mean = scene.load.as_ref().map_or(0.0, |l| l.mean);
-            let standstill = model.motor.torque(0.0);
-            if shaft.initial_speed.is_none() && model.u_start <= 0.0 && standstill <= mean {
-                return Err(scene.checker(file).bad(
-                    "load.mean",
-                    mean,
-                    format!(
-                        "the mean load is at least the motor's torque at standstill ({standstill:.4} \
-                         N·m): started at rest the shaft would be driven backwards, and no speed \
-                         the drive model finds carries it (`drive-sim predict` shows the drive); \
-                         give `shaft.initial_speed` to simulate a run-down"
-                    ),
-                ));
-            }
             // Start at the predicted mean speed (or the given one) to shorten the transient.
             let omega0 = shaft
                 .initial_speed
                 .unwrap_or_else(|| model.u_start.max(0.0).sqrt());
+            // A default start at the drive model's mean speed is where a speed carries the
+            // load; a given start, or none carrying it, is checked.
+            let checked = shaft.initial_speed.is_some() || model.u_start <= 0.0;
+            if let Some(why) = driven_backwards(scene, &model.motor, omega0).filter(|_| checked) {
+                return Err(scene.checker(file).bad(
+                    "load.mean",
+                    scene.load.as_ref().map_or(0.0, |l| l.mean),
+                    why,
+                ));
+            }
             Ok(ShaftModel::Dynamic(DynamicShaft {
                 inertia: shaft.inertia,
                 flywheel: shaft.flywheel,
@@ -1308,6 +1515,84 @@ fn shaft_model(
             "missing: a scene to run needs [motor] (a torque model or a prescribed speed)",
         )),
     }
+}
+
+/// Why a motor-driven shaft started at `omega0` rad/s would be driven backwards (`None` where
+/// it would not, to the mean load): the mean load is at least the motor's torque at standstill
+/// and the motor's torque stays below it at every speed from standstill up to the start, so
+/// the shaft slows to a stop and the load, an active torque (its sign whatever the speed),
+/// turns it backwards ever faster. `run` does not simulate that: the parabola continued to
+/// negative speeds falls without bound and the speed runs away in finite time (the kneader at
+/// a mean load of 200 N·m, started at 130 rad/s, failed at 1.83 s with a step size underflow
+/// that named the inertias), and the Kloss curve's braking branch leaves the load's excess to
+/// accelerate the shaft backwards without limit (22 M reverse edges in 10 s, reported as a
+/// standstill). The same for every motor kind, with or without an `[encoder]`.
+pub fn driven_backwards(
+    scene: &Scene,
+    motor: &drive_monitor::drive::Motor,
+    omega0: f64,
+) -> Option<String> {
+    let mean = scene.load.as_ref().map_or(0.0, |l| l.mean);
+    let standstill = motor.torque(0.0);
+    if mean.partial_cmp(&standstill) == Some(std::cmp::Ordering::Less) || mean.is_nan() {
+        return None;
+    }
+    // The motor's torque over [0, ω0] (smooth and single-peaked: 4096 points find where it
+    // reaches the load).
+    const POINTS: u32 = 4096;
+    let grid = |top: f64| (0..=POINTS).map(move |i| top * f64::from(i) / f64::from(POINTS));
+    if grid(omega0.max(0.0)).any(|w| motor.torque(w) > mean) {
+        return None;
+    }
+    // The lowest speed where the motor's torque exceeds the mean load, up to its no-load
+    // (synchronous) speed: a start above it reaches the working point.
+    let top = motor
+        .kloss_curve()
+        .map_or(motor.model().no_load_speed(), |k| k.synchronous_speed());
+    let above = grid(top).find(|&w| motor.torque(w) > mean);
+    let given = scene.shaft.as_ref().and_then(|s| s.initial_speed);
+    let start_text = match given {
+        _ if omega0 <= 0.0 => format!(
+            "the shaft starts at rest ({}), where the motor's torque is below it",
+            if given.is_some() {
+                "`shaft.initial_speed = 0`"
+            } else {
+                "no `shaft.initial_speed`, and no speed of the drive model carries the load"
+            }
+        ),
+        Some(w) => format!(
+            "from `shaft.initial_speed = {w}` rad/s down to standstill the motor's torque stays \
+             below it: the shaft would slow to a stop"
+        ),
+        None => format!(
+            "from the start at {omega0:.3} rad/s (the drive model's mean speed) down to \
+             standstill the motor's torque stays below it: the shaft would slow to a stop"
+        ),
+    };
+    let cure = match above {
+        // Rounded up: the start is above the point.
+        Some(w) => format!(
+            "a mean load below {standstill:.4} N·m runs, and a start above {:.3} rad/s \
+             (`shaft.initial_speed`), where the motor's torque first exceeds the mean load, can \
+             reach the motor's working point (the load's ripple may still turn it back, which \
+             the run then says)",
+            (w * 1e3).ceil() / 1e3
+        ),
+        None => format!(
+            "no speed of the motor carries it (its torque peaks at {:.4} N·m): a mean load \
+             below {standstill:.4} N·m, or a stronger motor, runs",
+            grid(top)
+                .map(|w| motor.torque(w))
+                .fold(f64::NEG_INFINITY, f64::max)
+        ),
+    };
+    Some(format!(
+        "the mean load {mean} N·m is at least the motor's torque at standstill ({standstill:.4} \
+         N·m), and {start_text}, and the load, modelled as an active torque (its sign whatever \
+         the speed, as a hoist's weight), would turn it backwards ever faster, which `run` does \
+         not simulate (a reactive load, friction or kneading, would stall it \
+         instead; `drive-sim predict` shows the drive); {cure}"
+    ))
 }
 
 /// The speed profile of a scene whose prescribed speed is a profile (`[motor] model =
@@ -1352,6 +1637,13 @@ fn assemble(
         effects.push(Box::new(model.load.clone()));
         names.push("load");
     }
+    let law = match &shaft {
+        ShaftModel::Dynamic(_) => "motor-driven",
+        ShaftModel::Profile(p) if p.ripple.is_some_and(|r| r.amplitude > 0.0) => {
+            "prescribed with a cranking ripple"
+        }
+        _ => "prescribed",
+    };
     let rotor_speed0 = match &shaft {
         ShaftModel::Prescribed(law) => law.shaft(0.0).omega,
         ShaftModel::Dynamic(d) => d.omega0,
@@ -1376,6 +1668,7 @@ fn assemble(
     let system = System::new(shaft, effects).map_err(|e| core_error(scene, file, "shaft", e))?;
     Ok(Assembly {
         system,
+        law,
         names,
         vib_params,
         vib_machine,
@@ -1500,6 +1793,7 @@ pub fn run_with(
     let parts = predict::drive_parts(scene, file, model.as_ref())?;
     let Assembly {
         system,
+        law,
         names,
         vib_params,
         vib_machine,
@@ -1554,11 +1848,24 @@ pub fn run_with(
         .as_ref()
         .is_some_and(|p| matches!(p.initial.loads, LoadPlacement::Together { .. }));
     let capture = match &options.capture {
-        Some(t) => Some(open_capture(scene, file, t)?),
+        Some(t) => Some(open_capture(scene, file, t, options.capture_max_bytes)?),
         None => None,
     };
+    let monitor = core_monitor(scene, file)?;
+    let poll = monitor.as_ref().zip(scene.encoder.as_ref()).map(|(m, e)| {
+        let enc = m.encoder();
+        (
+            crate::app::analyze::poll_interval(enc),
+            f64::from(enc.timeout_ticks()) / e.timer_hz,
+            e.timer_hz,
+            u64::from(enc.mask()),
+        )
+    });
     let mut col = Collector {
-        monitor: core_monitor(scene, file)?,
+        monitor,
+        poll,
+        last_event: None,
+        last_poll: f64::NEG_INFINITY,
         capture,
         capture_error: None,
         edge_list: options.keep_edges.then(Vec::new),
@@ -1577,6 +1884,7 @@ pub fn run_with(
         edges: 0,
         all_edges: 0,
         reverse_edges: 0,
+        reversed_at: None,
         steps: 0,
         stop: None,
         last_window: None,
@@ -1601,9 +1909,10 @@ pub fn run_with(
         state: vec![0.0; dim],
         progress: Progress::new(duration, options.progress),
     };
-    let stats = sim
-        .run_observed(duration, &mut col)
-        .map_err(|e| integration_error(scene, file, &e))?;
+    let stats = match sim.run_observed(duration, &mut col) {
+        Ok(stats) => stats,
+        Err(e) => return Err(integration_error(scene, file, &e, col.reversed_at)),
+    };
     drop(std::mem::replace(
         &mut col.progress,
         Progress::new(0.0, false),
@@ -1639,6 +1948,7 @@ pub fn run_with(
     let step_warning = fixed_step_warning(scene, file, sim.fixed_step_error());
     let mut report = RunReport {
         scene: file.display().to_string(),
+        shaft: law,
         effects: names,
         integrator: integ.name(),
         simulated_seconds: stats.time,
@@ -1691,20 +2001,25 @@ pub fn run_with(
         report.delta_predicted_through_samples_least = sampled.map(|s| s.least);
         report.delta_predicted_through_samples_most = sampled.map(|s| s.most);
     }
+    report.cranking_ripple = cranking_ripple_read(scene, file)?;
     let samples = match std::mem::replace(&mut col.samples, Samples::All(Vec::new())) {
         Samples::All(v) => v,
         Samples::Stream(s) => s.samples(),
     };
     // The end of the run: a window held for the edge after its frame is released as it is,
     // and a second window the last edge ended (handed by the next call).
+    col.polls_to_end(stats.time);
     while let Some(o) = col.monitor.as_mut().and_then(|m| m.release_held()) {
         col.outcome(stats.time, o);
     }
     measurement(&mut report, &mut col);
-    if col.reverse_edges > 0 {
-        report
-            .model_warnings
-            .extend(predict::active_load_note(scene, file));
+    // A motor-driven shaft the load turned backwards (its peak beyond the motor's torque at
+    // standstill), said with or without an [encoder].
+    if let (Some(t), "motor-driven") = (col.reversed_at, report.shaft) {
+        report.model_warnings.extend(
+            predict::active_load_note(scene, file)
+                .map(|n| format!("{n} (this run: backwards first at t = {t:.4} s)")),
+        );
     }
     // The vibration machine's torque is in the run (a motor-driven shaft integrates it) and
     // not in the prediction; the encoder's errors are in the measured δ and not its floor.
@@ -1723,6 +2038,11 @@ pub fn run_with(
             .and(model.as_ref())
             .filter(|_| over.speed.is_none())
             .and_then(|m| settle_note(m, settle, scene.simulation.settle.is_none())),
+        report
+            .cranking_ripple
+            .filter(|_| report.delta_measured.is_some())
+            .as_ref()
+            .and_then(cranking_ripple_warning),
     ]
     .into_iter()
     .flatten()
@@ -2087,6 +2407,7 @@ fn open_capture(
     scene: &Scene,
     file: &Path,
     target: &CaptureTarget,
+    max_bytes: f64,
 ) -> Result<CaptureWriter<std::io::BufWriter<std::fs::File>>, SceneError> {
     let spec = scene.capture.unwrap_or_default();
     let index = matches!(
@@ -2107,6 +2428,34 @@ fn open_capture(
             format!("cannot write {}: {e}", target.path.display()),
         )
     };
+    // A file of every sample grows with the duration and the rate, not the edges: its size
+    // is known before anything is written.
+    let duration = scene.simulation.duration;
+    let estimate = CaptureWriter::new(Vec::new(), settings)
+        .map_err(fail)?
+        .every_sample_bytes(duration);
+    if let Some(bytes) = estimate.filter(|&b| b > max_bytes) {
+        return Err(SceneError::value(
+            file,
+            "capture",
+            format!(
+                "{} would be about {:.3e} bytes ({:.3e} rows, a row for every sample of {} s at \
+                 `capture.sample_rate = {}`), more than the {max_bytes:.0e} bytes `run` writes \
+                 unasked: `[capture] dedup = true` writes only the rows where a level changes, a \
+                 shorter `simulation.duration` or a lower `capture.sample_rate` fewer rows, \
+                 another --capture-format (saleae, plain, vcd) only the changes, and \
+                 `--capture-max-bytes {:.0}` accepts it",
+                target.path.display(),
+                bytes,
+                (duration * spec.sample_rate).ceil() + 1.0,
+                duration,
+                scene
+                    .checker(file)
+                    .shown("capture.sample_rate", spec.sample_rate),
+                bytes.ceil()
+            ),
+        ));
+    }
     let f = std::fs::File::create(&target.path).map_err(fail)?;
     CaptureWriter::new(std::io::BufWriter::new(f), settings).map_err(fail)
 }
@@ -2148,11 +2497,15 @@ fn fixed_step_warning(scene: &Scene, file: &Path, error: Option<(f64, f64)>) -> 
     ))
 }
 
-/// An integration failure, with the scene keys that set the integration up.
+/// An integration failure, with the scene keys that set the integration up; where the shaft
+/// had turned backwards (at `reversed_at`, s) under a motor, that is said first: a load beyond
+/// the motor's torque runs the shaft away backwards (the parabola continued to negative speeds
+/// without bound, in finite time), which no tolerance resolves.
 fn integration_error(
     scene: &Scene,
     file: &Path,
     e: &crate::engine::system::SimError,
+    reversed_at: Option<f64>,
 ) -> SceneError {
     let c = scene.checker(file);
     let s = &scene.simulation;
@@ -2189,6 +2542,20 @@ fn integration_error(
                  {reached}; the run was stopped there: take simulation.step at most {:.2e} s{scale}, \
                  or the adaptive dp5 (the default)",
                 suggested_step(s.step, rate)
+            ),
+        );
+    }
+    if let (Some(t), Some(note)) = (
+        reversed_at,
+        reversed_at.and_then(|_| predict::active_load_note(scene, file)),
+    ) {
+        return SceneError::value(
+            file,
+            "simulation",
+            format!(
+                "{e}: the shaft turned backwards at t = {t:.4} s and ran away ({}); the \
+                 integration's settings are not the cause",
+                note.trim_start_matches("NOTE: ")
             ),
         );
     }
@@ -2247,6 +2614,7 @@ fn measurement(report: &mut RunReport, col: &mut Collector) {
     report.windows = d.valid_windows + d.invalid_windows;
     report.invalid_windows = d.invalid_windows;
     report.rejected_edges = [d.edges.glitches, d.edges.missing, d.edges.extra];
+    report.timeouts = d.edges.timeouts;
     report.invalid_reasons = std::mem::take(&mut col.invalid_reasons);
     report.delta_measured = median(
         &mut col
@@ -2310,6 +2678,13 @@ fn nothing_measured(
             r.invalid_windows,
             reasons.join(", ")
         ));
+    } else if edges > 0 && reverse == edges {
+        // Reverse edges are no forward time reference: the core measures forward rotation.
+        why.push(
+            "no window was completed: the core measures δ of forward rotation, and every edge \
+             came in reverse"
+                .to_string(),
+        );
     } else if edges > 0 && core.accepted == 0 {
         // Edges slower than the minimum speed allows are a shaft at rest: no window completes,
         // and the run is not too short.

@@ -52,6 +52,11 @@ enum Command {
         /// a .sr file (a sigrok session file, which analyze reads).
         #[arg(long, value_enum, requires = "capture")]
         capture_format: Option<CaptureFormat>,
+        /// The largest capture file to write, bytes (default 1e9): a sigrok file of every
+        /// sample (no [capture] dedup) estimated larger is refused before the run, with the
+        /// estimate and what makes it smaller.
+        #[arg(long, requires = "capture")]
+        capture_max_bytes: Option<f64>,
     },
     /// Run the core on a recorded capture (Saleae Logic 2 or 1.x, sigrok/PulseView or plain CSV, a
     /// sigrok session file (.sr), Saleae Logic 2's binary export (its folder, or one channel's
@@ -341,7 +346,7 @@ impl From<host_sim::app::scene::SceneError> for Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => run_cmd(DEFAULT_SCENE, false, None, None, None),
+        None => run_cmd(DEFAULT_SCENE, false, None, None, None, None),
         Some(Command::Run {
             scene,
             json,
@@ -349,6 +354,7 @@ fn main() -> ExitCode {
             out,
             capture,
             capture_format,
+            capture_max_bytes,
         }) => (|| {
             let capture = match capture {
                 Some(path) => Some(host_sim::app::run::CaptureTarget {
@@ -357,7 +363,14 @@ fn main() -> ExitCode {
                 }),
                 None => None,
             };
-            run_cmd(&scene, json, plot.as_deref(), out.as_deref(), capture)
+            run_cmd(
+                &scene,
+                json,
+                plot.as_deref(),
+                out.as_deref(),
+                capture,
+                capture_max_bytes,
+            )
         })(),
         Some(Command::Analyze {
             capture,
@@ -516,6 +529,7 @@ fn run_cmd(
     plot: Option<&Path>,
     out: Option<&Path>,
     capture: Option<host_sim::app::run::CaptureTarget>,
+    capture_max_bytes: Option<f64>,
 ) -> Result<(), Failure> {
     let (scene, path) = resolve(name)?;
     if let Some(dir) = plot {
@@ -529,6 +543,7 @@ fn run_cmd(
         keep_windows: plot.is_some(),
         capture,
         keep_edges: false,
+        capture_max_bytes: capture_max_bytes.unwrap_or(host_sim::app::run::CAPTURE_MAX_BYTES),
     };
     let report = host_sim::app::run::run_with(&scene, &path, Default::default(), options)?;
     let mut text = String::new();
