@@ -619,19 +619,26 @@ fn an_index_against_the_wrong_line_count_or_read_as_the_encoder_is_named() {
         .warnings
         .iter()
         .all(|w| !w.contains("the channel read")));
-    let (report, _) = run_analyze(
-        &file,
-        AnalyzeOptions {
-            lines: Some(24),
-            channel: Some(Channel::Name("Channel 1".into())),
-            ..AnalyzeOptions::default()
-        },
-    );
-    let w = report
-        .warnings
-        .iter()
-        .find(|w| w.contains("the channel read"))
-        .unwrap();
+    // The index channel read as the encoder of a disc of `lines` lines: the report's text and
+    // the WARNING about it.
+    let read_index = |lines: u16| {
+        let (report, _) = run_analyze(
+            &file,
+            AnalyzeOptions {
+                lines: Some(lines),
+                channel: Some(Channel::Name("Channel 1".into())),
+                ..AnalyzeOptions::default()
+            },
+        );
+        let w = report
+            .warnings
+            .iter()
+            .find(|w| w.contains("the channel read"))
+            .unwrap()
+            .clone();
+        (host_sim::app::analyze::text(&report), w)
+    };
+    let (text, w) = read_index(24);
     assert!(
         w.contains("`Channel 1`, the channel read, pulses once every 24 edges of `Channel 0`")
             && w.contains("read it with --channel 0")
@@ -639,22 +646,10 @@ fn an_index_against_the_wrong_line_count_or_read_as_the_encoder_is_named() {
             && w.contains("the speeds are about 24 times too low"),
         "{w}"
     );
-    assert!(host_sim::app::analyze::text(&report).contains(w.as_str()));
+    assert!(text.contains(w.as_str()));
     // Read as a disc of 60 lines, each pulse is a 60th of a revolution: the speeds are 60
     // times too low, not 24 (the factor said was the other channel's count).
-    let (report, _) = run_analyze(
-        &file,
-        AnalyzeOptions {
-            lines: Some(60),
-            channel: Some(Channel::Name("Channel 1".into())),
-            ..AnalyzeOptions::default()
-        },
-    );
-    let w = report
-        .warnings
-        .iter()
-        .find(|w| w.contains("the channel read"))
-        .unwrap();
+    let (_, w) = read_index(60);
     assert!(
         w.contains("pulses once every 24 edges of `Channel 0`")
             && w.contains("one of the 60 pitches a revolution configured")
