@@ -188,41 +188,14 @@ fn direct_extremes_after(
     while solver.t() < start {
         solver.step(drive, start).unwrap();
     }
-    // Every step's polynomial over the period, with its largest and smallest sample.
-    let mut polys: Vec<(ComponentPoly, f64, f64)> = Vec::new();
+    // Every step's polynomial over the period.
+    let mut polys: Vec<ComponentPoly> = Vec::new();
     while solver.t() < start + period {
         solver.step(drive, start + period).unwrap();
-        let poly = solver.dense().component(0);
-        let (mut hi, mut lo) = (f64::NEG_INFINITY, f64::INFINITY);
-        for i in 0..=16 {
-            let w = poly.base + poly.eval_rel(f64::from(i) / 16.0).0;
-            hi = hi.max(w);
-            lo = lo.min(w);
-        }
-        polys.push((poly, hi, lo));
+        polys.push(solver.dense().component(0));
     }
-    let top = polys.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
-    let bottom = polys.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
-    // Golden section on every step whose samples come within 1 % of the swing of the best
-    // (many peaks of a long period are nearly equal, and samples 1/16 step apart can rank
-    // them wrongly), and on its neighbours (the extremum can lie in the next step).
-    let refine = |sign: f64| {
-        let best = if sign > 0.0 { top } else { -bottom };
-        let margin = 0.01 * (top - bottom);
-        let mut out = f64::NEG_INFINITY;
-        for (k, p) in polys.iter().enumerate() {
-            let sample = if sign > 0.0 { p.1 } else { -p.2 };
-            if sample < best - margin {
-                continue;
-            }
-            for (poly, ..) in &polys[k.saturating_sub(1)..(k + 2).min(polys.len())] {
-                out = out.max(step_max(|t| sign * (poly.base + poly.eval_rel(t).0)));
-            }
-        }
-        sign * out
-    };
-    let w_max = refine(1.0) + drive.offset;
-    let w_min = refine(-1.0) + drive.offset;
+    let (hi, lo) = step_extremes(polys.len(), |k, t| polys[k].base + polys[k].eval_rel(t).0);
+    let (w_max, w_min) = (hi + drive.offset, lo + drive.offset);
     ((w_max / drive.j).sqrt(), (w_min / drive.j).sqrt())
 }
 
@@ -240,6 +213,44 @@ fn step_max(f: impl Fn(f64) -> f64) -> f64 {
         }
     }
     f(0.5 * (lo + hi)).max(f(0.0)).max(f(1.0))
+}
+
+/// The largest and the smallest value of `value(k, t)` over `steps` steps (`t` in [0, 1] on
+/// step `k`): each step sampled at 17 points, and every step whose samples come within 1 % of
+/// the swing of the best (many peaks of a long period are nearly equal, and samples 1/16 step
+/// apart can rank them wrongly) refined by golden section, with its neighbours (the extremum
+/// can lie in the next step).
+fn step_extremes(steps: usize, value: impl Fn(usize, f64) -> f64) -> (f64, f64) {
+    let samples: Vec<(f64, f64)> = (0..steps)
+        .map(|k| {
+            (0..=16)
+                .map(|i| value(k, f64::from(i) / 16.0))
+                .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), w| {
+                    (hi.max(w), lo.min(w))
+                })
+        })
+        .collect();
+    let top = samples
+        .iter()
+        .map(|s| s.0)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let bottom = samples.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
+    let refine = |sign: f64| {
+        let best = if sign > 0.0 { top } else { -bottom };
+        let margin = 0.01 * (top - bottom);
+        let mut out = f64::NEG_INFINITY;
+        for (k, s) in samples.iter().enumerate() {
+            let sample = if sign > 0.0 { s.0 } else { -s.1 };
+            if sample < best - margin {
+                continue;
+            }
+            for j in k.saturating_sub(1)..(k + 2).min(steps) {
+                out = out.max(step_max(|t| sign * value(j, t)));
+            }
+        }
+        sign * out
+    };
+    (refine(1.0), refine(-1.0))
 }
 
 fn delta_of((hi, lo): (f64, f64)) -> f64 {
@@ -713,37 +724,7 @@ fn direct_varying_extremes(
     drive: &VaryingDrive,
     polys: &[host_sim::engine::ode::ComponentPoly],
 ) -> (f64, f64) {
-    let samples: Vec<(f64, f64)> = polys
-        .iter()
-        .map(|p| {
-            (0..=16)
-                .map(|i| omega_on(drive, p, f64::from(i) / 16.0))
-                .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), w| {
-                    (hi.max(w), lo.min(w))
-                })
-        })
-        .collect();
-    let top = samples
-        .iter()
-        .map(|s| s.0)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let bottom = samples.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
-    let refine = |sign: f64| {
-        let best = if sign > 0.0 { top } else { -bottom };
-        let margin = 0.01 * (top - bottom);
-        let mut out = f64::NEG_INFINITY;
-        for (k, s) in samples.iter().enumerate() {
-            let sample = if sign > 0.0 { s.0 } else { -s.1 };
-            if sample < best - margin {
-                continue;
-            }
-            for p in &polys[k.saturating_sub(1)..(k + 2).min(polys.len())] {
-                out = out.max(step_max(|t| sign * omega_on(drive, p, t)));
-            }
-        }
-        sign * out
-    };
-    (refine(1.0), refine(-1.0))
+    step_extremes(polys.len(), |k, t| omega_on(drive, &polys[k], t))
 }
 
 /// The time to turn through each of `count` pitches of `pitch` rad from the steps' start,
